@@ -1,0 +1,312 @@
+//! Diagnostics as data, and the one place that turns them into text (ariadne) or JSON.
+//!
+//! Every stage reports problems as [`Diagnostic`] values: a stable code from [`codes`], a
+//! message, labelled spans, notes and hints. Only this module knows about ariadne.
+
+use std::fmt::Write as _;
+
+use ariadne::{Config, IndexType, Label as ALabel, Report, ReportKind};
+
+use crate::source::SourceMap;
+use crate::span::Span;
+
+/// How bad a diagnostic is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Severity {
+    /// The file cannot be compiled.
+    Error,
+    /// The file compiles, but something is probably not what the author meant.
+    Warning,
+}
+
+/// A labelled span; the primary label says what is wrong here, secondary ones point elsewhere.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Label {
+    /// Where.
+    pub span: Span,
+    /// What to say there.
+    pub message: String,
+    /// Whether this is the main location.
+    pub primary: bool,
+}
+
+/// One problem found in the input.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Diagnostic {
+    /// Error or warning.
+    pub severity: Severity,
+    /// A stable code such as `E0200`, documented in `docs/errors.md`.
+    pub code: &'static str,
+    /// One line, lowercase start, no trailing period.
+    pub message: String,
+    /// The primary label first, then secondary ones.
+    pub labels: Vec<Label>,
+    /// Extra facts.
+    pub notes: Vec<String>,
+    /// Suggested fixes, phrased "try …" or "did you mean …".
+    pub hints: Vec<String>,
+}
+
+impl Diagnostic {
+    /// An error with a primary label.
+    pub fn error(code: &'static str, span: Span, message: impl Into<String>, label: impl Into<String>) -> Diagnostic {
+        Diagnostic::new(Severity::Error, code, span, message, label)
+    }
+
+    /// A warning with a primary label.
+    pub fn warning(code: &'static str, span: Span, message: impl Into<String>, label: impl Into<String>) -> Diagnostic {
+        Diagnostic::new(Severity::Warning, code, span, message, label)
+    }
+
+    fn new(
+        severity: Severity,
+        code: &'static str,
+        span: Span,
+        message: impl Into<String>,
+        label: impl Into<String>,
+    ) -> Diagnostic {
+        Diagnostic {
+            severity,
+            code,
+            message: message.into(),
+            labels: vec![Label {
+                span,
+                message: label.into(),
+                primary: true,
+            }],
+            notes: Vec::new(),
+            hints: Vec::new(),
+        }
+    }
+
+    /// Adds a secondary label.
+    pub fn with_label(mut self, span: Span, message: impl Into<String>) -> Diagnostic {
+        self.labels.push(Label {
+            span,
+            message: message.into(),
+            primary: false,
+        });
+        self
+    }
+
+    /// Adds a note.
+    pub fn with_note(mut self, note: impl Into<String>) -> Diagnostic {
+        self.notes.push(note.into());
+        self
+    }
+
+    /// Adds a hint.
+    pub fn with_hint(mut self, hint: impl Into<String>) -> Diagnostic {
+        self.hints.push(hint.into());
+        self
+    }
+
+    /// The primary span.
+    pub fn span(&self) -> Span {
+        self.labels[0].span
+    }
+
+    /// True for errors.
+    pub fn is_error(&self) -> bool {
+        self.severity == Severity::Error
+    }
+
+    /// Renders with ariadne, as `rustc` would print it; `color` for a terminal.
+    pub fn render(&self, map: &SourceMap, color: bool) -> String {
+        let name = |span: Span| map.file(map.file_of(span)).name.clone();
+        let (_, primary) = map.local_range(self.span());
+        let kind = match self.severity {
+            Severity::Error => ReportKind::Error,
+            Severity::Warning => ReportKind::Warning,
+        };
+        let mut report = Report::build(kind, (name(self.span()), primary))
+            .with_config(Config::default().with_color(color).with_index_type(IndexType::Byte))
+            .with_code(self.code)
+            .with_message(&self.message);
+        // ariadne starts a new source group whenever a label lies above the previous one,
+        // so labels go in source order.
+        let mut labels: Vec<&Label> = self.labels.iter().collect();
+        labels.sort_by_key(|l| (l.span.start, l.span.end));
+        for label in labels {
+            let (_, range) = map.local_range(label.span);
+            let mut l = ALabel::new((name(label.span), range)).with_message(&label.message);
+            if color {
+                l = l.with_color(if label.primary {
+                    match self.severity {
+                        Severity::Error => ariadne::Color::Red,
+                        Severity::Warning => ariadne::Color::Yellow,
+                    }
+                } else {
+                    ariadne::Color::Blue
+                });
+            }
+            report = report.with_label(l);
+        }
+        for note in &self.notes {
+            report = report.with_note(note);
+        }
+        for hint in &self.hints {
+            report = report.with_help(hint);
+        }
+        let cache = ariadne::sources(map.files().map(|(_, f)| (f.name.clone(), f.text.clone())));
+        let mut out = Vec::new();
+        // Writing to a Vec cannot fail, and every span was clamped into its file above.
+        let _ = report.finish().write(cache, &mut out);
+        String::from_utf8_lossy(&out).into_owned()
+    }
+
+    /// One JSON object (one line) for editors and tests.
+    pub fn to_json(&self, map: &SourceMap) -> String {
+        let loc = |span: Span| {
+            let (id, r) = map.local_range(span);
+            let (line, col) = map.line_col(id, r.start);
+            let (end_line, end_col) = map.line_col(id, r.end);
+            serde_json::json!({
+                "file": map.file(id).name,
+                "byte_start": r.start, "byte_end": r.end,
+                "line_start": line, "column_start": col,
+                "line_end": end_line, "column_end": end_col,
+            })
+        };
+        let mut primary = loc(self.span());
+        primary["label"] = self.labels[0].message.clone().into();
+        let related: Vec<_> = self.labels[1..]
+            .iter()
+            .map(|l| {
+                let mut v = loc(l.span);
+                v["label"] = l.message.clone().into();
+                v
+            })
+            .collect();
+        let json = serde_json::json!({
+            "severity": match self.severity { Severity::Error => "error", Severity::Warning => "warning" },
+            "code": self.code,
+            "message": self.message,
+            "span": primary,
+            "related": related,
+            "notes": self.notes,
+            "hints": self.hints,
+        });
+        json.to_string()
+    }
+}
+
+/// Renders many diagnostics, one after another, without colour (for golden tests).
+pub fn render_all(diags: &[Diagnostic], map: &SourceMap) -> String {
+    let mut out = String::new();
+    for d in diags {
+        let _ = write!(out, "{}", d.render(map, false));
+    }
+    out
+}
+
+/// Every diagnostic code with a one-line summary; `docs/errors.md` explains each.
+pub mod codes {
+    /// Unexpected character.
+    pub const UNEXPECTED_CHAR: &str = "E0001";
+    /// Unterminated string literal.
+    pub const UNTERMINATED_STRING: &str = "E0002";
+    /// Unterminated block comment.
+    pub const UNTERMINATED_COMMENT: &str = "E0003";
+    /// Malformed number literal.
+    pub const BAD_NUMBER: &str = "E0004";
+    /// Malformed colour literal.
+    pub const BAD_COLOR: &str = "E0005";
+    /// Syntax error.
+    pub const SYNTAX: &str = "E0100";
+    /// Unknown name.
+    pub const UNKNOWN_NAME: &str = "E0200";
+    /// Unknown function.
+    pub const UNKNOWN_FUNCTION: &str = "E0201";
+    /// Duplicate parameter name.
+    pub const DUPLICATE_PARAM: &str = "E0202";
+    /// A function used as a value, or a value called.
+    pub const NOT_A_VALUE: &str = "E0203";
+    /// Type mismatch.
+    pub const TYPE_MISMATCH: &str = "E0300";
+    /// Wrong number of arguments.
+    pub const ARITY: &str = "E0301";
+    /// Unknown named argument.
+    pub const UNKNOWN_ARG: &str = "E0302";
+    /// Argument given twice.
+    pub const DUPLICATE_ARG: &str = "E0303";
+    /// Required argument missing.
+    pub const MISSING_ARG: &str = "E0304";
+    /// Operator not defined for these operand types.
+    pub const BAD_OPERANDS: &str = "E0305";
+    /// List index out of bounds.
+    pub const INDEX_OUT_OF_BOUNDS: &str = "E0306";
+    /// A whole number was expected.
+    pub const NOT_INTEGER: &str = "E0307";
+    /// `mesh` applied to something that is not a mesh generator.
+    pub const NOT_A_MESH_GENERATOR: &str = "E0308";
+    /// Transform not allowed on this value.
+    pub const BAD_TRANSFORM: &str = "E0309";
+    /// Value out of its allowed range.
+    pub const OUT_OF_RANGE: &str = "E0400";
+    /// Arithmetic produced a non-finite number (division by zero, overflow).
+    pub const NOT_FINITE: &str = "E0401";
+    /// Degenerate camera.
+    pub const BAD_CAMERA: &str = "E0402";
+    /// `camera` or `render` given twice.
+    pub const DUPLICATE_STATEMENT: &str = "E0500";
+    /// `object` of something that is not a shape or mesh.
+    pub const NOT_AN_OBJECT: &str = "E0501";
+    /// `light` of something that is not a light.
+    pub const NOT_A_LIGHT: &str = "E0502";
+    /// Included file cannot be read.
+    pub const INCLUDE_READ: &str = "E0600";
+    /// Include cycle.
+    pub const INCLUDE_CYCLE: &str = "E0601";
+    /// Nesting too deep (brackets or expressions).
+    pub const TOO_DEEP: &str = "E0700";
+    /// Too many loop iterations in total.
+    pub const TOO_MANY_ITERATIONS: &str = "E0701";
+    /// Function calls nested too deeply.
+    pub const CALL_DEPTH: &str = "E0702";
+    /// Includes nested too deeply.
+    pub const INCLUDE_DEPTH: &str = "E0703";
+    /// Too many objects or lights.
+    pub const TOO_MANY_OBJECTS: &str = "E0704";
+    /// A list or file too large.
+    pub const TOO_LARGE: &str = "E0705";
+    /// A render-time failure traced back to the source (e.g. a mesh file that cannot be read).
+    pub const LOWERING: &str = "E0800";
+    /// Unused `let` binding.
+    pub const UNUSED: &str = "W0001";
+    /// Scene without lights.
+    pub const NO_LIGHTS: &str = "W0002";
+    /// Light that cannot affect anything.
+    pub const USELESS_LIGHT: &str = "W0003";
+    /// Scene without objects.
+    pub const NO_OBJECTS: &str = "W0004";
+    /// Object entirely behind the camera.
+    pub const BEHIND_CAMERA: &str = "W0005";
+}
+
+/// Edit distance for "did you mean" suggestions.
+pub fn levenshtein(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, cb) in b.iter().enumerate() {
+            let cost = usize::from(ca != *cb);
+            cur[j + 1] = (prev[j] + cost).min(prev[j + 1] + 1).min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+/// The closest candidate within a distance that scales with the word's length.
+pub fn suggest<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+    let limit = (word.chars().count() / 3).max(1);
+    candidates
+        .into_iter()
+        .filter(|c| *c != word)
+        .map(|c| (levenshtein(word, c), c))
+        .filter(|(d, _)| *d <= limit)
+        .min()
+        .map(|(_, c)| c)
+}

@@ -1,0 +1,107 @@
+//! The one owner of input text: every file of a compile, each at its own global base offset.
+
+use std::path::{Path, PathBuf};
+
+use crate::span::Span;
+
+/// Index of a file in a [`SourceMap`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct FileId(pub u32);
+
+/// One loaded source file.
+#[derive(Debug)]
+pub struct SourceFile {
+    /// The name shown in diagnostics (the path as the user or the `include` wrote it).
+    pub name: String,
+    /// The resolved path, used for include resolution and cycle detection.
+    pub path: PathBuf,
+    /// The full text.
+    pub text: String,
+    /// Global offset of the first byte.
+    pub base: u32,
+}
+
+/// All files of one compile, laid end to end in one offset space (with a gap byte
+/// between files so an end-of-file span never touches the next file).
+#[derive(Debug, Default)]
+pub struct SourceMap {
+    files: Vec<SourceFile>,
+    next_base: u32,
+}
+
+/// The most text one compile may hold across all its files (so global `u32` offsets never overflow).
+pub const MAX_TOTAL_BYTES: usize = 256 * 1024 * 1024;
+
+impl SourceMap {
+    /// An empty map.
+    pub fn new() -> SourceMap {
+        SourceMap::default()
+    }
+
+    /// Adds a file and returns its id; `None` when the compile's total size limit is exceeded.
+    pub fn add(&mut self, name: impl Into<String>, path: impl AsRef<Path>, text: String) -> Option<FileId> {
+        let end = self.next_base as usize + text.len() + 1;
+        if end > MAX_TOTAL_BYTES {
+            return None;
+        }
+        let id = FileId(self.files.len() as u32);
+        self.files.push(SourceFile {
+            name: name.into(),
+            path: path.as_ref().to_path_buf(),
+            text,
+            base: self.next_base,
+        });
+        self.next_base = end as u32;
+        Some(id)
+    }
+
+    /// The file with this id.
+    pub fn file(&self, id: FileId) -> &SourceFile {
+        &self.files[id.0 as usize]
+    }
+
+    /// All files in load order.
+    pub fn files(&self) -> impl Iterator<Item = (FileId, &SourceFile)> {
+        self.files.iter().enumerate().map(|(i, f)| (FileId(i as u32), f))
+    }
+
+    /// The file a span lies in.
+    pub fn file_of(&self, span: Span) -> FileId {
+        let idx = self.files.partition_point(|f| f.base <= span.start);
+        FileId(idx.saturating_sub(1) as u32)
+    }
+
+    /// The span's range local to its file, clamped to the file's text.
+    pub fn local_range(&self, span: Span) -> (FileId, std::ops::Range<usize>) {
+        let id = self.file_of(span);
+        let f = self.file(id);
+        let len = f.text.len();
+        let start = (span.start.saturating_sub(f.base) as usize).min(len);
+        let end = (span.end.saturating_sub(f.base) as usize).clamp(start, len);
+        (id, start..end)
+    }
+
+    /// The source text a span covers.
+    pub fn snippet(&self, span: Span) -> &str {
+        let (id, r) = self.local_range(span);
+        &self.file(id).text[r]
+    }
+
+    /// One-based line and column (in characters) of a file-local byte offset.
+    pub fn line_col(&self, id: FileId, offset: usize) -> (usize, usize) {
+        let text = &self.file(id).text;
+        let offset = offset.min(text.len());
+        let before = &text[..floor_char_boundary(text, offset)];
+        let line = before.matches('\n').count() + 1;
+        let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+        let col = before[line_start..].chars().count() + 1;
+        (line, col)
+    }
+}
+
+fn floor_char_boundary(s: &str, mut i: usize) -> usize {
+    while i > 0 && !s.is_char_boundary(i) {
+        i -= 1;
+    }
+    i
+}
