@@ -1,0 +1,331 @@
+//! chumsky parsers over the token stream: statements, expressions (precedence climbing
+//! with `foldl`), error recovery at delimiters and at statement starts.
+//!
+//! Precedence, loosest first (see `grammar/scn.ebnf`): postfix transforms
+//! (`at rotate scale with`), `+ -`, `* / %`, unary `-` and `mesh`, indexing `x[i]`, atoms.
+
+use chumsky::input::ValueInput;
+use chumsky::prelude::*;
+
+use super::ast::{Arg, BinOp, Expr, ExprKind, File, Ident, Stmt, StmtKind, TransformOp};
+use super::token::Token;
+use crate::span::Span;
+
+/// The parser's error type.
+pub type ParseError<'t, 's> = Rich<'t, Token<'s>, SimpleSpan>;
+type Extra<'t, 's> = extra::Err<ParseError<'t, 's>>;
+
+const OTHER_DELIMS: [(Token<'static>, Token<'static>); 2] =
+    [(Token::LBracket, Token::RBracket), (Token::LBrace, Token::RBrace)];
+
+fn error_expr(span: SimpleSpan) -> Expr {
+    Expr {
+        kind: ExprKind::Error,
+        span: span.into(),
+    }
+}
+
+fn ident<'t, 's: 't, I>() -> impl Parser<'t, I, Ident, Extra<'t, 's>> + Clone
+where
+    I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
+{
+    select! { Token::Ident(s) => s }
+        .map_with(|s: &str, e| Ident {
+            name: s.to_string(),
+            span: Span::from(e.span()),
+        })
+        .labelled("identifier")
+}
+
+/// Resolves the escapes `\" \\ \n \t` of a string literal's body.
+fn unescape(quoted: &str) -> String {
+    let body = &quoted[1..quoted.len() - 1];
+    let mut out = String::with_capacity(body.len());
+    let mut chars = body.chars();
+    while let Some(c) = chars.next() {
+        if c == '\\' {
+            match chars.next() {
+                Some('n') => out.push('\n'),
+                Some('t') => out.push('\t'),
+                Some(other) => out.push(other),
+                None => {}
+            }
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+fn hex_color(s: &str) -> [u8; 3] {
+    let byte = |i: usize| u8::from_str_radix(s.get(1 + 2 * i..3 + 2 * i).unwrap_or("00"), 16).unwrap_or(0);
+    [byte(0), byte(1), byte(2)]
+}
+
+fn args<'t, 's: 't, I, P>(expr: P) -> impl Parser<'t, I, Vec<Arg>, Extra<'t, 's>> + Clone
+where
+    I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
+    P: Parser<'t, I, Expr, Extra<'t, 's>> + Clone,
+{
+    let arg = ident()
+        .then_ignore(just(Token::Eq))
+        .or_not()
+        .then(expr)
+        .map(|(name, value)| Arg { name, value });
+    arg.separated_by(just(Token::Comma))
+        .allow_trailing()
+        .collect::<Vec<_>>()
+        .delimited_by(just(Token::LParen), just(Token::RParen))
+        .labelled("argument list")
+        .recover_with(via_parser(nested_delimiters(
+            Token::LParen,
+            Token::RParen,
+            OTHER_DELIMS,
+            // One error argument tells the checker not to report arity on a list it never saw.
+            |span| {
+                vec![Arg {
+                    name: None,
+                    value: error_expr(span),
+                }]
+            },
+        )))
+}
+
+/// The expression parser.
+pub fn expr<'t, 's: 't, I>() -> impl Parser<'t, I, Expr, Extra<'t, 's>> + Clone
+where
+    I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
+{
+    recursive(|expr| {
+        let literal = select! {
+            Token::Number(s) => ExprKind::Number(s.to_string()),
+            Token::Bool(b) => ExprKind::Bool(b),
+            Token::Str(s) => ExprKind::Str(unescape(s)),
+            Token::HexColor(s) => ExprKind::HexColor(hex_color(s)),
+        }
+        .labelled("literal");
+
+        let call = ident()
+            .then(args(expr.clone()))
+            .map(|(callee, args)| ExprKind::Call { callee, args });
+
+        let list = expr
+            .clone()
+            .separated_by(just(Token::Comma))
+            .allow_trailing()
+            .collect::<Vec<_>>()
+            .delimited_by(just(Token::LBracket), just(Token::RBracket))
+            .map(ExprKind::List)
+            .labelled("vector or list");
+
+        let mesh = just(Token::Mesh)
+            .ignore_then(ident().labelled("mesh generator"))
+            .then(args(expr.clone()))
+            .map(|(generator, args)| ExprKind::Mesh { generator, args })
+            .labelled("mesh");
+
+        let atom = choice((
+            literal,
+            call,
+            // A name followed by `(` is a call or nothing: never fall back to a bare name.
+            ident().then_ignore(just(Token::LParen).not()).map(ExprKind::Ident),
+            list,
+            mesh,
+        ))
+        .map_with(|kind, e| Expr {
+            kind,
+            span: Span::from(e.span()),
+        })
+        .or(expr.clone().delimited_by(just(Token::LParen), just(Token::RParen)))
+        .recover_with(via_parser(nested_delimiters(
+            Token::LParen,
+            Token::RParen,
+            OTHER_DELIMS,
+            error_expr,
+        )))
+        .recover_with(via_parser(nested_delimiters(
+            Token::LBracket,
+            Token::RBracket,
+            [(Token::LParen, Token::RParen), (Token::LBrace, Token::RBrace)],
+            error_expr,
+        )))
+        .boxed();
+
+        let index = atom.foldl_with(
+            expr.clone()
+                .delimited_by(just(Token::LBracket), just(Token::RBracket))
+                .repeated(),
+            |base, index, e| Expr {
+                kind: ExprKind::Index {
+                    base: Box::new(base),
+                    index: Box::new(index),
+                },
+                span: Span::from(e.span()),
+            },
+        );
+
+        let unary = just(Token::Minus)
+            .to_span()
+            .repeated()
+            .foldr_with(index, |_, operand, e| Expr {
+                kind: ExprKind::Neg(Box::new(operand)),
+                span: Span::from(e.span()),
+            })
+            .boxed();
+
+        let binary = |ops: &'static [(Token<'static>, BinOp)]| {
+            move |operand: chumsky::Boxed<'t, 't, I, Expr, Extra<'t, 's>>| {
+                let op = select! { t if ops.iter().any(|(o, _)| *o == t) => t }
+                    .map(move |t| ops.iter().find(|(o, _)| *o == t).map_or(BinOp::Add, |(_, b)| *b));
+                operand
+                    .clone()
+                    .foldl_with(op.then(operand).repeated(), |lhs, (op, rhs), e| Expr {
+                        kind: ExprKind::Binary {
+                            op,
+                            lhs: Box::new(lhs),
+                            rhs: Box::new(rhs),
+                        },
+                        span: Span::from(e.span()),
+                    })
+                    .boxed()
+            }
+        };
+        let product = binary(&[
+            (Token::Star, BinOp::Mul),
+            (Token::Slash, BinOp::Div),
+            (Token::Percent, BinOp::Rem),
+        ])(unary);
+        let sum = binary(&[(Token::Plus, BinOp::Add), (Token::Minus, BinOp::Sub)])(product);
+
+        let transform_op = select! {
+            Token::At => TransformOp::At,
+            Token::Rotate => TransformOp::Rotate,
+            Token::Scale => TransformOp::Scale,
+            Token::With => TransformOp::With,
+        }
+        .map_with(|op, e| (op, Span::from(e.span())));
+
+        sum.clone()
+            .foldl_with(transform_op.then(sum).repeated(), |target, ((op, op_span), arg), e| {
+                Expr {
+                    kind: ExprKind::Transform {
+                        op,
+                        op_span,
+                        target: Box::new(target),
+                        arg: Box::new(arg),
+                    },
+                    span: Span::from(e.span()),
+                }
+            })
+            .labelled("expression")
+    })
+}
+
+fn stmt_start<'t, 's: 't, I>() -> impl Parser<'t, I, (), Extra<'t, 's>> + Clone
+where
+    I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
+{
+    one_of([
+        Token::Let,
+        Token::Object,
+        Token::Light,
+        Token::For,
+        Token::Include,
+        Token::Camera,
+        Token::Render,
+        Token::RBrace,
+    ])
+    .ignored()
+}
+
+/// The file parser: statements until the end of input.
+pub fn file<'t, 's: 't, I>() -> impl Parser<'t, I, File, Extra<'t, 's>>
+where
+    I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
+{
+    let stmt = recursive(|stmt| {
+        let e = expr();
+        let settings =
+            |kw: Token<'static>, name: &'static str| just(kw).ignore_then(args(expr())).labelled(name).as_context();
+        let camera = settings(Token::Camera, "camera statement").map(StmtKind::Camera);
+        let render = settings(Token::Render, "render statement").map(StmtKind::Render);
+        let light = just(Token::Light)
+            .ignore_then(e.clone())
+            .map(StmtKind::Light)
+            .labelled("light statement")
+            .as_context();
+        let object = just(Token::Object)
+            .ignore_then(e.clone())
+            .map(StmtKind::Object)
+            .labelled("object statement")
+            .as_context();
+        let params = ident()
+            .separated_by(just(Token::Comma))
+            .allow_trailing()
+            .collect::<Vec<_>>()
+            .delimited_by(just(Token::LParen), just(Token::RParen))
+            .labelled("parameter list");
+        let let_ = just(Token::Let)
+            .ignore_then(ident())
+            .then(params.or_not())
+            .then_ignore(just(Token::Eq))
+            .then(e.clone())
+            .map(|((name, params), value)| StmtKind::Let { name, params, value })
+            .labelled("let statement")
+            .as_context();
+        let body = stmt
+            .repeated()
+            .collect::<Vec<_>>()
+            .delimited_by(just(Token::LBrace), just(Token::RBrace));
+        let for_ = just(Token::For)
+            .ignore_then(ident())
+            .then_ignore(just(Token::In))
+            .then(e.clone())
+            .then_ignore(just(Token::DotDot))
+            .then(e.clone())
+            .then(body)
+            .map(|(((var, start), end), body)| StmtKind::For { var, start, end, body })
+            .labelled("for loop")
+            .as_context();
+        let include = just(Token::Include)
+            .ignore_then(
+                select! { Token::Str(s) => s }
+                    .map_with(|s: &str, e| (unescape(s), Span::from(e.span())))
+                    .labelled("string"),
+            )
+            .map(|(path, path_span)| StmtKind::Include { path, path_span })
+            .labelled("include statement")
+            .as_context();
+
+        choice((camera, render, light, object, let_, for_, include))
+            .map_with(|kind, e| Stmt {
+                kind,
+                span: Span::from(e.span()),
+            })
+            .labelled("statement")
+            // Skip the bad statement up to the next one, so later mistakes are reported too.
+            .recover_with(via_parser(
+                any()
+                    .and_is(just(Token::RBrace).not())
+                    .ignored()
+                    .then(any().and_is(stmt_start().not()).repeated())
+                    .map_with(|_, e| Stmt {
+                        kind: StmtKind::Error,
+                        span: Span::from(e.span()),
+                    }),
+            ))
+    });
+    // A `}` with no `for` to close is reported and skipped at the top level.
+    let stray_brace = just(Token::RBrace).validate(|_, e, emitter| {
+        emitter.emit(Rich::custom(e.span(), "unmatched `}`"));
+        Stmt {
+            kind: StmtKind::Error,
+            span: Span::from(e.span()),
+        }
+    });
+    stmt.or(stray_brace)
+        .repeated()
+        .collect::<Vec<_>>()
+        .then_ignore(end())
+        .map(|stmts| File { stmts })
+}
