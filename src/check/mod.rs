@@ -1,0 +1,661 @@
+//! Checking and evaluation: an [`ast::File`](crate::syntax::ast::File) (and everything it
+//! includes) to an [`ir::Scene`] plus diagnostics.
+//!
+//! The language is pure and evaluated at compile time, so the checker *is* an evaluator
+//! over typed values: names are resolved in lexical scopes, every operation checks the
+//! types of its operands, every builtin checks arity, named arguments, types and ranges.
+//! Errors evaluate to a poison value that later operations pass through silently, so
+//! one run reports every independent mistake once. Function bodies are also evaluated
+//! once at their definition with poisoned parameters, and empty loops once with a
+//! poisoned variable, so mistakes in code that never runs are still reported.
+//!
+//! **Invariant:** a `Scene` is returned only when no error was reported, and then it
+//! satisfies the invariants stated in [`ir`].
+
+pub mod builtins;
+mod construct;
+mod expr;
+mod value;
+
+use std::collections::{HashMap, HashSet};
+use std::path::{Component, Path, PathBuf};
+use std::rc::Rc;
+
+use glam::DVec3;
+
+use crate::diag::{codes, Diagnostic};
+use crate::ir::{self, Camera, Scene, Settings};
+use crate::source::{FileId, SourceMap};
+use crate::span::Span;
+use crate::syntax::{self, ast};
+pub use value::Value;
+
+/// Most loop iterations in one compile, over all loops.
+pub const MAX_ITERATIONS: u64 = 1_000_000;
+/// Deepest chain of function calls.
+pub const MAX_CALL_DEPTH: usize = 64;
+/// Deepest chain of includes.
+pub const MAX_INCLUDE_DEPTH: usize = 16;
+/// Most objects in a scene.
+pub const MAX_OBJECTS: usize = 100_000;
+/// Most lights in a scene.
+pub const MAX_LIGHTS: usize = 1_000;
+/// Longest list.
+pub const MAX_LIST: usize = 100_000;
+/// Deepest expression nesting (operators, calls and transforms count).
+pub const MAX_EXPR_DEPTH: usize = 256;
+/// Largest source file.
+pub const MAX_FILE_BYTES: usize = 4 * 1024 * 1024;
+
+/// Reads included files; the CLI reads the disk, tests may serve files from memory.
+pub trait Loader {
+    /// The text of the file at `path`.
+    fn read(&self, path: &Path) -> std::io::Result<String>;
+}
+
+/// Reads files from the file system.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FsLoader;
+
+impl Loader for FsLoader {
+    fn read(&self, path: &Path) -> std::io::Result<String> {
+        let meta = std::fs::metadata(path)?;
+        if meta.is_dir() {
+            return Err(std::io::Error::other("it is a directory"));
+        }
+        if meta.len() > MAX_FILE_BYTES as u64 {
+            return Err(std::io::Error::other(format!(
+                "it is larger than the {} MiB limit",
+                MAX_FILE_BYTES >> 20
+            )));
+        }
+        let bytes = std::fs::read(path)?;
+        String::from_utf8(bytes).map_err(|_| std::io::Error::other("it is not valid UTF-8"))
+    }
+}
+
+/// What a name is bound to.
+#[derive(Clone, Debug)]
+enum Bound {
+    Value(Value),
+    Func(Rc<Func>),
+}
+
+#[derive(Debug)]
+struct Func {
+    name: String,
+    params: Vec<ast::Ident>,
+    body: Rc<ast::Expr>,
+    env: Vec<Rc<Binding>>,
+    file_dir: PathBuf,
+}
+
+#[derive(Debug)]
+struct Binding {
+    name: String,
+    span: Span,
+    bound: Bound,
+}
+
+/// The evaluator's state for one compile.
+struct Ctx<'a> {
+    map: &'a mut SourceMap,
+    loader: &'a dyn Loader,
+    diags: Vec<Diagnostic>,
+    reported: HashSet<(&'static str, Span, String)>,
+    scopes: Vec<Vec<Rc<Binding>>>,
+    /// `let` definitions by span, and whether each was ever used.
+    lets: HashMap<Span, (String, bool)>,
+    camera: Option<Camera>,
+    settings: Option<Settings>,
+    lights: Vec<ir::Light>,
+    objects: Vec<ir::Object>,
+    iterations: u64,
+    call_depth: usize,
+    expr_depth: usize,
+    include_stack: Vec<PathBuf>,
+    /// Directory of the file being evaluated (for `include` and `mesh file`).
+    dir: PathBuf,
+    /// > 0 while evaluating code only to find mistakes (nothing is emitted).
+    dry: u32,
+    too_many_objects: bool,
+    /// Set once "expression nests too deeply" was reported, so it is reported once.
+    too_deep: bool,
+}
+
+impl Ctx<'_> {
+    fn report(&mut self, d: Diagnostic) {
+        if self.reported.insert((d.code, d.span(), d.message.clone())) {
+            self.diags.push(d);
+        }
+    }
+
+    fn lookup(&mut self, name: &str) -> Option<Rc<Binding>> {
+        let found = self
+            .scopes
+            .iter()
+            .rev()
+            .flat_map(|s| s.iter().rev())
+            .find(|b| b.name == name)
+            .cloned()?;
+        if let Some(entry) = self.lets.get_mut(&found.span) {
+            entry.1 = true;
+        }
+        Some(found)
+    }
+
+    fn bind(&mut self, name: &ast::Ident, bound: Bound) {
+        let binding = Rc::new(Binding {
+            name: name.name.clone(),
+            span: name.span,
+            bound,
+        });
+        if let Some(scope) = self.scopes.last_mut() {
+            scope.push(binding);
+        }
+    }
+
+    fn names_in_scope(&self, funcs: bool) -> Vec<String> {
+        self.scopes
+            .iter()
+            .flatten()
+            .filter(|b| matches!(b.bound, Bound::Func(_)) == funcs)
+            .map(|b| b.name.clone())
+            .collect()
+    }
+
+    fn stmts(&mut self, stmts: &[ast::Stmt]) {
+        for stmt in stmts {
+            self.stmt(stmt);
+        }
+    }
+
+    fn stmt(&mut self, stmt: &ast::Stmt) {
+        match &stmt.kind {
+            ast::StmtKind::Error => {}
+            ast::StmtKind::Let {
+                name,
+                params: None,
+                value,
+            } => {
+                let v = self.expr(value);
+                if self.dry == 0 || !self.lets.contains_key(&name.span) {
+                    self.lets.entry(name.span).or_insert_with(|| (name.name.clone(), false));
+                }
+                self.bind(name, Bound::Value(v));
+            }
+            ast::StmtKind::Let {
+                name,
+                params: Some(params),
+                value,
+            } => self.define_function(name, params, value),
+            ast::StmtKind::Object(e) => {
+                let v = self.expr(e);
+                self.object(v, e.span, stmt.span);
+            }
+            ast::StmtKind::Light(e) => {
+                let v = self.expr(e);
+                match v {
+                    Value::Light(light) => {
+                        if self.dry == 0 {
+                            if self.lights.len() >= MAX_LIGHTS {
+                                self.report(Diagnostic::error(codes::TOO_MANY_OBJECTS, stmt.span, "too many lights", format!("light number {} is one too many", MAX_LIGHTS + 1)).with_note(format!("a scene may have at most {MAX_LIGHTS} lights")));
+                            } else {
+                                self.lights.push((*light).clone());
+                            }
+                        }
+                    }
+                    Value::Error => {}
+                    other => self.report(
+                        Diagnostic::error(codes::NOT_A_LIGHT, e.span, format!("expected a light, found `{}`", other.ty_name()), format!("this is a `{}`", other.ty_name()))
+                            .with_hint("try `light ambient(0.2)`, `light point(0.6) at [2, 1, 0]` or `light directional(0.2, towards = [1, 4, 4])`"),
+                    ),
+                }
+            }
+            ast::StmtKind::Camera(args) => {
+                let cam = self.camera_stmt(args, stmt.span);
+                if self.dry > 0 {
+                    return;
+                }
+                if let Some(prev) = self.camera.as_ref().and_then(|c| c.span) {
+                    self.report(
+                        Diagnostic::error(
+                            codes::DUPLICATE_STATEMENT,
+                            stmt.span,
+                            "the camera is set twice",
+                            "second `camera` statement",
+                        )
+                        .with_label(prev, "first set here")
+                        .with_hint("try merging the two into one `camera(…)`"),
+                    );
+                } else if let Some(cam) = cam {
+                    self.camera = Some(cam);
+                } else {
+                    // Remember that a (bad) camera statement was here, so a second one is still a duplicate.
+                    self.camera = Some(Camera {
+                        span: Some(stmt.span),
+                        ..Camera::default()
+                    });
+                }
+            }
+            ast::StmtKind::Render(args) => {
+                let settings = self.render_stmt(args, stmt.span);
+                if self.dry > 0 {
+                    return;
+                }
+                if let Some(prev) = self.settings.as_ref().and_then(|s| s.span) {
+                    self.report(
+                        Diagnostic::error(
+                            codes::DUPLICATE_STATEMENT,
+                            stmt.span,
+                            "render settings are given twice",
+                            "second `render` statement",
+                        )
+                        .with_label(prev, "first given here")
+                        .with_hint("try merging the two into one `render(…)`"),
+                    );
+                } else {
+                    self.settings = Some(settings.unwrap_or(Settings {
+                        span: Some(stmt.span),
+                        ..Settings::default()
+                    }));
+                }
+            }
+            ast::StmtKind::For { var, start, end, body } => self.for_loop(var, start, end, body, stmt.span),
+            ast::StmtKind::Include { path, path_span } => self.include(path, *path_span),
+        }
+    }
+
+    fn define_function(&mut self, name: &ast::Ident, params: &[ast::Ident], body: &ast::Expr) {
+        let mut seen: HashMap<&str, Span> = HashMap::new();
+        for p in params {
+            if let Some(first) = seen.insert(&p.name, p.span) {
+                self.report(
+                    Diagnostic::error(
+                        codes::DUPLICATE_PARAM,
+                        p.span,
+                        format!("parameter `{}` is declared twice", p.name),
+                        "declared again here",
+                    )
+                    .with_label(first, "first declared here"),
+                );
+            }
+        }
+        let env: Vec<Rc<Binding>> = self.scopes.iter().flatten().cloned().collect();
+        let func = Rc::new(Func {
+            name: name.name.clone(),
+            params: params.to_vec(),
+            body: Rc::new(body.clone()),
+            env,
+            file_dir: self.dir.clone(),
+        });
+        self.lets.entry(name.span).or_insert_with(|| (name.name.clone(), false));
+        // Evaluate the body once with poisoned parameters: reports unknown names and type
+        // errors that do not depend on the arguments, even if the function is never called.
+        let poisoned = params.iter().map(|_| Value::Error).collect();
+        self.dry += 1;
+        let _ = self.call_user(&func, poisoned, name.span);
+        self.dry -= 1;
+        self.bind(name, Bound::Func(func));
+    }
+
+    fn for_loop(&mut self, var: &ast::Ident, start: &ast::Expr, end: &ast::Expr, body: &[ast::Stmt], span: Span) {
+        let lo = self.expr(start);
+        let hi = self.expr(end);
+        let lo = self.int_operand(&lo, start.span, "the loop start");
+        let hi = self.int_operand(&hi, end.span, "the loop end");
+        let run = |this: &mut Self, value: Value| {
+            this.scopes.push(Vec::new());
+            this.bind(var, Bound::Value(value));
+            this.stmts(body);
+            this.scopes.pop();
+        };
+        let (Some(lo), Some(hi)) = (lo, hi) else {
+            self.dry += 1;
+            run(self, Value::Error);
+            self.dry -= 1;
+            return;
+        };
+        if hi <= lo {
+            self.dry += 1;
+            run(self, Value::Error);
+            self.dry -= 1;
+            return;
+        }
+        let count = (hi - lo) as u64;
+        if self.iterations + count > MAX_ITERATIONS {
+            self.report(
+                Diagnostic::error(
+                    codes::TOO_MANY_ITERATIONS,
+                    span,
+                    "too many loop iterations",
+                    format!("this loop would run {count} times"),
+                )
+                .with_note(format!(
+                    "a scene may run at most {MAX_ITERATIONS} loop iterations in total"
+                )),
+            );
+            self.dry += 1;
+            run(self, Value::Error);
+            self.dry -= 1;
+            return;
+        }
+        self.iterations += count;
+        for i in lo..hi {
+            run(self, Value::Num(i as f64));
+            if self.too_many_objects {
+                break;
+            }
+        }
+    }
+
+    /// A number that must be a whole number in i64 range, for loop bounds.
+    fn int_operand(&mut self, v: &Value, span: Span, what: &str) -> Option<i64> {
+        match v {
+            Value::Num(x) if x.fract() == 0.0 && x.abs() <= 1e15 => Some(*x as i64),
+            Value::Num(x) => {
+                self.report(
+                    Diagnostic::error(
+                        codes::NOT_INTEGER,
+                        span,
+                        format!("{what} must be a whole number"),
+                        format!("this is {}", ir::dump_num(*x)),
+                    )
+                    .with_hint("try `floor(…)`"),
+                );
+                None
+            }
+            Value::Error => None,
+            other => {
+                self.report(Diagnostic::error(
+                    codes::TYPE_MISMATCH,
+                    span,
+                    format!("expected `int`, found `{}`", other.ty_name()),
+                    format!("{what} must be a whole number"),
+                ));
+                None
+            }
+        }
+    }
+
+    fn object(&mut self, v: Value, expr_span: Span, stmt_span: Span) {
+        let geometry = match v {
+            Value::Shape(s) => ir::Geometry::Shape(s),
+            Value::Mesh(m) => ir::Geometry::Mesh(m),
+            Value::Error => return,
+            other => {
+                let mut d = Diagnostic::error(
+                    codes::NOT_AN_OBJECT,
+                    expr_span,
+                    format!("expected a shape or a mesh, found `{}`", other.ty_name()),
+                    format!("this is a `{}`", other.ty_name()),
+                );
+                if matches!(other, Value::Light(_)) {
+                    d = d.with_hint("lights are added with `light …`, not `object …`");
+                }
+                self.report(d);
+                return;
+            }
+        };
+        if self.dry > 0 {
+            return;
+        }
+        if self.objects.len() >= MAX_OBJECTS {
+            if !self.too_many_objects {
+                self.too_many_objects = true;
+                self.report(
+                    Diagnostic::error(
+                        codes::TOO_MANY_OBJECTS,
+                        stmt_span,
+                        "too many objects",
+                        format!("object number {} is one too many", MAX_OBJECTS + 1),
+                    )
+                    .with_note(format!(
+                        "a scene may have at most {MAX_OBJECTS} objects; `repeat(…)` draws many copies as one object"
+                    )),
+                );
+            }
+            return;
+        }
+        self.objects.push(ir::Object {
+            geometry,
+            span: stmt_span,
+        });
+    }
+
+    fn include(&mut self, written: &str, span: Span) {
+        let path = normalize(&self.dir.join(written));
+        if let Some(pos) = self.include_stack.iter().position(|p| *p == path) {
+            let chain: Vec<String> = self.include_stack[pos..]
+                .iter()
+                .chain(std::iter::once(&path))
+                .map(|p| p.display().to_string())
+                .collect();
+            self.report(
+                Diagnostic::error(
+                    codes::INCLUDE_CYCLE,
+                    span,
+                    format!("`{written}` includes itself"),
+                    "this include closes a cycle",
+                )
+                .with_note(format!("include chain: {}", chain.join(" → "))),
+            );
+            return;
+        }
+        if self.include_stack.len() >= MAX_INCLUDE_DEPTH {
+            self.report(
+                Diagnostic::error(
+                    codes::INCLUDE_DEPTH,
+                    span,
+                    "includes nest too deeply",
+                    format!("include depth {MAX_INCLUDE_DEPTH} is exceeded here"),
+                )
+                .with_note(format!(
+                    "files may include each other at most {MAX_INCLUDE_DEPTH} levels deep"
+                )),
+            );
+            return;
+        }
+        let text = match self.loader.read(&path) {
+            Ok(text) if text.len() > MAX_FILE_BYTES => {
+                self.report(Diagnostic::error(
+                    codes::TOO_LARGE,
+                    span,
+                    format!("`{written}` is too large"),
+                    format!("larger than {} MiB", MAX_FILE_BYTES >> 20),
+                ));
+                return;
+            }
+            Ok(text) => text,
+            Err(e) => {
+                self.report(
+                    Diagnostic::error(
+                        codes::INCLUDE_READ,
+                        span,
+                        format!("cannot read `{written}`"),
+                        io_reason(&e),
+                    )
+                    .with_note(format!("looked for {}", path.display())),
+                );
+                return;
+            }
+        };
+        let Some(id) = self.map.add(written, &path, text) else {
+            self.report(Diagnostic::error(
+                codes::TOO_LARGE,
+                span,
+                "the scene's files are too large in total",
+                "including this file exceeds the limit",
+            ));
+            return;
+        };
+        self.run_file(id);
+    }
+
+    fn run_file(&mut self, id: FileId) {
+        let (file, diags) = {
+            let f = self.map.file(id);
+            syntax::parse(&f.text, f.base)
+        };
+        for d in diags {
+            self.report(d);
+        }
+        let path = self.map.file(id).path.clone();
+        let old_dir = std::mem::replace(&mut self.dir, path.parent().map(Path::to_path_buf).unwrap_or_default());
+        self.include_stack.push(normalize(&path));
+        self.stmts(&file.stmts);
+        self.include_stack.pop();
+        self.dir = old_dir;
+    }
+
+    fn finish(mut self) -> (Option<Scene>, Vec<Diagnostic>) {
+        let mut unused: Vec<(Span, String)> = self
+            .lets
+            .iter()
+            .filter(|(_, (name, used))| !used && !name.starts_with('_'))
+            .map(|(s, (n, _))| (*s, n.clone()))
+            .collect();
+        unused.sort();
+        for (span, name) in unused {
+            self.report(
+                Diagnostic::warning(codes::UNUSED, span, format!("`{name}` is never used"), "defined here")
+                    .with_hint(format!("if this is intentional, try naming it `_{name}`")),
+            );
+        }
+        let end = self
+            .map
+            .files()
+            .next()
+            .map_or(Span::default(), |(_, f)| Span::new(f.base as usize, f.base as usize));
+        let has_errors = self.diags.iter().any(Diagnostic::is_error);
+        if has_errors {
+            // Objects and lights were dropped with their errors; do not warn about their absence.
+        } else if self.objects.is_empty() {
+            self.report(
+                Diagnostic::warning(
+                    codes::NO_OBJECTS,
+                    end,
+                    "the scene has no objects",
+                    "the image will show only the background",
+                )
+                .with_hint("try `object sphere(1) at [0, 0, 5]`"),
+            );
+        } else if self.lights.is_empty() {
+            self.report(
+                Diagnostic::warning(
+                    codes::NO_LIGHTS,
+                    end,
+                    "the scene has no lights",
+                    "every object will be black",
+                )
+                .with_hint("try `light ambient(0.2)` and `light point(0.6) at [2, 1, 0]`"),
+            );
+        }
+        for light in &self.lights.clone() {
+            if light.intensity == 0.0 {
+                self.report(
+                    Diagnostic::warning(
+                        codes::USELESS_LIGHT,
+                        light.span,
+                        "this light has intensity 0",
+                        "it lights nothing",
+                    )
+                    .with_hint("try removing it, or giving it an intensity above 0"),
+                );
+            }
+        }
+        let camera = self.camera.clone().unwrap_or_default();
+        for obj in &self.objects.clone() {
+            if let Some(dist) = behind_camera(obj, &camera) {
+                self.report(
+                    Diagnostic::warning(
+                        codes::BEHIND_CAMERA,
+                        obj.span,
+                        "this object is behind the camera",
+                        format!("its bounds end {} units behind the eye", ir::dump_num(dist)),
+                    )
+                    .with_note("it can still show in reflections"),
+                );
+            }
+        }
+        let mut diags = self.diags;
+        diags.sort_by_key(|d| (d.span().start, d.severity));
+        if diags.iter().any(Diagnostic::is_error) {
+            return (None, diags);
+        }
+        let scene = Scene {
+            camera,
+            settings: self.settings.unwrap_or_default(),
+            lights: self.lights,
+            objects: self.objects,
+        };
+        (Some(scene), diags)
+    }
+}
+
+/// How far behind the camera plane an object's bounding sphere lies, if entirely behind it.
+fn behind_camera(obj: &ir::Object, camera: &Camera) -> Option<f64> {
+    let (centre, radius) = ir::bounding_sphere(&obj.geometry)?;
+    let forward = (camera.look_at - camera.position).normalize();
+    let depth = (centre - camera.position).dot(forward);
+    (depth + radius < 0.0).then_some(-(depth + radius))
+}
+
+fn io_reason(e: &std::io::Error) -> String {
+    match e.kind() {
+        std::io::ErrorKind::NotFound => "no such file".into(),
+        std::io::ErrorKind::PermissionDenied => "permission denied".into(),
+        _ => e.to_string(),
+    }
+}
+
+/// Lexically normalises `a/./b/../c` to `a/c`, for include-cycle detection.
+fn normalize(path: &Path) -> PathBuf {
+    let mut out = PathBuf::new();
+    for c in path.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                if !out.pop() {
+                    out.push("..");
+                }
+            }
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// Checks and evaluates the file `root` of `map` (already added), loading includes
+/// through `loader`. Returns the scene when there are no errors, and every diagnostic.
+pub fn check(map: &mut SourceMap, root: FileId, loader: &dyn Loader) -> (Option<Scene>, Vec<Diagnostic>) {
+    let dir = map.file(root).path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let mut ctx = Ctx {
+        map,
+        loader,
+        diags: Vec::new(),
+        reported: HashSet::new(),
+        scopes: vec![Vec::new()],
+        lets: HashMap::new(),
+        camera: None,
+        settings: None,
+        lights: Vec::new(),
+        objects: Vec::new(),
+        iterations: 0,
+        call_depth: 0,
+        expr_depth: 0,
+        include_stack: Vec::new(),
+        dir,
+        dry: 0,
+        too_many_objects: false,
+        too_deep: false,
+    };
+    ctx.run_file(root);
+    ctx.finish()
+}
+
+/// The unit vector along `v`, or `None` for a zero or non-finite vector.
+pub(crate) fn direction(v: DVec3) -> Option<DVec3> {
+    let n = v.try_normalize()?;
+    n.is_finite().then_some(n)
+}

@@ -1,0 +1,75 @@
+//! Values of the evaluator: what an expression evaluates to at compile time.
+
+use std::rc::Rc;
+use std::sync::Arc;
+
+use glam::DVec3;
+
+use super::builtins::Ty;
+use crate::ir;
+
+/// A compile-time value. `Error` is poison: an expression that already failed, which
+/// every operation passes through silently so one mistake is reported once.
+#[derive(Clone, Debug)]
+pub enum Value {
+    /// A number.
+    Num(f64),
+    /// A boolean.
+    Bool(bool),
+    /// A string.
+    Str(Rc<str>),
+    /// A vector.
+    Vec3(DVec3),
+    /// A colour, 0–255 per channel.
+    Color(DVec3),
+    /// A material.
+    Material(Arc<ir::Material>),
+    /// A shape tree.
+    Shape(Arc<ir::Shape>),
+    /// A mesh.
+    Mesh(Arc<ir::Mesh>),
+    /// A light.
+    Light(Arc<ir::Light>),
+    /// A list.
+    List(Rc<Vec<Value>>),
+    /// Poison.
+    Error,
+}
+
+impl Value {
+    /// The value's type; `None` for poison.
+    pub fn ty(&self) -> Option<Ty> {
+        Some(match self {
+            Value::Num(x) if x.fract() == 0.0 => Ty::Int,
+            Value::Num(_) => Ty::Num,
+            Value::Bool(_) => Ty::Bool,
+            Value::Str(_) => Ty::Str,
+            Value::Vec3(_) => Ty::Vec3,
+            Value::Color(_) => Ty::Color,
+            Value::Material(_) => Ty::Material,
+            Value::Shape(_) => Ty::Shape,
+            Value::Mesh(_) => Ty::Mesh,
+            Value::Light(_) => Ty::Light,
+            Value::List(_) => Ty::List,
+            Value::Error => return None,
+        })
+    }
+
+    /// The type as users read it (`num` for any number).
+    pub fn ty_name(&self) -> String {
+        match self {
+            Value::Num(_) => "num".into(),
+            Value::List(items) => match items.first().and_then(Value::ty) {
+                Some(Ty::Int) => "list<num>".into(),
+                Some(t) => format!("list<{t}>"),
+                None => "list".into(),
+            },
+            v => v.ty().map_or("?".into(), |t| t.to_string()),
+        }
+    }
+
+    /// True for poison.
+    pub fn is_error(&self) -> bool {
+        matches!(self, Value::Error)
+    }
+}

@@ -1,0 +1,260 @@
+//! A stable, readable text form of the IR, for `scnc ir` and golden tests.
+
+use std::fmt::Write as _;
+
+use glam::{DAffine3, DVec3};
+
+use super::{Geometry, LightKind, Material, Mesh, MeshSource, Scene, Shape, ShapeKind};
+use crate::source::SourceMap;
+use crate::span::Span;
+
+/// Formats a number with at most 12 decimals, trailing zeros trimmed and `-0` as `0`,
+/// so dumps do not change with the last bits of a rotation matrix.
+pub(crate) fn num(x: f64) -> String {
+    let s = format!("{x:.12}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" {
+        "0".to_string()
+    } else {
+        s.to_string()
+    }
+}
+
+pub(crate) fn vec(v: DVec3) -> String {
+    format!("[{}, {}, {}]", num(v.x), num(v.y), num(v.z))
+}
+
+fn color(c: DVec3) -> String {
+    format!("rgb({}, {}, {})", num(c.x), num(c.y), num(c.z))
+}
+
+struct Dumper<'a> {
+    out: String,
+    map: &'a SourceMap,
+}
+
+impl Dumper<'_> {
+    fn at(&self, span: Span) -> String {
+        let (id, r) = self.map.local_range(span);
+        let (line, col) = self.map.line_col(id, r.start);
+        format!("@{}:{line}:{col}", self.map.file(id).name)
+    }
+
+    fn line(&mut self, indent: usize, text: &str, span: Option<Span>) {
+        let _ = write!(self.out, "{:indent$}{text}", "", indent = indent * 2);
+        if let Some(span) = span {
+            let _ = write!(self.out, "  {}", self.at(span));
+        }
+        self.out.push('\n');
+    }
+
+    fn material(m: &Material) -> String {
+        let spec = m.specular.map_or("none".to_string(), num);
+        format!("{} specular {} reflective {}", color(m.color), spec, num(m.reflective))
+    }
+
+    fn xf(xf: &DAffine3) -> String {
+        let mut s = format!("at {}", vec(xf.translation));
+        let m = xf.matrix3;
+        if m != glam::DMat3::IDENTITY {
+            let rows = (0..3).map(|r| vec(m.row(r))).collect::<Vec<_>>().join(", ");
+            let _ = write!(s, " linear [{rows}]");
+        }
+        s
+    }
+
+    fn shape(&mut self, indent: usize, shape: &Shape) {
+        let children = |this: &mut Self, kids: &[std::sync::Arc<Shape>]| {
+            for kid in kids {
+                this.shape(indent + 1, kid);
+            }
+        };
+        let span = Some(shape.span);
+        match &shape.kind {
+            ShapeKind::Sphere { radius } => self.line(indent, &format!("sphere radius {}", num(*radius)), span),
+            ShapeKind::Box { half } => self.line(indent, &format!("box half {}", vec(*half)), span),
+            ShapeKind::Cylinder { radius, half_height } => self.line(
+                indent,
+                &format!("cylinder radius {} half_height {}", num(*radius), num(*half_height)),
+                span,
+            ),
+            ShapeKind::Torus { major, minor } => self.line(
+                indent,
+                &format!("torus major {} minor {}", num(*major), num(*minor)),
+                span,
+            ),
+            ShapeKind::Plane { normal, offset } => self.line(
+                indent,
+                &format!("plane normal {} offset {}", vec(*normal), num(*offset)),
+                span,
+            ),
+            ShapeKind::Capsule { radius, half_height } => self.line(
+                indent,
+                &format!("capsule radius {} half_height {}", num(*radius), num(*half_height)),
+                span,
+            ),
+            ShapeKind::Cone { radius, half_height } => self.line(
+                indent,
+                &format!("cone radius {} half_height {}", num(*radius), num(*half_height)),
+                span,
+            ),
+            ShapeKind::Union { children: kids, smooth }
+            | ShapeKind::Intersect { children: kids, smooth }
+            | ShapeKind::Subtract { children: kids, smooth } => {
+                let op = match &shape.kind {
+                    ShapeKind::Union { .. } => "union",
+                    ShapeKind::Intersect { .. } => "intersect",
+                    _ => "subtract",
+                };
+                let text = if *smooth > 0.0 {
+                    format!("{op} smooth {}", num(*smooth))
+                } else {
+                    op.to_string()
+                };
+                self.line(indent, &text, span);
+                children(self, kids);
+            }
+            ShapeKind::Round { child, radius } => {
+                self.line(indent, &format!("round radius {}", num(*radius)), span);
+                self.shape(indent + 1, child);
+            }
+            ShapeKind::Shell { child, thickness } => {
+                self.line(indent, &format!("shell thickness {}", num(*thickness)), span);
+                self.shape(indent + 1, child);
+            }
+            ShapeKind::Repeat { child, period, count } => {
+                self.line(
+                    indent,
+                    &format!(
+                        "repeat period {} count [{}, {}, {}]",
+                        vec(*period),
+                        count[0],
+                        count[1],
+                        count[2]
+                    ),
+                    span,
+                );
+                self.shape(indent + 1, child);
+            }
+            ShapeKind::Transform { child, xf } => {
+                self.line(indent, &format!("transform {}", Self::xf(xf)), span);
+                self.shape(indent + 1, child);
+            }
+            ShapeKind::Paint { child, material } => {
+                self.line(
+                    indent,
+                    &format!("paint {}", Self::material(material)),
+                    Some(material.span),
+                );
+                self.shape(indent + 1, child);
+            }
+        }
+    }
+
+    fn mesh(&mut self, indent: usize, mesh: &Mesh) {
+        let src = match &mesh.source {
+            MeshSource::UvSphere {
+                radius,
+                rings,
+                segments,
+            } => format!("uvsphere radius {} rings {rings} segments {segments}", num(*radius)),
+            MeshSource::IcoSphere { radius, subdivisions } => {
+                format!("icosphere radius {} subdivisions {subdivisions}", num(*radius))
+            }
+            MeshSource::Box { half } => format!("box half {}", vec(*half)),
+            MeshSource::Cylinder {
+                radius,
+                half_height,
+                segments,
+            } => format!(
+                "cylinder radius {} half_height {} segments {segments}",
+                num(*radius),
+                num(*half_height)
+            ),
+            MeshSource::Torus {
+                major,
+                minor,
+                segments,
+                sides,
+            } => format!(
+                "torus major {} minor {} segments {segments} sides {sides}",
+                num(*major),
+                num(*minor)
+            ),
+            MeshSource::Plane { size } => format!("plane size {}", num(*size)),
+            MeshSource::Isosurface { cell, .. } => format!("isosurface cell {}", num(*cell)),
+            MeshSource::File { written, .. } => format!("file {written:?}"),
+        };
+        let shading = if mesh.smooth { "smooth" } else { "flat" };
+        self.line(
+            indent,
+            &format!("mesh {src} {shading} {}", Self::xf(&mesh.xf)),
+            Some(mesh.span),
+        );
+        if let Some(m) = &mesh.material {
+            self.line(indent + 1, &format!("material {}", Self::material(m)), Some(m.span));
+        }
+        if let MeshSource::Isosurface { shape, .. } = &mesh.source {
+            self.shape(indent + 1, shape);
+        }
+    }
+}
+
+/// The IR as text: one line per node, children indented, each with its source location.
+pub fn dump(scene: &Scene, map: &SourceMap) -> String {
+    let mut d = Dumper {
+        out: String::new(),
+        map,
+    };
+    let c = &scene.camera;
+    d.line(
+        0,
+        &format!(
+            "camera position {} look_at {} up {} fov {}",
+            vec(c.position),
+            vec(c.look_at),
+            vec(c.up),
+            num(c.fov)
+        ),
+        c.span,
+    );
+    let s = &scene.settings;
+    d.line(
+        0,
+        &format!(
+            "render {}x{} depth {} background {} epsilon {} max_steps {} max_distance {} samples {}",
+            s.width,
+            s.height,
+            s.depth,
+            color(s.background),
+            num(s.epsilon),
+            s.max_steps,
+            num(s.max_distance),
+            s.samples
+        ),
+        s.span,
+    );
+    for light in &scene.lights {
+        let kind = match &light.kind {
+            LightKind::Ambient => "ambient".to_string(),
+            LightKind::Point { position } => format!("point at {}", vec(*position)),
+            LightKind::Directional { towards } => format!("directional towards {}", vec(*towards)),
+        };
+        let mut text = format!("light {kind} intensity {}", num(light.intensity));
+        if !matches!(light.kind, LightKind::Ambient) {
+            text.push_str(if light.shadows { " shadows" } else { " no_shadows" });
+        }
+        if light.radius > 0.0 {
+            let _ = write!(text, " radius {}", num(light.radius));
+        }
+        d.line(0, &text, Some(light.span));
+    }
+    for (i, obj) in scene.objects.iter().enumerate() {
+        d.line(0, &format!("object {i}"), Some(obj.span));
+        match &obj.geometry {
+            Geometry::Shape(shape) => d.shape(1, shape),
+            Geometry::Mesh(mesh) => d.mesh(1, mesh),
+        }
+    }
+    d.out
+}

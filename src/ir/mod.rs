@@ -1,0 +1,377 @@
+//! The scene IR: what the file means, fully evaluated and checked, in f64.
+//!
+//! Loops, functions, arithmetic and includes are gone; what remains is a camera, render
+//! settings, lights, and objects whose geometry is a tree of primitives, CSG operators,
+//! modifiers, composed affine transforms and material nodes, or a mesh generator.
+//!
+//! **Invariant:** every number is finite and within the range its builtin documents
+//! (radii > 0, reflectivity in [0, 1], scale factors > 0, counts ≥ 1); the checker
+//! guarantees it, so back-ends never re-validate. Every node keeps its source span.
+
+mod bounds;
+mod dump;
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use glam::{DAffine3, DVec3};
+
+pub use bounds::{bounding_sphere, mesh_bounds, shape_bounds, Aabb};
+pub use dump::dump;
+pub(crate) use dump::{num as dump_num, vec as dump_vec};
+
+use crate::span::Span;
+
+/// A fully evaluated scene.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// The camera (the study's default when the file has no `camera`).
+    pub camera: Camera,
+    /// Image and tracer settings.
+    pub settings: Settings,
+    /// Lights in source order.
+    pub lights: Vec<Light>,
+    /// Objects in source order.
+    pub objects: Vec<Object>,
+}
+
+/// A pinhole camera.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Camera {
+    /// Eye position.
+    pub position: DVec3,
+    /// A point the camera looks at (never equal to `position`).
+    pub look_at: DVec3,
+    /// Up hint (never parallel to the view direction).
+    pub up: DVec3,
+    /// Vertical field of view in degrees, in (0, 180).
+    pub fov: f64,
+    /// The `camera` statement, if any.
+    pub span: Option<Span>,
+}
+
+/// The study's vertical field of view: a 1×1 viewport at distance 1, `2·atan(0.5)` in degrees.
+pub const SEED_FOV: f64 = 53.13010235415598;
+
+impl Default for Camera {
+    fn default() -> Camera {
+        Camera {
+            position: DVec3::ZERO,
+            look_at: DVec3::Z,
+            up: DVec3::Y,
+            fov: SEED_FOV,
+            span: None,
+        }
+    }
+}
+
+/// Image size and tracer knobs from `render(…)`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Settings {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Reflection recursion depth (0 = no reflection rays).
+    pub depth: u32,
+    /// Background colour, 0–255 per channel.
+    pub background: DVec3,
+    /// Sphere-tracing hit threshold, relative to the distance travelled (see `sdf`).
+    pub epsilon: f64,
+    /// Sphere-tracing step budget per ray.
+    pub max_steps: u32,
+    /// Far limit of every ray.
+    pub max_distance: f64,
+    /// Samples per pixel (antialiasing), a perfect square is not required.
+    pub samples: u32,
+    /// The `render` statement, if any.
+    pub span: Option<Span>,
+}
+
+impl Default for Settings {
+    fn default() -> Settings {
+        Settings {
+            width: 500,
+            height: 500,
+            depth: 5,
+            background: DVec3::splat(245.0),
+            epsilon: 1e-4,
+            max_steps: 512,
+            max_distance: 1000.0,
+            samples: 1,
+            span: None,
+        }
+    }
+}
+
+/// A surface material, as in the study.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// Colour, 0–255 per channel.
+    pub color: DVec3,
+    /// Phong exponent; `None` for no highlight (the study's −1).
+    pub specular: Option<f64>,
+    /// Reflectivity in [0, 1].
+    pub reflective: f64,
+    /// The `material(…)` call.
+    pub span: Span,
+}
+
+impl Material {
+    /// The colour of an object with no material anywhere above it: light grey, matte.
+    pub fn default_grey() -> Material {
+        Material {
+            color: DVec3::splat(200.0),
+            specular: None,
+            reflective: 0.0,
+            span: Span::default(),
+        }
+    }
+}
+
+/// What kind of light.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LightKind {
+    /// Lights every point equally.
+    Ambient,
+    /// A point light.
+    Point {
+        /// Where it is.
+        position: DVec3,
+    },
+    /// A light at infinity.
+    Directional {
+        /// Direction *towards* the light (non-zero, not normalised, as written).
+        towards: DVec3,
+    },
+}
+
+/// A light.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Light {
+    /// Its kind and placement.
+    pub kind: LightKind,
+    /// Intensity, ≥ 0.
+    pub intensity: f64,
+    /// Whether it casts shadows (`shadows = false` opts out).
+    pub shadows: bool,
+    /// Radius for soft shadows (0 = hard).
+    pub radius: f64,
+    /// The light's expression.
+    pub span: Span,
+}
+
+/// One `object` statement.
+#[derive(Clone, Debug)]
+pub struct Object {
+    /// Its geometry.
+    pub geometry: Geometry,
+    /// The statement.
+    pub span: Span,
+}
+
+/// Either an SDF-able shape tree or an explicit mesh.
+#[derive(Clone, Debug)]
+pub enum Geometry {
+    /// A shape: sphere traced by the SDF back-end, tessellated by the mesh back-end.
+    Shape(Arc<Shape>),
+    /// A mesh: traced as triangles by both back-ends.
+    Mesh(Arc<Mesh>),
+}
+
+/// A node of a shape tree.
+#[derive(Clone, Debug)]
+pub struct Shape {
+    /// What it is.
+    pub kind: ShapeKind,
+    /// The expression it came from.
+    pub span: Span,
+}
+
+/// Shape nodes. Primitives are centred at the origin; sizes are radii and half-extents.
+#[derive(Clone, Debug)]
+pub enum ShapeKind {
+    /// Sphere of radius `radius`.
+    Sphere {
+        /// Radius > 0.
+        radius: f64,
+    },
+    /// Box with half-extents `half`.
+    Box {
+        /// Half-extents, each > 0.
+        half: DVec3,
+    },
+    /// Capped cylinder along y.
+    Cylinder {
+        /// Radius > 0.
+        radius: f64,
+        /// Half-height > 0.
+        half_height: f64,
+    },
+    /// Torus in the xz plane.
+    Torus {
+        /// Distance from centre to tube centre, > 0.
+        major: f64,
+        /// Tube radius, > 0.
+        minor: f64,
+    },
+    /// Half-space below the plane `n·p = offset`.
+    Plane {
+        /// Unit normal.
+        normal: DVec3,
+        /// Offset along the normal.
+        offset: f64,
+    },
+    /// Capsule along y.
+    Capsule {
+        /// Radius > 0.
+        radius: f64,
+        /// Half-height of the axis segment, > 0.
+        half_height: f64,
+    },
+    /// Capped cone along y, apex up, base of radius `radius` at `-half_height`.
+    Cone {
+        /// Base radius > 0.
+        radius: f64,
+        /// Half-height > 0.
+        half_height: f64,
+    },
+    /// Union of the children (`smooth` = 0 for a sharp one).
+    Union {
+        /// At least one child.
+        children: Vec<Arc<Shape>>,
+        /// Smoothing radius ≥ 0.
+        smooth: f64,
+    },
+    /// Intersection of the children.
+    Intersect {
+        /// At least one child.
+        children: Vec<Arc<Shape>>,
+        /// Smoothing radius ≥ 0.
+        smooth: f64,
+    },
+    /// The first child minus the rest.
+    Subtract {
+        /// At least one child.
+        children: Vec<Arc<Shape>>,
+        /// Smoothing radius ≥ 0.
+        smooth: f64,
+    },
+    /// Rounded by `radius` (grows the shape).
+    Round {
+        /// The shape.
+        child: Arc<Shape>,
+        /// Radius ≥ 0.
+        radius: f64,
+    },
+    /// Hollowed to a wall of `thickness` around the surface.
+    Shell {
+        /// The shape.
+        child: Arc<Shape>,
+        /// Thickness > 0.
+        thickness: f64,
+    },
+    /// Finite repetition, `count` copies along each axis centred at the origin.
+    Repeat {
+        /// The shape.
+        child: Arc<Shape>,
+        /// Spacing per axis, > 0.
+        period: DVec3,
+        /// Copies per axis, ≥ 1.
+        count: [u32; 3],
+    },
+    /// An affine transform (world from local), composed from `at`, `rotate` and `scale`.
+    Transform {
+        /// The shape.
+        child: Arc<Shape>,
+        /// World-from-local transform; always invertible.
+        xf: DAffine3,
+    },
+    /// A material for every part below that has none of its own.
+    Paint {
+        /// The shape.
+        child: Arc<Shape>,
+        /// The material.
+        material: Arc<Material>,
+    },
+}
+
+/// An explicit triangle mesh.
+#[derive(Clone, Debug)]
+pub struct Mesh {
+    /// How the triangles are made.
+    pub source: MeshSource,
+    /// World-from-local transform.
+    pub xf: DAffine3,
+    /// Material, if one was given.
+    pub material: Option<Arc<Material>>,
+    /// Interpolate vertex normals instead of flat faces.
+    pub smooth: bool,
+    /// The `mesh` expression.
+    pub span: Span,
+}
+
+/// Mesh generators.
+#[derive(Clone, Debug)]
+pub enum MeshSource {
+    /// UV sphere.
+    UvSphere {
+        /// Radius.
+        radius: f64,
+        /// Rings (latitude bands), ≥ 3.
+        rings: u32,
+        /// Segments (longitude), ≥ 3.
+        segments: u32,
+    },
+    /// Subdivided icosahedron.
+    IcoSphere {
+        /// Radius.
+        radius: f64,
+        /// Subdivision steps.
+        subdivisions: u32,
+    },
+    /// Box (12 triangles).
+    Box {
+        /// Half-extents.
+        half: DVec3,
+    },
+    /// Capped cylinder along y.
+    Cylinder {
+        /// Radius.
+        radius: f64,
+        /// Half-height.
+        half_height: f64,
+        /// Points per cap circle, ≥ 3.
+        segments: u32,
+    },
+    /// Torus in the xz plane.
+    Torus {
+        /// Major radius.
+        major: f64,
+        /// Minor radius.
+        minor: f64,
+        /// Segments around the major circle.
+        segments: u32,
+        /// Sides around the tube.
+        sides: u32,
+    },
+    /// A finite square in the xz plane.
+    Plane {
+        /// Half the side length.
+        size: f64,
+    },
+    /// Any shape, triangulated.
+    Isosurface {
+        /// The shape.
+        shape: Arc<Shape>,
+        /// Cell size in world units.
+        cell: f64,
+    },
+    /// A mesh file.
+    File {
+        /// The path resolved against the including file.
+        path: PathBuf,
+        /// The path as written.
+        written: String,
+    },
+}

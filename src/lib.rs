@@ -1,0 +1,75 @@
+//! scnc: a scene-language compiler and renderer.
+//!
+//! The pipeline, one module per stage, each with one entry point:
+//!
+//! ```text
+//! source text ──syntax::parse──▶ ast::File ──check::check──▶ ir::Scene
+//!     (logos + chumsky;            (names, types, ranges;     (f64, spans kept)
+//!      errors → Diagnostic)         evaluates loops/functions)
+//! ```
+//!
+//! Every stage reports problems as [`diag::Diagnostic`] values; only the binary prints.
+
+pub mod check;
+pub mod diag;
+pub mod ir;
+pub mod source;
+pub mod span;
+pub mod syntax;
+
+use std::path::Path;
+
+use check::Loader;
+use diag::Diagnostic;
+use source::SourceMap;
+
+/// The result of compiling one file: its sources (for rendering diagnostics), the
+/// scene if it compiled, and every diagnostic.
+#[derive(Debug)]
+pub struct Compiled {
+    /// All files read.
+    pub map: SourceMap,
+    /// The scene; `None` when there were errors.
+    pub scene: Option<ir::Scene>,
+    /// Errors and warnings, in source order.
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+/// Compiles scene text named `name` (whose includes resolve relative to `path`).
+pub fn compile_source(name: &str, path: &Path, text: String, loader: &dyn Loader) -> Compiled {
+    let mut map = SourceMap::new();
+    let Some(root) = map.add(name, path, text) else {
+        let mut map = SourceMap::new();
+        let _ = map.add(name, path, String::new());
+        let d = Diagnostic::error(
+            diag::codes::TOO_LARGE,
+            span::Span::default(),
+            format!("`{name}` is too large"),
+            "the file is too large",
+        );
+        return Compiled {
+            map,
+            scene: None,
+            diagnostics: vec![d],
+        };
+    };
+    let (scene, diagnostics) = check::check(&mut map, root, loader);
+    Compiled {
+        map,
+        scene,
+        diagnostics,
+    }
+}
+
+/// Runs `f` on a thread with a large stack, so that pathological nesting in user input
+/// (bounded by the limits in [`check`] and [`syntax`]) cannot overflow the stack.
+pub fn with_big_stack<T: Send>(f: impl FnOnce() -> T + Send) -> T {
+    std::thread::scope(|s| {
+        std::thread::Builder::new()
+            .stack_size(256 << 20)
+            .spawn_scoped(s, f)
+            .expect("spawning the compiler thread")
+            .join()
+            .unwrap_or_else(|e| std::panic::resume_unwind(e))
+    })
+}
