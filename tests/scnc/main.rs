@@ -1,0 +1,6 @@
+//! The single integration-test binary: every test module links into it.
+
+mod cli;
+mod golden;
+mod nopanic;
+mod support;

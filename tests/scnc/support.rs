@@ -1,0 +1,87 @@
+//! Shared helpers: listing cases, comparing against golden files, compiling test input.
+
+use std::path::{Path, PathBuf};
+
+use scnc::check::FsLoader;
+use scnc::Compiled;
+
+/// The `.scn` files directly inside `dir`, sorted.
+pub fn cases(dir: &str) -> Vec<PathBuf> {
+    let mut out: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("reading {dir}: {e}"))
+        .map(|e| e.expect("directory entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "scn"))
+        .collect();
+    out.sort();
+    out
+}
+
+/// Compiles a file, naming it by its file name only so goldens do not depend on the checkout.
+pub fn compile(path: &Path) -> Compiled {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
+    let name = path
+        .file_name()
+        .map_or(String::new(), |n| n.to_string_lossy().into_owned());
+    scnc::with_big_stack(|| scnc::compile_source(&name, path, text, &FsLoader))
+}
+
+/// Whether golden files should be rewritten (`UPDATE_EXPECT=1`).
+pub fn updating() -> bool {
+    std::env::var_os("UPDATE_EXPECT").is_some_and(|v| v == "1")
+}
+
+/// A line diff of expected and actual, for failure messages.
+pub fn diff(expected: &str, actual: &str) -> String {
+    let e: Vec<&str> = expected.lines().collect();
+    let a: Vec<&str> = actual.lines().collect();
+    let mut out = String::new();
+    for i in 0..e.len().max(a.len()) {
+        match (e.get(i), a.get(i)) {
+            (Some(x), Some(y)) if x == y => {}
+            (x, y) => {
+                if let Some(x) = x {
+                    out.push_str(&format!("{:>4} - {x}\n", i + 1));
+                }
+                if let Some(y) = y {
+                    out.push_str(&format!("{:>4} + {y}\n", i + 1));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Compares `actual` with the golden file; returns a failure description, or rewrites
+/// the file when updating. A missing golden file is written and reported as a failure,
+/// so a new case is never silently green.
+pub fn check_golden(golden: &Path, actual: &str) -> Option<String> {
+    let expected = std::fs::read_to_string(golden).ok();
+    if expected.as_deref() == Some(actual) {
+        return None;
+    }
+    if updating() || expected.is_none() {
+        std::fs::write(golden, actual).unwrap_or_else(|e| panic!("writing {}: {e}", golden.display()));
+        if updating() {
+            return None;
+        }
+        return Some(format!(
+            "{}: golden file was missing; written, review it and run again",
+            golden.display()
+        ));
+    }
+    Some(format!(
+        "{} differs (rerun with UPDATE_EXPECT=1 to accept):\n{}",
+        golden.display(),
+        diff(&expected.unwrap_or_default(), actual)
+    ))
+}
+
+/// Panics listing every failure.
+pub fn finish(failures: Vec<String>) {
+    assert!(
+        failures.is_empty(),
+        "{} case(s) failed:\n\n{}",
+        failures.len(),
+        failures.join("\n\n")
+    );
+}
