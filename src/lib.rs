@@ -3,16 +3,20 @@
 //! The pipeline, one module per stage, each with one entry point:
 //!
 //! ```text
-//! source text ──syntax::parse──▶ ast::File ──check::check──▶ ir::Scene
-//!     (logos + chumsky;            (names, types, ranges;     (f64, spans kept)
-//!      errors → Diagnostic)         evaluates loops/functions)
+//! source text ──syntax::parse──▶ ast::File ──check::check──▶ ir::Scene ──sdf::lower──▶ SdfScene ─┐
+//!     (logos + chumsky;            (names, types, ranges;     (f64, spans)   (closures, f32,       │
+//!      errors → Diagnostic)         evaluates loops/functions)                camera-relative)      │
+//!                                                 render::Frame::new ──▶ Frame ──render::render(&dyn Geometry)──▶ Image
 //! ```
 //!
 //! Every stage reports problems as [`diag::Diagnostic`] values; only the binary prints.
 
+pub mod bvh;
 pub mod check;
 pub mod diag;
 pub mod ir;
+pub mod render;
+pub mod sdf;
 pub mod source;
 pub mod span;
 pub mod syntax;

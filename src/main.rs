@@ -3,6 +3,7 @@
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::time::Instant;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
@@ -36,6 +37,8 @@ enum Command {
         #[arg(long, value_enum, default_value = "human")]
         message_format: MessageFormat,
     },
+    /// Render a scene to an image (written whole or not at all).
+    Render(RenderArgs),
     /// Print the evaluated scene IR.
     Ir {
         /// The scene file.
@@ -44,6 +47,72 @@ enum Command {
         #[arg(long, value_enum, default_value = "human")]
         message_format: MessageFormat,
     },
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum GeometryKind {
+    /// Sphere-trace signed distance functions.
+    Sdf,
+}
+
+#[derive(clap::Args)]
+struct RenderArgs {
+    /// The scene file.
+    file: PathBuf,
+    /// Output image (PNG).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Image width in pixels (overrides the scene's `render`).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    width: Option<u32>,
+    /// Image height in pixels (overrides the scene's `render`).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    height: Option<u32>,
+    /// Worker threads (default: one per core).
+    #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024))]
+    threads: Option<u16>,
+    /// Sphere-tracing hit threshold, relative to distance from the camera.
+    #[arg(long, value_parser = parse_epsilon)]
+    epsilon: Option<f64>,
+    /// Sphere-tracing step budget per ray.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    max_steps: Option<u32>,
+    /// Far limit of every ray.
+    #[arg(long, value_parser = parse_positive)]
+    max_distance: Option<f64>,
+    /// Reflection recursion depth.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=64))]
+    depth: Option<u32>,
+    /// Samples per pixel (antialiasing).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=256))]
+    samples: Option<u32>,
+    /// Geometry back-end.
+    #[arg(long, value_enum, default_value = "sdf")]
+    geometry: GeometryKind,
+    /// Print ray counts, work per ray and memory.
+    #[arg(long)]
+    stats: bool,
+    /// How to print diagnostics.
+    #[arg(long, value_enum, default_value = "human")]
+    message_format: MessageFormat,
+}
+
+fn parse_epsilon(s: &str) -> Result<f64, String> {
+    let x: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
+    if x > 0.0 && x < 1.0 {
+        Ok(x)
+    } else {
+        Err("must be between 0 and 1 (exclusive)".into())
+    }
+}
+
+fn parse_positive(s: &str) -> Result<f64, String> {
+    let x: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
+    if x > 0.0 && x.is_finite() {
+        Ok(x)
+    } else {
+        Err("must be a finite number greater than 0".into())
+    }
 }
 
 fn compile(path: &Path) -> Compiled {
@@ -92,8 +161,213 @@ fn report(c: &Compiled, format: MessageFormat) -> bool {
     c.diagnostics.iter().any(Diagnostic::is_error)
 }
 
+/// A usage problem found after argument parsing: printed like clap's, exit 2.
+fn usage_error(msg: &str) -> ExitCode {
+    let _ = writeln!(std::io::stderr(), "error: {msg}");
+    ExitCode::from(2)
+}
+
+fn render_cmd(args: RenderArgs) -> ExitCode {
+    let ext = args
+        .output
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    if ext.as_deref() != Some("png") {
+        return usage_error(&format!(
+            "cannot write `{}`: scnc writes PNG images; try a `.png` file name",
+            args.output.display()
+        ));
+    }
+    let out_dir = match args.output.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    if !out_dir.is_dir() {
+        return usage_error(&format!(
+            "cannot write `{}`: the directory `{}` does not exist",
+            args.output.display(),
+            out_dir.display()
+        ));
+    }
+    let compiled = compile(&args.file);
+    if report(&compiled, args.message_format) {
+        return ExitCode::from(1);
+    }
+    let Some(mut scene) = compiled.scene else {
+        return ExitCode::from(1);
+    };
+    let s = &mut scene.settings;
+    s.width = args.width.unwrap_or(s.width);
+    s.height = args.height.unwrap_or(s.height);
+    s.epsilon = args.epsilon.unwrap_or(s.epsilon);
+    s.max_steps = args.max_steps.unwrap_or(s.max_steps);
+    s.max_distance = args.max_distance.unwrap_or(s.max_distance);
+    s.depth = args.depth.unwrap_or(s.depth);
+    s.samples = args.samples.unwrap_or(s.samples);
+    if s.width as u64 * s.height as u64 > scnc::check::construct::MAX_PIXELS {
+        return usage_error(&format!(
+            "{}×{} is too large: at most {} pixels",
+            s.width,
+            s.height,
+            scnc::check::construct::MAX_PIXELS
+        ));
+    }
+    let mut pool = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = args.threads {
+        pool = pool.num_threads(n as usize);
+    }
+    let pool = match pool.build() {
+        Ok(p) => p,
+        Err(e) => return usage_error(&format!("cannot start worker threads: {e}")),
+    };
+    let GeometryKind::Sdf = args.geometry;
+    let started = Instant::now();
+    let mut frame = scnc::render::Frame::new(&scene);
+    let params = scnc::sdf::MarchParams {
+        epsilon: scene.settings.epsilon as f32,
+        max_steps: scene.settings.max_steps,
+    };
+    let geometry = match scnc::sdf::lower(&scene, &mut frame, params) {
+        Ok(g) => g,
+        Err(d) => {
+            let c = Compiled {
+                map: compiled.map,
+                scene: None,
+                diagnostics: vec![d],
+            };
+            report(&c, args.message_format);
+            return ExitCode::from(1);
+        }
+    };
+    let lowered = started.elapsed();
+    let progress = Progress::new(frame.height);
+    let (image, counters) = pool.install(|| scnc::render::render(&geometry, &frame, &|| progress.row()));
+    progress.finish();
+    let traced = started.elapsed() - lowered;
+    if let Err(e) = write_png(&args.output, &image) {
+        let _ = writeln!(
+            std::io::stderr(),
+            "error: cannot write `{}`: {e}",
+            args.output.display()
+        );
+        return ExitCode::from(1);
+    }
+    let secs = traced.as_secs_f64();
+    let mut err = std::io::stderr().lock();
+    let _ = writeln!(
+        err,
+        "rendered {}: {}×{} in {:.3} s ({:.2} M rays/s, {} threads)",
+        args.output.display(),
+        image.width,
+        image.height,
+        started.elapsed().as_secs_f64(),
+        counters.rays() as f64 / secs.max(1e-9) / 1e6,
+        pool.current_num_threads()
+    );
+    if args.stats {
+        let _ = write!(err, "{}", stats_text(&counters, &geometry, lowered.as_secs_f64(), secs));
+    }
+    ExitCode::SUCCESS
+}
+
+fn stats_text(c: &scnc::render::Counters, g: &scnc::sdf::SdfScene, lower_s: f64, trace_s: f64) -> String {
+    let mem = g.memory();
+    let marches = c.rays().max(1) as f64;
+    format!(
+        "stats:
+  time            lower {:.3} s, trace {:.3} s
+  rays            {} primary, {} shadow, {} reflection ({} total, {:.2} M/s)
+  sdf evaluations {} marching ({:.1} per ray, max {} on one ray), {} for normals and materials
+  step budget     {} marches ran out of steps (counted as misses)
+  bvh             {} node visits ({:.2} per ray)
+  memory          {} objects: {} bytes of evaluator closures, {} bytes of top-level BVH
+",
+        lower_s,
+        trace_s,
+        c.primary_rays,
+        c.shadow_rays,
+        c.reflection_rays,
+        c.rays(),
+        c.rays() as f64 / trace_s.max(1e-9) / 1e6,
+        c.sdf_evals,
+        c.sdf_evals as f64 / marches,
+        c.max_evals_per_ray,
+        c.sdf_shading_evals,
+        c.budget_misses,
+        c.node_visits,
+        c.node_visits as f64 / marches,
+        g.len(),
+        mem.closure_bytes,
+        mem.bvh_bytes,
+    )
+}
+
+/// Encodes to a temporary file beside the target, then renames it over the target, so
+/// the output is written whole or not at all and an existing file survives any failure.
+fn write_png(path: &Path, image: &scnc::render::Image) -> std::io::Result<()> {
+    use image::ImageEncoder;
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".scnc-")
+        .suffix(".png.tmp")
+        .tempfile_in(dir)?;
+    {
+        let mut w = std::io::BufWriter::new(tmp.as_file_mut());
+        image::codecs::png::PngEncoder::new(&mut w)
+            .write_image(&image.pixels, image.width, image.height, image::ExtendedColorType::Rgb8)
+            .map_err(std::io::Error::other)?;
+        w.flush()?;
+    }
+    tmp.as_file().sync_all()?;
+    tmp.persist(path).map_err(|e| e.error)?;
+    Ok(())
+}
+
+/// A progress bar on a terminal, shown only once a render has taken a second.
+struct Progress {
+    bar: Option<indicatif::ProgressBar>,
+    started: Instant,
+}
+
+impl Progress {
+    fn new(rows: u32) -> Progress {
+        let bar = std::io::stderr().is_terminal().then(|| {
+            let bar =
+                indicatif::ProgressBar::with_draw_target(Some(rows as u64), indicatif::ProgressDrawTarget::hidden());
+            if let Ok(style) = indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} rows, {eta} left") {
+                bar.set_style(style);
+            }
+            bar
+        });
+        Progress {
+            bar,
+            started: Instant::now(),
+        }
+    }
+
+    fn row(&self) {
+        if let Some(bar) = &self.bar {
+            if bar.is_hidden() && self.started.elapsed().as_secs_f64() > 1.0 {
+                bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+            }
+            bar.inc(1);
+        }
+    }
+
+    fn finish(&self) {
+        if let Some(bar) = &self.bar {
+            bar.finish_and_clear();
+        }
+    }
+}
+
 fn run(cli: Cli) -> ExitCode {
     match cli.command {
+        Command::Render(args) => render_cmd(args),
         Command::Check { files, message_format } => {
             let mut failed = false;
             for file in &files {

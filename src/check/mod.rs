@@ -13,7 +13,7 @@
 //! satisfies the invariants stated in [`ir`].
 
 pub mod builtins;
-mod construct;
+pub mod construct;
 mod expr;
 mod value;
 

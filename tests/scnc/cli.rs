@@ -91,3 +91,104 @@ fn check_many_files_reports_all() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("E0201") && err.contains("E0200"), "{err}");
 }
+
+#[test]
+fn render_writes_a_png() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("seed1.png");
+    let o = scnc(&[
+        "render",
+        "examples/seed/01-sphere.scn",
+        "-o",
+        out.to_str().unwrap_or_default(),
+        "--width",
+        "40",
+        "--height",
+        "30",
+        "--stats",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let img = image::open(&out).expect("a PNG was written").to_rgb8();
+    assert_eq!((img.width(), img.height()), (40, 30));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("rendered") && err.contains("1200 primary"), "{err}");
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+        .expect("dir")
+        .filter_map(Result::ok)
+        .filter(|e| e.file_name() != "seed1.png")
+        .collect();
+    assert!(leftovers.is_empty(), "temporary files left behind: {leftovers:?}");
+}
+
+#[test]
+fn failed_render_leaves_no_file_and_keeps_an_existing_one() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let fresh = dir.path().join("fresh.png");
+    let o = scnc(&[
+        "render",
+        "tests/data/diag/unknown-function.scn",
+        "-o",
+        fresh.to_str().unwrap_or_default(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(!fresh.exists(), "an image was written for a scene with errors");
+    let existing = dir.path().join("existing.png");
+    std::fs::write(&existing, b"keep me").expect("write");
+    let o = scnc(&[
+        "render",
+        "tests/data/diag/unknown-function.scn",
+        "-o",
+        existing.to_str().unwrap_or_default(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert_eq!(std::fs::read(&existing).expect("read"), b"keep me");
+    assert_eq!(
+        std::fs::read_dir(dir.path()).expect("dir").count(),
+        1,
+        "no temporary file may remain"
+    );
+}
+
+#[test]
+fn render_rejects_bad_flags_with_exit_2() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let png = dir.path().join("a.png");
+    let png = png.to_str().unwrap_or_default();
+    for args in [
+        vec!["render", "examples/seed/01-sphere.scn", "-o", png, "--width", "0"],
+        vec!["render", "examples/seed/01-sphere.scn", "-o", png, "--epsilon", "2"],
+        vec!["render", "examples/seed/01-sphere.scn", "-o", png, "--threads", "0"],
+        vec![
+            "render",
+            "examples/seed/01-sphere.scn",
+            "-o",
+            png,
+            "--max-steps",
+            "lots",
+        ],
+        vec!["render", "examples/seed/01-sphere.scn"],
+    ] {
+        let o = scnc(&args);
+        assert_eq!(
+            o.status.code(),
+            Some(2),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+    let jpg = dir.path().join("a.jpg");
+    let o = scnc(&[
+        "render",
+        "examples/seed/01-sphere.scn",
+        "-o",
+        jpg.to_str().unwrap_or_default(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("scnc writes PNG"));
+    let o = scnc(&["render", "examples/seed/01-sphere.scn", "-o", "/no/such/dir/a.png"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        std::fs::read_dir(dir.path()).expect("dir").next().is_none(),
+        "nothing may be written"
+    );
+}

@@ -3,4 +3,5 @@
 mod cli;
 mod golden;
 mod nopanic;
+mod render;
 mod support;

@@ -5,6 +5,8 @@ use std::path::Path;
 
 use scnc::check::Loader;
 
+use crate::support::Rng;
+
 /// Serves includes from the examples but never fails on a mutated include path.
 struct Examples;
 
@@ -46,22 +48,6 @@ fn every_prefix_compiles_or_reports() {
             }
         }
     });
-}
-
-/// A small deterministic generator (xorshift), so failures reproduce.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
 }
 
 #[test]

@@ -1,0 +1,176 @@
+//! The common Whitted tracer: camera, lights, Phong shading, hard shadows, recursive
+//! reflections. It knows geometry only through the [`Geometry`] contract, so the SDF
+//! and mesh back-ends plug in unchanged.
+//!
+//! Everything here works in *render space*: world space translated so the camera sits at
+//! the origin, in f32. Lowering subtracts the camera position in f64 first, so a scene
+//! far from the world origin keeps its precision.
+//!
+//! **Invariant:** the image depends only on the scene and the settings, never on the
+//! thread count: rows are independent and counters are summed exactly.
+
+mod frame;
+mod shade;
+
+use glam::Vec3A;
+use rayon::prelude::*;
+
+pub use frame::{Frame, MaterialTable, ShadeLight, ShadeMaterial};
+
+/// A ray in render space.
+#[derive(Clone, Copy, Debug)]
+pub struct Ray {
+    /// Start point.
+    pub origin: Vec3A,
+    /// Unit direction.
+    pub dir: Vec3A,
+    /// Component-wise `1 / dir`, for slab tests.
+    pub inv_dir: Vec3A,
+    /// Nearest accepted hit distance.
+    pub t_min: f32,
+    /// Farthest accepted hit distance.
+    pub t_max: f32,
+}
+
+impl Ray {
+    /// A ray from `origin` along the unit vector `dir`, accepting hits in `[0, t_max]`.
+    pub fn new(origin: Vec3A, dir: Vec3A, t_max: f32) -> Ray {
+        debug_assert!(origin.is_finite() && dir.is_finite(), "non-finite ray");
+        Ray {
+            origin,
+            dir,
+            inv_dir: dir.recip(),
+            t_min: 0.0,
+            t_max,
+        }
+    }
+
+    /// The point at distance `t`.
+    pub fn at(&self, t: f32) -> Vec3A {
+        self.origin + self.dir * t
+    }
+}
+
+/// A surface hit.
+#[derive(Clone, Copy, Debug)]
+pub struct Hit {
+    /// Distance along the ray.
+    pub t: f32,
+    /// Hit point in render space.
+    pub point: Vec3A,
+    /// Unit outward surface normal.
+    pub normal: Vec3A,
+    /// Index into the frame's material table.
+    pub material: u32,
+    /// A bound on how far `point` may lie from the true surface (the back-end's own
+    /// tolerance); secondary rays start beyond it.
+    pub error: f32,
+}
+
+/// Work counters, summed over the whole render.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Counters {
+    /// Camera rays.
+    pub primary_rays: u64,
+    /// Shadow (occlusion) rays.
+    pub shadow_rays: u64,
+    /// Reflection rays.
+    pub reflection_rays: u64,
+    /// SDF evaluations during marching (SDF back-end).
+    pub sdf_evals: u64,
+    /// SDF evaluations for normals and materials at hits.
+    pub sdf_shading_evals: u64,
+    /// Most SDF evaluations spent on one ray.
+    pub max_evals_per_ray: u64,
+    /// Marches that ran out of steps before deciding (counted as misses).
+    pub budget_misses: u64,
+    /// BVH nodes visited.
+    pub node_visits: u64,
+    /// Ray–triangle tests (mesh back-end).
+    pub triangle_tests: u64,
+    /// Samples whose colour was not finite (always 0 unless there is a bug; such a
+    /// sample is written as black).
+    pub nonfinite_samples: u64,
+}
+
+impl Counters {
+    /// Adds another set of counters.
+    pub fn add(&mut self, o: &Counters) {
+        self.primary_rays += o.primary_rays;
+        self.shadow_rays += o.shadow_rays;
+        self.reflection_rays += o.reflection_rays;
+        self.sdf_evals += o.sdf_evals;
+        self.sdf_shading_evals += o.sdf_shading_evals;
+        self.max_evals_per_ray = self.max_evals_per_ray.max(o.max_evals_per_ray);
+        self.budget_misses += o.budget_misses;
+        self.node_visits += o.node_visits;
+        self.triangle_tests += o.triangle_tests;
+        self.nonfinite_samples += o.nonfinite_samples;
+    }
+
+    /// All rays cast.
+    pub fn rays(&self) -> u64 {
+        self.primary_rays + self.shadow_rays + self.reflection_rays
+    }
+}
+
+/// What a geometry back-end provides to the tracer.
+pub trait Geometry: Sync {
+    /// The closest hit along the ray within `[t_min, t_max]`.
+    fn intersect(&self, ray: &Ray, counters: &mut Counters) -> Option<Hit>;
+    /// Whether anything lies along the ray within `[t_min, t_max]` (for shadows).
+    fn occluded(&self, ray: &Ray, counters: &mut Counters) -> bool;
+    /// Bytes of the back-end's geometry structures.
+    fn bytes(&self) -> usize;
+}
+
+/// A rendered image: RGB, 8 bits per channel, rows top to bottom.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Image {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// `width × height × 3` bytes.
+    pub pixels: Vec<u8>,
+}
+
+/// Renders the frame with any geometry. Rows run in parallel on the current rayon
+/// pool; `progress` is called once per finished row.
+pub fn render(geometry: &dyn Geometry, frame: &Frame, progress: &(dyn Fn() + Sync)) -> (Image, Counters) {
+    let (w, h) = (frame.width, frame.height);
+    let rows: Vec<(Vec<u8>, Counters)> = (0..h)
+        .into_par_iter()
+        .map(|y| {
+            let mut c = Counters::default();
+            let mut row = Vec::with_capacity(w as usize * 3);
+            for x in 0..w {
+                let colour = shade::pixel(geometry, frame, x, y, &mut c);
+                row.extend_from_slice(&colour);
+            }
+            progress();
+            (row, c)
+        })
+        .collect();
+    let mut counters = Counters::default();
+    let mut pixels = Vec::with_capacity(w as usize * h as usize * 3);
+    for (row, c) in rows {
+        pixels.extend_from_slice(&row);
+        counters.add(&c);
+    }
+    (
+        Image {
+            width: w,
+            height: h,
+            pixels,
+        },
+        counters,
+    )
+}
+
+/// How far a secondary ray must start from a hit point to not find the same surface:
+/// beyond the back-end's stated error, plus a few f32 ulps of the point's magnitude
+/// (so the offset grows with distance instead of being a fixed 1e-3).
+pub fn spawn_offset(point: Vec3A, error: f32) -> f32 {
+    2.0 * error + point.abs().max_element() * 4.0 * f32::EPSILON + f32::MIN_POSITIVE
+}

@@ -1,0 +1,130 @@
+//! Whitted/Phong shading exactly as the study: ambient + Σ lights (diffuse `N·L/|L|` +
+//! Phong `(R·V/|R||V|)^s`), hard shadows, reflections blended `(1 − r)·local + r·reflected`,
+//! colour clamped once at the end.
+
+use glam::Vec3A;
+
+use super::{spawn_offset, Counters, Frame, Geometry, Ray, ShadeLight};
+
+/// The 8-bit colour of pixel `(x, y)`, averaging `frame.samples` deterministic samples.
+pub(super) fn pixel(g: &dyn Geometry, frame: &Frame, x: u32, y: u32, c: &mut Counters) -> [u8; 3] {
+    let n = frame.samples.max(1);
+    let mut sum = Vec3A::ZERO;
+    for s in 0..n {
+        let (ox, oy) = sample_offset(s, n);
+        let dir = frame.direction(x as f32 + ox, y as f32 + oy);
+        c.primary_rays += 1;
+        let ray = Ray::new(Vec3A::ZERO, dir, frame.max_distance);
+        let mut colour = trace(g, frame, &ray, frame.depth, c);
+        if !colour.is_finite() {
+            c.nonfinite_samples += 1;
+            colour = Vec3A::ZERO;
+        }
+        sum += colour.clamp(Vec3A::ZERO, Vec3A::splat(255.0));
+    }
+    let avg = if n == 1 { sum } else { sum * (1.0 / n as f32) };
+    // Values are in [0, 255], so adding one half and truncating rounds to nearest.
+    let q = avg + 0.5;
+    [q.x as u8, q.y as u8, q.z as u8]
+}
+
+/// Sample positions inside the pixel: its centre for one sample, else the R2
+/// low-discrepancy sequence (Roberts 2018), which is stratified and deterministic.
+fn sample_offset(s: u32, n: u32) -> (f32, f32) {
+    if n == 1 {
+        return (0.5, 0.5);
+    }
+    const G: f64 = 1.324_717_957_244_746; // the plastic number
+    let (a1, a2) = (1.0 / G, 1.0 / (G * G));
+    let i = s as f64 + 1.0;
+    (((0.5 + a1 * i) % 1.0) as f32, ((0.5 + a2 * i) % 1.0) as f32)
+}
+
+/// The colour seen along `ray`, 0–255 per channel but not yet clamped.
+pub(super) fn trace(g: &dyn Geometry, frame: &Frame, ray: &Ray, depth: u32, c: &mut Counters) -> Vec3A {
+    let Some(hit) = g.intersect(ray, c) else {
+        return frame.background;
+    };
+    let view = -ray.dir;
+    // Seen from behind (inside a solid or a one-sided surface): shade the side we see.
+    let normal = if hit.normal.dot(view) < 0.0 {
+        -hit.normal
+    } else {
+        hit.normal
+    };
+    let material = frame.materials.materials[hit.material as usize];
+    let origin = hit.point + normal * spawn_offset(hit.point, hit.error);
+
+    let mut intensity = 0.0f32;
+    for light in &frame.lights {
+        let (to_light, dist, power, shadows) = match *light {
+            ShadeLight::Ambient(a) => {
+                intensity += a;
+                continue;
+            }
+            ShadeLight::Point {
+                position,
+                intensity,
+                shadows,
+            } => {
+                let l = position - hit.point;
+                (l, l.length(), intensity, shadows)
+            }
+            ShadeLight::Directional {
+                towards,
+                intensity,
+                shadows,
+            } => (towards, f32::INFINITY, intensity, shadows),
+        };
+        let l_len = to_light.length();
+        if l_len <= 0.0 {
+            continue;
+        }
+        let l_unit = to_light / l_len;
+        let n_dot_l = normal.dot(l_unit);
+        let diffuse = n_dot_l.max(0.0);
+        let specular = match material.specular {
+            Some(s) => {
+                let r = normal * (2.0 * n_dot_l) - l_unit;
+                let r_dot_v = r.dot(view) / r.length().max(f32::MIN_POSITIVE);
+                if r_dot_v > 0.0 {
+                    r_dot_v.powf(s)
+                } else {
+                    0.0
+                }
+            }
+            None => 0.0,
+        };
+        // A light that adds nothing here needs no shadow ray.
+        if diffuse <= 0.0 && specular <= 0.0 {
+            continue;
+        }
+        if shadows {
+            c.shadow_rays += 1;
+            let shadow = Ray::new(
+                origin,
+                l_unit,
+                (dist - spawn_offset(hit.point, hit.error)).min(frame.max_distance),
+            );
+            if shadow.t_max > 0.0 && g.occluded(&shadow, c) {
+                continue;
+            }
+        }
+        intensity += power * (diffuse + specular);
+    }
+    let local = material.color * intensity;
+    let r = material.reflective;
+    if depth == 0 || r <= 0.0 {
+        return local;
+    }
+    let reflected_dir = (normal * (2.0 * normal.dot(view)) - view).normalize();
+    c.reflection_rays += 1;
+    let reflected = trace(
+        g,
+        frame,
+        &Ray::new(origin, reflected_dir, frame.max_distance),
+        depth - 1,
+        c,
+    );
+    local * (1.0 - r) + reflected * r
+}

@@ -1,0 +1,405 @@
+//! Lowering a shape tree to closures. Transforms are pushed down to the leaves and
+//! composed in f64 (render-from-local), so each primitive applies one f32 affine map
+//! computed from exact f64 products; operators that work in local distance units
+//! (smooth blends, round, shell, repeat) keep their own frame and are wrapped instead.
+
+use std::sync::Arc;
+
+use glam::{Affine3A, DAffine3, DMat3, Vec3A};
+
+use super::prim;
+use crate::ir::{Shape, ShapeKind};
+use crate::render::MaterialTable;
+
+/// A distance bound: never more than the true distance to the surface.
+pub type Sdf = Arc<dyn Fn(Vec3A) -> f32 + Send + Sync>;
+/// A distance bound and the material of the nearest part.
+pub type MatSdf = Arc<dyn Fn(Vec3A) -> (f32, u32) + Send + Sync>;
+
+/// Builds closures and counts the bytes they capture.
+pub struct Builder<'a> {
+    /// Material interning.
+    pub materials: &'a mut MaterialTable,
+    /// Bytes of captured closure state and reference-counted headers.
+    pub bytes: usize,
+}
+
+/// Arc header (two counts) that every closure allocation carries.
+const ARC_HEADER: usize = 16;
+
+impl Builder<'_> {
+    fn sdf<F: Fn(Vec3A) -> f32 + Send + Sync + 'static>(&mut self, f: F) -> Sdf {
+        self.bytes += std::mem::size_of_val(&f) + ARC_HEADER;
+        Arc::new(f)
+    }
+
+    fn mat<F: Fn(Vec3A) -> (f32, u32) + Send + Sync + 'static>(&mut self, f: F) -> MatSdf {
+        // Material closures mirror the distance ones; their bytes count too.
+        self.bytes += std::mem::size_of_val(&f) + ARC_HEADER;
+        Arc::new(f)
+    }
+
+    /// Lowers `shape` seen through `xf` (render from local), painted `mat` where it has no material.
+    pub fn build(&mut self, shape: &Shape, xf: DAffine3, mat: u32) -> (Sdf, MatSdf) {
+        match &shape.kind {
+            ShapeKind::Transform { child, xf: inner } => self.build(child, xf * *inner, mat),
+            ShapeKind::Paint { child, material } => {
+                let id = self.materials.intern(material);
+                self.build(child, xf, id)
+            }
+            ShapeKind::Union { children, smooth } if *smooth == 0.0 => {
+                let kids: Vec<(Sdf, MatSdf)> = children.iter().map(|c| self.build(c, xf, mat)).collect();
+                self.combine(kids, Combine::Union)
+            }
+            ShapeKind::Intersect { children, smooth } if *smooth == 0.0 => {
+                let kids: Vec<(Sdf, MatSdf)> = children.iter().map(|c| self.build(c, xf, mat)).collect();
+                self.combine(kids, Combine::Intersect)
+            }
+            ShapeKind::Subtract { children, smooth } if *smooth == 0.0 => {
+                let kids: Vec<(Sdf, MatSdf)> = children.iter().map(|c| self.build(c, xf, mat)).collect();
+                self.combine(kids, Combine::Subtract)
+            }
+            kind if is_primitive(kind) => self.primitive(kind, xf, mat),
+            _ => {
+                // Smooth operators and modifiers work in their own units: build locally, then wrap.
+                let (d, m) = self.local(shape, mat);
+                self.wrap(d, m, xf)
+            }
+        }
+    }
+
+    fn primitive(&mut self, kind: &ShapeKind, xf: DAffine3, mat: u32) -> (Sdf, MatSdf) {
+        let local: Sdf = match *kind {
+            ShapeKind::Sphere { radius } => {
+                let r = radius as f32;
+                // A sphere under a similarity is a sphere: no inverse map needed.
+                if let Some(scale) = similarity(xf.matrix3) {
+                    let c = Vec3A::from(xf.translation.as_vec3());
+                    let r = (radius * scale) as f32;
+                    let d = self.sdf(move |p| prim::sphere(p - c, r));
+                    let m = self.mat(move |p| (prim::sphere(p - c, r), mat));
+                    return (d, m);
+                }
+                self.sdf(move |p| prim::sphere(p, r))
+            }
+            ShapeKind::Box { half } => {
+                let b = half.as_vec3a();
+                self.sdf(move |p| prim::cuboid(p, b))
+            }
+            ShapeKind::Cylinder { radius, half_height } => {
+                let (r, h) = (radius as f32, half_height as f32);
+                self.sdf(move |p| prim::cylinder(p, r, h))
+            }
+            ShapeKind::Torus { major, minor } => {
+                let (a, b) = (major as f32, minor as f32);
+                self.sdf(move |p| prim::torus(p, a, b))
+            }
+            ShapeKind::Plane { normal, offset } => {
+                // Transform the plane itself (exact for any invertible map), in f64.
+                let n_world = (xf.matrix3.inverse().transpose() * normal).normalize();
+                let point = xf.transform_point3(normal * offset);
+                let (n, o) = (n_world.as_vec3a(), n_world.dot(point) as f32);
+                let d = self.sdf(move |p| prim::plane(p, n, o));
+                let m = self.mat(move |p| (prim::plane(p, n, o), mat));
+                return (d, m);
+            }
+            ShapeKind::Capsule { radius, half_height } => {
+                let (r, h) = (radius as f32, half_height as f32);
+                self.sdf(move |p| prim::capsule(p, r, h))
+            }
+            ShapeKind::Cone { radius, half_height } => {
+                let (r, h) = (radius as f32, half_height as f32);
+                self.sdf(move |p| prim::cone(p, r, h))
+            }
+            // Only primitives reach here (see `is_primitive`); an empty shape is the safe answer.
+            _ => self.sdf(|_| f32::INFINITY),
+        };
+        let m = {
+            let local = local.clone();
+            self.mat(move |p| (local(p), mat))
+        };
+        self.wrap(local, m, xf)
+    }
+
+    /// Applies `xf` (render from local) to a local-frame evaluator: the inverse maps the
+    /// query point; the distance is scaled by the smallest singular value of the linear
+    /// part, which keeps it a bound under any scale (exact under a similarity).
+    fn wrap(&mut self, d: Sdf, m: MatSdf, xf: DAffine3) -> (Sdf, MatSdf) {
+        if xf.matrix3 == DMat3::IDENTITY {
+            if xf.translation == glam::DVec3::ZERO {
+                return (d, m);
+            }
+            let t = Vec3A::from(xf.translation.as_vec3());
+            let dd = self.sdf(move |p| d(p - t));
+            let mm = self.mat(move |p| m(p - t));
+            return (dd, mm);
+        }
+        let inv = xf.inverse();
+        let inv32 = Affine3A::from_mat3_translation(inv.matrix3.as_mat3(), inv.translation.as_vec3());
+        let k = min_singular_value(xf.matrix3) as f32;
+        let dd = self.sdf(move |p| d(inv32.transform_point3a(p)) * k);
+        let mm = self.mat(move |p| {
+            let (dist, id) = m(inv32.transform_point3a(p));
+            (dist * k, id)
+        });
+        (dd, mm)
+    }
+
+    /// Builds an operator or modifier node in its own frame.
+    fn local(&mut self, shape: &Shape, mat: u32) -> (Sdf, MatSdf) {
+        let id = DAffine3::IDENTITY;
+        match &shape.kind {
+            ShapeKind::Union { children, smooth }
+            | ShapeKind::Intersect { children, smooth }
+            | ShapeKind::Subtract { children, smooth } => {
+                let kids: Vec<(Sdf, MatSdf)> = children.iter().map(|c| self.build(c, id, mat)).collect();
+                let op = match &shape.kind {
+                    ShapeKind::Union { .. } => Combine::Union,
+                    ShapeKind::Intersect { .. } => Combine::Intersect,
+                    _ => Combine::Subtract,
+                };
+                self.smooth(kids, op, *smooth as f32)
+            }
+            ShapeKind::Round { child, radius } => {
+                let (d, m) = self.build(child, id, mat);
+                let r = *radius as f32;
+                (
+                    self.sdf(move |p| d(p) - r),
+                    self.mat(move |p| {
+                        let (x, i) = m(p);
+                        (x - r, i)
+                    }),
+                )
+            }
+            ShapeKind::Shell { child, thickness } => {
+                let (d, m) = self.build(child, id, mat);
+                let half = *thickness as f32 * 0.5;
+                (
+                    self.sdf(move |p| d(p).abs() - half),
+                    self.mat(move |p| {
+                        let (x, i) = m(p);
+                        (x.abs() - half, i)
+                    }),
+                )
+            }
+            ShapeKind::Repeat { child, period, count } => {
+                let (d, m) = self.build(child, id, mat);
+                let rep = Repeat::new(period.as_vec3a(), *count);
+                let rep2 = rep.clone();
+                (
+                    self.sdf(move |p| rep.eval(p, |q| d(q))),
+                    self.mat(move |p| rep2.eval_mat(p, |q| m(q))),
+                )
+            }
+            _ => self.build(shape, id, mat),
+        }
+    }
+
+    fn combine(&mut self, kids: Vec<(Sdf, MatSdf)>, op: Combine) -> (Sdf, MatSdf) {
+        let mut kids = kids;
+        if kids.len() == 1 {
+            if let Some(only) = kids.pop() {
+                return only;
+            }
+        }
+        let (ds, ms): (Vec<Sdf>, Vec<MatSdf>) = kids.into_iter().unzip();
+        self.bytes += ds.len() * 2 * std::mem::size_of::<Sdf>();
+        match op {
+            Combine::Union => (
+                self.sdf(move |p| ds.iter().fold(f32::INFINITY, |a, f| a.min(f(p)))),
+                self.mat(move |p| {
+                    ms.iter()
+                        .map(|f| f(p))
+                        .fold((f32::INFINITY, 0), |a, b| if b.0 < a.0 { b } else { a })
+                }),
+            ),
+            Combine::Intersect => (
+                self.sdf(move |p| ds.iter().fold(f32::NEG_INFINITY, |a, f| a.max(f(p)))),
+                self.mat(move |p| {
+                    ms.iter()
+                        .map(|f| f(p))
+                        .fold((f32::NEG_INFINITY, 0), |a, b| if b.0 > a.0 { b } else { a })
+                }),
+            ),
+            Combine::Subtract => (
+                self.sdf(move |p| ds[1..].iter().fold(ds[0](p), |a, f| a.max(-f(p)))),
+                // The cut faces take the material of the part cut away.
+                self.mat(move |p| {
+                    ms[1..]
+                        .iter()
+                        .map(|f| f(p))
+                        .fold(ms[0](p), |a, (d, i)| if -d > a.0 { (-d, i) } else { a })
+                }),
+            ),
+        }
+    }
+
+    fn smooth(&mut self, kids: Vec<(Sdf, MatSdf)>, op: Combine, k: f32) -> (Sdf, MatSdf) {
+        let (ds, ms): (Vec<Sdf>, Vec<MatSdf>) = kids.into_iter().unzip();
+        self.bytes += ds.len() * 2 * std::mem::size_of::<Sdf>();
+        // intersect = −smin(−a, −b); subtract(a, b) = −smin(−a, b).
+        let fold = move |vals: &mut dyn Iterator<Item = f32>| -> f32 {
+            let first = vals.next().unwrap_or(f32::INFINITY);
+            match op {
+                Combine::Union => vals.fold(first, |a, b| prim::smin(a, b, k)),
+                Combine::Intersect => -vals.fold(-first, |a, b| prim::smin(a, -b, k)),
+                Combine::Subtract => -vals.fold(-first, |a, b| prim::smin(a, b, k)),
+            }
+        };
+        let fold2 = fold;
+        let d = self.sdf(move |p| fold(&mut ds.iter().map(|f| f(p))));
+        let m = self.mat(move |p| {
+            let vals: Vec<(f32, u32)> = ms.iter().map(|f| f(p)).collect();
+            let dist = fold2(&mut vals.iter().map(|v| v.0));
+            let id = match op {
+                Combine::Union => {
+                    vals.iter()
+                        .fold((f32::INFINITY, 0), |a, b| if b.0 < a.0 { *b } else { a })
+                        .1
+                }
+                Combine::Intersect => {
+                    vals.iter()
+                        .fold((f32::NEG_INFINITY, 0), |a, b| if b.0 > a.0 { *b } else { a })
+                        .1
+                }
+                Combine::Subtract => {
+                    vals[1..]
+                        .iter()
+                        .fold(vals[0], |a, &(d, i)| if -d > a.0 { (-d, i) } else { a })
+                        .1
+                }
+            };
+            (dist, id)
+        });
+        (d, m)
+    }
+}
+
+#[derive(Clone, Copy)]
+enum Combine {
+    Union,
+    Intersect,
+    Subtract,
+}
+
+fn is_primitive(kind: &ShapeKind) -> bool {
+    matches!(
+        kind,
+        ShapeKind::Sphere { .. }
+            | ShapeKind::Box { .. }
+            | ShapeKind::Cylinder { .. }
+            | ShapeKind::Torus { .. }
+            | ShapeKind::Plane { .. }
+            | ShapeKind::Capsule { .. }
+            | ShapeKind::Cone { .. }
+    )
+}
+
+/// Finite repetition: `count` copies per axis, `period` apart, centred at the origin.
+/// The nearest copy and its neighbours on each repeated axis are evaluated, so the
+/// result stays a bound as long as a copy reaches no further than one period beyond its cell.
+#[derive(Clone)]
+struct Repeat {
+    period: Vec3A,
+    n: [i32; 3],
+    shift: Vec3A,
+}
+
+impl Repeat {
+    fn new(period: Vec3A, count: [u32; 3]) -> Repeat {
+        let n = [count[0] as i32, count[1] as i32, count[2] as i32];
+        let shift = period * Vec3A::new(n[0] as f32 - 1.0, n[1] as f32 - 1.0, n[2] as f32 - 1.0) * 0.5;
+        Repeat { period, n, shift }
+    }
+
+    fn cells(&self, p: Vec3A) -> impl Iterator<Item = Vec3A> + '_ {
+        let q = p + self.shift;
+        let mut centre = [0i32; 3];
+        for a in 0..3 {
+            centre[a] = ((q[a] / self.period[a]).round() as i32).clamp(0, self.n[a] - 1);
+        }
+        let range = |a: usize| {
+            let lo = (centre[a] - 1).max(0);
+            let hi = (centre[a] + 1).min(self.n[a] - 1);
+            lo..=hi
+        };
+        let (rx, ry, rz) = (range(0), range(1), range(2));
+        rx.flat_map(move |i| {
+            let rz = rz.clone();
+            ry.clone().flat_map(move |j| rz.clone().map(move |k| [i, j, k]))
+        })
+        .map(move |[i, j, k]| q - self.period * Vec3A::new(i as f32, j as f32, k as f32))
+    }
+
+    fn eval(&self, p: Vec3A, f: impl Fn(Vec3A) -> f32) -> f32 {
+        self.cells(p).fold(f32::INFINITY, |a, q| a.min(f(q)))
+    }
+
+    fn eval_mat(&self, p: Vec3A, f: impl Fn(Vec3A) -> (f32, u32)) -> (f32, u32) {
+        self.cells(p)
+            .map(f)
+            .fold((f32::INFINITY, 0), |a, b| if b.0 < a.0 { b } else { a })
+    }
+}
+
+/// `Some(k)` when `m` is a rotation times a uniform scale `k`.
+fn similarity(m: DMat3) -> Option<f64> {
+    let mtm = m.transpose() * m;
+    let k2 = mtm.x_axis.x;
+    let eye = DMat3::from_diagonal(glam::DVec3::splat(k2));
+    let close = (mtm - eye)
+        .to_cols_array()
+        .iter()
+        .all(|x| x.abs() <= 1e-12 * k2.max(1.0));
+    (close && k2 > 0.0).then(|| k2.sqrt())
+}
+
+/// The smallest singular value of `m`: the square root of the smallest eigenvalue of
+/// the symmetric `mᵀm`, by the closed-form trigonometric method (Smith 1961).
+pub fn min_singular_value(m: DMat3) -> f64 {
+    if let Some(k) = similarity(m) {
+        return k;
+    }
+    let a = m.transpose() * m;
+    let (a11, a22, a33) = (a.x_axis.x, a.y_axis.y, a.z_axis.z);
+    let (a12, a13, a23) = (a.y_axis.x, a.z_axis.x, a.z_axis.y);
+    let p1 = a12 * a12 + a13 * a13 + a23 * a23;
+    let smallest = if p1 == 0.0 {
+        a11.min(a22).min(a33)
+    } else {
+        let q = (a11 + a22 + a33) / 3.0;
+        let p2 = (a11 - q).powi(2) + (a22 - q).powi(2) + (a33 - q).powi(2) + 2.0 * p1;
+        let p = (p2 / 6.0).sqrt();
+        let b = (a - DMat3::from_diagonal(glam::DVec3::splat(q))) * (1.0 / p);
+        let r = (b.determinant() / 2.0).clamp(-1.0, 1.0);
+        let phi = r.acos() / 3.0;
+        // Eigenvalues q + 2p·cos(phi + 2πk/3); the smallest has k = 1.
+        q + 2.0 * p * (phi + 2.0 * std::f64::consts::PI / 3.0).cos()
+    };
+    // Shave a hair so rounding never makes the bound overstep.
+    smallest.max(0.0).sqrt() * (1.0 - 1e-9)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn min_singular_value_matches_known_cases() {
+        let s = DMat3::from_diagonal(glam::DVec3::new(2.0, 0.5, 3.0));
+        assert!((min_singular_value(s) - 0.5).abs() < 1e-9);
+        let r = DMat3::from_rotation_x(0.3) * DMat3::from_rotation_y(1.1);
+        assert!((min_singular_value(r * 4.0) - 4.0).abs() < 1e-9);
+        // Rotation does not change singular values.
+        let m = r * s * DMat3::from_rotation_z(0.7);
+        assert!((min_singular_value(m) - 0.5).abs() < 1e-9);
+        // Never above the true value (it is used as a bound).
+        let shear = DMat3::from_cols_array(&[1.0, 0.0, 0.0, 0.9, 1.0, 0.0, 0.0, 0.0, 1.0]);
+        let k = min_singular_value(shear);
+        for i in 0..1000 {
+            let a = i as f64 * 0.01;
+            let v = glam::DVec3::new(a.cos(), a.sin(), 0.0);
+            assert!((shear * v).length() >= k - 1e-12);
+        }
+    }
+}

@@ -1,0 +1,64 @@
+//! Sphere tracing: step along the ray by the distance bound until it falls below the
+//! hit threshold, the ray leaves the interval, or the step budget runs out.
+//!
+//! The threshold is *relative*: a hit is accepted when `f(p) < epsilon · (|origin| + t)`,
+//! i.e. `epsilon` times an upper bound of the point's distance from the camera. In render
+//! space the camera is the origin, so this is a cone around the ray whose width grows like
+//! a pixel's footprint, and the same `epsilon` means the same on-screen accuracy at any
+//! depth and for secondary rays alike.
+
+use glam::Vec3A;
+
+use crate::render::{Counters, Ray};
+
+/// The accuracy knobs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MarchParams {
+    /// Relative hit threshold.
+    pub epsilon: f32,
+    /// Step budget per march.
+    pub max_steps: u32,
+}
+
+/// Marches `f` along the ray for `t` in `[t0, t1]`. Returns the hit distance and
+/// the threshold used there (the hit point's error bound).
+#[inline]
+pub fn march(
+    f: &dyn Fn(Vec3A) -> f32,
+    ray: &Ray,
+    t0: f32,
+    t1: f32,
+    params: MarchParams,
+    c: &mut Counters,
+    evals: &mut u64,
+) -> Option<(f32, f32)> {
+    let (origin, dir) = (ray.origin, ray.dir);
+    let base = origin.length();
+    let mut t = t0;
+    for _ in 0..params.max_steps {
+        let d = f(origin + dir * t);
+        *evals += 1;
+        let threshold = params.epsilon * (base + t);
+        if d < threshold {
+            return Some((t, threshold));
+        }
+        t += d;
+        if t > t1 {
+            return None;
+        }
+    }
+    c.budget_misses += 1;
+    None
+}
+
+/// The unit gradient of `f` at `p` by the four-tap tetrahedral difference, step `h`.
+#[inline]
+pub fn normal(f: &dyn Fn(Vec3A) -> f32, p: Vec3A, h: f32) -> Vec3A {
+    const K0: Vec3A = Vec3A::new(1.0, -1.0, -1.0);
+    const K1: Vec3A = Vec3A::new(-1.0, -1.0, 1.0);
+    const K2: Vec3A = Vec3A::new(-1.0, 1.0, -1.0);
+    const K3: Vec3A = Vec3A::new(1.0, 1.0, 1.0);
+    let g = K0 * f(p + K0 * h) + K1 * f(p + K1 * h) + K2 * f(p + K2 * h) + K3 * f(p + K3 * h);
+    // A flat gradient (at a crease or a cusp) gets a defined, finite normal.
+    g.try_normalize().unwrap_or(Vec3A::Y)
+}

@@ -1,0 +1,212 @@
+//! Rendering through the SDF back-end: golden images, determinism, the bound property.
+
+use std::path::Path;
+
+use glam::Vec3A;
+use scnc::render::{Counters, Frame, Image};
+
+use crate::support::{cases, finish, updating, Rng};
+
+/// Compiles and renders scene text at `w × h` on a pool of `threads`.
+pub fn render_text(text: &str, w: u32, h: u32, threads: usize) -> (Image, Counters) {
+    let c = scnc::compile_source("t.scn", Path::new("t.scn"), text.to_string(), &scnc::check::FsLoader);
+    let scene = c.scene.unwrap_or_else(|| {
+        panic!(
+            "scene did not compile:\n{}",
+            scnc::diag::render_all(&c.diagnostics, &c.map)
+        )
+    });
+    render_scene(scene, w, h, threads)
+}
+
+pub fn render_scene(mut scene: scnc::ir::Scene, w: u32, h: u32, threads: usize) -> (Image, Counters) {
+    scene.settings.width = w;
+    scene.settings.height = h;
+    let mut frame = Frame::new(&scene);
+    let params = scnc::sdf::MarchParams {
+        epsilon: scene.settings.epsilon as f32,
+        max_steps: scene.settings.max_steps,
+    };
+    let geometry = scnc::sdf::lower(&scene, &mut frame, params).expect("lowering");
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("pool");
+    pool.install(|| scnc::render::render(&geometry, &frame, &|| {}))
+}
+
+/// Golden images: a channel may differ by up to 2/255 (float reassociation between
+/// compilers), and at most 0.5 % of pixels may differ by more (silhouette pixels).
+const CHANNEL_TOLERANCE: u8 = 2;
+const MAX_DIFFERING_FRACTION: f64 = 0.005;
+const GOLDEN_SIZE: u32 = 128;
+
+fn compare(expected: &image::RgbImage, actual: &Image) -> Result<(), String> {
+    if expected.width() != actual.width || expected.height() != actual.height {
+        return Err(format!(
+            "size {}×{} vs {}×{}",
+            expected.width(),
+            expected.height(),
+            actual.width,
+            actual.height
+        ));
+    }
+    let differing = expected
+        .as_raw()
+        .chunks(3)
+        .zip(actual.pixels.chunks(3))
+        .filter(|(a, b)| a.iter().zip(b.iter()).any(|(x, y)| x.abs_diff(*y) > CHANNEL_TOLERANCE))
+        .count();
+    let allowed = (MAX_DIFFERING_FRACTION * (actual.width * actual.height) as f64) as usize;
+    if differing > allowed {
+        return Err(format!(
+            "{differing} pixels differ by more than {CHANNEL_TOLERANCE}/255 (at most {allowed} may)"
+        ));
+    }
+    Ok(())
+}
+
+fn save(path: &Path, img: &Image) {
+    image::save_buffer(path, &img.pixels, img.width, img.height, image::ExtendedColorType::Rgb8)
+        .unwrap_or_else(|e| panic!("writing {}: {e}", path.display()));
+}
+
+#[test]
+fn golden_images_sdf() {
+    let cases = cases("tests/data/render");
+    assert!(
+        cases.len() >= 14,
+        "expected the seed and feature scenes, found {}",
+        cases.len()
+    );
+    let mut failures = Vec::new();
+    for path in cases {
+        let c = crate::support::compile(&path);
+        let Some(scene) = c.scene else {
+            failures.push(format!("{}: did not compile", path.display()));
+            continue;
+        };
+        let (img, counters) = render_scene(scene, GOLDEN_SIZE, GOLDEN_SIZE, 2);
+        assert_eq!(counters.nonfinite_samples, 0, "{}: non-finite colours", path.display());
+        let golden = path.with_extension("sdf.png");
+        let expected = image::open(&golden).ok().map(|i| i.to_rgb8());
+        match expected {
+            Some(e) if compare(&e, &img).is_ok() && !updating() => {}
+            Some(e) if !updating() => {
+                let out = Path::new("target/test-output");
+                let _ = std::fs::create_dir_all(out);
+                let name = golden
+                    .file_name()
+                    .map(|n| n.to_string_lossy().into_owned())
+                    .unwrap_or_default();
+                save(&out.join(format!("actual-{name}")), &img);
+                failures.push(format!(
+                    "{}: {} (actual image in target/test-output; UPDATE_EXPECT=1 to accept)",
+                    golden.display(),
+                    compare(&e, &img).err().unwrap_or_default()
+                ));
+            }
+            _ => {
+                save(&golden, &img);
+                if !updating() {
+                    failures.push(format!(
+                        "{}: golden image was missing; written, review it and run again",
+                        golden.display()
+                    ));
+                }
+            }
+        }
+    }
+    finish(failures);
+}
+
+#[test]
+fn image_is_identical_for_any_thread_count() {
+    let text = std::fs::read_to_string("examples/seed/05-mirrors.scn")
+        .expect("scene")
+        .replace(
+            "include \"lights.scn\"",
+            "light ambient(0.2)\nlight point(0.6) at [2, 1, 0]\nlight directional(0.2, towards = [1, 4, 4])",
+        );
+    let (one, c1) = render_text(&text, 96, 80, 1);
+    for threads in [2, 3] {
+        let (many, cn) = render_text(&text, 96, 80, threads);
+        assert!(one == many, "image differs with {threads} threads");
+        assert_eq!(c1, cn, "counters differ with {threads} threads");
+    }
+    let (again, _) = render_text(&text, 96, 80, 2);
+    assert!(one == again, "image differs between runs");
+}
+
+/// A ray through the centre of a sphere hits; one beside it misses; colours are as shaded.
+#[test]
+fn centre_pixel_hits_and_corner_misses() {
+    let (img, c) = render_text("render(background = rgb(1, 2, 3))\nlight ambient(1)\nobject sphere(1) at [0, 0, 5] with material(color = rgb(100, 150, 200))\n", 33, 33, 1);
+    let px = |x: usize, y: usize| &img.pixels[(y * 33 + x) * 3..(y * 33 + x) * 3 + 3];
+    assert_eq!(px(16, 16), &[100, 150, 200], "ambient 1 gives the material colour");
+    assert_eq!(px(0, 0), &[1, 2, 3], "a miss shows the background");
+    assert_eq!(c.primary_rays, 33 * 33);
+    assert_eq!(c.shadow_rays, 0, "ambient light casts no shadow rays");
+    assert_eq!(c.reflection_rays, 0, "nothing reflects");
+}
+
+/// `|f(p) − f(q)| ≤ |p − q|` on random pairs for every primitive, operator, modifier and
+/// transform: the evaluator never claims more free space than there is.
+#[test]
+fn every_evaluator_is_a_distance_bound() {
+    let shapes = [
+        "sphere(1)",
+        "box(1, 0.5, 0.25)",
+        "cylinder(0.5, 1)",
+        "torus(1, 0.3)",
+        "capsule(0.4, 0.6)",
+        "cone(0.7, 0.8)",
+        "plane(normal = [1, 2, 3], offset = 0.5) rotate [10, 20, 30]",
+        "union(sphere(1), box(0.8) at [1, 0, 0])",
+        "union(sphere(1), box(0.8) at [1, 0, 0], smooth = 2)",
+        "intersect(sphere(1), box(0.8), smooth = 0.5)",
+        "subtract(box(1), sphere(1.2), smooth = 0.3)",
+        "subtract(box(1), sphere(0.5) at [1, 1, 0], cylinder(0.2, 2))",
+        "round(box(0.5), 0.3)",
+        "shell(sphere(1), 0.1)",
+        "repeat(sphere(0.2), period = [0.5, 0.7, 1], count = [4, 3, 2])",
+        "sphere(1) scale [3, 0.2, 1]",
+        "box(1) scale [0.1, 5, 1] rotate [30, 40, 50]",
+        "torus(1, 0.2) rotate [10, 0, 0] scale [1, 2, 1] rotate [0, 70, 0] scale 0.3 rotate [0, 0, 45]",
+        "union(sphere(1) scale [2, 1, 1], torus(1, 0.2) scale 3, smooth = 0.4) rotate [5, 6, 7]",
+        "shell(subtract(sphere(1), box(0.5) at [0.8, 0, 0]), 0.01) scale [1, 1, 4]",
+    ];
+    let mut rng = Rng(0xb0u64 << 32 | 0x0d);
+    for shape in shapes {
+        let text = format!("light ambient(1)\nobject {shape} at [0, 0, 5]\n");
+        let c = scnc::compile_source("t.scn", Path::new("t.scn"), text, &scnc::check::FsLoader);
+        let scene = c
+            .scene
+            .unwrap_or_else(|| panic!("{shape}: {}", scnc::diag::render_all(&c.diagnostics, &c.map)));
+        let mut frame = Frame::new(&scene);
+        let g = scnc::sdf::lower(
+            &scene,
+            &mut frame,
+            scnc::sdf::MarchParams {
+                epsilon: 1e-4,
+                max_steps: 100,
+            },
+        )
+        .expect("lower");
+        for _ in 0..4000 {
+            let centre = Vec3A::new(0.0, 0.0, 5.0);
+            let p = centre + rng.vec(3.0);
+            let step = rng.f32().powi(3) * 2.0;
+            let q = p + rng.vec(step);
+            let (fp, fq) = (scnc::sdf::eval(&g, 0, p), scnc::sdf::eval(&g, 0, q));
+            assert!(fp.is_finite() && fq.is_finite(), "{shape}: non-finite at {p} or {q}");
+            let tolerance = 1e-4 * (1.0 + fp.abs().max(fq.abs()));
+            assert!(
+                (fp - fq).abs() <= (p - q).length() * (1.0 + 1e-4) + tolerance,
+                "{shape}: |f(p) − f(q)| = {} > |p − q| = {} at p = {p}, q = {q}",
+                (fp - fq).abs(),
+                (p - q).length()
+            );
+        }
+    }
+}
