@@ -131,3 +131,62 @@ pub fn bounding_sphere(g: &Geometry) -> Option<(DVec3, f64)> {
     };
     (b.min.cmple(b.max).all()).then(|| (b.centre(), (b.max - b.min).length() * 0.5))
 }
+
+/// A bounding sphere (centre, radius) of a shape tree, tight for primitives under
+/// similarities (a sphere's bound is the sphere itself); `None` when unbounded.
+pub fn shape_sphere(shape: &Shape) -> Option<(DVec3, f64)> {
+    let from_box = |b: Aabb| (b.centre(), (b.max - b.min).length() * 0.5);
+    match &shape.kind {
+        ShapeKind::Sphere { radius } => Some((DVec3::ZERO, *radius)),
+        ShapeKind::Box { half } => Some((DVec3::ZERO, half.length())),
+        ShapeKind::Cylinder {
+            radius: r,
+            half_height: h,
+        }
+        | ShapeKind::Cone {
+            radius: r,
+            half_height: h,
+        } => Some((DVec3::ZERO, (r * r + h * h).sqrt())),
+        ShapeKind::Capsule { radius, half_height } => Some((DVec3::ZERO, radius + half_height)),
+        ShapeKind::Torus { major, minor } => Some((DVec3::ZERO, major + minor)),
+        ShapeKind::Plane { .. } => None,
+        ShapeKind::Union { children, smooth } => {
+            let spheres: Option<Vec<(DVec3, f64)>> = children.iter().map(|c| shape_sphere(c)).collect();
+            let spheres = spheres?;
+            let boxes = spheres.iter().map(|(c, r)| Aabb {
+                min: *c - *r,
+                max: *c + *r,
+            });
+            let centre = boxes.reduce(Aabb::union)?.centre();
+            let radius = spheres
+                .iter()
+                .map(|(c, r)| (*c - centre).length() + r)
+                .fold(0.0, f64::max);
+            Some((centre, radius + smooth))
+        }
+        ShapeKind::Intersect { children, smooth } => children
+            .iter()
+            .filter_map(|c| shape_sphere(c))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(c, r)| (c, r + smooth)),
+        ShapeKind::Subtract { children, smooth } => shape_sphere(children.first()?).map(|(c, r)| (c, r + smooth)),
+        ShapeKind::Round { child, radius } => shape_sphere(child).map(|(c, r)| (c, r + radius)),
+        ShapeKind::Shell { child, thickness } => shape_sphere(child).map(|(c, r)| (c, r + thickness * 0.5)),
+        ShapeKind::Repeat { .. } => shape_bounds(shape).map(from_box),
+        ShapeKind::Transform { child, xf } => {
+            let (c, r) = shape_sphere(child)?;
+            Some((xf.transform_point3(c), r * max_stretch(xf.matrix3)))
+        }
+        ShapeKind::Paint { child, .. } => shape_sphere(child),
+    }
+}
+
+/// An upper bound of the largest singular value (how far the map can stretch a
+/// vector): the largest column-norm sum bound, exact for rotations and scales.
+fn max_stretch(m: glam::DMat3) -> f64 {
+    let mtm = m.transpose() * m;
+    // The largest eigenvalue of the symmetric mᵀm is at most its largest absolute row sum.
+    let rows = [mtm.row(0), mtm.row(1), mtm.row(2)];
+    let bound = rows.iter().map(|r| r.abs().element_sum()).fold(0.0, f64::max);
+    bound.sqrt()
+}

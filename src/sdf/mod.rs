@@ -28,6 +28,8 @@ pub struct SdfObject {
     pub mat: MatSdf,
     /// Render-space bounds, if bounded.
     pub bounds: Option<Aabb>,
+    /// Render-space bounding sphere (centre, radius), if bounded; tighter than the box for round shapes.
+    pub sphere: Option<(Vec3A, f32)>,
     /// The `object` statement.
     pub span: Span,
 }
@@ -84,10 +86,16 @@ pub fn lower(scene: &ir::Scene, frame: &mut Frame, params: MarchParams) -> Resul
                 max: (b.max + pad).as_vec3a(),
             }
         });
+        let sphere = ir::shape_sphere(shape).map(|(c, r)| {
+            let c = to_render.transform_point3(c);
+            let pad = (c.abs().max_element() + r) * 1e-6 + 1e-6;
+            (c.as_vec3a(), (r + pad) as f32)
+        });
         objects.push(SdfObject {
             dist,
             mat,
             bounds,
+            sphere,
             span: obj.span,
         });
     }
@@ -135,10 +143,18 @@ impl SdfScene {
 
     fn march_object(&self, i: u32, ray: &Ray, t_max: f32, c: &mut Counters, evals: &mut u64) -> Option<(f32, f32)> {
         let obj = &self.objects[i as usize];
-        let (t0, t1) = match obj.bounds {
+        let (mut t0, mut t1) = match obj.bounds {
             Some(b) => b.slab(ray.origin, ray.inv_dir, ray.t_min, t_max)?,
             None => (ray.t_min, t_max),
         };
+        if let Some((centre, radius)) = obj.sphere {
+            let (s0, s1) = sphere_interval(ray, centre, radius)?;
+            t0 = t0.max(s0);
+            t1 = t1.min(s1);
+            if t0 > t1 {
+                return None;
+            }
+        }
         march::march(&*obj.dist, ray, t0, t1, self.params, c, evals)
     }
 }
@@ -214,6 +230,22 @@ impl Geometry for SdfScene {
         let m = self.memory();
         m.closure_bytes + m.bvh_bytes
     }
+}
+
+/// Where the ray is inside the sphere, or `None`. The discriminant is computed from the
+/// perpendicular distance to the centre (Haines et al., *Ray Tracing Gems* ch. 7), which
+/// stays accurate for distant spheres where `b² − c` would cancel catastrophically.
+#[inline]
+pub fn sphere_interval(ray: &Ray, centre: Vec3A, radius: f32) -> Option<(f32, f32)> {
+    let oc = ray.origin - centre;
+    let b = oc.dot(ray.dir);
+    let perp = oc - ray.dir * b;
+    let disc = radius * radius - perp.length_squared();
+    if disc < 0.0 {
+        return None;
+    }
+    let s = disc.sqrt();
+    Some((-b - s, -b + s))
 }
 
 /// Evaluates the distance bound of object `i` at a render-space point (for tests).

@@ -1,0 +1,127 @@
+//! Criterion benchmarks: one SDF evaluation per primitive, the march (primary rays only,
+//! shading off) over seed scenes 1 and 6, and whole renders of every seed scene at a
+//! reduced size on one thread.
+
+use std::hint::black_box;
+use std::path::Path;
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use glam::Vec3A;
+use scnc::render::{Counters, Frame, Geometry, Ray};
+
+fn lower(path: &str, w: u32, h: u32) -> (Frame, scnc::sdf::SdfScene) {
+    let text = std::fs::read_to_string(path).expect("seed scene");
+    let c = scnc::compile_source(path, Path::new(path), text, &scnc::check::FsLoader);
+    let mut scene = c.scene.expect("seed scenes compile");
+    scene.settings.width = w;
+    scene.settings.height = h;
+    let mut frame = Frame::new(&scene);
+    let params = scnc::sdf::MarchParams {
+        epsilon: scene.settings.epsilon as f32,
+        max_steps: scene.settings.max_steps,
+    };
+    let g = scnc::sdf::lower(&scene, &mut frame, params).expect("lowering");
+    (frame, g)
+}
+
+fn primitives(c: &mut Criterion) {
+    let mut group = c.benchmark_group("sdf eval");
+    let shapes = [
+        "sphere(1)",
+        "box(1, 0.5, 0.25)",
+        "cylinder(0.5, 1)",
+        "torus(1, 0.3)",
+        "capsule(0.4, 0.6)",
+        "cone(0.7, 0.8)",
+        "box(1) rotate [10, 20, 30]",
+        "union(sphere(1), box(0.8) at [1, 0, 0], smooth = 0.3)",
+    ];
+    let points: Vec<Vec3A> = (0..256)
+        .map(|i| {
+            Vec3A::new(
+                (i as f32 * 0.37).sin() * 2.0,
+                (i as f32 * 0.71).cos() * 2.0,
+                5.0 + (i as f32 * 0.13).sin(),
+            )
+        })
+        .collect();
+    group.throughput(Throughput::Elements(points.len() as u64));
+    for shape in shapes {
+        let text = format!("light ambient(1)\nobject {shape} at [0, 0, 5]\n");
+        let c2 = scnc::compile_source("b.scn", Path::new("b.scn"), text, &scnc::check::FsLoader);
+        let scene = c2.scene.expect("compiles");
+        let mut frame = Frame::new(&scene);
+        let g = scnc::sdf::lower(
+            &scene,
+            &mut frame,
+            scnc::sdf::MarchParams {
+                epsilon: 1e-4,
+                max_steps: 512,
+            },
+        )
+        .expect("lowers");
+        group.bench_function(shape, |b| {
+            b.iter(|| {
+                points
+                    .iter()
+                    .map(|p| scnc::sdf::eval(&g, 0, black_box(*p)))
+                    .sum::<f32>()
+            })
+        });
+    }
+    group.finish();
+}
+
+fn march(c: &mut Criterion) {
+    let mut group = c.benchmark_group("primary rays");
+    for path in ["examples/seed/01-sphere.scn", "examples/seed/06-many-spheres.scn"] {
+        let (frame, g) = lower(path, 256, 256);
+        let dirs: Vec<Vec3A> = (0..256 * 256)
+            .map(|i| frame.direction((i % 256) as f32 + 0.5, (i / 256) as f32 + 0.5))
+            .collect();
+        group.throughput(Throughput::Elements(dirs.len() as u64));
+        let name = Path::new(path)
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        group.bench_function(BenchmarkId::new("intersect", name), |b| {
+            b.iter(|| {
+                let mut counters = Counters::default();
+                dirs.iter()
+                    .filter(|d| {
+                        g.intersect(&Ray::new(Vec3A::ZERO, **d, frame.max_distance), &mut counters)
+                            .is_some()
+                    })
+                    .count()
+            })
+        });
+    }
+    group.finish();
+}
+
+fn renders(c: &mut Criterion) {
+    let mut group = c.benchmark_group("render 200x200 1 thread");
+    group.sample_size(20);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("pool");
+    for i in 1..=7 {
+        let path = std::fs::read_dir("examples/seed")
+            .expect("examples")
+            .filter_map(Result::ok)
+            .map(|e| e.path())
+            .find(|p| {
+                p.file_name()
+                    .is_some_and(|n| n.to_string_lossy().starts_with(&format!("0{i}-")))
+            })
+            .expect("seed scene");
+        let path = path.to_string_lossy().into_owned();
+        let (frame, g) = lower(&path, 200, 200);
+        group.throughput(Throughput::Elements(200 * 200));
+        group.bench_function(BenchmarkId::new("sdf", i), |b| {
+            b.iter(|| pool.install(|| scnc::render::render(&g, &frame, &|| {})))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, primitives, march, renders);
+criterion_main!(benches);
