@@ -9,18 +9,19 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Through
 use glam::Vec3A;
 use scnc::render::{Counters, Frame, Geometry, Ray};
 
-fn lower(path: &str, w: u32, h: u32) -> (Frame, scnc::sdf::SdfScene) {
+fn lower(path: &str, w: u32, h: u32) -> (Frame, scnc::world::World) {
+    lower_mode(path, w, h, scnc::world::Mode::Sdf)
+}
+
+fn lower_mode(path: &str, w: u32, h: u32, mode: scnc::world::Mode) -> (Frame, scnc::world::World) {
     let text = std::fs::read_to_string(path).expect("seed scene");
     let c = scnc::compile_source(path, Path::new(path), text, &scnc::check::FsLoader);
     let mut scene = c.scene.expect("seed scenes compile");
     scene.settings.width = w;
     scene.settings.height = h;
     let mut frame = Frame::new(&scene);
-    let params = scnc::sdf::MarchParams {
-        epsilon: scene.settings.epsilon as f32,
-        max_steps: scene.settings.max_steps,
-    };
-    let g = scnc::sdf::lower(&scene, &mut frame, params).expect("lowering");
+    let params = scnc::sdf::MarchParams { epsilon: scene.settings.epsilon as f32, max_steps: scene.settings.max_steps };
+    let g = scnc::world::lower(&scene, &mut frame, mode, params, &scnc::check::FsLoader).expect("lowering");
     (frame, g)
 }
 
@@ -38,11 +39,7 @@ fn primitives(c: &mut Criterion) {
     ];
     let points: Vec<Vec3A> = (0..256)
         .map(|i| {
-            Vec3A::new(
-                (i as f32 * 0.37).sin() * 2.0,
-                (i as f32 * 0.71).cos() * 2.0,
-                5.0 + (i as f32 * 0.13).sin(),
-            )
+            Vec3A::new((i as f32 * 0.37).sin() * 2.0, (i as f32 * 0.71).cos() * 2.0, 5.0 + (i as f32 * 0.13).sin())
         })
         .collect();
     group.throughput(Throughput::Elements(points.len() as u64));
@@ -51,22 +48,11 @@ fn primitives(c: &mut Criterion) {
         let c2 = scnc::compile_source("b.scn", Path::new("b.scn"), text, &scnc::check::FsLoader);
         let scene = c2.scene.expect("compiles");
         let mut frame = Frame::new(&scene);
-        let g = scnc::sdf::lower(
-            &scene,
-            &mut frame,
-            scnc::sdf::MarchParams {
-                epsilon: 1e-4,
-                max_steps: 512,
-            },
-        )
-        .expect("lowers");
+        let params = scnc::sdf::MarchParams { epsilon: 1e-4, max_steps: 512 };
+        let g = scnc::world::lower(&scene, &mut frame, scnc::world::Mode::Sdf, params, &scnc::check::FsLoader)
+            .expect("lowers");
         group.bench_function(shape, |b| {
-            b.iter(|| {
-                points
-                    .iter()
-                    .map(|p| scnc::sdf::eval(&g, 0, black_box(*p)))
-                    .sum::<f32>()
-            })
+            b.iter(|| points.iter().map(|p| g.sdf_eval(0, black_box(*p)).unwrap_or(0.0)).sum::<f32>())
         });
     }
     group.finish();
@@ -74,24 +60,21 @@ fn primitives(c: &mut Criterion) {
 
 fn march(c: &mut Criterion) {
     let mut group = c.benchmark_group("primary rays");
-    for path in ["examples/seed/01-sphere.scn", "examples/seed/06-many-spheres.scn"] {
-        let (frame, g) = lower(path, 256, 256);
-        let dirs: Vec<Vec3A> = (0..256 * 256)
-            .map(|i| frame.direction((i % 256) as f32 + 0.5, (i / 256) as f32 + 0.5))
-            .collect();
+    let modes = [("sdf", scnc::world::Mode::Sdf), ("mesh-high", scnc::world::Mode::Mesh(scnc::world::Detail::High))];
+    for (path, (mode_name, mode)) in ["examples/seed/01-sphere.scn", "examples/seed/06-many-spheres.scn"]
+        .into_iter()
+        .flat_map(|p| modes.into_iter().map(move |m| (p, m)))
+    {
+        let (frame, g) = lower_mode(path, 256, 256, mode);
+        let dirs: Vec<Vec3A> =
+            (0..256 * 256).map(|i| frame.direction((i % 256) as f32 + 0.5, (i / 256) as f32 + 0.5)).collect();
         group.throughput(Throughput::Elements(dirs.len() as u64));
-        let name = Path::new(path)
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        group.bench_function(BenchmarkId::new("intersect", name), |b| {
+        let name = Path::new(path).file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        group.bench_function(BenchmarkId::new(format!("intersect {mode_name}"), name), |b| {
             b.iter(|| {
                 let mut counters = Counters::default();
                 dirs.iter()
-                    .filter(|d| {
-                        g.intersect(&Ray::new(Vec3A::ZERO, **d, frame.max_distance), &mut counters)
-                            .is_some()
-                    })
+                    .filter(|d| g.intersect(&Ray::new(Vec3A::ZERO, **d, frame.max_distance), &mut counters).is_some())
                     .count()
             })
         });
@@ -108,10 +91,7 @@ fn renders(c: &mut Criterion) {
             .expect("examples")
             .filter_map(Result::ok)
             .map(|e| e.path())
-            .find(|p| {
-                p.file_name()
-                    .is_some_and(|n| n.to_string_lossy().starts_with(&format!("0{i}-")))
-            })
+            .find(|p| p.file_name().is_some_and(|n| n.to_string_lossy().starts_with(&format!("0{i}-"))))
             .expect("seed scene");
         let path = path.to_string_lossy().into_owned();
         let (frame, g) = lower(&path, 200, 200);
@@ -123,5 +103,26 @@ fn renders(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, primitives, march, renders);
+fn bvh(c: &mut Criterion) {
+    let mut group = c.benchmark_group("bvh");
+    group.sample_size(10);
+    for rings in [14u32, 100, 700] {
+        let mesh = scnc::mesh::tessellate::uvsphere(1.0, rings, 2 * rings);
+        group.throughput(Throughput::Elements(mesh.triangles.len() as u64));
+        group.bench_function(BenchmarkId::new("build uvsphere triangles", mesh.triangles.len()), |b| {
+            b.iter(|| {
+                scnc::mesh::MeshObject::new(
+                    &mesh,
+                    glam::DAffine3::from_translation(glam::DVec3::new(0.0, 0.0, 5.0)),
+                    0,
+                    None,
+                    false,
+                )
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, primitives, march, renders, bvh);
 criterion_main!(benches);

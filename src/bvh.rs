@@ -20,17 +20,11 @@ pub struct Aabb {
 
 impl Aabb {
     /// The empty box (contains nothing; the identity of `union`).
-    pub const EMPTY: Aabb = Aabb {
-        min: Vec3A::splat(f32::INFINITY),
-        max: Vec3A::splat(f32::NEG_INFINITY),
-    };
+    pub const EMPTY: Aabb = Aabb { min: Vec3A::splat(f32::INFINITY), max: Vec3A::splat(f32::NEG_INFINITY) };
 
     /// The smallest box containing both.
     pub fn union(self, o: Aabb) -> Aabb {
-        Aabb {
-            min: self.min.min(o.min),
-            max: self.max.max(o.max),
-        }
+        Aabb { min: self.min.min(o.min), max: self.max.max(o.max) }
     }
 
     /// Centre point.
@@ -58,8 +52,11 @@ impl Aabb {
         let t0 = (self.min - origin) * inv_dir;
         let t1 = (self.max - origin) * inv_dir;
         // `min`/`max` of glam ignore a NaN operand (0 × ∞ on a slab face), keeping the other.
+        // The far distance is scaled by 1 + 2γ₃ (Ize 2013, "Robust BVH Ray Traversal") so
+        // rounding never rejects a ray that touches the box, e.g. through a mesh vertex.
+        const ROBUST: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON / (1.0 - 3.0 * f32::EPSILON));
         let near = t0.min(t1).max_element().max(t_min);
-        let far = t0.max(t1).min_element().min(t_max);
+        let far = (t0.max(t1).min_element() * ROBUST).min(t_max);
         (near <= far).then_some((near, far))
     }
 }
@@ -80,10 +77,7 @@ const _: () = assert!(std::mem::size_of::<Node>() == 32);
 
 impl Node {
     fn bounds(&self) -> Aabb {
-        Aabb {
-            min: Vec3A::from(self.min),
-            max: Vec3A::from(self.max),
-        }
+        Aabb { min: Vec3A::from(self.min), max: Vec3A::from(self.max) }
     }
 }
 
@@ -97,27 +91,34 @@ pub struct Bvh {
 /// Deepest traversal stack; the builder never makes a deeper tree.
 const MAX_DEPTH: usize = 64;
 const BINS: usize = 12;
-const LEAF_SIZE: usize = 2;
 
 impl Bvh {
-    /// Builds over the given boxes (primitive `i` has box `boxes[i]`).
-    pub fn build(boxes: &[Aabb]) -> Bvh {
-        let mut bvh = Bvh {
-            nodes: Vec::with_capacity(boxes.len() * 2),
-            prims: (0..boxes.len() as u32).collect(),
-        };
+    /// Builds over the given boxes (primitive `i` has box `boxes[i]`); leaves hold at
+    /// most `leaf_size` primitives unless SAH finds no useful split.
+    pub fn build(boxes: &[Aabb], leaf_size: usize) -> Bvh {
+        let mut bvh = Bvh { nodes: Vec::with_capacity(boxes.len() * 2), prims: (0..boxes.len() as u32).collect() };
         if !boxes.is_empty() {
             let centres: Vec<Vec3A> = boxes.iter().map(|b| b.centre()).collect();
-            bvh.build_node(boxes, &centres, 0, boxes.len(), 0);
+            bvh.build_node(boxes, &centres, 0, boxes.len(), 0, leaf_size.max(1));
         }
         bvh
     }
 
-    fn build_node(&mut self, boxes: &[Aabb], centres: &[Vec3A], start: usize, end: usize, depth: usize) -> usize {
+    fn build_node(
+        &mut self,
+        boxes: &[Aabb],
+        centres: &[Vec3A],
+        start: usize,
+        end: usize,
+        depth: usize,
+        leaf_size: usize,
+    ) -> usize {
         let idx = self.nodes.len();
-        let bounds = self.prims[start..end]
-            .iter()
-            .fold(Aabb::EMPTY, |b, &p| b.union(boxes[p as usize]));
+        // One pass for the node's bounds and the bounds of the primitives' centres.
+        let (bounds, cb) = self.prims[start..end].iter().fold((Aabb::EMPTY, Aabb::EMPTY), |(b, c), &p| {
+            let centre = centres[p as usize];
+            (b.union(boxes[p as usize]), c.union(Aabb { min: centre, max: centre }))
+        });
         self.nodes.push(Node {
             min: bounds.min.into(),
             first_or_right: start as u32,
@@ -125,54 +126,61 @@ impl Bvh {
             count: (end - start) as u32,
         });
         let n = end - start;
-        if n <= LEAF_SIZE || depth + 1 >= MAX_DEPTH {
+        if n <= leaf_size || depth + 1 >= MAX_DEPTH {
             return idx;
         }
-        let Some(mid) = self.split(boxes, centres, start, end, bounds) else {
+        let Some(mid) = self.split(boxes, centres, start, end, bounds, cb) else {
             return idx;
         };
-        self.build_node(boxes, centres, start, mid, depth + 1);
-        let right = self.build_node(boxes, centres, mid, end, depth + 1);
+        self.build_node(boxes, centres, start, mid, depth + 1, leaf_size);
+        let right = self.build_node(boxes, centres, mid, end, depth + 1, leaf_size);
         self.nodes[idx].first_or_right = right as u32;
         self.nodes[idx].count = 0;
         idx
     }
 
-    /// Binned SAH split of `prims[start..end]`; partitions in place and returns the
-    /// middle, or `None` when keeping a leaf is cheaper.
-    fn split(&mut self, boxes: &[Aabb], centres: &[Vec3A], start: usize, end: usize, bounds: Aabb) -> Option<usize> {
-        let cb = self.prims[start..end].iter().fold(Aabb::EMPTY, |b, &p| {
-            let c = centres[p as usize];
-            b.union(Aabb { min: c, max: c })
-        });
+    /// Binned SAH split of `prims[start..end]` (all three axes binned in one pass);
+    /// partitions in place and returns the middle, or `None` when a leaf is cheaper.
+    fn split(
+        &mut self,
+        boxes: &[Aabb],
+        centres: &[Vec3A],
+        start: usize,
+        end: usize,
+        bounds: Aabb,
+        cb: Aabb,
+    ) -> Option<usize> {
         let extent = cb.max - cb.min;
+        let scale = Vec3A::select(extent.cmpgt(Vec3A::ZERO), Vec3A::splat(BINS as f32) / extent, Vec3A::ZERO);
+        let bin_of = |c: Vec3A, axis: usize| (((c[axis] - cb.min[axis]) * scale[axis]) as usize).min(BINS - 1);
+        let mut bin_box = [[Aabb::EMPTY; BINS]; 3];
+        let mut bin_n = [[0usize; BINS]; 3];
+        for &p in &self.prims[start..end] {
+            let (c, b) = (centres[p as usize], boxes[p as usize]);
+            for axis in 0..3 {
+                let k = bin_of(c, axis);
+                bin_box[axis][k] = bin_box[axis][k].union(b);
+                bin_n[axis][k] += 1;
+            }
+        }
         let mut best: Option<(f32, usize, usize)> = None; // (cost, axis, bin)
         for axis in 0..3 {
             if extent[axis] <= 0.0 {
                 continue;
             }
-            let scale = BINS as f32 / extent[axis];
-            let bin_of = |p: u32| (((centres[p as usize][axis] - cb.min[axis]) * scale) as usize).min(BINS - 1);
-            let mut bin_box = [Aabb::EMPTY; BINS];
-            let mut bin_n = [0usize; BINS];
-            for &p in &self.prims[start..end] {
-                let b = bin_of(p);
-                bin_box[b] = bin_box[b].union(boxes[p as usize]);
-                bin_n[b] += 1;
-            }
             let mut right_area = [0.0f32; BINS];
             let mut right_n = [0usize; BINS];
             let (mut acc, mut acc_n) = (Aabb::EMPTY, 0);
             for b in (1..BINS).rev() {
-                acc = acc.union(bin_box[b]);
-                acc_n += bin_n[b];
+                acc = acc.union(bin_box[axis][b]);
+                acc_n += bin_n[axis][b];
                 right_area[b] = acc.half_area();
                 right_n[b] = acc_n;
             }
             let (mut acc, mut acc_n) = (Aabb::EMPTY, 0);
             for b in 0..BINS - 1 {
-                acc = acc.union(bin_box[b]);
-                acc_n += bin_n[b];
+                acc = acc.union(bin_box[axis][b]);
+                acc_n += bin_n[axis][b];
                 if acc_n == 0 || right_n[b + 1] == 0 {
                     continue;
                 }
@@ -186,12 +194,10 @@ impl Bvh {
         let leaf_cost = bounds.half_area() * n as f32;
         match best {
             Some((cost, axis, bin)) if cost < leaf_cost || n > 8 => {
-                let scale = BINS as f32 / extent[axis];
                 let slice = &mut self.prims[start..end];
                 let mut left = 0;
                 for i in 0..slice.len() {
-                    let b = (((centres[slice[i] as usize][axis] - cb.min[axis]) * scale) as usize).min(BINS - 1);
-                    if b <= bin {
+                    if bin_of(centres[slice[i] as usize], axis) <= bin {
                         slice.swap(i, left);
                         left += 1;
                     }
@@ -353,11 +359,7 @@ impl Bvh {
             let b = n.bounds();
             if n.count > 0 {
                 let first = n.first_or_right as usize;
-                for &p in bvh
-                    .prims
-                    .get(first..first + n.count as usize)
-                    .ok_or("leaf range out of bounds")?
-                {
+                for &p in bvh.prims.get(first..first + n.count as usize).ok_or("leaf range out of bounds")? {
                     let p = p as usize;
                     if std::mem::replace(&mut seen[p], true) {
                         return Err(format!("primitive {p} in two leaves"));

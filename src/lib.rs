@@ -15,11 +15,13 @@ pub mod bvh;
 pub mod check;
 pub mod diag;
 pub mod ir;
+pub mod mesh;
 pub mod render;
 pub mod sdf;
 pub mod source;
 pub mod span;
 pub mod syntax;
+pub mod world;
 
 use std::path::Path;
 
@@ -51,18 +53,10 @@ pub fn compile_source(name: &str, path: &Path, text: String, loader: &dyn Loader
             format!("`{name}` is too large"),
             "the file is too large",
         );
-        return Compiled {
-            map,
-            scene: None,
-            diagnostics: vec![d],
-        };
+        return Compiled { map, scene: None, diagnostics: vec![d] };
     };
     let (scene, diagnostics) = check::check(&mut map, root, loader);
-    Compiled {
-        map,
-        scene,
-        diagnostics,
-    }
+    Compiled { map, scene, diagnostics }
 }
 
 /// Runs `f` on a thread with a large stack, so that pathological nesting in user input

@@ -53,6 +53,19 @@ enum Command {
 enum GeometryKind {
     /// Sphere-trace signed distance functions.
     Sdf,
+    /// Tessellate every shape into triangles, traced through BVHs.
+    Mesh,
+}
+
+fn parse_detail(s: &str) -> Result<scnc::world::Detail, String> {
+    match s {
+        "low" => Ok(scnc::world::Detail::Low),
+        "high" => Ok(scnc::world::Detail::High),
+        n => match n.parse::<u32>() {
+            Ok(n) if (3..=2048).contains(&n) => Ok(scnc::world::Detail::N(n)),
+            _ => Err("expected `low`, `high` or a number of rings from 3 to 2048".into()),
+        },
+    }
 }
 
 #[derive(clap::Args)]
@@ -86,9 +99,13 @@ struct RenderArgs {
     /// Samples per pixel (antialiasing).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=256))]
     samples: Option<u32>,
-    /// Geometry back-end.
+    /// Geometry back-end for shapes (explicit meshes are always meshes).
     #[arg(long, value_enum, default_value = "sdf")]
     geometry: GeometryKind,
+    /// Tessellation detail with `--geometry mesh`: `low` (7 rings, 10-point circles),
+    /// `high` (14 rings, 50-point circles) or N (N rings, 2N-point circles).
+    #[arg(long, value_parser = parse_detail, default_value = "high")]
+    detail: scnc::world::Detail,
     /// Print ray counts, work per ray and memory.
     #[arg(long)]
     stats: bool,
@@ -132,11 +149,7 @@ fn compile(path: &Path) -> Compiled {
                 format!("cannot read `{name}`: {reason}"),
                 reason,
             );
-            Compiled {
-                map,
-                scene: None,
-                diagnostics: vec![d],
-            }
+            Compiled { map, scene: None, diagnostics: vec![d] }
         }
     }
 }
@@ -168,11 +181,7 @@ fn usage_error(msg: &str) -> ExitCode {
 }
 
 fn render_cmd(args: RenderArgs) -> ExitCode {
-    let ext = args
-        .output
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
+    let ext = args.output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     if ext.as_deref() != Some("png") {
         return usage_error(&format!(
             "cannot write `{}`: scnc writes PNG images; try a `.png` file name",
@@ -221,21 +230,18 @@ fn render_cmd(args: RenderArgs) -> ExitCode {
         Ok(p) => p,
         Err(e) => return usage_error(&format!("cannot start worker threads: {e}")),
     };
-    let GeometryKind::Sdf = args.geometry;
+    let mode = match args.geometry {
+        GeometryKind::Sdf => scnc::world::Mode::Sdf,
+        GeometryKind::Mesh => scnc::world::Mode::Mesh(args.detail),
+    };
     let started = Instant::now();
     let mut frame = scnc::render::Frame::new(&scene);
-    let params = scnc::sdf::MarchParams {
-        epsilon: scene.settings.epsilon as f32,
-        max_steps: scene.settings.max_steps,
-    };
-    let geometry = match scnc::sdf::lower(&scene, &mut frame, params) {
+    let params = scnc::sdf::MarchParams { epsilon: scene.settings.epsilon as f32, max_steps: scene.settings.max_steps };
+    let lowered = pool.install(|| scnc::world::lower(&scene, &mut frame, mode, params, &FsLoader));
+    let geometry = match lowered {
         Ok(g) => g,
         Err(d) => {
-            let c = Compiled {
-                map: compiled.map,
-                scene: None,
-                diagnostics: vec![d],
-            };
+            let c = Compiled { map: compiled.map, scene: None, diagnostics: vec![d] };
             report(&c, args.message_format);
             return ExitCode::from(1);
         }
@@ -246,11 +252,7 @@ fn render_cmd(args: RenderArgs) -> ExitCode {
     progress.finish();
     let traced = started.elapsed() - lowered;
     if let Err(e) = write_png(&args.output, &image) {
-        let _ = writeln!(
-            std::io::stderr(),
-            "error: cannot write `{}`: {e}",
-            args.output.display()
-        );
+        let _ = writeln!(std::io::stderr(), "error: cannot write `{}`: {e}", args.output.display());
         return ExitCode::from(1);
     }
     let secs = traced.as_secs_f64();
@@ -266,22 +268,28 @@ fn render_cmd(args: RenderArgs) -> ExitCode {
         pool.current_num_threads()
     );
     if args.stats {
-        let _ = write!(err, "{}", stats_text(&counters, &geometry, lowered.as_secs_f64(), secs));
+        let _ = write!(err, "{}", stats_text(&counters, &geometry, &compiled.map, lowered.as_secs_f64(), secs));
     }
     ExitCode::SUCCESS
 }
 
-fn stats_text(c: &scnc::render::Counters, g: &scnc::sdf::SdfScene, lower_s: f64, trace_s: f64) -> String {
+fn stats_text(
+    c: &scnc::render::Counters,
+    g: &scnc::world::World,
+    map: &scnc::source::SourceMap,
+    lower_s: f64,
+    trace_s: f64,
+) -> String {
     let mem = g.memory();
-    let marches = c.rays().max(1) as f64;
-    format!(
+    let rays = c.rays().max(1) as f64;
+    let mut out = format!(
         "stats:
-  time            lower {:.3} s, trace {:.3} s
+  time            lower {:.3} s (tessellation and BVH builds), trace {:.3} s
   rays            {} primary, {} shadow, {} reflection ({} total, {:.2} M/s)
   sdf evaluations {} marching ({:.1} per ray, max {} on one ray), {} for normals and materials
   step budget     {} marches ran out of steps (counted as misses)
-  bvh             {} node visits ({:.2} per ray)
-  memory          {} objects: {} bytes of evaluator closures, {} bytes of top-level BVH
+  bvh             {} node visits ({:.2} per ray), {} triangle tests ({:.2} per ray)
+  memory          {} bytes in total: {} SDF objects with {} bytes of closures, {} bytes of top-level BVH
 ",
         lower_s,
         trace_s,
@@ -291,16 +299,48 @@ fn stats_text(c: &scnc::render::Counters, g: &scnc::sdf::SdfScene, lower_s: f64,
         c.rays(),
         c.rays() as f64 / trace_s.max(1e-9) / 1e6,
         c.sdf_evals,
-        c.sdf_evals as f64 / marches,
+        c.sdf_evals as f64 / rays,
         c.max_evals_per_ray,
         c.sdf_shading_evals,
         c.budget_misses,
         c.node_visits,
-        c.node_visits as f64 / marches,
-        g.len(),
+        c.node_visits as f64 / rays,
+        c.triangle_tests,
+        c.triangle_tests as f64 / rays,
+        mem.total(),
+        mem.sdf_objects,
         mem.closure_bytes,
-        mem.bvh_bytes,
-    )
+        mem.top_bvh_bytes,
+    );
+    if !mem.meshes.is_empty() {
+        let tri = mem.triangles();
+        let bytes: usize = mem.meshes.iter().map(|(_, m)| m.vertex_bytes + m.index_bytes + m.bvh_bytes).sum();
+        out.push_str(&format!(
+            "  meshes          {} objects, {} triangles, {} bytes ({:.1} bytes per triangle)\n",
+            mem.meshes.len(),
+            tri,
+            bytes,
+            bytes as f64 / tri.max(1) as f64
+        ));
+        for (span, m) in mem.meshes.iter().take(20) {
+            let (id, r) = map.local_range(*span);
+            let (line, _) = map.line_col(id, r.start);
+            out.push_str(&format!(
+                "    {}:{line}: {} triangles; vertices {} B, indices {} B, BVH {} B ({} nodes, depth {})\n",
+                map.file(id).name,
+                m.triangles,
+                m.vertex_bytes,
+                m.index_bytes,
+                m.bvh_bytes,
+                m.bvh_nodes,
+                m.bvh_depth
+            ));
+        }
+        if mem.meshes.len() > 20 {
+            out.push_str(&format!("    … and {} more mesh objects\n", mem.meshes.len() - 20));
+        }
+    }
+    out
 }
 
 /// Encodes to a temporary file beside the target, then renames it over the target, so
@@ -311,10 +351,7 @@ fn write_png(path: &Path, image: &scnc::render::Image) -> std::io::Result<()> {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".scnc-")
-        .suffix(".png.tmp")
-        .tempfile_in(dir)?;
+    let mut tmp = tempfile::Builder::new().prefix(".scnc-").suffix(".png.tmp").tempfile_in(dir)?;
     {
         let mut w = std::io::BufWriter::new(tmp.as_file_mut());
         image::codecs::png::PngEncoder::new(&mut w)
@@ -343,10 +380,7 @@ impl Progress {
             }
             bar
         });
-        Progress {
-            bar,
-            started: Instant::now(),
-        }
+        Progress { bar, started: Instant::now() }
     }
 
     fn row(&self) {
@@ -386,9 +420,7 @@ fn run(cli: Cli) -> ExitCode {
                 return ExitCode::from(1);
             }
             if let Some(scene) = &compiled.scene {
-                let _ = std::io::stdout()
-                    .lock()
-                    .write_all(scnc::ir::dump(scene, &compiled.map).as_bytes());
+                let _ = std::io::stdout().lock().write_all(scnc::ir::dump(scene, &compiled.map).as_bytes());
             }
             ExitCode::SUCCESS
         }

@@ -116,36 +116,15 @@ const fn p(name: &'static str, ty: Ty, default: Default) -> Param {
 }
 
 const fn f(name: &'static str, params: &'static [Param], result: Ty, doc: &'static str) -> Builtin {
-    Builtin {
-        name,
-        kind: Kind::Function,
-        params,
-        variadic: None,
-        result,
-        doc,
-    }
+    Builtin { name, kind: Kind::Function, params, variadic: None, result, doc }
 }
 
 const fn variadic(name: &'static str, ty: Ty, params: &'static [Param], result: Ty, doc: &'static str) -> Builtin {
-    Builtin {
-        name,
-        kind: Kind::Function,
-        params,
-        variadic: Some(ty),
-        result,
-        doc,
-    }
+    Builtin { name, kind: Kind::Function, params, variadic: Some(ty), result, doc }
 }
 
 const fn gen(name: &'static str, params: &'static [Param], doc: &'static str) -> Builtin {
-    Builtin {
-        name,
-        kind: Kind::MeshGenerator,
-        params,
-        variadic: None,
-        result: Ty::Mesh,
-        doc,
-    }
+    Builtin { name, kind: Kind::MeshGenerator, params, variadic: None, result: Ty::Mesh, doc }
 }
 
 use self::Default::{Bool as B, Derived, Num as N, Required as Req, Vec3 as V};
@@ -155,30 +134,15 @@ const X: &[Param] = &[p("x", Ty::Num, Req)];
 /// Every builtin function, mesh generator and statement argument list.
 pub const BUILTINS: &[Builtin] = &[
     // Shapes.
-    f(
-        "sphere",
-        &[p("r", Ty::Num, Req)],
-        Ty::Shape,
-        "sphere of radius `r` centred at the origin",
-    ),
+    f("sphere", &[p("r", Ty::Num, Req)], Ty::Shape, "sphere of radius `r` centred at the origin"),
     f(
         "box",
         &[p("size", Ty::Size, Req)],
         Ty::Shape,
         "box with half-extents `size` (a number for a cube; `box(x, y, z)` also works)",
     ),
-    f(
-        "cylinder",
-        &[p("r", Ty::Num, Req), p("half_height", Ty::Num, Req)],
-        Ty::Shape,
-        "capped cylinder along y",
-    ),
-    f(
-        "torus",
-        &[p("major", Ty::Num, Req), p("minor", Ty::Num, Req)],
-        Ty::Shape,
-        "torus in the xz plane",
-    ),
+    f("cylinder", &[p("r", Ty::Num, Req), p("half_height", Ty::Num, Req)], Ty::Shape, "capped cylinder along y"),
+    f("torus", &[p("major", Ty::Num, Req), p("minor", Ty::Num, Req)], Ty::Shape, "torus in the xz plane"),
     f(
         "plane",
         &[p("normal", Ty::Vec3, V([0.0, 1.0, 0.0])), p("offset", Ty::Num, N(0.0))],
@@ -212,13 +176,7 @@ pub const BUILTINS: &[Builtin] = &[
         Ty::Shape,
         "only what is inside all of the shapes",
     ),
-    variadic(
-        "subtract",
-        Ty::Shape,
-        &[p("smooth", Ty::Num, N(0.0))],
-        Ty::Shape,
-        "the first shape minus all the others",
-    ),
+    variadic("subtract", Ty::Shape, &[p("smooth", Ty::Num, N(0.0))], Ty::Shape, "the first shape minus all the others"),
     f(
         "round",
         &[p("shape", Ty::Shape, Req), p("r", Ty::Num, Req)],
@@ -233,11 +191,7 @@ pub const BUILTINS: &[Builtin] = &[
     ),
     f(
         "repeat",
-        &[
-            p("shape", Ty::Shape, Req),
-            p("period", Ty::Size, Req),
-            p("count", Ty::Size, Req),
-        ],
+        &[p("shape", Ty::Shape, Req), p("period", Ty::Size, Req), p("count", Ty::Size, Req)],
         Ty::Shape,
         "`count` copies per axis, `period` apart, centred at the origin",
     ),
@@ -259,29 +213,16 @@ pub const BUILTINS: &[Builtin] = &[
         "a colour from 0–255 channels",
     ),
     // Lights.
-    f(
-        "ambient",
-        &[p("intensity", Ty::Num, Req)],
-        Ty::Light,
-        "light reaching every point equally",
-    ),
+    f("ambient", &[p("intensity", Ty::Num, Req)], Ty::Light, "light reaching every point equally"),
     f(
         "point",
-        &[
-            p("intensity", Ty::Num, Req),
-            p("shadows", Ty::Bool, B(true)),
-            p("radius", Ty::Num, N(0.0)),
-        ],
+        &[p("intensity", Ty::Num, Req), p("shadows", Ty::Bool, B(true)), p("radius", Ty::Num, N(0.0))],
         Ty::Light,
         "a point light, placed with `at`; `radius` > 0 gives soft shadows",
     ),
     f(
         "directional",
-        &[
-            p("intensity", Ty::Num, Req),
-            p("towards", Ty::Vec3, Req),
-            p("shadows", Ty::Bool, B(true)),
-        ],
+        &[p("intensity", Ty::Num, Req), p("towards", Ty::Vec3, Req), p("shadows", Ty::Bool, B(true))],
         Ty::Light,
         "a light at infinity, shining from direction `towards`",
     ),
@@ -294,12 +235,7 @@ pub const BUILTINS: &[Builtin] = &[
     f("floor", X, Ty::Num, "largest whole number not above `x`"),
     variadic("min", Ty::Num, &[], Ty::Num, "smallest of the numbers"),
     variadic("max", Ty::Num, &[], Ty::Num, "largest of the numbers"),
-    f(
-        "len",
-        &[p("list", Ty::List, Req)],
-        Ty::Int,
-        "number of elements of a list",
-    ),
+    f("len", &[p("list", Ty::List, Req)], Ty::Int, "number of elements of a list"),
     // Mesh generators (after `mesh`).
     gen(
         "uvsphere",
@@ -313,11 +249,7 @@ pub const BUILTINS: &[Builtin] = &[
     ),
     gen(
         "icosphere",
-        &[
-            p("r", Ty::Num, N(1.0)),
-            p("subdivisions", Ty::Int, N(2.0)),
-            p("smooth", Ty::Bool, B(false)),
-        ],
+        &[p("r", Ty::Num, N(1.0)), p("subdivisions", Ty::Int, N(2.0)), p("smooth", Ty::Bool, B(false))],
         "subdivided icosahedron",
     ),
     gen(
@@ -353,11 +285,7 @@ pub const BUILTINS: &[Builtin] = &[
     ),
     gen(
         "isosurface",
-        &[
-            p("shape", Ty::Shape, Req),
-            p("cell", Ty::Num, N(0.02)),
-            p("smooth", Ty::Bool, B(false)),
-        ],
+        &[p("shape", Ty::Shape, Req), p("cell", Ty::Num, N(0.02)), p("smooth", Ty::Bool, B(false))],
         "any shape triangulated on a grid of `cell`-sized cells",
     ),
     gen(

@@ -90,14 +90,7 @@ impl Ctx<'_> {
         if ok(x) {
             return true;
         }
-        self.range_error(
-            bound.span(i),
-            Range {
-                name: b.params[i].name,
-                rule,
-            },
-            dump_num(x),
-        );
+        self.range_error(bound.span(i), Range { name: b.params[i].name, rule }, dump_num(x));
         false
     }
 
@@ -106,21 +99,13 @@ impl Ctx<'_> {
         if ok(v.x) && ok(v.y) && ok(v.z) {
             return true;
         }
-        self.range_error(
-            bound.span(i),
-            Range {
-                name: b.params[i].name,
-                rule,
-            },
-            dump_vec(v),
-        );
+        self.range_error(bound.span(i), Range { name: b.params[i].name, rule }, dump_vec(v));
         false
     }
 
     fn check_int(&mut self, bound: &BoundArgs, b: &Builtin, i: usize, lo: u32, hi: u32) -> Option<u32> {
         let rule = format!("between {lo} and {hi}");
-        self.check_num(bound, b, i, |x| x >= lo as f64 && x <= hi as f64, &rule)
-            .then(|| bound.num(b, i) as u32)
+        self.check_num(bound, b, i, |x| x >= lo as f64 && x <= hi as f64, &rule).then(|| bound.num(b, i) as u32)
     }
 
     fn shape(kind: ShapeKind, span: Span) -> Value {
@@ -158,18 +143,9 @@ impl Ctx<'_> {
                 }
                 let (x, y) = (a.num(b, 0), a.num(b, 1));
                 let kind = match b.name {
-                    "cylinder" => ShapeKind::Cylinder {
-                        radius: x,
-                        half_height: y,
-                    },
-                    "capsule" => ShapeKind::Capsule {
-                        radius: x,
-                        half_height: y,
-                    },
-                    "cone" => ShapeKind::Cone {
-                        radius: x,
-                        half_height: y,
-                    },
+                    "cylinder" => ShapeKind::Cylinder { radius: x, half_height: y },
+                    "capsule" => ShapeKind::Capsule { radius: x, half_height: y },
+                    "cone" => ShapeKind::Cone { radius: x, half_height: y },
                     _ => ShapeKind::Torus { major: x, minor: y },
                 };
                 Self::shape(kind, span)
@@ -178,21 +154,12 @@ impl Ctx<'_> {
                 let Some(normal) = direction(a.vec(b, 0)) else {
                     self.range_error(
                         a.span(0),
-                        Range {
-                            name: "normal",
-                            rule: "a non-zero vector",
-                        },
+                        Range { name: "normal", rule: "a non-zero vector" },
                         dump_vec(a.vec(b, 0)),
                     );
                     return Value::Error;
                 };
-                Self::shape(
-                    ShapeKind::Plane {
-                        normal,
-                        offset: a.num(b, 1),
-                    },
-                    span,
-                )
+                Self::shape(ShapeKind::Plane { normal, offset: a.num(b, 1) }, span)
             }
             "union" | "intersect" | "subtract" => {
                 if a.rest.is_empty() {
@@ -231,24 +198,12 @@ impl Ctx<'_> {
                     if !self.check_num(&a, b, 1, nonneg, NONNEG) {
                         return Value::Error;
                     }
-                    Self::shape(
-                        ShapeKind::Round {
-                            child,
-                            radius: a.num(b, 1),
-                        },
-                        span,
-                    )
+                    Self::shape(ShapeKind::Round { child, radius: a.num(b, 1) }, span)
                 } else {
                     if !self.check_num(&a, b, 1, pos, POS) {
                         return Value::Error;
                     }
-                    Self::shape(
-                        ShapeKind::Shell {
-                            child,
-                            thickness: a.num(b, 1),
-                        },
-                        span,
-                    )
+                    Self::shape(ShapeKind::Shell { child, thickness: a.num(b, 1) }, span)
                 }
             }
             "repeat" => {
@@ -257,26 +212,14 @@ impl Ctx<'_> {
                 };
                 let ok_period = self.check_vec(&a, b, 1, pos, POS);
                 let rule = format!("whole numbers between 1 and {MAX_REPEAT}");
-                let ok_count = self.check_vec(
-                    &a,
-                    b,
-                    2,
-                    |x| x.fract() == 0.0 && (1.0..=MAX_REPEAT as f64).contains(&x),
-                    &rule,
-                );
+                let ok_count =
+                    self.check_vec(&a, b, 2, |x| x.fract() == 0.0 && (1.0..=MAX_REPEAT as f64).contains(&x), &rule);
                 if !(ok_period && ok_count) {
                     return Value::Error;
                 }
                 let c = a.vec(b, 2);
                 let count = [c.x as u32, c.y as u32, c.z as u32];
-                Self::shape(
-                    ShapeKind::Repeat {
-                        child,
-                        period: a.vec(b, 1),
-                        count,
-                    },
-                    span,
-                )
+                Self::shape(ShapeKind::Repeat { child, period: a.vec(b, 1), count }, span)
             }
             "material" => {
                 let spec = a.num(b, 1);
@@ -316,21 +259,14 @@ impl Ctx<'_> {
                         if !self.check_num(&a, b, 2, nonneg, NONNEG) {
                             return Value::Error;
                         }
-                        (
-                            ir::LightKind::Point { position: DVec3::ZERO },
-                            a.flag(b, 1),
-                            a.num(b, 2),
-                        )
+                        (ir::LightKind::Point { position: DVec3::ZERO }, a.flag(b, 1), a.num(b, 2))
                     }
                     _ => {
                         let towards = a.vec(b, 1);
                         if direction(towards).is_none() {
                             self.range_error(
                                 a.span(1),
-                                Range {
-                                    name: "towards",
-                                    rule: "a non-zero vector",
-                                },
+                                Range { name: "towards", rule: "a non-zero vector" },
                                 dump_vec(towards),
                             );
                             return Value::Error;
@@ -338,13 +274,7 @@ impl Ctx<'_> {
                         (ir::LightKind::Directional { towards }, a.flag(b, 2), 0.0)
                     }
                 };
-                Value::Light(Arc::new(ir::Light {
-                    kind,
-                    intensity,
-                    shadows,
-                    radius,
-                    span,
-                }))
+                Value::Light(Arc::new(ir::Light { kind, intensity, shadows, radius, span }))
             }
             "sin" | "cos" | "tan" | "sqrt" | "abs" | "floor" => {
                 let x = a.num(b, 0);
@@ -398,32 +328,21 @@ impl Ctx<'_> {
             "uvsphere" => {
                 let ok_r = self.check_num(&a, b, 0, pos, POS);
                 let rings = self.check_int(&a, b, 1, 3, res);
-                let segments = if a.given(2) {
-                    self.check_int(&a, b, 2, 3, res)
-                } else {
-                    rings.map(|r| 2 * r)
-                };
+                let segments = if a.given(2) { self.check_int(&a, b, 2, 3, res) } else { rings.map(|r| 2 * r) };
                 let (true, Some(rings), Some(segments)) = (ok_r, rings, segments) else {
                     return Value::Error;
                 };
                 if !self.triangle_budget(2 * rings as u64 * segments as u64, a.call) {
                     return Value::Error;
                 }
-                MeshSource::UvSphere {
-                    radius: a.num(b, 0),
-                    rings,
-                    segments,
-                }
+                MeshSource::UvSphere { radius: a.num(b, 0), rings, segments }
             }
             "icosphere" => {
                 let ok_r = self.check_num(&a, b, 0, pos, POS);
                 let (true, Some(subdivisions)) = (ok_r, self.check_int(&a, b, 1, 0, 10)) else {
                     return Value::Error;
                 };
-                MeshSource::IcoSphere {
-                    radius: a.num(b, 0),
-                    subdivisions,
-                }
+                MeshSource::IcoSphere { radius: a.num(b, 0), subdivisions }
             }
             "box" => {
                 if !self.check_vec(&a, b, 0, pos, POS) {
@@ -436,11 +355,7 @@ impl Ctx<'_> {
                 let (true, Some(segments)) = (ok, self.check_int(&a, b, 2, 3, res)) else {
                     return Value::Error;
                 };
-                MeshSource::Cylinder {
-                    radius: a.num(b, 0),
-                    half_height: a.num(b, 1),
-                    segments,
-                }
+                MeshSource::Cylinder { radius: a.num(b, 0), half_height: a.num(b, 1), segments }
             }
             "torus" => {
                 let ok = self.check_num(&a, b, 0, pos, POS) & self.check_num(&a, b, 1, pos, POS);
@@ -452,12 +367,7 @@ impl Ctx<'_> {
                 if !self.triangle_budget(2 * segments as u64 * sides as u64, a.call) {
                     return Value::Error;
                 }
-                MeshSource::Torus {
-                    major: a.num(b, 0),
-                    minor: a.num(b, 1),
-                    segments,
-                    sides,
-                }
+                MeshSource::Torus { major: a.num(b, 0), minor: a.num(b, 1), segments, sides }
             }
             "plane" => {
                 if !self.check_num(&a, b, 0, pos, POS) {
@@ -472,19 +382,13 @@ impl Ctx<'_> {
                 if !self.check_num(&a, b, 1, pos, POS) {
                     return Value::Error;
                 }
-                MeshSource::Isosurface {
-                    shape,
-                    cell: a.num(b, 1),
-                }
+                MeshSource::Isosurface { shape, cell: a.num(b, 1) }
             }
             "file" => {
                 let Value::Str(written) = a.value(b, 0) else {
                     return Value::Error;
                 };
-                MeshSource::File {
-                    path: self.dir.join(&*written),
-                    written: written.to_string(),
-                }
+                MeshSource::File { path: self.dir.join(&*written), written: written.to_string() }
             }
             _ => return Value::Error,
         };
@@ -548,14 +452,7 @@ impl Ctx<'_> {
         }
         match (view, direction(up)) {
             (_, None) => {
-                self.range_error(
-                    a.span(2),
-                    Range {
-                        name: "up",
-                        rule: "a non-zero vector",
-                    },
-                    dump_vec(up),
-                );
+                self.range_error(a.span(2), Range { name: "up", rule: "a non-zero vector" }, dump_vec(up));
                 ok = false;
             }
             (Some(v), Some(u)) if v.cross(u).length() < 1e-9 => {
@@ -573,13 +470,7 @@ impl Ctx<'_> {
             }
             _ => {}
         }
-        ok.then(|| Camera {
-            position,
-            look_at,
-            up,
-            fov: a.num(b, 3),
-            span: Some(span),
-        })
+        ok.then(|| Camera { position, look_at, up, fov: a.num(b, 3), span: Some(span) })
     }
 
     pub(super) fn render_stmt(&mut self, args: &[ast::Arg], span: Span) -> Option<Settings> {

@@ -146,12 +146,7 @@ impl Ctx<'_> {
             }
             ExprKind::Call { callee, args } => self.call(callee, args, e.span),
             ExprKind::Mesh { generator, args } => self.mesh_call(generator, args, e.span),
-            ExprKind::Transform {
-                op,
-                op_span,
-                target,
-                arg,
-            } => {
+            ExprKind::Transform { op, op_span, target, arg } => {
                 let t = self.expr(target);
                 let a = self.expr(arg);
                 self.transform(*op, *op_span, t, target.span, a, arg.span, e.span)
@@ -380,12 +375,7 @@ impl Ctx<'_> {
                 let mut d = Diagnostic::error(
                     codes::BAD_OPERANDS,
                     span,
-                    format!(
-                        "cannot apply `{}` to `{}` and `{}`",
-                        op.symbol(),
-                        a.ty_name(),
-                        b.ty_name()
-                    ),
+                    format!("cannot apply `{}` to `{}` and `{}`", op.symbol(), a.ty_name(), b.ty_name()),
                     format!("`{}` {} `{}` is not defined", a.ty_name(), op.symbol(), b.ty_name()),
                 )
                 .with_label(a_span, format!("this is a `{}`", a.ty_name()))
@@ -466,10 +456,7 @@ impl Ctx<'_> {
                 "not a builtin or a function in scope",
             );
             if builtins::lookup(&callee.name, Kind::MeshGenerator).is_some() {
-                d = d.with_hint(format!(
-                    "`{}` is a mesh generator: try `mesh {}(…)`",
-                    callee.name, callee.name
-                ));
+                d = d.with_hint(format!("`{}` is a mesh generator: try `mesh {}(…)`", callee.name, callee.name));
             } else if let Some(s) = suggest(&callee.name, candidates.iter().map(String::as_str)) {
                 d = d.with_hint(format!("did you mean `{s}`?"));
             } else if matches!(callee.name.as_str(), "camera" | "render") {
@@ -505,10 +492,7 @@ impl Ctx<'_> {
                     builtins::names(Kind::MeshGenerator).collect::<Vec<_>>().join(", ")
                 ));
                 if builtins::lookup(&generator.name, Kind::Function).is_some() {
-                    d = d.with_hint(format!(
-                        "try `mesh isosurface({}(…))` to triangulate any shape",
-                        generator.name
-                    ));
+                    d = d.with_hint(format!("try `mesh isosurface({}(…))` to triangulate any shape", generator.name));
                 }
             }
             self.report(d);
@@ -528,18 +512,12 @@ impl Ctx<'_> {
         // `box(x, y, z)`: three numbers are one size vector.
         if b.name == "box"
             && args.len() == 3
-            && args
-                .iter()
-                .all(|a| a.name.is_none() && matches!(a.value, Value::Num(_)))
+            && args.iter().all(|a| a.name.is_none() && matches!(a.value, Value::Num(_)))
         {
             let n = |a: &ArgVal| if let Value::Num(x) = a.value { x } else { 0.0 };
             let span = args[0].span.to(args[2].span);
             let v = DVec3::new(n(&args[0]), n(&args[1]), n(&args[2]));
-            args = vec![ArgVal {
-                name: None,
-                value: Value::Vec3(v),
-                span,
-            }];
+            args = vec![ArgVal { name: None, value: Value::Vec3(v), span }];
         }
         let mut ok = true;
         let mut vals: Vec<Option<(Value, Span)>> = vec![None; b.params.len()];
@@ -687,12 +665,7 @@ impl Ctx<'_> {
         .with_note(format!("{what} is a `{ty}`"));
         match (ty, v) {
             (Ty::Color, Value::Vec3(c)) => {
-                d = d.with_hint(format!(
-                    "try `rgb({}, {}, {})`",
-                    dump_num(c.x),
-                    dump_num(c.y),
-                    dump_num(c.z)
-                ))
+                d = d.with_hint(format!("try `rgb({}, {}, {})`", dump_num(c.x), dump_num(c.y), dump_num(c.z)))
             }
             (Ty::Shape, Value::Mesh(_)) => {
                 d = d.with_note("meshes cannot take part in CSG; shapes can be meshed with `mesh isosurface(…)`")
@@ -800,9 +773,7 @@ impl Ctx<'_> {
                     "function calls nest too deeply",
                     format!("call depth {MAX_CALL_DEPTH} is exceeded here"),
                 )
-                .with_note(format!(
-                    "functions may call each other at most {MAX_CALL_DEPTH} levels deep"
-                )),
+                .with_note(format!("functions may call each other at most {MAX_CALL_DEPTH} levels deep")),
             );
             return Value::Error;
         }
@@ -810,11 +781,7 @@ impl Ctx<'_> {
         let mut seen = HashMap::new();
         for (p, v) in f.params.iter().zip(args) {
             if seen.insert(p.name.clone(), ()).is_none() {
-                frame.push(Rc::new(super::Binding {
-                    name: p.name.clone(),
-                    span: p.span,
-                    bound: Bound::Value(v),
-                }));
+                frame.push(Rc::new(super::Binding { name: p.name.clone(), span: p.span, bound: Bound::Value(v) }));
             }
         }
         let saved = std::mem::replace(&mut self.scopes, vec![f.env.clone(), frame]);
@@ -897,10 +864,9 @@ impl Ctx<'_> {
                 return Value::Error;
             };
             return match target {
-                Value::Shape(s) => Value::Shape(Arc::new(ir::Shape {
-                    kind: ir::ShapeKind::Paint { child: s, material: m },
-                    span,
-                })),
+                Value::Shape(s) => {
+                    Value::Shape(Arc::new(ir::Shape { kind: ir::ShapeKind::Paint { child: s, material: m }, span }))
+                }
                 Value::Mesh(mesh) => {
                     let mut mesh = (*mesh).clone();
                     // The innermost material wins, as for shapes.
@@ -948,11 +914,7 @@ impl Ctx<'_> {
                 DAffine3::from_scale(k)
             }
             _ => {
-                let expected = if op == TransformOp::Scale {
-                    "num` or `vec3"
-                } else {
-                    "vec3"
-                };
+                let expected = if op == TransformOp::Scale { "num` or `vec3" } else { "vec3" };
                 let mut d = Diagnostic::error(
                     codes::TYPE_MISMATCH,
                     arg_span,
@@ -988,24 +950,14 @@ pub(crate) fn rotation(deg: DVec3) -> DMat3 {
 /// Applies `xf` on top of `shape`, merging consecutive transforms and keeping materials outside them.
 fn apply_xf(shape: Arc<ir::Shape>, xf: DAffine3, span: Span) -> Arc<ir::Shape> {
     match &shape.kind {
-        ir::ShapeKind::Transform { child, xf: inner } => Arc::new(ir::Shape {
-            kind: ir::ShapeKind::Transform {
-                child: child.clone(),
-                xf: xf * *inner,
-            },
-            span,
-        }),
+        ir::ShapeKind::Transform { child, xf: inner } => {
+            Arc::new(ir::Shape { kind: ir::ShapeKind::Transform { child: child.clone(), xf: xf * *inner }, span })
+        }
         ir::ShapeKind::Paint { child, material } => Arc::new(ir::Shape {
-            kind: ir::ShapeKind::Paint {
-                child: apply_xf(child.clone(), xf, span),
-                material: material.clone(),
-            },
+            kind: ir::ShapeKind::Paint { child: apply_xf(child.clone(), xf, span), material: material.clone() },
             span: shape.span,
         }),
-        _ => Arc::new(ir::Shape {
-            kind: ir::ShapeKind::Transform { child: shape, xf },
-            span,
-        }),
+        _ => Arc::new(ir::Shape { kind: ir::ShapeKind::Transform { child: shape, xf }, span }),
     }
 }
 

@@ -64,10 +64,7 @@ impl Loader for FsLoader {
             return Err(std::io::Error::other("it is a directory"));
         }
         if meta.len() > MAX_FILE_BYTES as u64 {
-            return Err(std::io::Error::other(format!(
-                "it is larger than the {} MiB limit",
-                MAX_FILE_BYTES >> 20
-            )));
+            return Err(std::io::Error::other(format!("it is larger than the {} MiB limit", MAX_FILE_BYTES >> 20)));
         }
         let bytes = std::fs::read(path)?;
         String::from_utf8(bytes).map_err(|_| std::io::Error::other("it is not valid UTF-8"))
@@ -131,13 +128,7 @@ impl Ctx<'_> {
     }
 
     fn lookup(&mut self, name: &str) -> Option<Rc<Binding>> {
-        let found = self
-            .scopes
-            .iter()
-            .rev()
-            .flat_map(|s| s.iter().rev())
-            .find(|b| b.name == name)
-            .cloned()?;
+        let found = self.scopes.iter().rev().flat_map(|s| s.iter().rev()).find(|b| b.name == name).cloned()?;
         if let Some(entry) = self.lets.get_mut(&found.span) {
             entry.1 = true;
         }
@@ -145,11 +136,7 @@ impl Ctx<'_> {
     }
 
     fn bind(&mut self, name: &ast::Ident, bound: Bound) {
-        let binding = Rc::new(Binding {
-            name: name.name.clone(),
-            span: name.span,
-            bound,
-        });
+        let binding = Rc::new(Binding { name: name.name.clone(), span: name.span, bound });
         if let Some(scope) = self.scopes.last_mut() {
             scope.push(binding);
         }
@@ -173,22 +160,14 @@ impl Ctx<'_> {
     fn stmt(&mut self, stmt: &ast::Stmt) {
         match &stmt.kind {
             ast::StmtKind::Error => {}
-            ast::StmtKind::Let {
-                name,
-                params: None,
-                value,
-            } => {
+            ast::StmtKind::Let { name, params: None, value } => {
                 let v = self.expr(value);
                 if self.dry == 0 || !self.lets.contains_key(&name.span) {
                     self.lets.entry(name.span).or_insert_with(|| (name.name.clone(), false));
                 }
                 self.bind(name, Bound::Value(v));
             }
-            ast::StmtKind::Let {
-                name,
-                params: Some(params),
-                value,
-            } => self.define_function(name, params, value),
+            ast::StmtKind::Let { name, params: Some(params), value } => self.define_function(name, params, value),
             ast::StmtKind::Object(e) => {
                 let v = self.expr(e);
                 self.object(v, e.span, stmt.span);
@@ -232,10 +211,7 @@ impl Ctx<'_> {
                     self.camera = Some(cam);
                 } else {
                     // Remember that a (bad) camera statement was here, so a second one is still a duplicate.
-                    self.camera = Some(Camera {
-                        span: Some(stmt.span),
-                        ..Camera::default()
-                    });
+                    self.camera = Some(Camera { span: Some(stmt.span), ..Camera::default() });
                 }
             }
             ast::StmtKind::Render(args) => {
@@ -255,10 +231,7 @@ impl Ctx<'_> {
                         .with_hint("try merging the two into one `render(…)`"),
                     );
                 } else {
-                    self.settings = Some(settings.unwrap_or(Settings {
-                        span: Some(stmt.span),
-                        ..Settings::default()
-                    }));
+                    self.settings = Some(settings.unwrap_or(Settings { span: Some(stmt.span), ..Settings::default() }));
                 }
             }
             ast::StmtKind::For { var, start, end, body } => self.for_loop(var, start, end, body, stmt.span),
@@ -331,9 +304,7 @@ impl Ctx<'_> {
                     "too many loop iterations",
                     format!("this loop would run {count} times"),
                 )
-                .with_note(format!(
-                    "a scene may run at most {MAX_ITERATIONS} loop iterations in total"
-                )),
+                .with_note(format!("a scene may run at most {MAX_ITERATIONS} loop iterations in total")),
             );
             self.dry += 1;
             run(self, Value::Error);
@@ -417,10 +388,7 @@ impl Ctx<'_> {
             }
             return;
         }
-        self.objects.push(ir::Object {
-            geometry,
-            span: stmt_span,
-        });
+        self.objects.push(ir::Object { geometry, span: stmt_span });
     }
 
     fn include(&mut self, written: &str, span: Span) {
@@ -450,9 +418,7 @@ impl Ctx<'_> {
                     "includes nest too deeply",
                     format!("include depth {MAX_INCLUDE_DEPTH} is exceeded here"),
                 )
-                .with_note(format!(
-                    "files may include each other at most {MAX_INCLUDE_DEPTH} levels deep"
-                )),
+                .with_note(format!("files may include each other at most {MAX_INCLUDE_DEPTH} levels deep")),
             );
             return;
         }
@@ -469,13 +435,8 @@ impl Ctx<'_> {
             Ok(text) => text,
             Err(e) => {
                 self.report(
-                    Diagnostic::error(
-                        codes::INCLUDE_READ,
-                        span,
-                        format!("cannot read `{written}`"),
-                        io_reason(&e),
-                    )
-                    .with_note(format!("looked for {}", path.display())),
+                    Diagnostic::error(codes::INCLUDE_READ, span, format!("cannot read `{written}`"), io_reason(&e))
+                        .with_note(format!("looked for {}", path.display())),
                 );
                 return;
             }
@@ -522,11 +483,7 @@ impl Ctx<'_> {
                     .with_hint(format!("if this is intentional, try naming it `_{name}`")),
             );
         }
-        let end = self
-            .map
-            .files()
-            .next()
-            .map_or(Span::default(), |(_, f)| Span::new(f.base as usize, f.base as usize));
+        let end = self.map.files().next().map_or(Span::default(), |(_, f)| Span::new(f.base as usize, f.base as usize));
         let has_errors = self.diags.iter().any(Diagnostic::is_error);
         if has_errors {
             // Objects and lights were dropped with their errors; do not warn about their absence.
@@ -542,13 +499,8 @@ impl Ctx<'_> {
             );
         } else if self.lights.is_empty() {
             self.report(
-                Diagnostic::warning(
-                    codes::NO_LIGHTS,
-                    end,
-                    "the scene has no lights",
-                    "every object will be black",
-                )
-                .with_hint("try `light ambient(0.2)` and `light point(0.6) at [2, 1, 0]`"),
+                Diagnostic::warning(codes::NO_LIGHTS, end, "the scene has no lights", "every object will be black")
+                    .with_hint("try `light ambient(0.2)` and `light point(0.6) at [2, 1, 0]`"),
             );
         }
         for light in &self.lights.clone() {
@@ -583,12 +535,8 @@ impl Ctx<'_> {
         if diags.iter().any(Diagnostic::is_error) {
             return (None, diags);
         }
-        let scene = Scene {
-            camera,
-            settings: self.settings.unwrap_or_default(),
-            lights: self.lights,
-            objects: self.objects,
-        };
+        let scene =
+            Scene { camera, settings: self.settings.unwrap_or_default(), lights: self.lights, objects: self.objects };
         (Some(scene), diags)
     }
 }
@@ -601,7 +549,8 @@ fn behind_camera(obj: &ir::Object, camera: &Camera) -> Option<f64> {
     (depth + radius < 0.0).then_some(-(depth + radius))
 }
 
-fn io_reason(e: &std::io::Error) -> String {
+/// A short, lowercase reason for an I/O error.
+pub fn io_reason(e: &std::io::Error) -> String {
     match e.kind() {
         std::io::ErrorKind::NotFound => "no such file".into(),
         std::io::ErrorKind::PermissionDenied => "permission denied".into(),

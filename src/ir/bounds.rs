@@ -21,26 +21,17 @@ impl Aabb {
 
     /// Grown by `d` on every side.
     pub fn grow(self, d: f64) -> Aabb {
-        Aabb {
-            min: self.min - d,
-            max: self.max + d,
-        }
+        Aabb { min: self.min - d, max: self.max + d }
     }
 
     /// The smallest box containing both.
     pub fn union(self, o: Aabb) -> Aabb {
-        Aabb {
-            min: self.min.min(o.min),
-            max: self.max.max(o.max),
-        }
+        Aabb { min: self.min.min(o.min), max: self.max.max(o.max) }
     }
 
     /// The overlap of both (may be empty: `min > max` on some axis).
     pub fn intersect(self, o: Aabb) -> Aabb {
-        Aabb {
-            min: self.min.max(o.min),
-            max: self.max.min(o.max),
-        }
+        Aabb { min: self.min.max(o.min), max: self.max.min(o.max) }
     }
 
     /// The bounds of this box after an affine map.
@@ -66,39 +57,26 @@ pub fn shape_bounds(shape: &Shape) -> Option<Aabb> {
     match &shape.kind {
         ShapeKind::Sphere { radius } => Some(Aabb::centred(DVec3::splat(*radius))),
         ShapeKind::Box { half } => Some(Aabb::centred(*half)),
-        ShapeKind::Cylinder {
-            radius: r,
-            half_height: h,
+        ShapeKind::Cylinder { radius: r, half_height: h } | ShapeKind::Cone { radius: r, half_height: h } => {
+            Some(Aabb::centred(DVec3::new(*r, *h, *r)))
         }
-        | ShapeKind::Cone {
-            radius: r,
-            half_height: h,
-        } => Some(Aabb::centred(DVec3::new(*r, *h, *r))),
-        ShapeKind::Capsule {
-            radius: r,
-            half_height: h,
-        } => Some(Aabb::centred(DVec3::new(*r, h + r, *r))),
+        ShapeKind::Capsule { radius: r, half_height: h } => Some(Aabb::centred(DVec3::new(*r, h + r, *r))),
         ShapeKind::Torus { major, minor } => Some(Aabb::centred(DVec3::new(major + minor, *minor, major + minor))),
         ShapeKind::Plane { .. } => None,
         ShapeKind::Union { children: kids, smooth } => {
             let all: Option<Vec<Aabb>> = children(kids).into_iter().collect();
             all?.into_iter().reduce(Aabb::union).map(|b| b.grow(*smooth))
         }
-        ShapeKind::Intersect { children: kids, smooth } => children(kids)
-            .into_iter()
-            .flatten()
-            .reduce(Aabb::intersect)
-            .map(|b| b.grow(*smooth)),
+        ShapeKind::Intersect { children: kids, smooth } => {
+            children(kids).into_iter().flatten().reduce(Aabb::intersect).map(|b| b.grow(*smooth))
+        }
         ShapeKind::Subtract { children: kids, smooth } => shape_bounds(kids.first()?).map(|b| b.grow(*smooth)),
         ShapeKind::Round { child, radius } => shape_bounds(child).map(|b| b.grow(*radius)),
         ShapeKind::Shell { child, thickness } => shape_bounds(child).map(|b| b.grow(thickness * 0.5)),
         ShapeKind::Repeat { child, period, count } => {
             let b = shape_bounds(child)?;
             let reach = *period * (DVec3::new(count[0] as f64, count[1] as f64, count[2] as f64) - 1.0) * 0.5;
-            Some(Aabb {
-                min: b.min - reach,
-                max: b.max + reach,
-            })
+            Some(Aabb { min: b.min - reach, max: b.max + reach })
         }
         ShapeKind::Transform { child, xf } => shape_bounds(child).map(|b| b.transform(xf)),
         ShapeKind::Paint { child, .. } => shape_bounds(child),
@@ -112,9 +90,7 @@ pub fn mesh_bounds(mesh: &Mesh) -> Option<Aabb> {
             Aabb::centred(DVec3::splat(*radius))
         }
         MeshSource::Box { half } => Aabb::centred(*half),
-        MeshSource::Cylinder {
-            radius, half_height, ..
-        } => Aabb::centred(DVec3::new(*radius, *half_height, *radius)),
+        MeshSource::Cylinder { radius, half_height, .. } => Aabb::centred(DVec3::new(*radius, *half_height, *radius)),
         MeshSource::Torus { major, minor, .. } => Aabb::centred(DVec3::new(major + minor, *minor, major + minor)),
         MeshSource::Plane { size } => Aabb::centred(DVec3::new(*size, 0.0, *size)),
         MeshSource::Isosurface { shape, .. } => shape_bounds(shape)?,
@@ -139,29 +115,18 @@ pub fn shape_sphere(shape: &Shape) -> Option<(DVec3, f64)> {
     match &shape.kind {
         ShapeKind::Sphere { radius } => Some((DVec3::ZERO, *radius)),
         ShapeKind::Box { half } => Some((DVec3::ZERO, half.length())),
-        ShapeKind::Cylinder {
-            radius: r,
-            half_height: h,
+        ShapeKind::Cylinder { radius: r, half_height: h } | ShapeKind::Cone { radius: r, half_height: h } => {
+            Some((DVec3::ZERO, (r * r + h * h).sqrt()))
         }
-        | ShapeKind::Cone {
-            radius: r,
-            half_height: h,
-        } => Some((DVec3::ZERO, (r * r + h * h).sqrt())),
         ShapeKind::Capsule { radius, half_height } => Some((DVec3::ZERO, radius + half_height)),
         ShapeKind::Torus { major, minor } => Some((DVec3::ZERO, major + minor)),
         ShapeKind::Plane { .. } => None,
         ShapeKind::Union { children, smooth } => {
             let spheres: Option<Vec<(DVec3, f64)>> = children.iter().map(|c| shape_sphere(c)).collect();
             let spheres = spheres?;
-            let boxes = spheres.iter().map(|(c, r)| Aabb {
-                min: *c - *r,
-                max: *c + *r,
-            });
+            let boxes = spheres.iter().map(|(c, r)| Aabb { min: *c - *r, max: *c + *r });
             let centre = boxes.reduce(Aabb::union)?.centre();
-            let radius = spheres
-                .iter()
-                .map(|(c, r)| (*c - centre).length() + r)
-                .fold(0.0, f64::max);
+            let radius = spheres.iter().map(|(c, r)| (*c - centre).length() + r).fold(0.0, f64::max);
             Some((centre, radius + smooth))
         }
         ShapeKind::Intersect { children, smooth } => children

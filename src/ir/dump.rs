@@ -73,31 +73,21 @@ impl Dumper<'_> {
         match &shape.kind {
             ShapeKind::Sphere { radius } => self.line(indent, &format!("sphere radius {}", num(*radius)), span),
             ShapeKind::Box { half } => self.line(indent, &format!("box half {}", vec(*half)), span),
-            ShapeKind::Cylinder { radius, half_height } => self.line(
-                indent,
-                &format!("cylinder radius {} half_height {}", num(*radius), num(*half_height)),
-                span,
-            ),
-            ShapeKind::Torus { major, minor } => self.line(
-                indent,
-                &format!("torus major {} minor {}", num(*major), num(*minor)),
-                span,
-            ),
-            ShapeKind::Plane { normal, offset } => self.line(
-                indent,
-                &format!("plane normal {} offset {}", vec(*normal), num(*offset)),
-                span,
-            ),
-            ShapeKind::Capsule { radius, half_height } => self.line(
-                indent,
-                &format!("capsule radius {} half_height {}", num(*radius), num(*half_height)),
-                span,
-            ),
-            ShapeKind::Cone { radius, half_height } => self.line(
-                indent,
-                &format!("cone radius {} half_height {}", num(*radius), num(*half_height)),
-                span,
-            ),
+            ShapeKind::Cylinder { radius, half_height } => {
+                self.line(indent, &format!("cylinder radius {} half_height {}", num(*radius), num(*half_height)), span)
+            }
+            ShapeKind::Torus { major, minor } => {
+                self.line(indent, &format!("torus major {} minor {}", num(*major), num(*minor)), span)
+            }
+            ShapeKind::Plane { normal, offset } => {
+                self.line(indent, &format!("plane normal {} offset {}", vec(*normal), num(*offset)), span)
+            }
+            ShapeKind::Capsule { radius, half_height } => {
+                self.line(indent, &format!("capsule radius {} half_height {}", num(*radius), num(*half_height)), span)
+            }
+            ShapeKind::Cone { radius, half_height } => {
+                self.line(indent, &format!("cone radius {} half_height {}", num(*radius), num(*half_height)), span)
+            }
             ShapeKind::Union { children: kids, smooth }
             | ShapeKind::Intersect { children: kids, smooth }
             | ShapeKind::Subtract { children: kids, smooth } => {
@@ -106,11 +96,7 @@ impl Dumper<'_> {
                     ShapeKind::Intersect { .. } => "intersect",
                     _ => "subtract",
                 };
-                let text = if *smooth > 0.0 {
-                    format!("{op} smooth {}", num(*smooth))
-                } else {
-                    op.to_string()
-                };
+                let text = if *smooth > 0.0 { format!("{op} smooth {}", num(*smooth)) } else { op.to_string() };
                 self.line(indent, &text, span);
                 children(self, kids);
             }
@@ -125,13 +111,7 @@ impl Dumper<'_> {
             ShapeKind::Repeat { child, period, count } => {
                 self.line(
                     indent,
-                    &format!(
-                        "repeat period {} count [{}, {}, {}]",
-                        vec(*period),
-                        count[0],
-                        count[1],
-                        count[2]
-                    ),
+                    &format!("repeat period {} count [{}, {}, {}]", vec(*period), count[0], count[1], count[2]),
                     span,
                 );
                 self.shape(indent + 1, child);
@@ -141,11 +121,7 @@ impl Dumper<'_> {
                 self.shape(indent + 1, child);
             }
             ShapeKind::Paint { child, material } => {
-                self.line(
-                    indent,
-                    &format!("paint {}", Self::material(material)),
-                    Some(material.span),
-                );
+                self.line(indent, &format!("paint {}", Self::material(material)), Some(material.span));
                 self.shape(indent + 1, child);
             }
         }
@@ -153,44 +129,25 @@ impl Dumper<'_> {
 
     fn mesh(&mut self, indent: usize, mesh: &Mesh) {
         let src = match &mesh.source {
-            MeshSource::UvSphere {
-                radius,
-                rings,
-                segments,
-            } => format!("uvsphere radius {} rings {rings} segments {segments}", num(*radius)),
+            MeshSource::UvSphere { radius, rings, segments } => {
+                format!("uvsphere radius {} rings {rings} segments {segments}", num(*radius))
+            }
             MeshSource::IcoSphere { radius, subdivisions } => {
                 format!("icosphere radius {} subdivisions {subdivisions}", num(*radius))
             }
             MeshSource::Box { half } => format!("box half {}", vec(*half)),
-            MeshSource::Cylinder {
-                radius,
-                half_height,
-                segments,
-            } => format!(
-                "cylinder radius {} half_height {} segments {segments}",
-                num(*radius),
-                num(*half_height)
-            ),
-            MeshSource::Torus {
-                major,
-                minor,
-                segments,
-                sides,
-            } => format!(
-                "torus major {} minor {} segments {segments} sides {sides}",
-                num(*major),
-                num(*minor)
-            ),
+            MeshSource::Cylinder { radius, half_height, segments } => {
+                format!("cylinder radius {} half_height {} segments {segments}", num(*radius), num(*half_height))
+            }
+            MeshSource::Torus { major, minor, segments, sides } => {
+                format!("torus major {} minor {} segments {segments} sides {sides}", num(*major), num(*minor))
+            }
             MeshSource::Plane { size } => format!("plane size {}", num(*size)),
             MeshSource::Isosurface { cell, .. } => format!("isosurface cell {}", num(*cell)),
             MeshSource::File { written, .. } => format!("file {written:?}"),
         };
         let shading = if mesh.smooth { "smooth" } else { "flat" };
-        self.line(
-            indent,
-            &format!("mesh {src} {shading} {}", Self::xf(&mesh.xf)),
-            Some(mesh.span),
-        );
+        self.line(indent, &format!("mesh {src} {shading} {}", Self::xf(&mesh.xf)), Some(mesh.span));
         if let Some(m) = &mesh.material {
             self.line(indent + 1, &format!("material {}", Self::material(m)), Some(m.span));
         }
@@ -202,20 +159,11 @@ impl Dumper<'_> {
 
 /// The IR as text: one line per node, children indented, each with its source location.
 pub fn dump(scene: &Scene, map: &SourceMap) -> String {
-    let mut d = Dumper {
-        out: String::new(),
-        map,
-    };
+    let mut d = Dumper { out: String::new(), map };
     let c = &scene.camera;
     d.line(
         0,
-        &format!(
-            "camera position {} look_at {} up {} fov {}",
-            vec(c.position),
-            vec(c.look_at),
-            vec(c.up),
-            num(c.fov)
-        ),
+        &format!("camera position {} look_at {} up {} fov {}", vec(c.position), vec(c.look_at), vec(c.up), num(c.fov)),
         c.span,
     );
     let s = &scene.settings;

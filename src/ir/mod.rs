@@ -55,13 +55,7 @@ pub const SEED_FOV: f64 = 53.13010235415598;
 
 impl Default for Camera {
     fn default() -> Camera {
-        Camera {
-            position: DVec3::ZERO,
-            look_at: DVec3::Z,
-            up: DVec3::Y,
-            fov: SEED_FOV,
-            span: None,
-        }
+        Camera { position: DVec3::ZERO, look_at: DVec3::Z, up: DVec3::Y, fov: SEED_FOV, span: None }
     }
 }
 
@@ -120,12 +114,7 @@ pub struct Material {
 impl Material {
     /// The colour of an object with no material anywhere above it: light grey, matte.
     pub fn default_grey() -> Material {
-        Material {
-            color: DVec3::splat(200.0),
-            specular: None,
-            reflective: 0.0,
-            span: Span::default(),
-        }
+        Material { color: DVec3::splat(200.0), specular: None, reflective: 0.0, span: Span::default() }
     }
 }
 

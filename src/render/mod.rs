@@ -36,13 +36,7 @@ impl Ray {
     /// A ray from `origin` along the unit vector `dir`, accepting hits in `[0, t_max]`.
     pub fn new(origin: Vec3A, dir: Vec3A, t_max: f32) -> Ray {
         debug_assert!(origin.is_finite() && dir.is_finite(), "non-finite ray");
-        Ray {
-            origin,
-            dir,
-            inv_dir: dir.recip(),
-            t_min: 0.0,
-            t_max,
-        }
+        Ray { origin, dir, inv_dir: dir.recip(), t_min: 0.0, t_max }
     }
 
     /// The point at distance `t`.
@@ -158,14 +152,7 @@ pub fn render(geometry: &dyn Geometry, frame: &Frame, progress: &(dyn Fn() + Syn
         pixels.extend_from_slice(&row);
         counters.add(&c);
     }
-    (
-        Image {
-            width: w,
-            height: h,
-            pixels,
-        },
-        counters,
-    )
+    (Image { width: w, height: h, pixels }, counters)
 }
 
 /// How far a secondary ray must start from a hit point to not find the same surface:

@@ -47,11 +47,7 @@ pub(super) fn trace(g: &dyn Geometry, frame: &Frame, ray: &Ray, depth: u32, c: &
     };
     let view = -ray.dir;
     // Seen from behind (inside a solid or a one-sided surface): shade the side we see.
-    let normal = if hit.normal.dot(view) < 0.0 {
-        -hit.normal
-    } else {
-        hit.normal
-    };
+    let normal = if hit.normal.dot(view) < 0.0 { -hit.normal } else { hit.normal };
     let material = frame.materials.materials[hit.material as usize];
     let origin = hit.point + normal * spawn_offset(hit.point, hit.error);
 
@@ -62,19 +58,11 @@ pub(super) fn trace(g: &dyn Geometry, frame: &Frame, ray: &Ray, depth: u32, c: &
                 intensity += a;
                 continue;
             }
-            ShadeLight::Point {
-                position,
-                intensity,
-                shadows,
-            } => {
+            ShadeLight::Point { position, intensity, shadows } => {
                 let l = position - hit.point;
                 (l, l.length(), intensity, shadows)
             }
-            ShadeLight::Directional {
-                towards,
-                intensity,
-                shadows,
-            } => (towards, f32::INFINITY, intensity, shadows),
+            ShadeLight::Directional { towards, intensity, shadows } => (towards, f32::INFINITY, intensity, shadows),
         };
         let l_len = to_light.length();
         if l_len <= 0.0 {
@@ -101,11 +89,7 @@ pub(super) fn trace(g: &dyn Geometry, frame: &Frame, ray: &Ray, depth: u32, c: &
         }
         if shadows {
             c.shadow_rays += 1;
-            let shadow = Ray::new(
-                origin,
-                l_unit,
-                (dist - spawn_offset(hit.point, hit.error)).min(frame.max_distance),
-            );
+            let shadow = Ray::new(origin, l_unit, (dist - spawn_offset(hit.point, hit.error)).min(frame.max_distance));
             if shadow.t_max > 0.0 && g.occluded(&shadow, c) {
                 continue;
             }
@@ -119,12 +103,6 @@ pub(super) fn trace(g: &dyn Geometry, frame: &Frame, ray: &Ray, depth: u32, c: &
     }
     let reflected_dir = (normal * (2.0 * normal.dot(view)) - view).normalize();
     c.reflection_rays += 1;
-    let reflected = trace(
-        g,
-        frame,
-        &Ray::new(origin, reflected_dir, frame.max_distance),
-        depth - 1,
-        c,
-    );
+    let reflected = trace(g, frame, &Ray::new(origin, reflected_dir, frame.max_distance), depth - 1, c);
     local * (1.0 - r) + reflected * r
 }

@@ -186,10 +186,7 @@ impl Builder<'_> {
                 let (d, m) = self.build(child, id, mat);
                 let rep = Repeat::new(period.as_vec3a(), *count);
                 let rep2 = rep.clone();
-                (
-                    self.sdf(move |p| rep.eval(p, |q| d(q))),
-                    self.mat(move |p| rep2.eval_mat(p, |q| m(q))),
-                )
+                (self.sdf(move |p| rep.eval(p, |q| d(q))), self.mat(move |p| rep2.eval_mat(p, |q| m(q))))
             }
             _ => self.build(shape, id, mat),
         }
@@ -208,27 +205,20 @@ impl Builder<'_> {
             Combine::Union => (
                 self.sdf(move |p| ds.iter().fold(f32::INFINITY, |a, f| a.min(f(p)))),
                 self.mat(move |p| {
-                    ms.iter()
-                        .map(|f| f(p))
-                        .fold((f32::INFINITY, 0), |a, b| if b.0 < a.0 { b } else { a })
+                    ms.iter().map(|f| f(p)).fold((f32::INFINITY, 0), |a, b| if b.0 < a.0 { b } else { a })
                 }),
             ),
             Combine::Intersect => (
                 self.sdf(move |p| ds.iter().fold(f32::NEG_INFINITY, |a, f| a.max(f(p)))),
                 self.mat(move |p| {
-                    ms.iter()
-                        .map(|f| f(p))
-                        .fold((f32::NEG_INFINITY, 0), |a, b| if b.0 > a.0 { b } else { a })
+                    ms.iter().map(|f| f(p)).fold((f32::NEG_INFINITY, 0), |a, b| if b.0 > a.0 { b } else { a })
                 }),
             ),
             Combine::Subtract => (
                 self.sdf(move |p| ds[1..].iter().fold(ds[0](p), |a, f| a.max(-f(p)))),
                 // The cut faces take the material of the part cut away.
                 self.mat(move |p| {
-                    ms[1..]
-                        .iter()
-                        .map(|f| f(p))
-                        .fold(ms[0](p), |a, (d, i)| if -d > a.0 { (-d, i) } else { a })
+                    ms[1..].iter().map(|f| f(p)).fold(ms[0](p), |a, (d, i)| if -d > a.0 { (-d, i) } else { a })
                 }),
             ),
         }
@@ -252,22 +242,9 @@ impl Builder<'_> {
             let vals: Vec<(f32, u32)> = ms.iter().map(|f| f(p)).collect();
             let dist = fold2(&mut vals.iter().map(|v| v.0));
             let id = match op {
-                Combine::Union => {
-                    vals.iter()
-                        .fold((f32::INFINITY, 0), |a, b| if b.0 < a.0 { *b } else { a })
-                        .1
-                }
-                Combine::Intersect => {
-                    vals.iter()
-                        .fold((f32::NEG_INFINITY, 0), |a, b| if b.0 > a.0 { *b } else { a })
-                        .1
-                }
-                Combine::Subtract => {
-                    vals[1..]
-                        .iter()
-                        .fold(vals[0], |a, &(d, i)| if -d > a.0 { (-d, i) } else { a })
-                        .1
-                }
+                Combine::Union => vals.iter().fold((f32::INFINITY, 0), |a, b| if b.0 < a.0 { *b } else { a }).1,
+                Combine::Intersect => vals.iter().fold((f32::NEG_INFINITY, 0), |a, b| if b.0 > a.0 { *b } else { a }).1,
+                Combine::Subtract => vals[1..].iter().fold(vals[0], |a, &(d, i)| if -d > a.0 { (-d, i) } else { a }).1,
             };
             (dist, id)
         });
@@ -336,9 +313,7 @@ impl Repeat {
     }
 
     fn eval_mat(&self, p: Vec3A, f: impl Fn(Vec3A) -> (f32, u32)) -> (f32, u32) {
-        self.cells(p)
-            .map(f)
-            .fold((f32::INFINITY, 0), |a, b| if b.0 < a.0 { b } else { a })
+        self.cells(p).map(f).fold((f32::INFINITY, 0), |a, b| if b.0 < a.0 { b } else { a })
     }
 }
 
@@ -347,10 +322,7 @@ fn similarity(m: DMat3) -> Option<f64> {
     let mtm = m.transpose() * m;
     let k2 = mtm.x_axis.x;
     let eye = DMat3::from_diagonal(glam::DVec3::splat(k2));
-    let close = (mtm - eye)
-        .to_cols_array()
-        .iter()
-        .all(|x| x.abs() <= 1e-12 * k2.max(1.0));
+    let close = (mtm - eye).to_cols_array().iter().all(|x| x.abs() <= 1e-12 * k2.max(1.0));
     (close && k2 > 0.0).then(|| k2.sqrt())
 }
 

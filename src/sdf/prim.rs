@@ -114,15 +114,9 @@ mod tests {
             let p = rng.point(2.5);
             assert!((sphere(p, 0.8) - (p.length() - 0.8)).abs() < 1e-5);
             assert!((cuboid(p, b) - box_reference(p, b)).abs() < 1e-5, "box at {p}");
-            assert!(
-                (cylinder(p, 0.6, 0.9) - cylinder_reference(p, 0.6, 0.9)).abs() < 1e-5,
-                "cylinder at {p}"
-            );
+            assert!((cylinder(p, 0.6, 0.9) - cylinder_reference(p, 0.6, 0.9)).abs() < 1e-5, "cylinder at {p}");
             let ring = Vec3A::new(p.x, 0.0, p.z).try_normalize().unwrap_or(Vec3A::X) * 1.2;
-            assert!(
-                (torus(p, 1.2, 0.3) - ((p - ring).length() - 0.3)).abs() < 1e-5,
-                "torus at {p}"
-            );
+            assert!((torus(p, 1.2, 0.3) - ((p - ring).length() - 0.3)).abs() < 1e-5, "torus at {p}");
             let seg = segment_distance(p, Vec3A::new(0.0, -0.5, 0.0), Vec3A::new(0.0, 0.5, 0.0));
             assert!((capsule(p, 0.4, 0.5) - (seg - 0.4)).abs() < 1e-5, "capsule at {p}");
             let n = Vec3A::new(0.3, 0.9, -0.2).normalize();

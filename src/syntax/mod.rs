@@ -64,13 +64,8 @@ fn clean_tokens<'s>(tokens: Vec<(Token<'s>, Span)>, diags: &mut Vec<Diagnostic>)
             }
             Token::BadNumber(s) => {
                 diags.push(
-                    Diagnostic::error(
-                        codes::BAD_NUMBER,
-                        span,
-                        format!("malformed number `{s}`"),
-                        "not a valid number",
-                    )
-                    .with_note("numbers look like `12`, `0.5` or `1.5e-3`"),
+                    Diagnostic::error(codes::BAD_NUMBER, span, format!("malformed number `{s}`"), "not a valid number")
+                        .with_note("numbers look like `12`, `0.5` or `1.5e-3`"),
                 );
                 // An empty number evaluates to poison: no second error for the same mistake.
                 out.push((Token::Number(""), span));
@@ -137,9 +132,7 @@ fn check_nesting(tokens: &[(Token<'_>, Span)]) -> Option<Diagnostic> {
                             "brackets nest too deeply",
                             format!("nesting depth {MAX_NESTING} is exceeded here"),
                         )
-                        .with_note(format!(
-                            "scnc accepts at most {MAX_NESTING} levels of `(`, `[` and `{{`"
-                        )),
+                        .with_note(format!("scnc accepts at most {MAX_NESTING} levels of `(`, `[` and `{{`")),
                     );
                 }
             }
@@ -180,21 +173,10 @@ fn to_diagnostic(err: &parser::ParseError<'_, '_>) -> Diagnostic {
             Diagnostic::error(codes::SYNTAX, span, msg.clone(), "not expected here")
         }
         chumsky::error::RichReason::ExpectedFound { .. } => {
-            let mut items: Vec<String> = err
-                .expected()
-                .filter(|p| !matches!(p, RichPattern::SomethingElse))
-                .map(describe)
-                .collect();
+            let mut items: Vec<String> =
+                err.expected().filter(|p| !matches!(p, RichPattern::SomethingElse)).map(describe).collect();
             // The pieces an expression may start with read better as one word.
-            const STARTS: [&str; 7] = [
-                "`(`",
-                "`-`",
-                "identifier",
-                "literal",
-                "mesh",
-                "vector or list",
-                "expression",
-            ];
+            const STARTS: [&str; 7] = ["`(`", "`-`", "identifier", "literal", "mesh", "vector or list", "expression"];
             if items.iter().filter(|i| STARTS.contains(&i.as_str())).count() > 1 {
                 items.retain(|i| !STARTS.contains(&i.as_str()));
                 items.push("expression".into());
@@ -209,10 +191,7 @@ fn to_diagnostic(err: &parser::ParseError<'_, '_>) -> Diagnostic {
             for (label, ctx_span) in err.contexts() {
                 d = d.with_label(Span::from(*ctx_span), format!("while parsing this {}", describe(label)));
             }
-            let keyword = err
-                .found()
-                .map(|t| t.to_string())
-                .filter(|t| Token::KEYWORDS.contains(&t.as_str()));
+            let keyword = err.found().map(|t| t.to_string()).filter(|t| Token::KEYWORDS.contains(&t.as_str()));
             if let (Some(kw), true) = (keyword, expected.contains("identifier")) {
                 d = d.with_note(format!("`{kw}` is a keyword and cannot be used as a name"));
             }
@@ -232,10 +211,8 @@ pub fn parse(text: &str, base: u32) -> (ast::File, Vec<Diagnostic>) {
     }
     let eoi = SimpleSpan::from(base as usize + text.len()..base as usize + text.len());
     // The parser works on chumsky's span type; ours convert back from it.
-    let tokens_ss: Vec<(Token<'_>, SimpleSpan)> = tokens
-        .iter()
-        .map(|(t, s)| (t.clone(), SimpleSpan::from(s.range())))
-        .collect();
+    let tokens_ss: Vec<(Token<'_>, SimpleSpan)> =
+        tokens.iter().map(|(t, s)| (t.clone(), SimpleSpan::from(s.range()))).collect();
     let input = tokens_ss.as_slice().map(eoi, |(t, s)| (t, s));
     let (file, errs) = parser::file().parse(input).into_output_errors();
     diags.extend(errs.iter().map(to_diagnostic));

@@ -19,10 +19,7 @@ const OTHER_DELIMS: [(Token<'static>, Token<'static>); 2] =
     [(Token::LBracket, Token::RBracket), (Token::LBrace, Token::RBrace)];
 
 fn error_expr(span: SimpleSpan) -> Expr {
-    Expr {
-        kind: ExprKind::Error,
-        span: span.into(),
-    }
+    Expr { kind: ExprKind::Error, span: span.into() }
 }
 
 fn ident<'t, 's: 't, I>() -> impl Parser<'t, I, Ident, Extra<'t, 's>> + Clone
@@ -30,10 +27,7 @@ where
     I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
 {
     select! { Token::Ident(s) => s }
-        .map_with(|s: &str, e| Ident {
-            name: s.to_string(),
-            span: Span::from(e.span()),
-        })
+        .map_with(|s: &str, e| Ident { name: s.to_string(), span: Span::from(e.span()) })
         .labelled("identifier")
 }
 
@@ -67,11 +61,7 @@ where
     I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
     P: Parser<'t, I, Expr, Extra<'t, 's>> + Clone,
 {
-    let arg = ident()
-        .then_ignore(just(Token::Eq))
-        .or_not()
-        .then(expr)
-        .map(|(name, value)| Arg { name, value });
+    let arg = ident().then_ignore(just(Token::Eq)).or_not().then(expr).map(|(name, value)| Arg { name, value });
     arg.separated_by(just(Token::Comma))
         .allow_trailing()
         .collect::<Vec<_>>()
@@ -82,12 +72,7 @@ where
             Token::RParen,
             OTHER_DELIMS,
             // One error argument tells the checker not to report arity on a list it never saw.
-            |span| {
-                vec![Arg {
-                    name: None,
-                    value: error_expr(span),
-                }]
-            },
+            |span| vec![Arg { name: None, value: error_expr(span) }],
         )))
 }
 
@@ -105,9 +90,7 @@ where
         }
         .labelled("literal");
 
-        let call = ident()
-            .then(args(expr.clone()))
-            .map(|(callee, args)| ExprKind::Call { callee, args });
+        let call = ident().then(args(expr.clone())).map(|(callee, args)| ExprKind::Call { callee, args });
 
         let list = expr
             .clone()
@@ -132,17 +115,9 @@ where
             list,
             mesh,
         ))
-        .map_with(|kind, e| Expr {
-            kind,
-            span: Span::from(e.span()),
-        })
+        .map_with(|kind, e| Expr { kind, span: Span::from(e.span()) })
         .or(expr.clone().delimited_by(just(Token::LParen), just(Token::RParen)))
-        .recover_with(via_parser(nested_delimiters(
-            Token::LParen,
-            Token::RParen,
-            OTHER_DELIMS,
-            error_expr,
-        )))
+        .recover_with(via_parser(nested_delimiters(Token::LParen, Token::RParen, OTHER_DELIMS, error_expr)))
         .recover_with(via_parser(nested_delimiters(
             Token::LBracket,
             Token::RBracket,
@@ -152,14 +127,9 @@ where
         .boxed();
 
         let index = atom.foldl_with(
-            expr.clone()
-                .delimited_by(just(Token::LBracket), just(Token::RBracket))
-                .repeated(),
+            expr.clone().delimited_by(just(Token::LBracket), just(Token::RBracket)).repeated(),
             |base, index, e| Expr {
-                kind: ExprKind::Index {
-                    base: Box::new(base),
-                    index: Box::new(index),
-                },
+                kind: ExprKind::Index { base: Box::new(base), index: Box::new(index) },
                 span: Span::from(e.span()),
             },
         );
@@ -180,21 +150,14 @@ where
                 operand
                     .clone()
                     .foldl_with(op.then(operand).repeated(), |lhs, (op, rhs), e| Expr {
-                        kind: ExprKind::Binary {
-                            op,
-                            lhs: Box::new(lhs),
-                            rhs: Box::new(rhs),
-                        },
+                        kind: ExprKind::Binary { op, lhs: Box::new(lhs), rhs: Box::new(rhs) },
                         span: Span::from(e.span()),
                     })
                     .boxed()
             }
         };
-        let product = binary(&[
-            (Token::Star, BinOp::Mul),
-            (Token::Slash, BinOp::Div),
-            (Token::Percent, BinOp::Rem),
-        ])(unary);
+        let product =
+            binary(&[(Token::Star, BinOp::Mul), (Token::Slash, BinOp::Div), (Token::Percent, BinOp::Rem)])(unary);
         let sum = binary(&[(Token::Plus, BinOp::Add), (Token::Minus, BinOp::Sub)])(product);
 
         let transform_op = select! {
@@ -206,16 +169,9 @@ where
         .map_with(|op, e| (op, Span::from(e.span())));
 
         sum.clone()
-            .foldl_with(transform_op.then(sum).repeated(), |target, ((op, op_span), arg), e| {
-                Expr {
-                    kind: ExprKind::Transform {
-                        op,
-                        op_span,
-                        target: Box::new(target),
-                        arg: Box::new(arg),
-                    },
-                    span: Span::from(e.span()),
-                }
+            .foldl_with(transform_op.then(sum).repeated(), |target, ((op, op_span), arg), e| Expr {
+                kind: ExprKind::Transform { op, op_span, target: Box::new(target), arg: Box::new(arg) },
+                span: Span::from(e.span()),
             })
             .labelled("expression")
     })
@@ -249,16 +205,10 @@ where
             |kw: Token<'static>, name: &'static str| just(kw).ignore_then(args(expr())).labelled(name).as_context();
         let camera = settings(Token::Camera, "camera statement").map(StmtKind::Camera);
         let render = settings(Token::Render, "render statement").map(StmtKind::Render);
-        let light = just(Token::Light)
-            .ignore_then(e.clone())
-            .map(StmtKind::Light)
-            .labelled("light statement")
-            .as_context();
-        let object = just(Token::Object)
-            .ignore_then(e.clone())
-            .map(StmtKind::Object)
-            .labelled("object statement")
-            .as_context();
+        let light =
+            just(Token::Light).ignore_then(e.clone()).map(StmtKind::Light).labelled("light statement").as_context();
+        let object =
+            just(Token::Object).ignore_then(e.clone()).map(StmtKind::Object).labelled("object statement").as_context();
         let params = ident()
             .separated_by(just(Token::Comma))
             .allow_trailing()
@@ -273,10 +223,7 @@ where
             .map(|((name, params), value)| StmtKind::Let { name, params, value })
             .labelled("let statement")
             .as_context();
-        let body = stmt
-            .repeated()
-            .collect::<Vec<_>>()
-            .delimited_by(just(Token::LBrace), just(Token::RBrace));
+        let body = stmt.repeated().collect::<Vec<_>>().delimited_by(just(Token::LBrace), just(Token::RBrace));
         let for_ = just(Token::For)
             .ignore_then(ident())
             .then_ignore(just(Token::In))
@@ -298,10 +245,7 @@ where
             .as_context();
 
         choice((camera, render, light, object, let_, for_, include))
-            .map_with(|kind, e| Stmt {
-                kind,
-                span: Span::from(e.span()),
-            })
+            .map_with(|kind, e| Stmt { kind, span: Span::from(e.span()) })
             .labelled("statement")
             // Skip the bad statement up to the next one, so later mistakes are reported too.
             .recover_with(via_parser(
@@ -309,23 +253,13 @@ where
                     .and_is(just(Token::RBrace).not())
                     .ignored()
                     .then(any().and_is(stmt_start().not()).repeated())
-                    .map_with(|_, e| Stmt {
-                        kind: StmtKind::Error,
-                        span: Span::from(e.span()),
-                    }),
+                    .map_with(|_, e| Stmt { kind: StmtKind::Error, span: Span::from(e.span()) }),
             ))
     });
     // A `}` with no `for` to close is reported and skipped at the top level.
     let stray_brace = just(Token::RBrace).validate(|_, e, emitter| {
         emitter.emit(Rich::custom(e.span(), "unmatched `}`"));
-        Stmt {
-            kind: StmtKind::Error,
-            span: Span::from(e.span()),
-        }
+        Stmt { kind: StmtKind::Error, span: Span::from(e.span()) }
     });
-    stmt.or(stray_brace)
-        .repeated()
-        .collect::<Vec<_>>()
-        .then_ignore(end())
-        .map(|stmts| File { stmts })
+    stmt.or(stray_brace).repeated().collect::<Vec<_>>().then_ignore(end()).map(|stmts| File { stmts })
 }

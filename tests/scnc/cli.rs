@@ -3,11 +3,7 @@
 use std::process::Command;
 
 fn scnc(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_scnc"))
-        .args(args)
-        .env("NO_COLOR", "1")
-        .output()
-        .expect("running scnc")
+    Command::new(env!("CARGO_BIN_EXE_scnc")).args(args).env("NO_COLOR", "1").output().expect("running scnc")
 }
 
 #[test]
@@ -30,10 +26,7 @@ fn check_errors_exit_1_with_diagnostics_on_stderr() {
 fn usage_errors_exit_2() {
     assert_eq!(scnc(&["check"]).status.code(), Some(2));
     assert_eq!(scnc(&["frobnicate"]).status.code(), Some(2));
-    assert_eq!(
-        scnc(&["check", "--message-format", "xml", "a.scn"]).status.code(),
-        Some(2)
-    );
+    assert_eq!(scnc(&["check", "--message-format", "xml", "a.scn"]).status.code(), Some(2));
 }
 
 #[test]
@@ -45,25 +38,16 @@ fn missing_file_is_an_error() {
 
 #[test]
 fn json_message_format_has_one_object_per_diagnostic() {
-    let out = scnc(&[
-        "check",
-        "--message-format",
-        "json",
-        "tests/data/diag/two-syntax-errors.scn",
-    ]);
+    let out = scnc(&["check", "--message-format", "json", "tests/data/diag/two-syntax-errors.scn"]);
     assert_eq!(out.status.code(), Some(1));
     let text = String::from_utf8_lossy(&out.stderr);
-    let lines: Vec<serde_json::Value> = text
-        .lines()
-        .map(|l| serde_json::from_str(l).expect("valid JSON line"))
-        .collect();
+    let lines: Vec<serde_json::Value> =
+        text.lines().map(|l| serde_json::from_str(l).expect("valid JSON line")).collect();
     assert_eq!(lines.len(), 2, "{text}");
     for v in &lines {
         assert_eq!(v["severity"], "error");
         assert_eq!(v["code"], "E0100");
-        assert!(v["span"]["file"]
-            .as_str()
-            .is_some_and(|f| f.ends_with("two-syntax-errors.scn")));
+        assert!(v["span"]["file"].as_str().is_some_and(|f| f.ends_with("two-syntax-errors.scn")));
         assert!(v["span"]["line_start"].as_u64().is_some_and(|l| l >= 1));
         assert!(v["span"]["byte_end"].as_u64() >= v["span"]["byte_start"].as_u64());
     }
@@ -124,29 +108,15 @@ fn render_writes_a_png() {
 fn failed_render_leaves_no_file_and_keeps_an_existing_one() {
     let dir = tempfile::tempdir().expect("tempdir");
     let fresh = dir.path().join("fresh.png");
-    let o = scnc(&[
-        "render",
-        "tests/data/diag/unknown-function.scn",
-        "-o",
-        fresh.to_str().unwrap_or_default(),
-    ]);
+    let o = scnc(&["render", "tests/data/diag/unknown-function.scn", "-o", fresh.to_str().unwrap_or_default()]);
     assert_eq!(o.status.code(), Some(1));
     assert!(!fresh.exists(), "an image was written for a scene with errors");
     let existing = dir.path().join("existing.png");
     std::fs::write(&existing, b"keep me").expect("write");
-    let o = scnc(&[
-        "render",
-        "tests/data/diag/unknown-function.scn",
-        "-o",
-        existing.to_str().unwrap_or_default(),
-    ]);
+    let o = scnc(&["render", "tests/data/diag/unknown-function.scn", "-o", existing.to_str().unwrap_or_default()]);
     assert_eq!(o.status.code(), Some(1));
     assert_eq!(std::fs::read(&existing).expect("read"), b"keep me");
-    assert_eq!(
-        std::fs::read_dir(dir.path()).expect("dir").count(),
-        1,
-        "no temporary file may remain"
-    );
+    assert_eq!(std::fs::read_dir(dir.path()).expect("dir").count(), 1, "no temporary file may remain");
 }
 
 #[test]
@@ -158,37 +128,17 @@ fn render_rejects_bad_flags_with_exit_2() {
         vec!["render", "examples/seed/01-sphere.scn", "-o", png, "--width", "0"],
         vec!["render", "examples/seed/01-sphere.scn", "-o", png, "--epsilon", "2"],
         vec!["render", "examples/seed/01-sphere.scn", "-o", png, "--threads", "0"],
-        vec![
-            "render",
-            "examples/seed/01-sphere.scn",
-            "-o",
-            png,
-            "--max-steps",
-            "lots",
-        ],
+        vec!["render", "examples/seed/01-sphere.scn", "-o", png, "--max-steps", "lots"],
         vec!["render", "examples/seed/01-sphere.scn"],
     ] {
         let o = scnc(&args);
-        assert_eq!(
-            o.status.code(),
-            Some(2),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&o.stderr)
-        );
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
     }
     let jpg = dir.path().join("a.jpg");
-    let o = scnc(&[
-        "render",
-        "examples/seed/01-sphere.scn",
-        "-o",
-        jpg.to_str().unwrap_or_default(),
-    ]);
+    let o = scnc(&["render", "examples/seed/01-sphere.scn", "-o", jpg.to_str().unwrap_or_default()]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("scnc writes PNG"));
     let o = scnc(&["render", "examples/seed/01-sphere.scn", "-o", "/no/such/dir/a.png"]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(
-        std::fs::read_dir(dir.path()).expect("dir").next().is_none(),
-        "nothing may be written"
-    );
+    assert!(std::fs::read_dir(dir.path()).expect("dir").next().is_none(), "nothing may be written");
 }

@@ -6,11 +6,7 @@ use crate::support::{cases, check_golden, compile, finish};
 #[test]
 fn ir_dumps() {
     let cases = cases("tests/data/ir");
-    assert!(
-        cases.len() >= 25,
-        "expected at least 25 IR cases, found {}",
-        cases.len()
-    );
+    assert!(cases.len() >= 25, "expected at least 25 IR cases, found {}", cases.len());
     let mut failures = Vec::new();
     for path in cases {
         let c = compile(&path);
@@ -33,11 +29,7 @@ fn ir_dumps() {
 #[test]
 fn diagnostics() {
     let cases = cases("tests/data/diag");
-    assert!(
-        cases.len() >= 40,
-        "expected at least 40 diagnostic cases, found {}",
-        cases.len()
-    );
+    assert!(cases.len() >= 40, "expected at least 40 diagnostic cases, found {}", cases.len());
     let mut failures = Vec::new();
     for path in cases {
         let c = compile(&path);
@@ -62,11 +54,7 @@ fn examples_check_clean() {
             }
             let c = compile(&path);
             if !c.diagnostics.is_empty() || c.scene.is_none() {
-                failures.push(format!(
-                    "{}:\n{}",
-                    path.display(),
-                    scnc::diag::render_all(&c.diagnostics, &c.map)
-                ));
+                failures.push(format!("{}:\n{}", path.display(), scnc::diag::render_all(&c.diagnostics, &c.map)));
             }
         }
     }
@@ -97,12 +85,7 @@ fn lexer_covers_every_byte() {
         }
         for (i, b) in text.bytes().enumerate() {
             if !covered[i] {
-                assert!(
-                    b.is_ascii_whitespace(),
-                    "{}: byte {i} ({:?}) not covered",
-                    path.display(),
-                    b as char
-                );
+                assert!(b.is_ascii_whitespace(), "{}: byte {i} ({:?}) not covered", path.display(), b as char);
             }
         }
     }
@@ -121,9 +104,27 @@ fn every_code_is_documented() {
         .collect();
     assert!(codes.len() >= 30, "found only {} codes", codes.len());
     for code in codes {
-        assert!(
-            docs.contains(&format!("| {code} |")),
-            "{code} is not documented in docs/errors.md"
-        );
+        assert!(docs.contains(&format!("| {code} |")), "{code} is not documented in docs/errors.md");
     }
+}
+
+/// Lowering problems (mesh files, isosurface limits) are diagnostics at the object's
+/// source, rendered exactly as in `NAME.txt`.
+#[test]
+fn lowering_diagnostics() {
+    let mut failures = Vec::new();
+    for path in cases("tests/data/lower") {
+        let c = compile(&path);
+        let Some(scene) = &c.scene else {
+            failures.push(format!("{}: did not compile", path.display()));
+            continue;
+        };
+        let mut frame = scnc::render::Frame::new(scene);
+        let params = scnc::sdf::MarchParams { epsilon: 1e-4, max_steps: 64 };
+        match scnc::world::lower(scene, &mut frame, scnc::world::Mode::Sdf, params, &scnc::check::FsLoader) {
+            Ok(_) => failures.push(format!("{}: lowered without an error", path.display())),
+            Err(d) => failures.extend(check_golden(&path.with_extension("txt"), &d.render(&c.map, false))),
+        }
+    }
+    finish(failures);
 }

@@ -2,6 +2,7 @@
 
 mod cli;
 mod golden;
+mod mesh;
 mod nopanic;
 mod render;
 mod support;

@@ -4,35 +4,33 @@ use std::path::Path;
 
 use glam::Vec3A;
 use scnc::render::{Counters, Frame, Image};
+use scnc::world::{Detail, Mode};
 
 use crate::support::{cases, finish, updating, Rng};
 
 /// Compiles and renders scene text at `w × h` on a pool of `threads`.
 pub fn render_text(text: &str, w: u32, h: u32, threads: usize) -> (Image, Counters) {
     let c = scnc::compile_source("t.scn", Path::new("t.scn"), text.to_string(), &scnc::check::FsLoader);
-    let scene = c.scene.unwrap_or_else(|| {
-        panic!(
-            "scene did not compile:\n{}",
-            scnc::diag::render_all(&c.diagnostics, &c.map)
-        )
-    });
+    let scene =
+        c.scene.unwrap_or_else(|| panic!("scene did not compile:\n{}", scnc::diag::render_all(&c.diagnostics, &c.map)));
     render_scene(scene, w, h, threads)
 }
 
-pub fn render_scene(mut scene: scnc::ir::Scene, w: u32, h: u32, threads: usize) -> (Image, Counters) {
+pub fn render_scene(scene: scnc::ir::Scene, w: u32, h: u32, threads: usize) -> (Image, Counters) {
+    render_mode(scene, w, h, threads, Mode::Sdf)
+}
+
+/// Renders with shapes lowered by `mode`.
+pub fn render_mode(mut scene: scnc::ir::Scene, w: u32, h: u32, threads: usize, mode: Mode) -> (Image, Counters) {
     scene.settings.width = w;
     scene.settings.height = h;
     let mut frame = Frame::new(&scene);
-    let params = scnc::sdf::MarchParams {
-        epsilon: scene.settings.epsilon as f32,
-        max_steps: scene.settings.max_steps,
-    };
-    let geometry = scnc::sdf::lower(&scene, &mut frame, params).expect("lowering");
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .expect("pool");
-    pool.install(|| scnc::render::render(&geometry, &frame, &|| {}))
+    let params = scnc::sdf::MarchParams { epsilon: scene.settings.epsilon as f32, max_steps: scene.settings.max_steps };
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool");
+    pool.install(|| {
+        let geometry = scnc::world::lower(&scene, &mut frame, mode, params, &scnc::check::FsLoader).expect("lowering");
+        scnc::render::render(&geometry, &frame, &|| {})
+    })
 }
 
 /// Golden images: a channel may differ by up to 2/255 (float reassociation between
@@ -43,13 +41,7 @@ const GOLDEN_SIZE: u32 = 128;
 
 fn compare(expected: &image::RgbImage, actual: &Image) -> Result<(), String> {
     if expected.width() != actual.width || expected.height() != actual.height {
-        return Err(format!(
-            "size {}×{} vs {}×{}",
-            expected.width(),
-            expected.height(),
-            actual.width,
-            actual.height
-        ));
+        return Err(format!("size {}×{} vs {}×{}", expected.width(), expected.height(), actual.width, actual.height));
     }
     let differing = expected
         .as_raw()
@@ -59,9 +51,7 @@ fn compare(expected: &image::RgbImage, actual: &Image) -> Result<(), String> {
         .count();
     let allowed = (MAX_DIFFERING_FRACTION * (actual.width * actual.height) as f64) as usize;
     if differing > allowed {
-        return Err(format!(
-            "{differing} pixels differ by more than {CHANNEL_TOLERANCE}/255 (at most {allowed} may)"
-        ));
+        return Err(format!("{differing} pixels differ by more than {CHANNEL_TOLERANCE}/255 (at most {allowed} may)"));
     }
     Ok(())
 }
@@ -71,14 +61,9 @@ fn save(path: &Path, img: &Image) {
         .unwrap_or_else(|e| panic!("writing {}: {e}", path.display()));
 }
 
-#[test]
-fn golden_images_sdf() {
-    let cases = cases("tests/data/render");
-    assert!(
-        cases.len() >= 14,
-        "expected the seed and feature scenes, found {}",
-        cases.len()
-    );
+fn golden_images(mode: Mode, suffix: &str, filter: &dyn Fn(&Path) -> bool) {
+    let cases: Vec<_> = cases("tests/data/render").into_iter().filter(|p| filter(p)).collect();
+    assert!(!cases.is_empty(), "no render cases");
     let mut failures = Vec::new();
     for path in cases {
         let c = crate::support::compile(&path);
@@ -86,9 +71,9 @@ fn golden_images_sdf() {
             failures.push(format!("{}: did not compile", path.display()));
             continue;
         };
-        let (img, counters) = render_scene(scene, GOLDEN_SIZE, GOLDEN_SIZE, 2);
+        let (img, counters) = render_mode(scene, GOLDEN_SIZE, GOLDEN_SIZE, 2, mode);
         assert_eq!(counters.nonfinite_samples, 0, "{}: non-finite colours", path.display());
-        let golden = path.with_extension("sdf.png");
+        let golden = path.with_extension(format!("{suffix}.png"));
         let expected = image::open(&golden).ok().map(|i| i.to_rgb8());
         let verdict = expected.as_ref().map(|e| compare(e, &img));
         match verdict {
@@ -97,10 +82,7 @@ fn golden_images_sdf() {
             Some(Err(why)) if !updating() => {
                 let out = Path::new("target/test-output");
                 let _ = std::fs::create_dir_all(out);
-                let name = golden
-                    .file_name()
-                    .map(|n| n.to_string_lossy().into_owned())
-                    .unwrap_or_default();
+                let name = golden.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
                 save(&out.join(format!("actual-{name}")), &img);
                 failures.push(format!(
                     "{}: {why} (actual image in target/test-output; UPDATE_EXPECT=1 to accept)",
@@ -121,14 +103,31 @@ fn golden_images_sdf() {
     finish(failures);
 }
 
+fn is_seed(p: &Path) -> bool {
+    p.file_name().is_some_and(|n| n.to_string_lossy().starts_with("seed-"))
+}
+
+#[test]
+fn golden_images_sdf() {
+    golden_images(Mode::Sdf, "sdf", &|_| true);
+}
+
+#[test]
+fn golden_images_mesh_low() {
+    golden_images(Mode::Mesh(Detail::Low), "mesh-low", &is_seed);
+}
+
+#[test]
+fn golden_images_mesh_high() {
+    golden_images(Mode::Mesh(Detail::High), "mesh-high", &is_seed);
+}
+
 #[test]
 fn image_is_identical_for_any_thread_count() {
-    let text = std::fs::read_to_string("examples/seed/05-mirrors.scn")
-        .expect("scene")
-        .replace(
-            "include \"lights.scn\"",
-            "light ambient(0.2)\nlight point(0.6) at [2, 1, 0]\nlight directional(0.2, towards = [1, 4, 4])",
-        );
+    let text = std::fs::read_to_string("examples/seed/05-mirrors.scn").expect("scene").replace(
+        "include \"lights.scn\"",
+        "light ambient(0.2)\nlight point(0.6) at [2, 1, 0]\nlight directional(0.2, towards = [1, 4, 4])",
+    );
     let (one, c1) = render_text(&text, 96, 80, 1);
     for threads in [2, 3] {
         let (many, cn) = render_text(&text, 96, 80, threads);
@@ -181,25 +180,16 @@ fn every_evaluator_is_a_distance_bound() {
     for shape in shapes {
         let text = format!("light ambient(1)\nobject {shape} at [0, 0, 5]\n");
         let c = scnc::compile_source("t.scn", Path::new("t.scn"), text, &scnc::check::FsLoader);
-        let scene = c
-            .scene
-            .unwrap_or_else(|| panic!("{shape}: {}", scnc::diag::render_all(&c.diagnostics, &c.map)));
+        let scene = c.scene.unwrap_or_else(|| panic!("{shape}: {}", scnc::diag::render_all(&c.diagnostics, &c.map)));
         let mut frame = Frame::new(&scene);
-        let g = scnc::sdf::lower(
-            &scene,
-            &mut frame,
-            scnc::sdf::MarchParams {
-                epsilon: 1e-4,
-                max_steps: 100,
-            },
-        )
-        .expect("lower");
+        let params = scnc::sdf::MarchParams { epsilon: 1e-4, max_steps: 100 };
+        let g = scnc::world::lower(&scene, &mut frame, Mode::Sdf, params, &scnc::check::FsLoader).expect("lower");
         for _ in 0..4000 {
             let centre = Vec3A::new(0.0, 0.0, 5.0);
             let p = centre + rng.vec(3.0);
             let step = rng.f32().powi(3) * 2.0;
             let q = p + rng.vec(step);
-            let (fp, fq) = (scnc::sdf::eval(&g, 0, p), scnc::sdf::eval(&g, 0, q));
+            let (fp, fq) = (g.sdf_eval(0, p).expect("sdf object"), g.sdf_eval(0, q).expect("sdf object"));
             assert!(fp.is_finite() && fq.is_finite(), "{shape}: non-finite at {p} or {q}");
             let tolerance = 1e-4 * (1.0 + fp.abs().max(fq.abs()));
             assert!(

@@ -19,9 +19,7 @@ pub fn cases(dir: &str) -> Vec<PathBuf> {
 /// Compiles a file, naming it by its file name only so goldens do not depend on the checkout.
 pub fn compile(path: &Path) -> Compiled {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
-    let name = path
-        .file_name()
-        .map_or(String::new(), |n| n.to_string_lossy().into_owned());
+    let name = path.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned());
     scnc::with_big_stack(|| scnc::compile_source(&name, path, text, &FsLoader))
 }
 
@@ -64,10 +62,7 @@ pub fn check_golden(golden: &Path, actual: &str) -> Option<String> {
         if updating() {
             return None;
         }
-        return Some(format!(
-            "{}: golden file was missing; written, review it and run again",
-            golden.display()
-        ));
+        return Some(format!("{}: golden file was missing; written, review it and run again", golden.display()));
     }
     Some(format!(
         "{} differs (rerun with UPDATE_EXPECT=1 to accept):\n{}",
@@ -78,12 +73,7 @@ pub fn check_golden(golden: &Path, actual: &str) -> Option<String> {
 
 /// Panics listing every failure.
 pub fn finish(failures: Vec<String>) {
-    assert!(
-        failures.is_empty(),
-        "{} case(s) failed:\n\n{}",
-        failures.len(),
-        failures.join("\n\n")
-    );
+    assert!(failures.is_empty(), "{} case(s) failed:\n\n{}", failures.len(), failures.join("\n\n"));
 }
 
 /// A small deterministic generator (xorshift), so failures reproduce.

@@ -1,0 +1,195 @@
+//! Lowering IR geometry to mesh objects: explicit `mesh …` objects, and shape objects
+//! tessellated at a detail level (primitives by their generators, anything else by
+//! isosurface, a plane as a square reaching the far limit). Failures are diagnostics
+//! that point at the source.
+
+use glam::{DAffine3, DVec3};
+
+use super::{isosurface, obj, tessellate, MeshObject, TriMesh};
+use crate::check::Loader;
+use crate::diag::{codes, Diagnostic};
+use crate::ir::{self, MeshSource, Shape, ShapeKind};
+use crate::sdf::Builder;
+use crate::span::Span;
+use crate::world::Detail;
+
+/// Tessellates a shape object at `detail`.
+pub fn tessellate(
+    shape: &Shape,
+    xf: DAffine3,
+    detail: Detail,
+    max_distance: f64,
+    builder: &mut Builder<'_>,
+) -> Result<MeshObject, Diagnostic> {
+    // Walk down through transforms and materials to a primitive that has a generator.
+    let (mut node, mut xf, mut material) = (shape, xf, 0u32);
+    loop {
+        match &node.kind {
+            ShapeKind::Transform { child, xf: inner } => {
+                xf *= *inner;
+                node = child;
+            }
+            ShapeKind::Paint { child, material: m } => {
+                material = builder.materials.intern(m);
+                node = child;
+            }
+            _ => break,
+        }
+    }
+    let (rings, circle) = (detail.rings(), detail.circle());
+    let generated = match node.kind {
+        ShapeKind::Sphere { radius } => Some(tessellate::uvsphere(radius, rings, 2 * rings)),
+        ShapeKind::Box { half } => Some(tessellate::cuboid(half)),
+        ShapeKind::Cylinder { radius, half_height } => Some(tessellate::cylinder(radius, half_height, circle)),
+        ShapeKind::Cone { radius, half_height } => Some(tessellate::cone(radius, half_height, circle)),
+        ShapeKind::Torus { major, minor } => Some(tessellate::torus(major, minor, circle, rings)),
+        ShapeKind::Plane { normal, offset } => {
+            // A square centred on the point of the plane nearest the camera, reaching the far limit.
+            let inv = xf.inverse();
+            let eye = inv.transform_point3(DVec3::ZERO);
+            let foot = eye - normal * (normal.dot(eye) - offset);
+            let up = if normal.y.abs() < 0.9 { DVec3::Y } else { DVec3::X };
+            let u = normal.cross(up).normalize();
+            let w = normal.cross(u);
+            let frame = DAffine3::from_cols(u, normal, w, foot);
+            // Scale by the inverse's stretch so the square reaches `max_distance` in render space.
+            let reach = max_distance * inv.matrix3.to_cols_array().iter().fold(0.0f64, |a, x| a.max(x.abs())) * 2.0;
+            return Ok(MeshObject::new(&tessellate::square(reach.max(1.0)), xf * frame, material, None, false));
+        }
+        _ => None,
+    };
+    if let Some(mesh) = generated {
+        return Ok(MeshObject::new(&mesh, xf, material, None, false));
+    }
+    // Everything else: an isosurface of the subtree in render space, at a cell size that
+    // follows the detail (a 1/(4·rings) fraction of the bounding diameter).
+    let bounds = ir::shape_bounds(node).ok_or_else(|| unbounded(node.span))?.transform(&xf);
+    let diameter = (bounds.max - bounds.min).length();
+    let cell = diameter / (4.0 * rings as f64);
+    iso_object(node, xf, material, bounds, cell, false, node.span, builder)
+}
+
+fn unbounded(span: Span) -> Diagnostic {
+    Diagnostic::error(codes::LOWERING, span, "cannot tessellate an unbounded shape", "this shape has no finite extent")
+        .with_note("an isosurface needs finite bounds; only a bare `plane` is meshed as a large square")
+        .with_hint("try intersecting it with a `box` to bound it")
+}
+
+#[allow(clippy::too_many_arguments, reason = "the isosurface needs the shape, frame, material, grid and source span")]
+fn iso_object(
+    shape: &Shape,
+    xf: DAffine3,
+    material: u32,
+    bounds: ir::Aabb,
+    cell: f64,
+    smooth: bool,
+    span: Span,
+    builder: &mut Builder<'_>,
+) -> Result<MeshObject, Diagnostic> {
+    let (dist, mat) = builder.build(shape, xf, material);
+    let mesh = isosurface::extract(&*dist, bounds.min, bounds.max, cell).map_err(|e| match e {
+        isosurface::IsoError::TooManyCells { cells, min_cell } => Diagnostic::error(
+            codes::LOWERING,
+            span,
+            "isosurface grid is too fine",
+            format!("cell {} needs {cells} grid cells", ir::dump_num(cell)),
+        )
+        .with_note(format!("an isosurface may use at most {} cells", isosurface::MAX_CELLS))
+        .with_hint(format!("try a cell of at least {}", ir::dump_num((min_cell * 1.001 * 1e6).ceil() / 1e6))),
+        isosurface::IsoError::NoSurface => Diagnostic::error(
+            codes::LOWERING,
+            span,
+            "isosurface found no surface",
+            format!("no sign change on a grid of cell {}", ir::dump_num(cell)),
+        )
+        .with_note("the shape is thinner than a cell everywhere, so the mesh would be empty")
+        .with_hint("try a smaller cell"),
+    })?;
+    let per_triangle = mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            let c =
+                (mesh.positions[t[0] as usize] + mesh.positions[t[1] as usize] + mesh.positions[t[2] as usize]) / 3.0;
+            mat(c.as_vec3a()).1
+        })
+        .collect();
+    Ok(MeshObject::new(&mesh, DAffine3::IDENTITY, material, Some(per_triangle), smooth))
+}
+
+/// Lowers an explicit `mesh …` object.
+pub fn explicit(
+    m: &ir::Mesh,
+    to_render: DAffine3,
+    builder: &mut Builder<'_>,
+    loader: &dyn Loader,
+) -> Result<MeshObject, Diagnostic> {
+    let xf = to_render * m.xf;
+    let material = m.material.as_ref().map_or(0, |mat| builder.materials.intern(mat));
+    let local: TriMesh = match &m.source {
+        MeshSource::UvSphere { radius, rings, segments } => tessellate::uvsphere(*radius, *rings, *segments),
+        MeshSource::IcoSphere { radius, subdivisions } => tessellate::icosphere(*radius, *subdivisions),
+        MeshSource::Box { half } => tessellate::cuboid(*half),
+        MeshSource::Cylinder { radius, half_height, segments } => {
+            tessellate::cylinder(*radius, *half_height, *segments)
+        }
+        MeshSource::Torus { major, minor, segments, sides } => tessellate::torus(*major, *minor, *segments, *sides),
+        MeshSource::Plane { size } => tessellate::square(*size),
+        MeshSource::Isosurface { shape, cell } => {
+            let bounds = ir::shape_bounds(shape).ok_or_else(|| unbounded(shape.span))?;
+            // The grid is laid in the shape's own frame, so `cell` is in its units.
+            let (dist, mat) = builder.build(shape, DAffine3::IDENTITY, material);
+            let mesh = isosurface::extract(&*dist, bounds.min, bounds.max, *cell).map_err(|e| match e {
+                isosurface::IsoError::TooManyCells { cells, min_cell } => Diagnostic::error(
+                    codes::LOWERING,
+                    m.span,
+                    "isosurface grid is too fine",
+                    format!("cell {} needs {cells} grid cells", ir::dump_num(*cell)),
+                )
+                .with_note(format!("an isosurface may use at most {} cells", isosurface::MAX_CELLS))
+                .with_hint(format!("try `cell = {}` or more", ir::dump_num((min_cell * 1.001 * 1e6).ceil() / 1e6))),
+                isosurface::IsoError::NoSurface => Diagnostic::error(
+                    codes::LOWERING,
+                    m.span,
+                    "isosurface found no surface",
+                    format!("no sign change on a grid of cell {}", ir::dump_num(*cell)),
+                )
+                .with_note("the shape is thinner than a cell everywhere, so the mesh would be empty")
+                .with_hint("try a smaller `cell`"),
+            })?;
+            let per_triangle = mesh
+                .triangles
+                .iter()
+                .map(|t| {
+                    let c =
+                        (mesh.positions[t[0] as usize] + mesh.positions[t[1] as usize] + mesh.positions[t[2] as usize])
+                            / 3.0;
+                    mat(c.as_vec3a()).1
+                })
+                .collect();
+            return Ok(MeshObject::new(&mesh, xf, material, Some(per_triangle), m.smooth));
+        }
+        MeshSource::File { path, written } => {
+            let text = loader.read(path).map_err(|e| {
+                Diagnostic::error(
+                    codes::LOWERING,
+                    m.span,
+                    format!("cannot read mesh file `{written}`"),
+                    crate::check::io_reason(&e),
+                )
+                .with_note(format!("looked for {}", path.display()))
+            })?;
+            obj::parse(&text).map_err(|e| {
+                let place = if e.line > 0 { format!("{written}:{}", e.line) } else { written.clone() };
+                Diagnostic::error(
+                    codes::LOWERING,
+                    m.span,
+                    format!("bad mesh file `{written}`"),
+                    format!("{place}: {}", e.message),
+                )
+                .with_note("scnc reads OBJ files: `v x y z` and `f a b c …` records")
+            })?
+        }
+    };
+    Ok(MeshObject::new(&local, xf, material, None, m.smooth))
+}

@@ -1,0 +1,245 @@
+//! The mesh back-end: triangle meshes (generated, read from OBJ, or extracted from any
+//! shape as an isosurface), each with its own binned-SAH BVH, traced with a watertight
+//! ray/triangle test. Vertices are stored in render space (camera-relative f32),
+//! transformed once at lowering from f64.
+//!
+//! Supported IR subset: every shape (primitives by their generators at the chosen detail,
+//! everything else and primitives without a generator by `isosurface`) and every mesh.
+//! A plane shape becomes a finite square reaching `max_distance` around the camera.
+
+pub mod isosurface;
+pub mod lower;
+pub mod obj;
+pub mod tessellate;
+pub mod triangle;
+
+use glam::{DAffine3, DVec3, Vec3A};
+
+use crate::bvh::{Aabb, Bvh};
+use crate::render::{Counters, Hit, Ray};
+
+/// An indexed triangle mesh in some frame (local for generators, render space once lowered).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TriMesh {
+    /// Vertex positions.
+    pub positions: Vec<DVec3>,
+    /// Triangles as vertex indices, counter-clockwise seen from outside.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl TriMesh {
+    /// Appends another mesh.
+    pub fn append(&mut self, other: &TriMesh) {
+        let base = self.positions.len() as u32;
+        self.positions.extend_from_slice(&other.positions);
+        self.triangles.extend(other.triangles.iter().map(|t| [t[0] + base, t[1] + base, t[2] + base]));
+    }
+
+    /// Signed volume (positive for a closed mesh wound outward).
+    pub fn signed_volume(&self) -> f64 {
+        self.triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| self.positions[i as usize]);
+                a.dot(b.cross(c)) / 6.0
+            })
+            .sum()
+    }
+
+    /// Edges used by a number of triangles other than two, counting each undirected edge;
+    /// 0 for a closed (watertight) mesh. Directed edges used twice mean inconsistent winding.
+    pub fn open_edges(&self) -> (usize, usize) {
+        let mut undirected = std::collections::HashMap::new();
+        let mut directed = std::collections::HashMap::new();
+        for t in &self.triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                *undirected.entry((a.min(b), a.max(b))).or_insert(0usize) += 1;
+                *directed.entry((a, b)).or_insert(0usize) += 1;
+            }
+        }
+        (undirected.values().filter(|&&n| n != 2).count(), directed.values().filter(|&&n| n > 1).count())
+    }
+}
+
+/// A mesh object ready for tracing.
+pub struct MeshObject {
+    positions: Vec<Vec3A>,
+    triangles: Vec<[u32; 3]>,
+    /// Per-vertex unit normals when shading is smooth.
+    normals: Option<Vec<Vec3A>>,
+    /// Per-triangle material ids, or one for the whole mesh.
+    materials: Materials,
+    bvh: Bvh,
+    bounds: Aabb,
+}
+
+enum Materials {
+    One(u32),
+    PerTriangle(Vec<u32>),
+}
+
+/// Memory of one mesh object, by structure.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct MeshMemory {
+    /// Triangles.
+    pub triangles: usize,
+    /// Bytes of vertex positions (and normals, if smooth).
+    pub vertex_bytes: usize,
+    /// Bytes of triangle indices (and per-triangle materials).
+    pub index_bytes: usize,
+    /// Bytes of BVH nodes and primitive indices.
+    pub bvh_bytes: usize,
+    /// BVH nodes.
+    pub bvh_nodes: usize,
+    /// BVH depth.
+    pub bvh_depth: usize,
+}
+
+impl MeshObject {
+    /// Builds from a mesh in local space, mapped by `xf` (render from local), with one
+    /// material or one per triangle; `smooth` interpolates area-weighted vertex normals.
+    /// Degenerate (zero-area) triangles are dropped: they can never be hit.
+    pub fn new(
+        mesh: &TriMesh,
+        xf: DAffine3,
+        material: u32,
+        per_triangle: Option<Vec<u32>>,
+        smooth: bool,
+    ) -> MeshObject {
+        let positions: Vec<Vec3A> = mesh.positions.iter().map(|p| xf.transform_point3(*p).as_vec3a()).collect();
+        let mut triangles = Vec::with_capacity(mesh.triangles.len());
+        let mut mats = Vec::new();
+        for (i, t) in mesh.triangles.iter().enumerate() {
+            let [a, b, c] = t.map(|k| positions[k as usize]);
+            if (b - a).cross(c - a).length_squared() > 0.0 {
+                triangles.push(*t);
+                if let Some(m) = &per_triangle {
+                    mats.push(m[i]);
+                }
+            }
+        }
+        let normals = smooth.then(|| {
+            let mut n = vec![Vec3A::ZERO; positions.len()];
+            for t in &triangles {
+                let [a, b, c] = t.map(|k| positions[k as usize]);
+                let face = (b - a).cross(c - a);
+                for k in t {
+                    n[*k as usize] += face;
+                }
+            }
+            n.into_iter().map(|v| v.try_normalize().unwrap_or(Vec3A::Y)).collect()
+        });
+        let boxes: Vec<Aabb> = triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|k| positions[k as usize]);
+                Aabb { min: a.min(b).min(c), max: a.max(b).max(c) }
+            })
+            .collect();
+        let bvh = Bvh::build(&boxes, 4);
+        let bounds = boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(*b));
+        let materials = match per_triangle {
+            Some(_) if mats.iter().any(|&m| m != mats[0]) => Materials::PerTriangle(mats),
+            Some(_) => Materials::One(mats.first().copied().unwrap_or(material)),
+            None => Materials::One(material),
+        };
+        MeshObject { positions, triangles, normals, materials, bvh, bounds }
+    }
+
+    /// Render-space bounds (empty for a mesh without triangles).
+    pub fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+
+    /// Number of triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// Memory by structure.
+    pub fn memory(&self) -> MeshMemory {
+        let vertex_bytes = self.positions.len() * 12 + self.normals.as_ref().map_or(0, |n| n.len() * 12);
+        let index_bytes =
+            self.triangles.len() * 12 + if let Materials::PerTriangle(m) = &self.materials { m.len() * 4 } else { 0 };
+        MeshMemory {
+            triangles: self.triangles.len(),
+            vertex_bytes,
+            index_bytes,
+            bvh_bytes: self.bvh.bytes(),
+            bvh_nodes: self.bvh.node_count(),
+            bvh_depth: self.bvh.depth(),
+        }
+    }
+
+    fn tri(&self, i: u32) -> (Vec3A, Vec3A, Vec3A) {
+        let t = self.triangles[i as usize];
+        (self.positions[t[0] as usize], self.positions[t[1] as usize], self.positions[t[2] as usize])
+    }
+
+    /// The closest hit within `(ray.t_min, t_max)`.
+    pub fn intersect(&self, ray: &Ray, t_max: f32, c: &mut Counters) -> Option<Hit> {
+        let shear = triangle::Shear::new(ray.dir);
+        let mut best = None;
+        let mut tests = 0u64;
+        let found = self.bvh.closest(ray.origin, ray.inv_dir, ray.t_min, t_max, &mut c.node_visits, |i, t_max| {
+            tests += 1;
+            let (a, b, cc) = self.tri(i);
+            let hit = triangle::intersect(ray.origin, &shear, a, b, cc, ray.t_min, t_max)?;
+            best = Some(hit);
+            Some(hit.t)
+        });
+        c.triangle_tests += tests;
+        let (i, _) = found?;
+        let hit = best?;
+        let (a, b, cc) = self.tri(i);
+        let point = a * hit.bary[0] + b * hit.bary[1] + cc * hit.bary[2];
+        let normal = match &self.normals {
+            Some(n) => {
+                let t = self.triangles[i as usize];
+                (n[t[0] as usize] * hit.bary[0] + n[t[1] as usize] * hit.bary[1] + n[t[2] as usize] * hit.bary[2])
+                    .try_normalize()
+            }
+            None => None,
+        }
+        .unwrap_or_else(|| (b - a).cross(cc - a).normalize());
+        let material = match &self.materials {
+            Materials::One(m) => *m,
+            Materials::PerTriangle(m) => m[i as usize],
+        };
+        // The interpolated point lies within a few ulps of the true plane.
+        let error = point.abs().max_element() * 8.0 * f32::EPSILON;
+        Some(Hit { t: hit.t, point, normal, material, error })
+    }
+
+    /// Whether any triangle lies along the ray within `(ray.t_min, t_max)`.
+    pub fn occluded(&self, ray: &Ray, t_max: f32, c: &mut Counters) -> bool {
+        let shear = triangle::Shear::new(ray.dir);
+        let mut tests = 0u64;
+        let hit = self.bvh.any(ray.origin, ray.inv_dir, ray.t_min, t_max, &mut c.node_visits, |i, t_max| {
+            tests += 1;
+            let (a, b, cc) = self.tri(i);
+            triangle::intersect(ray.origin, &shear, a, b, cc, ray.t_min, t_max).is_some()
+        });
+        c.triangle_tests += tests;
+        hit
+    }
+}
+
+/// A bounding sphere of a set of points (centre of the box, farthest point).
+pub fn points_sphere(points: &[Vec3A]) -> Option<(Vec3A, f32)> {
+    let b = points.iter().fold(Aabb::EMPTY, |b, p| b.union(Aabb { min: *p, max: *p }));
+    if points.is_empty() {
+        return None;
+    }
+    let c = b.centre();
+    let r = points.iter().map(|p| (*p - c).length()).fold(0.0, f32::max);
+    Some((c, r))
+}
+
+impl MeshObject {
+    /// A bounding sphere in render space.
+    pub fn sphere(&self) -> Option<(Vec3A, f32)> {
+        points_sphere(&self.positions).map(|(c, r)| (c, r * (1.0 + 1e-6) + c.abs().max_element() * 1e-6))
+    }
+}

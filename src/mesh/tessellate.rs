@@ -1,0 +1,223 @@
+//! Parametric mesh generators. Every closed generator is watertight (shared vertices,
+//! each edge used by exactly two triangles) and wound counter-clockwise seen from
+//! outside, so face normals point out.
+
+use std::collections::HashMap;
+use std::f64::consts::{PI, TAU};
+
+use glam::DVec3;
+
+use super::TriMesh;
+
+/// UV sphere: `rings` latitude bands (≥ 2) and `segments` longitudes (≥ 3), poles on ±y.
+pub fn uvsphere(r: f64, rings: u32, segments: u32) -> TriMesh {
+    let (rings, segments) = (rings.max(2), segments.max(3));
+    let mut m = TriMesh::default();
+    m.positions.push(DVec3::new(0.0, r, 0.0));
+    for i in 1..rings {
+        let theta = PI * i as f64 / rings as f64;
+        for j in 0..segments {
+            let phi = TAU * j as f64 / segments as f64;
+            m.positions.push(DVec3::new(r * theta.sin() * phi.cos(), r * theta.cos(), r * theta.sin() * phi.sin()));
+        }
+    }
+    let south = m.positions.len() as u32;
+    m.positions.push(DVec3::new(0.0, -r, 0.0));
+    let ring = |i: u32, j: u32| 1 + (i - 1) * segments + (j % segments);
+    for j in 0..segments {
+        m.triangles.push([0, ring(1, j + 1), ring(1, j)]);
+        m.triangles.push([south, ring(rings - 1, j), ring(rings - 1, j + 1)]);
+    }
+    for i in 1..rings - 1 {
+        for j in 0..segments {
+            let (a, b, c, d) = (ring(i, j), ring(i, j + 1), ring(i + 1, j), ring(i + 1, j + 1));
+            m.triangles.push([a, b, d]);
+            m.triangles.push([a, d, c]);
+        }
+    }
+    m
+}
+
+/// Box with half-extents `h`: 8 vertices, 12 triangles.
+pub fn cuboid(h: DVec3) -> TriMesh {
+    let positions = (0..8)
+        .map(|i| {
+            DVec3::new(
+                if i & 1 == 0 { -h.x } else { h.x },
+                if i & 2 == 0 { -h.y } else { h.y },
+                if i & 4 == 0 { -h.z } else { h.z },
+            )
+        })
+        .collect();
+    // Each face as a quad (a, b, c, d) counter-clockwise seen from outside.
+    let quads = [[0, 4, 6, 2], [1, 3, 7, 5], [0, 1, 5, 4], [2, 6, 7, 3], [0, 2, 3, 1], [4, 5, 7, 6]];
+    let triangles = quads.iter().flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
+    TriMesh { positions, triangles }
+}
+
+/// Capped cylinder along y with `segments` points per cap circle.
+pub fn cylinder(r: f64, h: f64, segments: u32) -> TriMesh {
+    let n = segments.max(3);
+    let mut m = TriMesh::default();
+    for y in [h, -h] {
+        for j in 0..n {
+            let phi = TAU * j as f64 / n as f64;
+            m.positions.push(DVec3::new(r * phi.cos(), y, r * phi.sin()));
+        }
+    }
+    let (top, bottom) = (m.positions.len() as u32, m.positions.len() as u32 + 1);
+    m.positions.push(DVec3::new(0.0, h, 0.0));
+    m.positions.push(DVec3::new(0.0, -h, 0.0));
+    for j in 0..n {
+        let k = (j + 1) % n;
+        m.triangles.push([top, k, j]);
+        m.triangles.push([bottom, n + j, n + k]);
+        m.triangles.push([j, k, n + k]);
+        m.triangles.push([j, n + k, n + j]);
+    }
+    m
+}
+
+/// Cone along y: base radius `r` at `−h`, apex at `h`, `segments` points on the base.
+pub fn cone(r: f64, h: f64, segments: u32) -> TriMesh {
+    let n = segments.max(3);
+    let mut m = TriMesh::default();
+    for j in 0..n {
+        let phi = TAU * j as f64 / n as f64;
+        m.positions.push(DVec3::new(r * phi.cos(), -h, r * phi.sin()));
+    }
+    let (apex, base) = (n, n + 1);
+    m.positions.push(DVec3::new(0.0, h, 0.0));
+    m.positions.push(DVec3::new(0.0, -h, 0.0));
+    for j in 0..n {
+        let k = (j + 1) % n;
+        m.triangles.push([apex, k, j]);
+        m.triangles.push([base, j, k]);
+    }
+    m
+}
+
+/// Torus in the xz plane: `segments` around the major circle, `sides` around the tube.
+pub fn torus(major: f64, minor: f64, segments: u32, sides: u32) -> TriMesh {
+    let (n, s) = (segments.max(3), sides.max(3));
+    let mut m = TriMesh::default();
+    for i in 0..n {
+        let phi = TAU * i as f64 / n as f64;
+        let dir = DVec3::new(phi.cos(), 0.0, phi.sin());
+        for j in 0..s {
+            let theta = TAU * j as f64 / s as f64;
+            m.positions.push(dir * (major + minor * theta.cos()) + DVec3::Y * (minor * theta.sin()));
+        }
+    }
+    let idx = |i: u32, j: u32| (i % n) * s + (j % s);
+    for i in 0..n {
+        for j in 0..s {
+            let (a, b, c, d) = (idx(i, j), idx(i + 1, j), idx(i, j + 1), idx(i + 1, j + 1));
+            m.triangles.push([a, c, d]);
+            m.triangles.push([a, d, b]);
+        }
+    }
+    m
+}
+
+/// A square of half-side `size` in the xz plane facing +y (two triangles; not closed).
+pub fn square(size: f64) -> TriMesh {
+    let positions = vec![
+        DVec3::new(-size, 0.0, -size),
+        DVec3::new(size, 0.0, -size),
+        DVec3::new(size, 0.0, size),
+        DVec3::new(-size, 0.0, size),
+    ];
+    TriMesh { positions, triangles: vec![[0, 2, 1], [0, 3, 2]] }
+}
+
+/// Icosphere: an icosahedron subdivided `subdivisions` times, projected onto the sphere.
+pub fn icosphere(r: f64, subdivisions: u32) -> TriMesh {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut positions: Vec<DVec3> = [
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ]
+    .iter()
+    .map(|p| DVec3::from(*p).normalize())
+    .collect();
+    let mut triangles: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..subdivisions {
+        let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut midpoint = |a: u32, b: u32, positions: &mut Vec<DVec3>| -> u32 {
+            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                positions.push(((positions[a as usize] + positions[b as usize]) * 0.5).normalize());
+                positions.len() as u32 - 1
+            })
+        };
+        let mut next = Vec::with_capacity(triangles.len() * 4);
+        for [a, b, c] in triangles {
+            let (ab, bc, ca) =
+                (midpoint(a, b, &mut positions), midpoint(b, c, &mut positions), midpoint(c, a, &mut positions));
+            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        triangles = next;
+    }
+    TriMesh { positions: positions.into_iter().map(|p| p * r).collect(), triangles }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn closed_and_outward(name: &str, m: &TriMesh, volume: f64, tol: f64) {
+        assert_eq!(m.open_edges(), (0, 0), "{name}: open or inconsistently wound edges");
+        let v = m.signed_volume();
+        assert!(v > 0.0, "{name}: wound inward (volume {v})");
+        assert!((v - volume).abs() <= tol * volume, "{name}: volume {v}, expected about {volume}");
+    }
+
+    #[test]
+    fn generators_are_closed_and_outward() {
+        closed_and_outward("uvsphere", &uvsphere(1.0, 14, 28), 4.0 / 3.0 * PI, 0.05);
+        closed_and_outward("uvsphere low", &uvsphere(1.0, 7, 10), 4.0 / 3.0 * PI, 0.3);
+        closed_and_outward("icosphere", &icosphere(1.0, 3), 4.0 / 3.0 * PI, 0.05);
+        closed_and_outward("box", &cuboid(DVec3::new(1.0, 2.0, 3.0)), 48.0, 1e-9);
+        closed_and_outward("cylinder", &cylinder(1.0, 1.0, 64), 2.0 * PI, 0.01);
+        closed_and_outward("cone", &cone(1.0, 1.0, 64), 2.0 * PI / 3.0, 0.01);
+        closed_and_outward("torus", &torus(1.0, 0.25, 64, 32), 2.0 * PI * PI * 0.0625, 0.01);
+    }
+
+    #[test]
+    fn counts_match_the_study() {
+        assert_eq!(cuboid(DVec3::ONE).triangles.len(), 12);
+        assert_eq!(uvsphere(1.0, 7, 14).triangles.len(), 2 * 7 * 14 - 2 * 14);
+        assert_eq!(cylinder(1.0, 1.0, 10).triangles.len(), 40);
+    }
+}

@@ -1,0 +1,285 @@
+//! The lowered scene: every object, SDF or mesh, under one top-level BVH, implementing
+//! the tracer's [`Geometry`] contract. Lowering picks each object's back-end: shapes go
+//! to the SDF back-end, or are tessellated in mesh mode; explicit meshes are always meshes.
+//!
+//! **Invariant:** every object lies in render space (camera at the origin); each bounded
+//! object's box and sphere contain its surface, so a ray outside them cannot hit it.
+
+use glam::{DAffine3, Vec3A};
+
+use crate::bvh::{Aabb, Bvh};
+use crate::check::Loader;
+use crate::diag::Diagnostic;
+use crate::ir;
+use crate::mesh::{self, MeshMemory, MeshObject};
+use crate::render::{Counters, Frame, Geometry, Hit, Ray};
+use crate::sdf::{self, MarchParams, SdfObject};
+use crate::span::Span;
+
+/// How finely shapes are tessellated in mesh mode.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Detail {
+    /// The study's low detail: spheres of 7 rings, circles of 10 points.
+    Low,
+    /// The study's high detail: spheres of 14 rings, circles of 50 points.
+    High,
+    /// Spheres of `N` rings (and `2N` segments), circles of `2N` points.
+    N(u32),
+}
+
+impl Detail {
+    /// Rings of a UV sphere (segments are twice this) and sides of a torus tube.
+    pub fn rings(self) -> u32 {
+        match self {
+            Detail::Low => 7,
+            Detail::High => 14,
+            Detail::N(n) => n.max(3),
+        }
+    }
+
+    /// Points on a circle (cylinder and cone caps, torus rings).
+    pub fn circle(self) -> u32 {
+        match self {
+            Detail::Low => 10,
+            Detail::High => 50,
+            Detail::N(n) => 2 * n.max(3),
+        }
+    }
+}
+
+/// Which back-end renders shapes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    /// Sphere tracing.
+    Sdf,
+    /// Tessellation at the given detail.
+    Mesh(Detail),
+}
+
+/// One object of the world.
+pub enum ObjectKind {
+    /// Sphere traced.
+    Sdf(SdfObject),
+    /// Triangles.
+    Mesh(MeshObject),
+}
+
+struct Object {
+    kind: ObjectKind,
+    bounds: Option<Aabb>,
+    sphere: Option<(Vec3A, f32)>,
+    span: Span,
+}
+
+/// The lowered scene.
+pub struct World {
+    objects: Vec<Object>,
+    bvh: Bvh,
+    bounded: Vec<u32>,
+    unbounded: Vec<u32>,
+    params: MarchParams,
+    closure_bytes: usize,
+}
+
+/// Memory of the world by structure, for `--stats`.
+#[derive(Clone, Debug, Default)]
+pub struct Memory {
+    /// Objects sphere traced.
+    pub sdf_objects: usize,
+    /// Bytes of SDF closure state.
+    pub closure_bytes: usize,
+    /// Per mesh object: its `object` statement and memory.
+    pub meshes: Vec<(Span, MeshMemory)>,
+    /// Bytes of the top-level BVH.
+    pub top_bvh_bytes: usize,
+}
+
+impl Memory {
+    /// Every byte of geometry.
+    pub fn total(&self) -> usize {
+        self.closure_bytes
+            + self.top_bvh_bytes
+            + self.meshes.iter().map(|(_, m)| m.vertex_bytes + m.index_bytes + m.bvh_bytes).sum::<usize>()
+    }
+
+    /// All triangles.
+    pub fn triangles(&self) -> usize {
+        self.meshes.iter().map(|(_, m)| m.triangles).sum()
+    }
+}
+
+fn pad_box(b: ir::Aabb) -> Aabb {
+    // Widen by a few ulps so the f32 box never clips the surface.
+    let pad = b.max.abs().max(b.min.abs()).max_element() * 1e-6 + 1e-6;
+    Aabb { min: (b.min - pad).as_vec3a(), max: (b.max + pad).as_vec3a() }
+}
+
+/// Lowers every object of the scene. Materials are interned into `frame`; mesh files
+/// are read through `loader`.
+pub fn lower(
+    scene: &ir::Scene,
+    frame: &mut Frame,
+    mode: Mode,
+    params: MarchParams,
+    loader: &dyn Loader,
+) -> Result<World, Diagnostic> {
+    // Render space: world translated so the camera is at the origin, composed in f64.
+    let to_render = DAffine3::from_translation(-frame.origin);
+    let max_distance = frame.max_distance as f64;
+    let mut builder = sdf::Builder { materials: &mut frame.materials, bytes: 0 };
+    let mut objects = Vec::with_capacity(scene.objects.len());
+    for obj in &scene.objects {
+        let (kind, bounds, sphere) = match (&obj.geometry, mode) {
+            (ir::Geometry::Shape(shape), Mode::Sdf) => {
+                let bounds = ir::shape_bounds(shape).map(|b| pad_box(b.transform(&to_render)));
+                let sphere = ir::shape_sphere(shape).map(|(c, r)| {
+                    let c = to_render.transform_point3(c);
+                    let pad = (c.abs().max_element() + r) * 1e-6 + 1e-6;
+                    (c.as_vec3a(), (r + pad) as f32)
+                });
+                (ObjectKind::Sdf(SdfObject::new(shape, to_render, &mut builder)), bounds, sphere)
+            }
+            (ir::Geometry::Shape(shape), Mode::Mesh(detail)) => {
+                let m = mesh::lower::tessellate(shape, to_render, detail, max_distance, &mut builder)?;
+                let (b, s) = (m.bounds(), m.sphere());
+                (ObjectKind::Mesh(m), Some(b), s)
+            }
+            (ir::Geometry::Mesh(m), _) => {
+                let m = mesh::lower::explicit(m, to_render, &mut builder, loader)?;
+                let (b, s) = (m.bounds(), m.sphere());
+                (ObjectKind::Mesh(m), Some(b), s)
+            }
+        };
+        objects.push(Object { kind, bounds, sphere, span: obj.span });
+    }
+    let closure_bytes = builder.bytes;
+    let bounded: Vec<u32> = (0..objects.len() as u32)
+        .filter(|&i| objects[i as usize].bounds.is_some_and(|b| b.min.cmple(b.max).all()))
+        .collect();
+    let unbounded = (0..objects.len() as u32).filter(|&i| objects[i as usize].bounds.is_none()).collect();
+    let boxes: Vec<Aabb> = bounded.iter().map(|&i| objects[i as usize].bounds.unwrap_or(Aabb::EMPTY)).collect();
+    let bvh = Bvh::build(&boxes, 2);
+    debug_assert!(bvh.validate(&boxes).is_ok());
+    Ok(World { objects, bvh, bounded, unbounded, params, closure_bytes })
+}
+
+impl World {
+    /// Memory by structure.
+    pub fn memory(&self) -> Memory {
+        let mut m = Memory { closure_bytes: self.closure_bytes, top_bvh_bytes: self.bvh.bytes(), ..Memory::default() };
+        for o in &self.objects {
+            match &o.kind {
+                ObjectKind::Sdf(_) => m.sdf_objects += 1,
+                ObjectKind::Mesh(mesh) => m.meshes.push((o.span, mesh.memory())),
+            }
+        }
+        m
+    }
+
+    /// Number of objects.
+    pub fn len(&self) -> usize {
+        self.objects.len()
+    }
+
+    /// Whether there are no objects.
+    pub fn is_empty(&self) -> bool {
+        self.objects.is_empty()
+    }
+
+    /// The SDF of object `i` at a render-space point, if it is an SDF object (for tests).
+    pub fn sdf_eval(&self, i: usize, p: Vec3A) -> Option<f32> {
+        match &self.objects.get(i)?.kind {
+            ObjectKind::Sdf(o) => Some(o.eval(p)),
+            ObjectKind::Mesh(_) => None,
+        }
+    }
+
+    /// The interval of the ray inside object `i`'s bounds, clipped to `[ray.t_min, t_max]`.
+    #[inline]
+    fn interval(&self, o: &Object, ray: &Ray, t_max: f32) -> Option<(f32, f32)> {
+        let (mut t0, mut t1) = match o.bounds {
+            Some(b) => b.slab(ray.origin, ray.inv_dir, ray.t_min, t_max)?,
+            None => (ray.t_min, t_max),
+        };
+        if let Some((centre, radius)) = o.sphere {
+            let (s0, s1) = sphere_interval(ray, centre, radius)?;
+            t0 = t0.max(s0);
+            t1 = t1.min(s1);
+        }
+        (t0 <= t1).then_some((t0, t1))
+    }
+
+    fn hit_object(&self, i: u32, ray: &Ray, t_max: f32, c: &mut Counters, evals: &mut u64) -> Option<Hit> {
+        let o = &self.objects[i as usize];
+        let (t0, t1) = self.interval(o, ray, t_max)?;
+        match &o.kind {
+            ObjectKind::Sdf(s) => s.intersect(ray, t0, t1, self.params, c, evals),
+            // Triangles are tested exactly; the interval only decides whether to look.
+            ObjectKind::Mesh(m) => m.intersect(ray, t_max, c),
+        }
+    }
+
+    fn blocks(&self, i: u32, ray: &Ray, t_max: f32, c: &mut Counters, evals: &mut u64) -> bool {
+        let o = &self.objects[i as usize];
+        let Some((t0, t1)) = self.interval(o, ray, t_max) else { return false };
+        match &o.kind {
+            ObjectKind::Sdf(s) => s.occluded(ray, t0, t1, self.params, c, evals),
+            ObjectKind::Mesh(m) => m.occluded(ray, t_max, c),
+        }
+    }
+}
+
+/// Where the ray is inside the sphere, or `None`. The discriminant is computed from the
+/// perpendicular distance to the centre (Haines et al., *Ray Tracing Gems* ch. 7), which
+/// stays accurate for distant spheres where `b² − c` would cancel catastrophically.
+#[inline]
+pub fn sphere_interval(ray: &Ray, centre: Vec3A, radius: f32) -> Option<(f32, f32)> {
+    let oc = ray.origin - centre;
+    let b = oc.dot(ray.dir);
+    let perp = oc - ray.dir * b;
+    let disc = radius * radius - perp.length_squared();
+    if disc < 0.0 {
+        return None;
+    }
+    let s = disc.sqrt();
+    Some((-b - s, -b + s))
+}
+
+impl Geometry for World {
+    fn intersect(&self, ray: &Ray, c: &mut Counters) -> Option<Hit> {
+        let mut evals = 0u64;
+        let mut visits = 0u64;
+        let mut best: Option<Hit> = None;
+        self.bvh.closest(ray.origin, ray.inv_dir, ray.t_min, ray.t_max, &mut visits, |k, t_max| {
+            let hit = self.hit_object(self.bounded[k as usize], ray, t_max, c, &mut evals)?;
+            best = Some(hit);
+            Some(hit.t)
+        });
+        for &i in &self.unbounded {
+            let limit = best.map_or(ray.t_max, |h| h.t);
+            if let Some(hit) = self.hit_object(i, ray, limit, c, &mut evals) {
+                best = Some(hit);
+            }
+        }
+        c.node_visits += visits;
+        c.sdf_evals += evals;
+        c.max_evals_per_ray = c.max_evals_per_ray.max(evals);
+        best
+    }
+
+    fn occluded(&self, ray: &Ray, c: &mut Counters) -> bool {
+        let mut evals = 0u64;
+        let mut visits = 0u64;
+        let hit = self.bvh.any(ray.origin, ray.inv_dir, ray.t_min, ray.t_max, &mut visits, |k, t_max| {
+            self.blocks(self.bounded[k as usize], ray, t_max, c, &mut evals)
+        }) || self.unbounded.iter().any(|&i| self.blocks(i, ray, ray.t_max, c, &mut evals));
+        c.node_visits += visits;
+        c.sdf_evals += evals;
+        c.max_evals_per_ray = c.max_evals_per_ray.max(evals);
+        hit
+    }
+
+    fn bytes(&self) -> usize {
+        self.memory().total()
+    }
+}
