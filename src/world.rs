@@ -209,23 +209,43 @@ impl World {
         (t0 <= t1).then_some((t0, t1))
     }
 
-    fn hit_object(&self, i: u32, ray: &Ray, t_max: f32, c: &mut Counters, evals: &mut u64) -> Option<Hit> {
+    fn hit_object(&self, i: u32, q: &mut Query<'_>, t_max: f32, c: &mut Counters) -> Option<Hit> {
         let o = &self.objects[i as usize];
-        let (t0, t1) = self.interval(o, ray, t_max)?;
+        let (t0, t1) = self.interval(o, q.ray, t_max)?;
         match &o.kind {
-            ObjectKind::Sdf(s) => s.intersect(ray, t0, t1, self.params, c, evals),
+            ObjectKind::Sdf(s) => s.intersect(q.ray, t0, t1, self.params, c, &mut q.evals),
             // Triangles are tested exactly; the interval only decides whether to look.
-            ObjectKind::Mesh(m) => m.intersect(ray, t_max, c),
+            ObjectKind::Mesh(m) => m.intersect(q.ray, q.shear(), t_max, c),
         }
     }
 
-    fn blocks(&self, i: u32, ray: &Ray, t_max: f32, c: &mut Counters, evals: &mut u64) -> bool {
+    fn blocks(&self, i: u32, q: &mut Query<'_>, t_max: f32, c: &mut Counters) -> bool {
         let o = &self.objects[i as usize];
-        let Some((t0, t1)) = self.interval(o, ray, t_max) else { return false };
+        let Some((t0, t1)) = self.interval(o, q.ray, t_max) else { return false };
         match &o.kind {
-            ObjectKind::Sdf(s) => s.occluded(ray, t0, t1, self.params, c, evals),
-            ObjectKind::Mesh(m) => m.occluded(ray, t_max, c),
+            ObjectKind::Sdf(s) => s.occluded(q.ray, t0, t1, self.params, c, &mut q.evals),
+            ObjectKind::Mesh(m) => m.occluded(q.ray, q.shear(), t_max, c),
         }
+    }
+}
+
+/// Per-ray state shared by the objects one query visits.
+struct Query<'a> {
+    ray: &'a Ray,
+    /// The triangle test's shear, computed the first time a mesh is visited.
+    shear: Option<mesh::triangle::Shear>,
+    /// SDF evaluations so far.
+    evals: u64,
+}
+
+impl<'a> Query<'a> {
+    fn new(ray: &'a Ray) -> Query<'a> {
+        Query { ray, shear: None, evals: 0 }
+    }
+
+    fn shear(&mut self) -> &mesh::triangle::Shear {
+        let dir = self.ray.dir;
+        self.shear.get_or_insert_with(|| mesh::triangle::Shear::new(dir))
     }
 }
 
@@ -247,35 +267,35 @@ pub fn sphere_interval(ray: &Ray, centre: Vec3A, radius: f32) -> Option<(f32, f3
 
 impl Geometry for World {
     fn intersect(&self, ray: &Ray, c: &mut Counters) -> Option<Hit> {
-        let mut evals = 0u64;
+        let mut q = Query::new(ray);
         let mut visits = 0u64;
         let mut best: Option<Hit> = None;
         self.bvh.closest(ray.origin, ray.inv_dir, ray.t_min, ray.t_max, &mut visits, |k, t_max| {
-            let hit = self.hit_object(self.bounded[k as usize], ray, t_max, c, &mut evals)?;
+            let hit = self.hit_object(self.bounded[k as usize], &mut q, t_max, c)?;
             best = Some(hit);
             Some(hit.t)
         });
         for &i in &self.unbounded {
             let limit = best.map_or(ray.t_max, |h| h.t);
-            if let Some(hit) = self.hit_object(i, ray, limit, c, &mut evals) {
+            if let Some(hit) = self.hit_object(i, &mut q, limit, c) {
                 best = Some(hit);
             }
         }
         c.node_visits += visits;
-        c.sdf_evals += evals;
-        c.max_evals_per_ray = c.max_evals_per_ray.max(evals);
+        c.sdf_evals += q.evals;
+        c.max_evals_per_ray = c.max_evals_per_ray.max(q.evals);
         best
     }
 
     fn occluded(&self, ray: &Ray, c: &mut Counters) -> bool {
-        let mut evals = 0u64;
+        let mut q = Query::new(ray);
         let mut visits = 0u64;
         let hit = self.bvh.any(ray.origin, ray.inv_dir, ray.t_min, ray.t_max, &mut visits, |k, t_max| {
-            self.blocks(self.bounded[k as usize], ray, t_max, c, &mut evals)
-        }) || self.unbounded.iter().any(|&i| self.blocks(i, ray, ray.t_max, c, &mut evals));
+            self.blocks(self.bounded[k as usize], &mut q, t_max, c)
+        }) || self.unbounded.iter().any(|&i| self.blocks(i, &mut q, ray.t_max, c));
         c.node_visits += visits;
-        c.sdf_evals += evals;
-        c.max_evals_per_ray = c.max_evals_per_ray.max(evals);
+        c.sdf_evals += q.evals;
+        c.max_evals_per_ray = c.max_evals_per_ray.max(q.evals);
         hit
     }
 

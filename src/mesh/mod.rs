@@ -177,15 +177,15 @@ impl MeshObject {
         (self.positions[t[0] as usize], self.positions[t[1] as usize], self.positions[t[2] as usize])
     }
 
-    /// The closest hit within `(ray.t_min, t_max)`.
-    pub fn intersect(&self, ray: &Ray, t_max: f32, c: &mut Counters) -> Option<Hit> {
-        let shear = triangle::Shear::new(ray.dir);
+    /// The closest hit within `(ray.t_min, t_max)`; `shear` is `Shear::new(ray.dir)`,
+    /// computed once per ray by the caller.
+    pub fn intersect(&self, ray: &Ray, shear: &triangle::Shear, t_max: f32, c: &mut Counters) -> Option<Hit> {
         let mut best = None;
         let mut tests = 0u64;
         let found = self.bvh.closest(ray.origin, ray.inv_dir, ray.t_min, t_max, &mut c.node_visits, |i, t_max| {
             tests += 1;
             let (a, b, cc) = self.tri(i);
-            let hit = triangle::intersect(ray.origin, &shear, a, b, cc, ray.t_min, t_max)?;
+            let hit = triangle::intersect(ray.origin, shear, a, b, cc, ray.t_min, t_max)?;
             best = Some(hit);
             Some(hit.t)
         });
@@ -213,13 +213,12 @@ impl MeshObject {
     }
 
     /// Whether any triangle lies along the ray within `(ray.t_min, t_max)`.
-    pub fn occluded(&self, ray: &Ray, t_max: f32, c: &mut Counters) -> bool {
-        let shear = triangle::Shear::new(ray.dir);
+    pub fn occluded(&self, ray: &Ray, shear: &triangle::Shear, t_max: f32, c: &mut Counters) -> bool {
         let mut tests = 0u64;
         let hit = self.bvh.any(ray.origin, ray.inv_dir, ray.t_min, t_max, &mut c.node_visits, |i, t_max| {
             tests += 1;
             let (a, b, cc) = self.tri(i);
-            triangle::intersect(ray.origin, &shear, a, b, cc, ray.t_min, t_max).is_some()
+            triangle::intersect(ray.origin, shear, a, b, cc, ray.t_min, t_max).is_some()
         });
         c.triangle_tests += tests;
         hit

@@ -38,9 +38,13 @@ fn bvh_closest_hit_equals_brute_force() {
             let dir = (rng.vec(spread) - origin).try_normalize().unwrap_or(Vec3A::Z);
             let ray = Ray::new(origin, dir, 1e4);
             let mut c = Counters::default();
-            let bvh = obj.intersect(&ray, ray.t_max, &mut c).map(|h| h.t);
+            let bvh = obj.intersect(&ray, &triangle::Shear::new(ray.dir), ray.t_max, &mut c).map(|h| h.t);
             assert_eq!(bvh, brute_force(&mesh, &ray), "{n} triangles: BVH and brute force disagree for {ray:?}");
-            assert_eq!(obj.occluded(&ray, ray.t_max, &mut c), bvh.is_some(), "any-hit disagrees with closest-hit");
+            assert_eq!(
+                obj.occluded(&ray, &triangle::Shear::new(ray.dir), ray.t_max, &mut c),
+                bvh.is_some(),
+                "any-hit disagrees with closest-hit"
+            );
         }
     }
 }
@@ -106,7 +110,7 @@ fn rays_through_shared_edges_and_vertices_never_miss() {
                 let dir = (target - origin).normalize();
                 let ray = Ray::new(origin, dir, 100.0);
                 assert!(
-                    obj.intersect(&ray, ray.t_max, &mut c).is_some(),
+                    obj.intersect(&ray, &triangle::Shear::new(ray.dir), ray.t_max, &mut c).is_some(),
                     "{name}: a ray from {origin} through {target} slipped through"
                 );
             }
