@@ -14,6 +14,7 @@
 pub mod bvh;
 pub mod check;
 pub mod diag;
+pub mod effects;
 pub mod ir;
 pub mod mesh;
 pub mod render;

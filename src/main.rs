@@ -68,6 +68,14 @@ fn parse_detail(s: &str) -> Result<scnc::world::Detail, String> {
     }
 }
 
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum EffectsArg {
+    /// Build the tracer with the effects the scene calls for.
+    Derived,
+    /// Build the general tracer with every effect.
+    All,
+}
+
 #[derive(clap::Args)]
 struct RenderArgs {
     /// The scene file.
@@ -106,9 +114,13 @@ struct RenderArgs {
     /// `high` (14 rings, 50-point circles) or N (N rings, 2N-point circles).
     #[arg(long, value_parser = parse_detail, default_value = "high")]
     detail: scnc::world::Detail,
-    /// Print ray counts, work per ray and memory.
+    /// Print the effect set, ray counts, work per ray and memory.
     #[arg(long)]
     stats: bool,
+    /// Which tracer to build: `derived` (only the effects the scene calls for) or `all`
+    /// (every effect compiled in; a debugging and benchmarking aid, same image).
+    #[arg(long, value_enum, default_value = "derived")]
+    effects: EffectsArg,
     /// How to print diagnostics.
     #[arg(long, value_enum, default_value = "human")]
     message_format: MessageFormat,
@@ -235,7 +247,11 @@ fn render_cmd(args: RenderArgs) -> ExitCode {
         GeometryKind::Mesh => scnc::world::Mode::Mesh(args.detail),
     };
     let started = Instant::now();
-    let mut frame = scnc::render::Frame::new(&scene);
+    let effects = match args.effects {
+        EffectsArg::Derived => scnc::effects::derive(&scene),
+        EffectsArg::All => scnc::effects::Effects::all(&scene),
+    };
+    let mut frame = scnc::render::Frame::with_effects(&scene, effects);
     let params = scnc::sdf::MarchParams { epsilon: scene.settings.epsilon as f32, max_steps: scene.settings.max_steps };
     let lowered = pool.install(|| scnc::world::lower(&scene, &mut frame, mode, params, &FsLoader));
     let geometry = match lowered {
@@ -268,6 +284,7 @@ fn render_cmd(args: RenderArgs) -> ExitCode {
         pool.current_num_threads()
     );
     if args.stats {
+        let _ = writeln!(err, "{}", frame.effects);
         let _ = write!(err, "{}", stats_text(&counters, &geometry, &compiled.map, lowered.as_secs_f64(), secs));
     }
     ExitCode::SUCCESS
@@ -420,7 +437,8 @@ fn run(cli: Cli) -> ExitCode {
                 return ExitCode::from(1);
             }
             if let Some(scene) = &compiled.scene {
-                let _ = std::io::stdout().lock().write_all(scnc::ir::dump(scene, &compiled.map).as_bytes());
+                let text = format!("{}{}\n", scnc::ir::dump(scene, &compiled.map), scnc::effects::derive(scene));
+                let _ = std::io::stdout().lock().write_all(text.as_bytes());
             }
             ExitCode::SUCCESS
         }

@@ -2,6 +2,7 @@
 
 use glam::{DVec3, Vec3A};
 
+use crate::effects::Effects;
 use crate::ir;
 
 /// A material ready for shading.
@@ -48,19 +49,15 @@ impl MaterialTable {
     }
 }
 
-/// A light in render space.
+/// A point or directional light in render space.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ShadeLight {
-    /// Ambient intensity.
-    Ambient(f32),
     /// A point light.
     Point {
         /// Position.
         position: Vec3A,
         /// Intensity.
         intensity: f32,
-        /// Casts shadows.
-        shadows: bool,
     },
     /// A light at infinity.
     Directional {
@@ -68,8 +65,6 @@ pub enum ShadeLight {
         towards: Vec3A,
         /// Intensity.
         intensity: f32,
-        /// Casts shadows.
-        shadows: bool,
     },
 }
 
@@ -86,13 +81,19 @@ pub struct Frame {
     pub right: Vec3A,
     /// Up vector scaled to half the viewport height at distance 1.
     pub up: Vec3A,
-    /// Lights.
-    pub lights: Vec<ShadeLight>,
+    /// Total ambient intensity.
+    pub ambient: f32,
+    /// Lights that cast shadows.
+    pub casting: Vec<ShadeLight>,
+    /// Lights that cast none (`shadows = false`).
+    pub plain: Vec<ShadeLight>,
+    /// The effect set the tracer is built for.
+    pub effects: Effects,
     /// Materials.
     pub materials: MaterialTable,
     /// Background colour, 0–255.
     pub background: Vec3A,
-    /// Reflection recursion depth.
+    /// Reflection recursion depth actually traced (the effect set's useful depth).
     pub depth: u32,
     /// Samples per pixel.
     pub samples: u32,
@@ -103,8 +104,14 @@ pub struct Frame {
 }
 
 impl Frame {
-    /// Builds the frame for a scene; materials are filled in by the back-end's lowering.
+    /// Builds the frame for a scene with its derived effect set; materials are filled in
+    /// by the back-end's lowering.
     pub fn new(scene: &ir::Scene) -> Frame {
+        Frame::with_effects(scene, crate::effects::derive(scene))
+    }
+
+    /// Builds the frame with a given effect set (`Effects::all` for the general tracer).
+    pub fn with_effects(scene: &ir::Scene, effects: Effects) -> Frame {
         let cam = &scene.camera;
         let s = &scene.settings;
         let origin = cam.position;
@@ -116,36 +123,37 @@ impl Frame {
         let up = right.cross(forward).normalize() * -1.0;
         let half_h = (cam.fov.to_radians() * 0.5).tan();
         let half_w = half_h * s.width as f64 / s.height as f64;
-        let lights = scene
-            .lights
-            .iter()
-            .map(|l| match &l.kind {
-                ir::LightKind::Ambient => ShadeLight::Ambient(l.intensity as f32),
-                ir::LightKind::Point { position } => ShadeLight::Point {
-                    position: (*position - origin).as_vec3a(),
-                    intensity: l.intensity as f32,
-                    shadows: l.shadows,
-                },
-                ir::LightKind::Directional { towards } => ShadeLight::Directional {
-                    towards: towards.normalize().as_vec3a(),
-                    intensity: l.intensity as f32,
-                    shadows: l.shadows,
-                },
-            })
-            .collect();
+        let light = |i: &usize| {
+            let l = &scene.lights[*i];
+            match &l.kind {
+                ir::LightKind::Point { position } => {
+                    ShadeLight::Point { position: (*position - origin).as_vec3a(), intensity: l.intensity as f32 }
+                }
+                ir::LightKind::Directional { towards } => {
+                    ShadeLight::Directional { towards: towards.normalize().as_vec3a(), intensity: l.intensity as f32 }
+                }
+                // Ambient lights are summed into `ambient`, never listed.
+                ir::LightKind::Ambient => ShadeLight::Directional { towards: Vec3A::Y, intensity: 0.0 },
+            }
+        };
+        let casting = effects.shadow_lights.iter().map(light).collect();
+        let plain = effects.unshadowed_lights.iter().map(light).collect();
         Frame {
             width: s.width,
             height: s.height,
             forward: forward.as_vec3a(),
             right: (right * half_w).as_vec3a(),
             up: (up * half_h).as_vec3a(),
-            lights,
+            ambient: effects.ambient as f32,
+            casting,
+            plain,
             materials: MaterialTable::default(),
             background: s.background.as_vec3a(),
-            depth: s.depth,
+            depth: effects.useful_depth,
             samples: s.samples,
             max_distance: s.max_distance as f32,
             origin,
+            effects,
         }
     }
 

@@ -132,6 +132,25 @@ pub struct Image {
 /// Renders the frame with any geometry. Rows run in parallel on the current rayon
 /// pool; `progress` is called once per finished row.
 pub fn render(geometry: &dyn Geometry, frame: &Frame, progress: &(dyn Fn() + Sync)) -> (Image, Counters) {
+    let e = &frame.effects;
+    // Pick the tracer built for this effect set, once, before the first ray.
+    match (e.shadows(), e.reflections && frame.depth > 0, e.specular) {
+        (false, false, false) => rows::<false, false, false>(geometry, frame, progress),
+        (false, false, true) => rows::<false, false, true>(geometry, frame, progress),
+        (false, true, false) => rows::<false, true, false>(geometry, frame, progress),
+        (false, true, true) => rows::<false, true, true>(geometry, frame, progress),
+        (true, false, false) => rows::<true, false, false>(geometry, frame, progress),
+        (true, false, true) => rows::<true, false, true>(geometry, frame, progress),
+        (true, true, false) => rows::<true, true, false>(geometry, frame, progress),
+        (true, true, true) => rows::<true, true, true>(geometry, frame, progress),
+    }
+}
+
+fn rows<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool>(
+    geometry: &dyn Geometry,
+    frame: &Frame,
+    progress: &(dyn Fn() + Sync),
+) -> (Image, Counters) {
     let (w, h) = (frame.width, frame.height);
     let rows: Vec<(Vec<u8>, Counters)> = (0..h)
         .into_par_iter()
@@ -139,7 +158,7 @@ pub fn render(geometry: &dyn Geometry, frame: &Frame, progress: &(dyn Fn() + Syn
             let mut c = Counters::default();
             let mut row = Vec::with_capacity(w as usize * 3);
             for x in 0..w {
-                let colour = shade::pixel(geometry, frame, x, y, &mut c);
+                let colour = shade::pixel::<SHADOWS, REFLECT, SPECULAR>(geometry, frame, x, y, &mut c);
                 row.extend_from_slice(&colour);
             }
             progress();

@@ -1,13 +1,25 @@
 //! Whitted/Phong shading exactly as the study: ambient + Σ lights (diffuse `N·L/|L|` +
 //! Phong `(R·V/|R||V|)^s`), hard shadows, reflections blended `(1 − r)·local + r·reflected`,
 //! colour clamped once at the end.
+//!
+//! The tracer is built for the scene's effect set: `trace` is generic over three const
+//! flags (shadow rays, reflection rays, specular highlights), and [`render`](super::render)
+//! picks the one of eight monomorphised variants that the effect set calls for before
+//! the first ray. Lights arrive pre-split into an ambient sum, casting and non-casting
+//! lists, so no per-ray code tests for an effect or a light kind the scene does not have.
 
 use glam::Vec3A;
 
 use super::{spawn_offset, Counters, Frame, Geometry, Ray, ShadeLight};
 
 /// The 8-bit colour of pixel `(x, y)`, averaging `frame.samples` deterministic samples.
-pub(super) fn pixel(g: &dyn Geometry, frame: &Frame, x: u32, y: u32, c: &mut Counters) -> [u8; 3] {
+pub(super) fn pixel<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool>(
+    g: &dyn Geometry,
+    frame: &Frame,
+    x: u32,
+    y: u32,
+    c: &mut Counters,
+) -> [u8; 3] {
     let n = frame.samples.max(1);
     let mut sum = Vec3A::ZERO;
     for s in 0..n {
@@ -15,7 +27,7 @@ pub(super) fn pixel(g: &dyn Geometry, frame: &Frame, x: u32, y: u32, c: &mut Cou
         let dir = frame.direction(x as f32 + ox, y as f32 + oy);
         c.primary_rays += 1;
         let ray = Ray::new(Vec3A::ZERO, dir, frame.max_distance);
-        let mut colour = trace(g, frame, &ray, frame.depth, c);
+        let mut colour = trace::<SHADOWS, REFLECT, SPECULAR>(g, frame, &ray, frame.depth, c);
         if !colour.is_finite() {
             c.nonfinite_samples += 1;
             colour = Vec3A::ZERO;
@@ -40,8 +52,51 @@ fn sample_offset(s: u32, n: u32) -> (f32, f32) {
     (((0.5 + a1 * i) % 1.0) as f32, ((0.5 + a2 * i) % 1.0) as f32)
 }
 
+/// The light a point receives from one direct light, before shadowing: `None` when the
+/// light adds nothing there (behind the surface, no highlight), so no shadow ray is needed.
+#[inline(always)]
+fn direct<const SPECULAR: bool>(
+    light: &ShadeLight,
+    point: Vec3A,
+    normal: Vec3A,
+    view: Vec3A,
+    specular: Option<f32>,
+) -> Option<(Vec3A, f32, f32)> {
+    let (to_light, dist, power) = match *light {
+        ShadeLight::Point { position, intensity } => {
+            let l = position - point;
+            (l, l.length(), intensity)
+        }
+        ShadeLight::Directional { towards, intensity } => (towards, f32::INFINITY, intensity),
+    };
+    let l_len = to_light.length();
+    if l_len <= 0.0 {
+        return None;
+    }
+    let l_unit = to_light / l_len;
+    let n_dot_l = normal.dot(l_unit);
+    let diffuse = n_dot_l.max(0.0);
+    let mut spec = 0.0;
+    if SPECULAR {
+        if let Some(s) = specular {
+            let r = normal * (2.0 * n_dot_l) - l_unit;
+            let r_dot_v = r.dot(view) / r.length().max(f32::MIN_POSITIVE);
+            if r_dot_v > 0.0 {
+                spec = r_dot_v.powf(s);
+            }
+        }
+    }
+    (diffuse > 0.0 || spec > 0.0).then_some((l_unit, dist, power * (diffuse + spec)))
+}
+
 /// The colour seen along `ray`, 0–255 per channel but not yet clamped.
-pub(super) fn trace(g: &dyn Geometry, frame: &Frame, ray: &Ray, depth: u32, c: &mut Counters) -> Vec3A {
+pub(super) fn trace<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool>(
+    g: &dyn Geometry,
+    frame: &Frame,
+    ray: &Ray,
+    depth: u32,
+    c: &mut Counters,
+) -> Vec3A {
     let Some(hit) = g.intersect(ray, c) else {
         return frame.background;
     };
@@ -49,60 +104,45 @@ pub(super) fn trace(g: &dyn Geometry, frame: &Frame, ray: &Ray, depth: u32, c: &
     // Seen from behind (inside a solid or a one-sided surface): shade the side we see.
     let normal = if hit.normal.dot(view) < 0.0 { -hit.normal } else { hit.normal };
     let material = frame.materials.materials[hit.material as usize];
-    let origin = hit.point + normal * spawn_offset(hit.point, hit.error);
+    let offset = spawn_offset(hit.point, hit.error);
+    let origin = hit.point + normal * offset;
 
-    let mut intensity = 0.0f32;
-    for light in &frame.lights {
-        let (to_light, dist, power, shadows) = match *light {
-            ShadeLight::Ambient(a) => {
-                intensity += a;
+    let mut intensity = frame.ambient;
+    if SHADOWS {
+        for light in &frame.casting {
+            let Some((l_unit, dist, amount)) = direct::<SPECULAR>(light, hit.point, normal, view, material.specular)
+            else {
                 continue;
-            }
-            ShadeLight::Point { position, intensity, shadows } => {
-                let l = position - hit.point;
-                (l, l.length(), intensity, shadows)
-            }
-            ShadeLight::Directional { towards, intensity, shadows } => (towards, f32::INFINITY, intensity, shadows),
-        };
-        let l_len = to_light.length();
-        if l_len <= 0.0 {
-            continue;
-        }
-        let l_unit = to_light / l_len;
-        let n_dot_l = normal.dot(l_unit);
-        let diffuse = n_dot_l.max(0.0);
-        let specular = match material.specular {
-            Some(s) => {
-                let r = normal * (2.0 * n_dot_l) - l_unit;
-                let r_dot_v = r.dot(view) / r.length().max(f32::MIN_POSITIVE);
-                if r_dot_v > 0.0 {
-                    r_dot_v.powf(s)
-                } else {
-                    0.0
-                }
-            }
-            None => 0.0,
-        };
-        // A light that adds nothing here needs no shadow ray.
-        if diffuse <= 0.0 && specular <= 0.0 {
-            continue;
-        }
-        if shadows {
+            };
             c.shadow_rays += 1;
-            let shadow = Ray::new(origin, l_unit, (dist - spawn_offset(hit.point, hit.error)).min(frame.max_distance));
+            let shadow = Ray::new(origin, l_unit, (dist - offset).min(frame.max_distance));
             if shadow.t_max > 0.0 && g.occluded(&shadow, c) {
                 continue;
             }
+            intensity += amount;
         }
-        intensity += power * (diffuse + specular);
+    }
+    for light in &frame.plain {
+        if let Some((_, _, amount)) = direct::<SPECULAR>(light, hit.point, normal, view, material.specular) {
+            intensity += amount;
+        }
     }
     let local = material.color * intensity;
+    if !REFLECT {
+        return local;
+    }
     let r = material.reflective;
     if depth == 0 || r <= 0.0 {
         return local;
     }
     let reflected_dir = (normal * (2.0 * normal.dot(view)) - view).normalize();
     c.reflection_rays += 1;
-    let reflected = trace(g, frame, &Ray::new(origin, reflected_dir, frame.max_distance), depth - 1, c);
+    let reflected = trace::<SHADOWS, REFLECT, SPECULAR>(
+        g,
+        frame,
+        &Ray::new(origin, reflected_dir, frame.max_distance),
+        depth - 1,
+        c,
+    );
     local * (1.0 - r) + reflected * r
 }

@@ -20,6 +20,7 @@ fn ir_dumps() {
         };
         let mut actual = scnc::diag::render_all(&c.diagnostics, &c.map);
         actual.push_str(&scnc::ir::dump(scene, &c.map));
+        actual.push_str(&format!("{}\n", scnc::effects::derive(scene)));
         failures.extend(check_golden(&path.with_extension("ir"), &actual));
     }
     finish(failures);

@@ -1,0 +1,189 @@
+//! The effect set: which parts of the shading model a scene calls for, derived from the
+//! IR alone, so the tracer is built with those and no others.
+//!
+//! Derived facts: whether any light casts shadows (`shadows = false` opts a light out;
+//! ambient light never casts), whether any material reflects (and how deep recursion
+//! can matter), whether any material has a specular highlight, the total ambient
+//! intensity, and the optional extras the scene asked for (`render(samples = n)`).
+
+use std::fmt;
+
+use crate::ir::{self, Geometry, LightKind, Scene, ShapeKind};
+
+/// The effects one scene needs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Effects {
+    /// Lights that cast shadows (indices into the scene's lights).
+    pub shadow_lights: Vec<usize>,
+    /// Point and directional lights that cast none.
+    pub unshadowed_lights: Vec<usize>,
+    /// Total ambient intensity.
+    pub ambient: f64,
+    /// Some material reflects and the depth allows a bounce.
+    pub reflections: bool,
+    /// The deepest recursion that can change a pixel (≤ the scene's `depth`).
+    pub useful_depth: u32,
+    /// Some material has a Phong highlight.
+    pub specular: bool,
+    /// Samples per pixel (1 = no antialiasing).
+    pub samples: u32,
+}
+
+impl Effects {
+    /// Every effect on, as `--effects all` asks: the general tracer, for comparisons.
+    pub fn all(scene: &Scene) -> Effects {
+        let mut e = derive(scene);
+        e.reflections = scene.settings.depth > 0;
+        e.useful_depth = scene.settings.depth;
+        e.specular = true;
+        e
+    }
+
+    /// Whether any shadow rays will be cast.
+    pub fn shadows(&self) -> bool {
+        !self.shadow_lights.is_empty()
+    }
+}
+
+fn materials_of_shape(shape: &ir::Shape, out: &mut Vec<ir::Material>) {
+    match &shape.kind {
+        ShapeKind::Paint { child, material } => {
+            out.push((**material).clone());
+            materials_of_shape(child, out);
+        }
+        ShapeKind::Union { children, .. }
+        | ShapeKind::Intersect { children, .. }
+        | ShapeKind::Subtract { children, .. } => {
+            children.iter().for_each(|c| materials_of_shape(c, out));
+        }
+        ShapeKind::Round { child, .. }
+        | ShapeKind::Shell { child, .. }
+        | ShapeKind::Repeat { child, .. }
+        | ShapeKind::Transform { child, .. } => materials_of_shape(child, out),
+        _ => {}
+    }
+}
+
+/// Every material an object can show, plus the default grey when some part has none.
+fn materials_of(geometry: &Geometry) -> Vec<ir::Material> {
+    let mut out = Vec::new();
+    match geometry {
+        Geometry::Shape(s) => {
+            materials_of_shape(s, &mut out);
+            if !painted_everywhere(s) {
+                out.push(ir::Material::default_grey());
+            }
+        }
+        Geometry::Mesh(m) => {
+            out.push(m.material.as_deref().cloned().unwrap_or_else(ir::Material::default_grey));
+            if let ir::MeshSource::Isosurface { shape, .. } = &m.source {
+                materials_of_shape(shape, &mut out);
+            }
+        }
+    }
+    out
+}
+
+/// Whether every leaf of the tree has a material above it.
+fn painted_everywhere(shape: &ir::Shape) -> bool {
+    match &shape.kind {
+        ShapeKind::Paint { .. } => true,
+        ShapeKind::Union { children, .. }
+        | ShapeKind::Intersect { children, .. }
+        | ShapeKind::Subtract { children, .. } => children.iter().all(|c| painted_everywhere(c)),
+        ShapeKind::Round { child, .. }
+        | ShapeKind::Shell { child, .. }
+        | ShapeKind::Repeat { child, .. }
+        | ShapeKind::Transform { child, .. } => painted_everywhere(child),
+        _ => false,
+    }
+}
+
+/// Whether a lone object is convex, so a ray reflected off it can never meet it again.
+fn convex(g: &Geometry) -> bool {
+    fn shape(s: &ir::Shape) -> bool {
+        match &s.kind {
+            ShapeKind::Sphere { .. }
+            | ShapeKind::Box { .. }
+            | ShapeKind::Cylinder { .. }
+            | ShapeKind::Capsule { .. }
+            | ShapeKind::Cone { .. }
+            | ShapeKind::Plane { .. } => true,
+            ShapeKind::Intersect { children, smooth } => *smooth == 0.0 && children.iter().all(|c| shape(c)),
+            ShapeKind::Round { child, .. } | ShapeKind::Paint { child, .. } | ShapeKind::Transform { child, .. } => {
+                shape(child)
+            }
+            _ => false,
+        }
+    }
+    match g {
+        Geometry::Shape(s) => shape(s),
+        Geometry::Mesh(m) => matches!(
+            m.source,
+            ir::MeshSource::UvSphere { .. }
+                | ir::MeshSource::IcoSphere { .. }
+                | ir::MeshSource::Box { .. }
+                | ir::MeshSource::Cylinder { .. }
+                | ir::MeshSource::Plane { .. }
+        ),
+    }
+}
+
+/// Derives the effect set of a scene.
+pub fn derive(scene: &Scene) -> Effects {
+    let mut shadow_lights = Vec::new();
+    let mut unshadowed_lights = Vec::new();
+    let mut ambient = 0.0;
+    for (i, l) in scene.lights.iter().enumerate() {
+        match l.kind {
+            LightKind::Ambient => ambient += l.intensity,
+            _ if l.intensity == 0.0 => {}
+            _ if l.shadows => shadow_lights.push(i),
+            _ => unshadowed_lights.push(i),
+        }
+    }
+    let per_object: Vec<Vec<ir::Material>> = scene.objects.iter().map(|o| materials_of(&o.geometry)).collect();
+    let reflective_objects = per_object.iter().filter(|ms| ms.iter().any(|m| m.reflective > 0.0)).count();
+    let reflections = reflective_objects > 0 && scene.settings.depth > 0;
+    // A single convex object sees nothing but the background in its reflection, so one
+    // bounce is all that can show; otherwise every allowed bounce may matter.
+    let useful_depth = if !reflections {
+        0
+    } else if scene.objects.len() == 1 && convex(&scene.objects[0].geometry) {
+        1
+    } else {
+        scene.settings.depth
+    };
+    let specular = per_object.iter().flatten().any(|m| m.specular.is_some());
+    Effects {
+        shadow_lights,
+        unshadowed_lights,
+        ambient,
+        reflections,
+        useful_depth,
+        specular,
+        samples: scene.settings.samples,
+    }
+}
+
+impl fmt::Display for Effects {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let list = |v: &[usize]| {
+            if v.is_empty() {
+                "none".to_string()
+            } else {
+                v.iter().map(|i| format!("#{i}")).collect::<Vec<_>>().join(", ")
+            }
+        };
+        write!(
+            f,
+            "effects: ambient {}, shadow rays from {}, unshadowed lights {}, specular {}, reflections {}, antialiasing {}",
+            ir::dump_num(self.ambient),
+            list(&self.shadow_lights),
+            list(&self.unshadowed_lights),
+            if self.specular { "on" } else { "off" },
+            if self.reflections { format!("up to depth {}", self.useful_depth) } else { "off".to_string() },
+            if self.samples > 1 { format!("{} samples", self.samples) } else { "off".to_string() },
+        )
+    }
+}

@@ -1,0 +1,144 @@
+//! The effect set: exact ray counts, and the specialised tracer agreeing bit for bit with
+//! the general one on scenes that do not use an effect.
+
+use std::path::Path;
+
+use glam::Vec3A;
+use scnc::effects::{self, Effects};
+use scnc::render::{Counters, Frame, Geometry, Image, Ray};
+use scnc::world::Mode;
+
+fn scene(text: &str) -> scnc::ir::Scene {
+    let c = scnc::compile_source("t.scn", Path::new("t.scn"), text.to_string(), &scnc::check::FsLoader);
+    c.scene.unwrap_or_else(|| panic!("{}", scnc::diag::render_all(&c.diagnostics, &c.map)))
+}
+
+/// Renders at `size`² with the given effect set (derived when `None`), and counts the
+/// pixels whose centre ray hits geometry.
+fn render(mut s: scnc::ir::Scene, size: u32, effects: Option<Effects>) -> (Image, Counters, u64) {
+    s.settings.width = size;
+    s.settings.height = size;
+    let effects = effects.unwrap_or_else(|| effects::derive(&s));
+    let mut frame = Frame::with_effects(&s, effects);
+    let params = scnc::sdf::MarchParams { epsilon: s.settings.epsilon as f32, max_steps: s.settings.max_steps };
+    let world = scnc::world::lower(&s, &mut frame, Mode::Sdf, params, &scnc::check::FsLoader).expect("lowering");
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().expect("pool");
+    let (img, c) = pool.install(|| scnc::render::render(&world, &frame, &|| {}));
+    let mut scratch = Counters::default();
+    let hits = (0..size * size)
+        .filter(|i| {
+            let dir = frame.direction((i % size) as f32 + 0.5, (i / size) as f32 + 0.5);
+            world.intersect(&Ray::new(Vec3A::ZERO, dir, frame.max_distance), &mut scratch).is_some()
+        })
+        .count() as u64;
+    (img, c, hits)
+}
+
+const SPHERES: &str = "object sphere(1) at [0, 0, 5] with material(color = rgb(255, 0, 0), specular = 50)
+object box(0.5) rotate [20, 30, 0] at [1.5, 0.5, 6] with material(color = rgb(0, 255, 0))
+";
+
+#[test]
+fn no_reflection_rays_without_a_reflective_material() {
+    let (_, c, hits) =
+        render(scene(&format!("light ambient(0.2)\nlight point(0.6) at [2, 1, 0]\n{SPHERES}")), 64, None);
+    assert!(hits > 0);
+    assert_eq!(c.reflection_rays, 0);
+}
+
+#[test]
+fn no_shadow_rays_from_ambient_or_unshadowed_lights() {
+    let (_, c, _) = render(scene(&format!("light ambient(0.5)\n{SPHERES}")), 64, None);
+    assert_eq!(c.shadow_rays, 0, "ambient light casts no shadow rays");
+    let text = format!("light ambient(0.2)\nlight point(0.6, shadows = false) at [2, 1, 0]\nlight directional(0.3, towards = [1, 1, -1], shadows = false)\n{SPHERES}");
+    let (_, c, _) = render(scene(&text), 64, None);
+    assert_eq!(c.shadow_rays, 0, "lights with `shadows = false` cast no shadow rays");
+    let e = effects::derive(&scene(&text));
+    assert!(e.shadow_lights.is_empty() && e.unshadowed_lights.len() == 2);
+}
+
+/// Lights at the eye light every visible point, so each hit casts exactly one shadow ray
+/// per casting light, and a non-casting light adds none.
+#[test]
+fn shadow_rays_are_hits_times_casting_lights() {
+    let text = format!("light point(0.3) at [0, 0, 0]\nlight point(0.3) at [0, 0, 0.01]\nlight point(0.2, shadows = false) at [0, 0, 0]\n{SPHERES}");
+    let (_, c, hits) = render(scene(&text), 64, None);
+    assert!(hits > 500, "the objects should fill part of the frame ({hits} hits)");
+    assert_eq!(c.shadow_rays, 2 * hits);
+}
+
+#[test]
+fn reflection_rays_are_bounded_by_depth() {
+    let mirrors = "light ambient(0.3)\nlight point(0.5) at [0, 2, 0]
+let mirror = material(color = rgb(200, 200, 200), reflective = 1)
+object box(0.2, 3, 20) at [-1.5, 0, 10] with mirror
+object box(0.2, 3, 20) at [1.5, 0, 10] with mirror
+object sphere(0.5) at [0, 0, 8] with material(color = rgb(255, 0, 0))
+";
+    let mut previous = 0;
+    for depth in [0u32, 1, 3, 50] {
+        let mut s = scene(mirrors);
+        s.settings.depth = depth;
+        let (img, c, hits) = render(s, 48, None);
+        assert!(
+            c.reflection_rays <= hits * depth as u64,
+            "depth {depth}: {} reflection rays for {hits} hits",
+            c.reflection_rays
+        );
+        assert!(c.reflection_rays >= previous, "more depth never means fewer bounces");
+        assert_eq!(c.nonfinite_samples, 0, "depth {depth}: non-finite colours");
+        assert_eq!(img.pixels.len(), 48 * 48 * 3);
+        previous = c.reflection_rays;
+        if depth == 0 {
+            assert_eq!(c.reflection_rays, 0);
+        }
+    }
+    assert!(previous > 0);
+}
+
+#[test]
+fn antialiasing_multiplies_primary_rays_exactly() {
+    for samples in [1u32, 2, 4, 9] {
+        let mut s = scene(&format!("light ambient(1)\n{SPHERES}"));
+        s.settings.samples = samples;
+        let (_, c, _) = render(s, 40, None);
+        assert_eq!(c.primary_rays, 40 * 40 * samples as u64);
+    }
+}
+
+/// A lone convex reflective object gains nothing past one bounce: the derived tracer
+/// stops at depth 1 and the image equals the general tracer's at the scene's depth.
+#[test]
+fn useful_depth_of_a_lone_convex_mirror_is_one() {
+    let text = "light ambient(0.3)\nlight point(0.6) at [2, 1, 0]\nobject sphere(1) at [0, 0, 5] with material(color = rgb(255, 0, 0), specular = 40, reflective = 0.5)\n";
+    let s = scene(text);
+    assert_eq!(effects::derive(&s).useful_depth, 1);
+    let (derived, c, hits) = render(s.clone(), 64, None);
+    let (general, c_all, _) = render(s.clone(), 64, Some(Effects::all(&s)));
+    assert_eq!(c.reflection_rays, hits);
+    assert!(derived == general, "depth 1 and depth 5 differ for a lone convex mirror");
+    assert_eq!(c.reflection_rays, c_all.reflection_rays, "the general tracer finds no second bounce either");
+}
+
+/// The tracer built for a scene's effects and the general tracer with every effect
+/// compiled in produce the same pixels on scenes that do not use those effects.
+#[test]
+fn specialised_and_general_tracers_agree_bit_for_bit() {
+    let scenes = [
+        format!("light ambient(1)\n{SPHERES}"),
+        format!("light ambient(0.2)\nlight point(0.6, shadows = false) at [2, 1, 0]\n{SPHERES}"),
+        format!("light ambient(0.2)\nlight point(0.6) at [2, 1, 0]\nlight directional(0.2, towards = [1, 4, 4])\n{SPHERES}"),
+        "light ambient(0.2)\nlight point(0.6) at [2, 1, 0]\nobject sphere(1) at [0, 0, 5] with material(reflective = 0.5)\nobject sphere(1) at [2, 0, 6]\n".to_string(),
+    ];
+    for text in scenes {
+        let s = scene(&text);
+        let (derived, c, _) = render(s.clone(), 64, None);
+        let (general, c_all, _) = render(s.clone(), 64, Some(Effects::all(&s)));
+        assert!(derived == general, "images differ for:\n{text}");
+        assert_eq!(
+            (c.shadow_rays, c.reflection_rays),
+            (c_all.shadow_rays, c_all.reflection_rays),
+            "ray counts differ for:\n{text}"
+        );
+    }
+}
