@@ -27,6 +27,8 @@ pub struct Effects {
     pub specular: bool,
     /// Samples per pixel (1 = no antialiasing).
     pub samples: u32,
+    /// Casting point lights with a radius (soft shadows).
+    pub soft_lights: Vec<usize>,
 }
 
 impl Effects {
@@ -155,6 +157,7 @@ pub fn derive(scene: &Scene) -> Effects {
         scene.settings.depth
     };
     let specular = per_object.iter().flatten().any(|m| m.specular.is_some());
+    let soft_lights = shadow_lights.iter().copied().filter(|&i| scene.lights[i].radius > 0.0).collect();
     Effects {
         shadow_lights,
         unshadowed_lights,
@@ -163,6 +166,7 @@ pub fn derive(scene: &Scene) -> Effects {
         useful_depth,
         specular,
         samples: scene.settings.samples,
+        soft_lights,
     }
 }
 
@@ -177,10 +181,11 @@ impl fmt::Display for Effects {
         };
         write!(
             f,
-            "effects: ambient {}, shadow rays from {}, unshadowed lights {}, specular {}, reflections {}, antialiasing {}",
+            "effects: ambient {}, shadow rays from {}, unshadowed lights {}, soft shadows from {}, specular {}, reflections {}, antialiasing {}",
             ir::dump_num(self.ambient),
             list(&self.shadow_lights),
             list(&self.unshadowed_lights),
+            list(&self.soft_lights),
             if self.specular { "on" } else { "off" },
             if self.reflections { format!("up to depth {}", self.useful_depth) } else { "off".to_string() },
             if self.samples > 1 { format!("{} samples", self.samples) } else { "off".to_string() },

@@ -299,6 +299,37 @@ impl Geometry for World {
         hit
     }
 
+    fn soft_visibility(&self, ray: &Ray, cone: f32, c: &mut Counters) -> Option<f32> {
+        if self.objects.iter().any(|o| matches!(o.kind, ObjectKind::Mesh(_))) {
+            return None;
+        }
+        // The penumbra reaches `cone·t` beyond an object, so each object's bounding sphere
+        // is widened by the cone's radius at the far end before it is skipped.
+        let widen = cone * ray.t_max.min(1e6);
+        let mut evals = 0u64;
+        let mut visibility = 1.0f32;
+        for o in &self.objects {
+            let ObjectKind::Sdf(s) = &o.kind else { continue };
+            let (t0, t1) = match o.sphere {
+                Some((centre, radius)) => match sphere_interval(ray, centre, radius + widen) {
+                    Some((a, b)) => (a.max(ray.t_min), b.min(ray.t_max)),
+                    None => continue,
+                },
+                None => (ray.t_min, ray.t_max),
+            };
+            if t0 > t1 {
+                continue;
+            }
+            visibility = visibility.min(s.penumbra(ray, (t0, t1), cone, self.params, c, &mut evals));
+            if visibility <= 0.0 {
+                break;
+            }
+        }
+        c.sdf_evals += evals;
+        c.max_evals_per_ray = c.max_evals_per_ray.max(evals);
+        Some(visibility)
+    }
+
     fn bytes(&self) -> usize {
         self.memory().total()
     }

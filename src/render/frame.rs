@@ -83,8 +83,10 @@ pub struct Frame {
     pub up: Vec3A,
     /// Total ambient intensity.
     pub ambient: f32,
-    /// Lights that cast shadows.
+    /// Lights that cast hard shadows.
     pub casting: Vec<ShadeLight>,
+    /// Point lights that cast soft shadows, with their radius.
+    pub soft: Vec<(ShadeLight, f32)>,
     /// Lights that cast none (`shadows = false`).
     pub plain: Vec<ShadeLight>,
     /// The effect set the tracer is built for.
@@ -136,7 +138,10 @@ impl Frame {
                 ir::LightKind::Ambient => ShadeLight::Directional { towards: Vec3A::Y, intensity: 0.0 },
             }
         };
-        let casting = effects.shadow_lights.iter().map(light).collect();
+        let is_soft = |i: &&usize| scene.lights[**i].radius > 0.0;
+        let casting = effects.shadow_lights.iter().filter(|i| !is_soft(i)).map(light).collect();
+        let soft =
+            effects.shadow_lights.iter().filter(is_soft).map(|i| (light(i), scene.lights[*i].radius as f32)).collect();
         let plain = effects.unshadowed_lights.iter().map(light).collect();
         Frame {
             width: s.width,
@@ -146,6 +151,7 @@ impl Frame {
             up: (up * half_h).as_vec3a(),
             ambient: effects.ambient as f32,
             casting,
+            soft,
             plain,
             materials: MaterialTable::default(),
             background: s.background.as_vec3a(),

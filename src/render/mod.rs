@@ -114,6 +114,12 @@ pub trait Geometry: Sync {
     fn intersect(&self, ray: &Ray, counters: &mut Counters) -> Option<Hit>;
     /// Whether anything lies along the ray within `[t_min, t_max]` (for shadows).
     fn occluded(&self, ray: &Ray, counters: &mut Counters) -> bool;
+    /// The unblocked fraction of a cone of half-angle `atan(cone)` around the ray (a soft
+    /// shadow from a round light), if the back-end can estimate it from one query; `None`
+    /// asks the tracer to sample the light with several shadow rays instead.
+    fn soft_visibility(&self, _ray: &Ray, _cone: f32, _counters: &mut Counters) -> Option<f32> {
+        None
+    }
     /// Bytes of the back-end's geometry structures.
     fn bytes(&self) -> usize;
 }

@@ -89,6 +89,38 @@ fn direct<const SPECULAR: bool>(
     (diffuse > 0.0 || spec > 0.0).then_some((l_unit, dist, power * (diffuse + spec)))
 }
 
+/// Shadow rays per soft light when the back-end cannot estimate a penumbra.
+const SOFT_SAMPLES: u32 = 16;
+
+/// The visible fraction of a round light of `radius` at distance `t_max` along `dir`:
+/// the back-end's one-query penumbra estimate if it has one (SDF scenes), else the
+/// fraction of [`SOFT_SAMPLES`] shadow rays to points spread over the light's disk.
+fn soft_visibility(g: &dyn Geometry, origin: Vec3A, dir: Vec3A, t_max: f32, radius: f32, c: &mut Counters) -> f32 {
+    let cone = radius / t_max.max(f32::MIN_POSITIVE);
+    c.shadow_rays += 1;
+    if let Some(v) = g.soft_visibility(&Ray::new(origin, dir, t_max), cone, c) {
+        return v;
+    }
+    c.shadow_rays -= 1;
+    let centre = origin + dir * t_max;
+    let u = dir.any_orthonormal_vector();
+    let w = dir.cross(u);
+    let mut visible = 0;
+    for s in 0..SOFT_SAMPLES {
+        // Deterministic, evenly spread points on the disk (Vogel's sunflower spiral).
+        let r = radius * ((s as f32 + 0.5) / SOFT_SAMPLES as f32).sqrt();
+        let a = s as f32 * 2.399_963;
+        let target = centre + u * (r * a.cos()) + w * (r * a.sin());
+        let to = target - origin;
+        let len = to.length();
+        c.shadow_rays += 1;
+        if !g.occluded(&Ray::new(origin, to / len, len), c) {
+            visible += 1;
+        }
+    }
+    visible as f32 / SOFT_SAMPLES as f32
+}
+
 /// The colour seen along `ray`, 0–255 per channel but not yet clamped.
 pub(super) fn trace<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool>(
     g: &dyn Geometry,
@@ -120,6 +152,18 @@ pub(super) fn trace<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bo
                 continue;
             }
             intensity += amount;
+        }
+        for (light, radius) in &frame.soft {
+            let Some((l_unit, dist, amount)) = direct::<SPECULAR>(light, hit.point, normal, view, material.specular)
+            else {
+                continue;
+            };
+            let t_max = (dist - offset).min(frame.max_distance);
+            if t_max <= 0.0 {
+                intensity += amount;
+                continue;
+            }
+            intensity += amount * soft_visibility(g, origin, l_unit, t_max, *radius, c);
         }
     }
     for light in &frame.plain {

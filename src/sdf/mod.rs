@@ -65,6 +65,40 @@ impl SdfObject {
         march::march(&*self.dist, ray, t0, t1, params, c, evals).is_some()
     }
 
+    /// The unblocked fraction of a cone of slope `cone` around the ray over `[t0, t1]`: the
+    /// penumbra estimate `min(h / (cone·t))` gathered while marching (Quilez), 0 on a hit.
+    /// `(t0, t1)` is the interval to march.
+    pub fn penumbra(
+        &self,
+        ray: &Ray,
+        (t0, t1): (f32, f32),
+        cone: f32,
+        params: MarchParams,
+        c: &mut Counters,
+        evals: &mut u64,
+    ) -> f32 {
+        let base = ray.origin.length();
+        let mut t = t0;
+        let mut res = 1.0f32;
+        for _ in 0..params.max_steps {
+            let h = (self.dist)(ray.at(t));
+            *evals += 1;
+            if h < params.epsilon * (base + t) {
+                return 0.0;
+            }
+            res = res.min(h / (cone * t.max(f32::MIN_POSITIVE)));
+            // Never step less than a small fraction of the distance, so grazing stays cheap.
+            t += h.max(1e-3 * t);
+            if t > t1 || res <= 0.0 {
+                break;
+            }
+        }
+        if t <= t1 && res > 0.0 {
+            c.budget_misses += 1;
+        }
+        res.clamp(0.0, 1.0)
+    }
+
     /// The distance bound at a render-space point.
     pub fn eval(&self, p: Vec3A) -> f32 {
         (self.dist)(p)

@@ -142,3 +142,40 @@ fn specialised_and_general_tracers_agree_bit_for_bit() {
         );
     }
 }
+
+/// A light with a radius gives a penumbra: on the floor across the shadow, the largest
+/// step between neighbouring pixels (the shadow's edge) is much smaller than with a hard
+/// shadow; an SDF scene pays one shadow ray per hit (the penumbra estimate), a mesh scene sixteen.
+#[test]
+fn soft_shadows_have_a_penumbra() {
+    let base = "render(background = rgb(0, 0, 0))\nlight ambient(0.2)\nlight point(0.8, radius = RADIUS) at [4, 2, 6]
+object box(20, 0.5, 20) at [0, -1.5, 6] with material(color = rgb(200, 200, 200))
+object sphere(0.8) at [0, -0.2, 6] with material(color = rgb(255, 60, 60))
+";
+    // The sharpest edge over the floor rows that cross the shadow (left of the sphere at 96²).
+    let edge = |img: &Image, size: u32| {
+        let n = size as usize;
+        (65..70)
+            .flat_map(|row| (1..n).map(move |x| (row, x)))
+            .map(|(row, x)| img.pixels[(row * n + x) * 3].abs_diff(img.pixels[(row * n + x - 1) * 3]))
+            .max()
+            .unwrap_or(0)
+    };
+    let (hard, hc, _) = render(scene(&base.replace(", radius = RADIUS", "")), 96, None);
+    let (soft, sc, hits) = render(scene(&base.replace("RADIUS", "0.8")), 96, None);
+    let (h, s_) = (edge(&hard, 96), edge(&soft, 96));
+    assert!(h >= 40, "the hard shadow should have a sharp edge (largest step {h})");
+    assert!(s_ * 2 <= h, "the soft shadow's largest step {s_} should be far below the hard one's {h}");
+    assert!(sc.shadow_rays <= hits && hc.shadow_rays <= hits, "one shadow query per lit hit in an SDF scene");
+    let mut s = scene(&base.replace("RADIUS", "0.8"));
+    s.settings.width = 48;
+    s.settings.height = 48;
+    let mut frame = Frame::new(&s);
+    let params = scnc::sdf::MarchParams { epsilon: 1e-4, max_steps: 512 };
+    let world =
+        scnc::world::lower(&s, &mut frame, Mode::Mesh(scnc::world::Detail::High), params, &scnc::check::FsLoader)
+            .expect("lowering");
+    let (_, mc) = scnc::render::render(&world, &frame, &|| {});
+    assert_eq!(mc.shadow_rays % 16, 0, "meshes sample the light with 16 rays");
+    assert!(mc.shadow_rays > 0);
+}
