@@ -29,6 +29,8 @@ pub struct Effects {
     pub samples: u32,
     /// Casting point lights with a radius (soft shadows).
     pub soft_lights: Vec<usize>,
+    /// Reach of ambient occlusion in world units, when asked for and there is ambient light.
+    pub ambient_occlusion: Option<f64>,
 }
 
 impl Effects {
@@ -167,6 +169,9 @@ pub fn derive(scene: &Scene) -> Effects {
         specular,
         samples: scene.settings.samples,
         soft_lights,
+        // Occlusion only darkens ambient light; without any there is nothing to occlude.
+        ambient_occlusion: (scene.settings.ambient_occlusion > 0.0 && ambient > 0.0)
+            .then_some(scene.settings.ambient_occlusion),
     }
 }
 
@@ -181,7 +186,7 @@ impl fmt::Display for Effects {
         };
         write!(
             f,
-            "effects: ambient {}, shadow rays from {}, unshadowed lights {}, soft shadows from {}, specular {}, reflections {}, antialiasing {}",
+            "effects: ambient {}, shadow rays from {}, unshadowed lights {}, soft shadows from {}, specular {}, reflections {}, antialiasing {}, ambient occlusion {}",
             ir::dump_num(self.ambient),
             list(&self.shadow_lights),
             list(&self.unshadowed_lights),
@@ -189,6 +194,7 @@ impl fmt::Display for Effects {
             if self.specular { "on" } else { "off" },
             if self.reflections { format!("up to depth {}", self.useful_depth) } else { "off".to_string() },
             if self.samples > 1 { format!("{} samples", self.samples) } else { "off".to_string() },
+            self.ambient_occlusion.map_or("off".to_string(), |d| format!("within {}", ir::dump_num(d))),
         )
     }
 }

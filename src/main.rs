@@ -302,7 +302,7 @@ fn stats_text(
     let mut out = format!(
         "stats:
   time            lower {:.3} s (tessellation and BVH builds), trace {:.3} s
-  rays            {} primary, {} shadow, {} reflection ({} total, {:.2} M/s)
+  rays            {} primary, {} shadow, {} reflection, {} occlusion ({} total, {:.2} M/s)
   sdf evaluations {} marching ({:.1} per ray, max {} on one ray), {} for normals and materials
   step budget     {} marches ran out of steps (counted as misses)
   bvh             {} node visits ({:.2} per ray), {} triangle tests ({:.2} per ray)
@@ -313,6 +313,7 @@ fn stats_text(
         c.primary_rays,
         c.shadow_rays,
         c.reflection_rays,
+        c.occlusion_rays,
         c.rays(),
         c.rays() as f64 / trace_s.max(1e-9) / 1e6,
         c.sdf_evals,

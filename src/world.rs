@@ -330,6 +330,39 @@ impl Geometry for World {
         Some(visibility)
     }
 
+    fn occlusion(&self, point: Vec3A, normal: Vec3A, reach: f32, c: &mut Counters) -> Option<f32> {
+        if self.objects.iter().any(|o| matches!(o.kind, ObjectKind::Mesh(_))) {
+            return None;
+        }
+        // Five taps along the normal (Quilez): where the field is below the distance
+        // travelled, something is near; nearer taps weigh more.
+        let mut shortfall = 0.0f32;
+        let mut weight = 1.0f32;
+        let mut evals = 0u64;
+        for i in 1..=5 {
+            let h = reach * i as f32 / 5.0;
+            let p = point + normal * h;
+            let d = self
+                .objects
+                .iter()
+                .filter_map(|o| match &o.kind {
+                    ObjectKind::Sdf(s) => {
+                        let near = o.sphere.is_none_or(|(centre, r)| (p - centre).length() - r < reach);
+                        near.then(|| {
+                            evals += 1;
+                            s.eval(p)
+                        })
+                    }
+                    ObjectKind::Mesh(_) => None,
+                })
+                .fold(f32::INFINITY, f32::min);
+            shortfall += weight * (h - d.min(h)).max(0.0) / reach;
+            weight *= 0.5;
+        }
+        c.sdf_shading_evals += evals;
+        Some((1.0 - shortfall * 1.5).clamp(0.0, 1.0))
+    }
+
     fn bytes(&self) -> usize {
         self.memory().total()
     }

@@ -319,10 +319,11 @@ pub const BUILTINS: &[Builtin] = &[
             p("max_steps", Ty::Int, N(512.0)),
             p("max_distance", Ty::Num, N(1000.0)),
             p("samples", Ty::Int, N(1.0)),
+            p("ambient_occlusion", Ty::Num, N(0.0)),
         ],
         variadic: None,
         result: Ty::Num,
-        doc: "image size, reflection depth, background and sphere-tracing accuracy",
+        doc: "image size, reflection depth, background, sphere-tracing accuracy, antialiasing and ambient-occlusion reach",
     },
 ];
 

@@ -482,8 +482,9 @@ impl Ctx<'_> {
         let steps = self.check_int(&a, b, 5, 1, MAX_STEPS);
         let ok_dist = self.check_num(&a, b, 6, |d| d > 0.0, "greater than 0");
         let samples = self.check_int(&a, b, 7, 1, MAX_SAMPLES);
+        let ok_ao = self.check_num(&a, b, 8, |d| d >= 0.0, "at least 0 (0 turns it off)");
         let (Some(width), Some(height), Some(depth), true, Some(max_steps), true, Some(samples)) =
-            (width, height, depth, ok_eps, steps, ok_dist, samples)
+            (width, height, depth, ok_eps && ok_ao, steps, ok_dist, samples)
         else {
             return None;
         };
@@ -511,6 +512,7 @@ impl Ctx<'_> {
             max_steps,
             max_distance: a.num(b, 6),
             samples,
+            ambient_occlusion: a.num(b, 8),
             span: Some(span),
         })
     }

@@ -170,7 +170,7 @@ pub fn dump(scene: &Scene, map: &SourceMap) -> String {
     d.line(
         0,
         &format!(
-            "render {}x{} depth {} background {} epsilon {} max_steps {} max_distance {} samples {}",
+            "render {}x{} depth {} background {} epsilon {} max_steps {} max_distance {} samples {}{}",
             s.width,
             s.height,
             s.depth,
@@ -178,7 +178,12 @@ pub fn dump(scene: &Scene, map: &SourceMap) -> String {
             num(s.epsilon),
             s.max_steps,
             num(s.max_distance),
-            s.samples
+            s.samples,
+            if s.ambient_occlusion > 0.0 {
+                format!(" ambient_occlusion {}", num(s.ambient_occlusion))
+            } else {
+                String::new()
+            }
         ),
         s.span,
     );

@@ -78,6 +78,8 @@ pub struct Settings {
     pub max_distance: f64,
     /// Samples per pixel (antialiasing), a perfect square is not required.
     pub samples: u32,
+    /// Reach of ambient occlusion in world units (0 = off).
+    pub ambient_occlusion: f64,
     /// The `render` statement, if any.
     pub span: Option<Span>,
 }
@@ -93,6 +95,7 @@ impl Default for Settings {
             max_steps: 512,
             max_distance: 1000.0,
             samples: 1,
+            ambient_occlusion: 0.0,
             span: None,
         }
     }

@@ -83,6 +83,8 @@ pub struct Frame {
     pub up: Vec3A,
     /// Total ambient intensity.
     pub ambient: f32,
+    /// Reach of ambient occlusion in render units (0 when off).
+    pub ao_reach: f32,
     /// Lights that cast hard shadows.
     pub casting: Vec<ShadeLight>,
     /// Point lights that cast soft shadows, with their radius.
@@ -150,6 +152,7 @@ impl Frame {
             right: (right * half_w).as_vec3a(),
             up: (up * half_h).as_vec3a(),
             ambient: effects.ambient as f32,
+            ao_reach: effects.ambient_occlusion.unwrap_or(0.0) as f32,
             casting,
             soft,
             plain,

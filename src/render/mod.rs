@@ -70,6 +70,8 @@ pub struct Counters {
     pub shadow_rays: u64,
     /// Reflection rays.
     pub reflection_rays: u64,
+    /// Ambient-occlusion rays (mesh scenes; SDF scenes estimate without rays).
+    pub occlusion_rays: u64,
     /// SDF evaluations during marching (SDF back-end).
     pub sdf_evals: u64,
     /// SDF evaluations for normals and materials at hits.
@@ -93,6 +95,7 @@ impl Counters {
         self.primary_rays += o.primary_rays;
         self.shadow_rays += o.shadow_rays;
         self.reflection_rays += o.reflection_rays;
+        self.occlusion_rays += o.occlusion_rays;
         self.sdf_evals += o.sdf_evals;
         self.sdf_shading_evals += o.sdf_shading_evals;
         self.max_evals_per_ray = self.max_evals_per_ray.max(o.max_evals_per_ray);
@@ -104,7 +107,7 @@ impl Counters {
 
     /// All rays cast.
     pub fn rays(&self) -> u64 {
-        self.primary_rays + self.shadow_rays + self.reflection_rays
+        self.primary_rays + self.shadow_rays + self.reflection_rays + self.occlusion_rays
     }
 }
 
@@ -118,6 +121,12 @@ pub trait Geometry: Sync {
     /// shadow from a round light), if the back-end can estimate it from one query; `None`
     /// asks the tracer to sample the light with several shadow rays instead.
     fn soft_visibility(&self, _ray: &Ray, _cone: f32, _counters: &mut Counters) -> Option<f32> {
+        None
+    }
+    /// How open the space above a surface point is, within `reach` along the normal
+    /// (1 = unoccluded), if the back-end can estimate it without rays; `None` asks the
+    /// tracer to cast occlusion rays instead.
+    fn occlusion(&self, _point: Vec3A, _normal: Vec3A, _reach: f32, _counters: &mut Counters) -> Option<f32> {
         None
     }
     /// Bytes of the back-end's geometry structures.
@@ -140,19 +149,22 @@ pub struct Image {
 pub fn render(geometry: &dyn Geometry, frame: &Frame, progress: &(dyn Fn() + Sync)) -> (Image, Counters) {
     let e = &frame.effects;
     // Pick the tracer built for this effect set, once, before the first ray.
-    match (e.shadows(), e.reflections && frame.depth > 0, e.specular) {
-        (false, false, false) => rows::<false, false, false>(geometry, frame, progress),
-        (false, false, true) => rows::<false, false, true>(geometry, frame, progress),
-        (false, true, false) => rows::<false, true, false>(geometry, frame, progress),
-        (false, true, true) => rows::<false, true, true>(geometry, frame, progress),
-        (true, false, false) => rows::<true, false, false>(geometry, frame, progress),
-        (true, false, true) => rows::<true, false, true>(geometry, frame, progress),
-        (true, true, false) => rows::<true, true, false>(geometry, frame, progress),
-        (true, true, true) => rows::<true, true, true>(geometry, frame, progress),
+    macro_rules! pick {
+        ($($s:literal $r:literal $p:literal $a:literal),*) => {
+            match (e.shadows(), e.reflections && frame.depth > 0, e.specular, e.ambient_occlusion.is_some()) {
+                $(($s, $r, $p, $a) => rows::<$s, $r, $p, $a>(geometry, frame, progress),)*
+            }
+        };
     }
+    pick!(
+        false false false false, false false false true, false false true false, false false true true,
+        false true false false, false true false true, false true true false, false true true true,
+        true false false false, true false false true, true false true false, true false true true,
+        true true false false, true true false true, true true true false, true true true true
+    )
 }
 
-fn rows<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool>(
+fn rows<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const AO: bool>(
     geometry: &dyn Geometry,
     frame: &Frame,
     progress: &(dyn Fn() + Sync),
@@ -164,7 +176,7 @@ fn rows<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool>(
             let mut c = Counters::default();
             let mut row = Vec::with_capacity(w as usize * 3);
             for x in 0..w {
-                let colour = shade::pixel::<SHADOWS, REFLECT, SPECULAR>(geometry, frame, x, y, &mut c);
+                let colour = shade::pixel::<SHADOWS, REFLECT, SPECULAR, AO>(geometry, frame, x, y, &mut c);
                 row.extend_from_slice(&colour);
             }
             progress();

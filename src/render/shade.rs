@@ -13,7 +13,7 @@ use glam::Vec3A;
 use super::{spawn_offset, Counters, Frame, Geometry, Ray, ShadeLight};
 
 /// The 8-bit colour of pixel `(x, y)`, averaging `frame.samples` deterministic samples.
-pub(super) fn pixel<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool>(
+pub(super) fn pixel<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const AO: bool>(
     g: &dyn Geometry,
     frame: &Frame,
     x: u32,
@@ -27,7 +27,7 @@ pub(super) fn pixel<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bo
         let dir = frame.direction(x as f32 + ox, y as f32 + oy);
         c.primary_rays += 1;
         let ray = Ray::new(Vec3A::ZERO, dir, frame.max_distance);
-        let mut colour = trace::<SHADOWS, REFLECT, SPECULAR>(g, frame, &ray, frame.depth, c);
+        let mut colour = trace::<SHADOWS, REFLECT, SPECULAR, AO>(g, frame, &ray, frame.depth, c);
         if !colour.is_finite() {
             c.nonfinite_samples += 1;
             colour = Vec3A::ZERO;
@@ -121,8 +121,35 @@ fn soft_visibility(g: &dyn Geometry, origin: Vec3A, dir: Vec3A, t_max: f32, radi
     visible as f32 / SOFT_SAMPLES as f32
 }
 
+/// Occlusion rays per hit when the back-end cannot estimate occlusion.
+const AO_SAMPLES: u32 = 16;
+
+/// The open fraction of the hemisphere above `origin` within `reach`: the back-end's
+/// estimate if it has one (SDF scenes), else the fraction of [`AO_SAMPLES`]
+/// cosine-distributed rays (deterministic) that escape.
+fn occlusion(g: &dyn Geometry, origin: Vec3A, normal: Vec3A, reach: f32, c: &mut Counters) -> f32 {
+    if let Some(open) = g.occlusion(origin, normal, reach, c) {
+        return open;
+    }
+    let u = normal.any_orthonormal_vector();
+    let w = normal.cross(u);
+    let mut open = 0;
+    for s in 0..AO_SAMPLES {
+        // A disk point (Vogel's spiral) lifted onto the hemisphere: cosine-distributed.
+        let r2 = (s as f32 + 0.5) / AO_SAMPLES as f32;
+        let a = s as f32 * 2.399_963;
+        let (x, y) = (r2.sqrt() * a.cos(), r2.sqrt() * a.sin());
+        let dir = (u * x + w * y + normal * (1.0 - r2).max(0.0).sqrt()).normalize();
+        c.occlusion_rays += 1;
+        if !g.occluded(&Ray::new(origin, dir, reach), c) {
+            open += 1;
+        }
+    }
+    open as f32 / AO_SAMPLES as f32
+}
+
 /// The colour seen along `ray`, 0–255 per channel but not yet clamped.
-pub(super) fn trace<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool>(
+pub(super) fn trace<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const AO: bool>(
     g: &dyn Geometry,
     frame: &Frame,
     ray: &Ray,
@@ -140,6 +167,9 @@ pub(super) fn trace<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bo
     let origin = hit.point + normal * offset;
 
     let mut intensity = frame.ambient;
+    if AO {
+        intensity *= occlusion(g, origin, normal, frame.ao_reach, c);
+    }
     if SHADOWS {
         for light in &frame.casting {
             let Some((l_unit, dist, amount)) = direct::<SPECULAR>(light, hit.point, normal, view, material.specular)
@@ -181,7 +211,7 @@ pub(super) fn trace<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bo
     }
     let reflected_dir = (normal * (2.0 * normal.dot(view)) - view).normalize();
     c.reflection_rays += 1;
-    let reflected = trace::<SHADOWS, REFLECT, SPECULAR>(
+    let reflected = trace::<SHADOWS, REFLECT, SPECULAR, AO>(
         g,
         frame,
         &Ray::new(origin, reflected_dir, frame.max_distance),

@@ -179,3 +179,34 @@ object sphere(0.8) at [0, -0.2, 6] with material(color = rgb(255, 60, 60))
     assert_eq!(mc.shadow_rays % 16, 0, "meshes sample the light with 16 rays");
     assert!(mc.shadow_rays > 0);
 }
+
+/// Ambient occlusion darkens ambient light near contacts and leaves open ground alone;
+/// SDF scenes estimate it without rays, mesh scenes cast 16 per hit.
+#[test]
+fn ambient_occlusion_darkens_contacts_only() {
+    let text = "render(background = rgb(0, 0, 0), depth = 0, ambient_occlusion = 0.6)\nlight ambient(1)
+object box(6, 0.5, 6) at [0, -1.5, 7] with material(color = rgb(200, 200, 200))
+object sphere(0.7) at [0, -0.3, 6.5] with material(color = rgb(200, 200, 200))
+";
+    let (with, c, hits) = render(scene(text), 80, None);
+    let (without, _, _) = render(scene(&text.replace(", ambient_occlusion = 0.6", "")), 80, None);
+    assert_eq!(c.occlusion_rays, 0, "SDF scenes estimate occlusion without rays");
+    let px = |img: &Image, x: usize, y: usize| img.pixels[(y * 80 + x) * 3];
+    // Just below the sphere, where it meets the floor: darker. A floor corner far away: unchanged.
+    let contact = (40..80).map(|y| (px(&without, 40, y) as i32 - px(&with, 40, y) as i32).max(0)).max().unwrap_or(0);
+    assert!(contact >= 40, "occlusion should darken the contact (largest change {contact})");
+    assert_eq!(px(&with, 2, 78), px(&without, 2, 78), "open floor is not occluded");
+    let mut s = scene(text);
+    s.settings.width = 40;
+    s.settings.height = 40;
+    let mut frame = Frame::new(&s);
+    let params = scnc::sdf::MarchParams { epsilon: 1e-4, max_steps: 512 };
+    let world =
+        scnc::world::lower(&s, &mut frame, Mode::Mesh(scnc::world::Detail::High), params, &scnc::check::FsLoader)
+            .expect("lowering");
+    let (_, mc) = scnc::render::render(&world, &frame, &|| {});
+    assert!(hits > 0 && mc.occlusion_rays > 0 && mc.occlusion_rays % 16 == 0);
+    // Without ambient light there is nothing to occlude, so the effect is not built.
+    let e = effects::derive(&scene(&text.replace("light ambient(1)", "light point(1) at [0, 3, 0]")));
+    assert_eq!(e.ambient_occlusion, None);
+}
