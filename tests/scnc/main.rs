@@ -6,4 +6,5 @@ mod golden;
 mod mesh;
 mod nopanic;
 mod render;
+mod stability;
 mod support;
