@@ -19,9 +19,8 @@ fn lower_mode(path: &str, w: u32, h: u32, mode: scnc::world::Mode) -> (Frame, sc
     let mut scene = c.scene.expect("seed scenes compile");
     scene.settings.width = w;
     scene.settings.height = h;
-    let mut frame = Frame::new(&scene);
-    let params = scnc::sdf::MarchParams { epsilon: scene.settings.epsilon as f32, max_steps: scene.settings.max_steps };
-    let g = scnc::world::lower(&scene, &mut frame, mode, params, &scnc::check::FsLoader).expect("lowering");
+    let (frame, g) =
+        scnc::world::prepare(&scene, scnc::effects::derive(&scene), mode, &scnc::check::FsLoader).expect("lowering");
     (frame, g)
 }
 
@@ -47,10 +46,9 @@ fn primitives(c: &mut Criterion) {
         let text = format!("light ambient(1)\nobject {shape} at [0, 0, 5]\n");
         let c2 = scnc::compile_source("b.scn", Path::new("b.scn"), text, &scnc::check::FsLoader);
         let scene = c2.scene.expect("compiles");
-        let mut frame = Frame::new(&scene);
-        let params = scnc::sdf::MarchParams { epsilon: 1e-4, max_steps: 512 };
-        let g = scnc::world::lower(&scene, &mut frame, scnc::world::Mode::Sdf, params, &scnc::check::FsLoader)
-            .expect("lowers");
+        let (_, g) =
+            scnc::world::prepare(&scene, scnc::effects::derive(&scene), scnc::world::Mode::Sdf, &scnc::check::FsLoader)
+                .expect("lowers");
         group.bench_function(shape, |b| {
             b.iter(|| points.iter().map(|p| g.sdf_eval(0, black_box(*p)).unwrap_or(0.0)).sum::<f32>())
         });

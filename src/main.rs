@@ -251,10 +251,8 @@ fn render_cmd(args: RenderArgs) -> ExitCode {
         EffectsArg::Derived => scnc::effects::derive(&scene),
         EffectsArg::All => scnc::effects::Effects::all(&scene),
     };
-    let mut frame = scnc::render::Frame::with_effects(&scene, effects);
-    let params = scnc::sdf::MarchParams { epsilon: scene.settings.epsilon as f32, max_steps: scene.settings.max_steps };
-    let lowered = pool.install(|| scnc::world::lower(&scene, &mut frame, mode, params, &FsLoader));
-    let geometry = match lowered {
+    let lowered = pool.install(|| scnc::world::prepare(&scene, effects, mode, &FsLoader));
+    let (frame, geometry) = match lowered {
         Ok(g) => g,
         Err(d) => {
             let c = Compiled { map: compiled.map, scene: None, diagnostics: vec![d] };

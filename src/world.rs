@@ -114,6 +114,20 @@ fn pad_box(b: ir::Aabb) -> Aabb {
     Aabb { min: (b.min - pad).as_vec3a(), max: (b.max + pad).as_vec3a() }
 }
 
+/// Builds the frame for `effects` and lowers the scene into a world, with the scene's
+/// own sphere-tracing settings: the one call the CLI, tests and benchmarks use.
+pub fn prepare(
+    scene: &ir::Scene,
+    effects: crate::effects::Effects,
+    mode: Mode,
+    loader: &dyn Loader,
+) -> Result<(Frame, World), Diagnostic> {
+    let mut frame = Frame::with_effects(scene, effects);
+    let params = MarchParams { epsilon: scene.settings.epsilon as f32, max_steps: scene.settings.max_steps };
+    let world = lower(scene, &mut frame, mode, params, loader)?;
+    Ok((frame, world))
+}
+
 /// Lowers every object of the scene. Materials are interned into `frame`; mesh files
 /// are read through `loader`.
 pub fn lower(

@@ -507,6 +507,93 @@ impl Ctx<'_> {
     }
 
     /// Binds arguments to a builtin's parameters; `None` after reporting (or on poison).
+    /// Matches arguments to parameter slots: positional ones in order (or all into `rest`
+    /// for a variadic callee), named ones by name. Reports too many arguments, unknown
+    /// names (with a suggestion) and arguments given twice; returns the slots, the extra
+    /// positional values, and whether all went well. `note` is the callee's signature.
+    #[allow(clippy::type_complexity, reason = "slots and variadic values, both with the span to blame")]
+    fn bind_slots(
+        &mut self,
+        callee: &str,
+        params: &[&str],
+        variadic: bool,
+        args: Vec<ArgVal>,
+        call: Span,
+        note: Option<String>,
+    ) -> (Vec<Option<(Value, Span)>>, Vec<(Value, Span)>, bool) {
+        let recovered = args.iter().any(|a| a.value.is_error() && a.name.is_none());
+        let with_note = |d: Diagnostic| match &note {
+            Some(n) => d.with_note(n.clone()),
+            None => d,
+        };
+        let mut ok = true;
+        let mut vals: Vec<Option<(Value, Span)>> = vec![None; params.len()];
+        let mut rest = Vec::new();
+        let mut next = 0;
+        for arg in args {
+            let idx = match &arg.name {
+                None if variadic => {
+                    rest.push((arg.value, arg.span));
+                    continue;
+                }
+                None if next >= params.len() => {
+                    if !recovered {
+                        let plural = if params.len() == 1 { "" } else { "s" };
+                        let d = Diagnostic::error(
+                            codes::ARITY,
+                            arg.span,
+                            format!("`{callee}` takes {} argument{plural}, but more were given", params.len()),
+                            "unexpected argument",
+                        )
+                        .with_label(call, "in this call");
+                        self.report(with_note(d));
+                    }
+                    ok = false;
+                    continue;
+                }
+                None => {
+                    next += 1;
+                    next - 1
+                }
+                Some(name) => match params.iter().position(|p| *p == name.name) {
+                    Some(i) => i,
+                    None => {
+                        let mut d = Diagnostic::error(
+                            codes::UNKNOWN_ARG,
+                            name.span,
+                            format!("`{callee}` has no parameter named `{}`", name.name),
+                            "unknown parameter",
+                        );
+                        let synonym =
+                            SYNONYMS.iter().find(|(word, p)| *word == name.name && params.contains(p)).map(|(_, p)| *p);
+                        if let Some(s) = synonym.or_else(|| suggest(&name.name, params.iter().copied())) {
+                            d = d.with_hint(format!("did you mean `{s}`?"));
+                        }
+                        self.report(with_note(d));
+                        ok = false;
+                        continue;
+                    }
+                },
+            };
+            if let Some((_, prev)) = &vals[idx] {
+                self.report(
+                    Diagnostic::error(
+                        codes::DUPLICATE_ARG,
+                        arg.span,
+                        format!("argument `{}` is given twice", params[idx]),
+                        "given again here",
+                    )
+                    .with_label(*prev, "first given here"),
+                );
+                ok = false;
+                continue;
+            }
+            vals[idx] = Some((arg.value, arg.span));
+        }
+        (vals, rest, ok && !recovered)
+    }
+
+    /// Binds arguments to a builtin's parameters; `None` after reporting (or on poison).
     pub(super) fn bind_builtin(&mut self, b: &Builtin, mut args: Vec<ArgVal>, call: Span) -> Option<BoundArgs> {
         let recovered = args.iter().any(|a| a.value.is_error() && a.name.is_none());
         // `box(x, y, z)`: three numbers are one size vector.
@@ -519,75 +606,9 @@ impl Ctx<'_> {
             let v = DVec3::new(n(&args[0]), n(&args[1]), n(&args[2]));
             args = vec![ArgVal { name: None, value: Value::Vec3(v), span }];
         }
-        let mut ok = true;
-        let mut vals: Vec<Option<(Value, Span)>> = vec![None; b.params.len()];
-        let mut rest = Vec::new();
-        let mut next_positional = 0;
-        for arg in args {
-            match &arg.name {
-                None if b.variadic.is_some() => rest.push((arg.value, arg.span)),
-                None => {
-                    if next_positional >= b.params.len() {
-                        if !recovered {
-                            self.report(
-                                Diagnostic::error(
-                                    codes::ARITY,
-                                    arg.span,
-                                    format!(
-                                        "`{}` takes {} argument{}, but more were given",
-                                        b.name,
-                                        b.params.len(),
-                                        if b.params.len() == 1 { "" } else { "s" }
-                                    ),
-                                    "unexpected argument",
-                                )
-                                .with_label(call, "in this call")
-                                .with_note(format!("signature: {}", signature(b))),
-                            );
-                        }
-                        ok = false;
-                        continue;
-                    }
-                    vals[next_positional] = Some((arg.value, arg.span));
-                    next_positional += 1;
-                }
-                Some(name) => {
-                    let Some(idx) = b.params.iter().position(|p| p.name == name.name) else {
-                        let mut d = Diagnostic::error(
-                            codes::UNKNOWN_ARG,
-                            name.span,
-                            format!("`{}` has no parameter named `{}`", b.name, name.name),
-                            "unknown parameter",
-                        )
-                        .with_note(format!("signature: {}", signature(b)));
-                        let synonym = SYNONYMS
-                            .iter()
-                            .find(|(word, p)| *word == name.name && b.params.iter().any(|q| q.name == *p))
-                            .map(|(_, p)| *p);
-                        if let Some(s) = synonym.or_else(|| suggest(&name.name, b.params.iter().map(|p| p.name))) {
-                            d = d.with_hint(format!("did you mean `{s}`?"));
-                        }
-                        self.report(d);
-                        ok = false;
-                        continue;
-                    };
-                    if let Some((_, prev)) = &vals[idx] {
-                        self.report(
-                            Diagnostic::error(
-                                codes::DUPLICATE_ARG,
-                                arg.span,
-                                format!("argument `{}` is given twice", name.name),
-                                "given again here",
-                            )
-                            .with_label(*prev, "first given here"),
-                        );
-                        ok = false;
-                        continue;
-                    }
-                    vals[idx] = Some((arg.value, arg.span));
-                }
-            }
-        }
+        let names: Vec<&str> = b.params.iter().map(|p| p.name).collect();
+        let note = Some(format!("signature: {}", signature(b)));
+        let (mut vals, mut rest, mut ok) = self.bind_slots(b.name, &names, b.variadic.is_some(), args, call, note);
         if !recovered {
             for (p, v) in b.params.iter().zip(&vals) {
                 if v.is_none() && p.default == builtins::Default::Required {
@@ -681,69 +702,9 @@ impl Ctx<'_> {
     }
 
     fn bind_user(&mut self, f: &Func, args: Vec<ArgVal>, call: Span, callee_span: Span) -> Option<Vec<Value>> {
-        let mut vals: Vec<Option<(Value, Span)>> = vec![None; f.params.len()];
-        let mut ok = true;
-        let mut next = 0;
         let recovered = args.iter().any(|a| a.value.is_error() && a.name.is_none());
-        for arg in args {
-            let idx = match &arg.name {
-                None => {
-                    if next >= f.params.len() {
-                        if !recovered {
-                            self.report(
-                                Diagnostic::error(
-                                    codes::ARITY,
-                                    arg.span,
-                                    format!(
-                                        "`{}` takes {} argument{}, but more were given",
-                                        f.name,
-                                        f.params.len(),
-                                        if f.params.len() == 1 { "" } else { "s" }
-                                    ),
-                                    "unexpected argument",
-                                )
-                                .with_label(callee_span, "in this call"),
-                            );
-                        }
-                        ok = false;
-                        continue;
-                    }
-                    next += 1;
-                    next - 1
-                }
-                Some(name) => match f.params.iter().position(|p| p.name == name.name) {
-                    Some(i) => i,
-                    None => {
-                        let mut d = Diagnostic::error(
-                            codes::UNKNOWN_ARG,
-                            name.span,
-                            format!("`{}` has no parameter named `{}`", f.name, name.name),
-                            "unknown parameter",
-                        );
-                        if let Some(s) = suggest(&name.name, f.params.iter().map(|p| p.name.as_str())) {
-                            d = d.with_hint(format!("did you mean `{s}`?"));
-                        }
-                        self.report(d);
-                        ok = false;
-                        continue;
-                    }
-                },
-            };
-            if let Some((_, prev)) = &vals[idx] {
-                self.report(
-                    Diagnostic::error(
-                        codes::DUPLICATE_ARG,
-                        arg.span,
-                        format!("argument `{}` is given twice", f.params[idx].name),
-                        "given again here",
-                    )
-                    .with_label(*prev, "first given here"),
-                );
-                ok = false;
-                continue;
-            }
-            vals[idx] = Some((arg.value, arg.span));
-        }
+        let names: Vec<&str> = f.params.iter().map(|p| p.name.as_str()).collect();
+        let (vals, _, mut ok) = self.bind_slots(&f.name, &names, false, args, callee_span, None);
         if recovered {
             return None;
         }

@@ -64,9 +64,9 @@ pub fn tessellate(
     // Everything else: an isosurface of the subtree in render space, at a cell size that
     // follows the detail (a 1/(4·rings) fraction of the bounding diameter).
     let bounds = ir::shape_bounds(node).ok_or_else(|| unbounded(node.span))?.transform(&xf);
-    let diameter = (bounds.max - bounds.min).length();
-    let cell = diameter / (4.0 * rings as f64);
-    iso_object(node, xf, material, bounds, cell, false, node.span, builder)
+    let cell = (bounds.max - bounds.min).length() / (4.0 * rings as f64);
+    // Sampled in render space, so the vertices need no further placing.
+    isosurface_object(node, xf, DAffine3::IDENTITY, material, cell, false, node.span, CellFrom::Detail, builder)
 }
 
 fn unbounded(span: Span) -> Diagnostic {
@@ -75,46 +75,71 @@ fn unbounded(span: Span) -> Diagnostic {
         .with_hint("try intersecting it with a `box` to bound it")
 }
 
-#[allow(clippy::too_many_arguments, reason = "the isosurface needs the shape, frame, material, grid and source span")]
-fn iso_object(
+/// Where an isosurface's cell size came from, so a failure can say what to change.
+#[derive(Clone, Copy)]
+enum CellFrom {
+    /// `mesh isosurface(…, cell = …)`.
+    Scene,
+    /// `--detail` in mesh mode.
+    Detail,
+}
+
+/// An isosurface of `shape` on a grid laid out in the frame `grid` (render from the
+/// grid's frame), placed by `place` (render from the grid's frame, applied to the
+/// vertices), each triangle taking the material of the shape's nearest part.
+#[allow(clippy::too_many_arguments, reason = "shape, two frames, material, grid, shading and the span to blame")]
+fn isosurface_object(
     shape: &Shape,
-    xf: DAffine3,
+    grid: DAffine3,
+    place: DAffine3,
     material: u32,
-    bounds: ir::Aabb,
     cell: f64,
     smooth: bool,
     span: Span,
+    from: CellFrom,
     builder: &mut Builder<'_>,
 ) -> Result<MeshObject, Diagnostic> {
-    let (dist, mat) = builder.build(shape, xf, material);
+    let bounds = ir::shape_bounds(shape).ok_or_else(|| unbounded(shape.span))?.transform(&grid);
+    let (dist, mat) = builder.build(shape, grid, material);
     let mesh = isosurface::extract(&*dist, bounds.min, bounds.max, cell).map_err(|e| match e {
-        isosurface::IsoError::TooManyCells { cells, min_cell } => Diagnostic::error(
-            codes::LOWERING,
-            span,
-            "isosurface grid is too fine",
-            format!("cell {} needs {cells} grid cells", ir::dump_num(cell)),
-        )
-        .with_note(format!("an isosurface may use at most {} cells", isosurface::MAX_CELLS))
-        .with_hint(format!("try a cell of at least {}", ir::dump_num((min_cell * 1.001 * 1e6).ceil() / 1e6))),
-        isosurface::IsoError::NoSurface => Diagnostic::error(
-            codes::LOWERING,
-            span,
-            "isosurface found no surface",
-            format!("no sign change on a grid of cell {}", ir::dump_num(cell)),
-        )
-        .with_note("the shape is thinner than a cell everywhere, so the mesh would be empty")
-        .with_hint("try a smaller cell"),
+        isosurface::IsoError::TooManyCells { cells, min_cell } => {
+            let d = Diagnostic::error(
+                codes::LOWERING,
+                span,
+                "isosurface grid is too fine",
+                format!("cell {} needs {cells} grid cells", ir::dump_num(cell)),
+            )
+            .with_note(format!("an isosurface may use at most {} cells", isosurface::MAX_CELLS));
+            match from {
+                CellFrom::Scene => {
+                    d.with_hint(format!("try `cell = {}` or more", ir::dump_num((min_cell * 1.001 * 1e6).ceil() / 1e6)))
+                }
+                CellFrom::Detail => d.with_hint("try a lower `--detail`"),
+            }
+        }
+        isosurface::IsoError::NoSurface => {
+            let d = Diagnostic::error(
+                codes::LOWERING,
+                span,
+                "isosurface found no surface",
+                format!("no sign change on a grid of cell {}", ir::dump_num(cell)),
+            )
+            .with_note("the shape is thinner than a cell everywhere, so the mesh would be empty");
+            match from {
+                CellFrom::Scene => d.with_hint("try a smaller `cell`"),
+                CellFrom::Detail => d.with_hint("try a higher `--detail`"),
+            }
+        }
     })?;
     let per_triangle = mesh
         .triangles
         .iter()
         .map(|t| {
-            let c =
-                (mesh.positions[t[0] as usize] + mesh.positions[t[1] as usize] + mesh.positions[t[2] as usize]) / 3.0;
-            mat(c.as_vec3a()).1
+            let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+            mat(((a + b + c) / 3.0).as_vec3a()).1
         })
         .collect();
-    Ok(MeshObject::new(&mesh, DAffine3::IDENTITY, material, Some(per_triangle), smooth))
+    Ok(MeshObject::new(&mesh, place, material, Some(per_triangle), smooth))
 }
 
 /// Lowers an explicit `mesh …` object.
@@ -136,38 +161,18 @@ pub fn explicit(
         MeshSource::Torus { major, minor, segments, sides } => tessellate::torus(*major, *minor, *segments, *sides),
         MeshSource::Plane { size } => tessellate::square(*size),
         MeshSource::Isosurface { shape, cell } => {
-            let bounds = ir::shape_bounds(shape).ok_or_else(|| unbounded(shape.span))?;
             // The grid is laid in the shape's own frame, so `cell` is in its units.
-            let (dist, mat) = builder.build(shape, DAffine3::IDENTITY, material);
-            let mesh = isosurface::extract(&*dist, bounds.min, bounds.max, *cell).map_err(|e| match e {
-                isosurface::IsoError::TooManyCells { cells, min_cell } => Diagnostic::error(
-                    codes::LOWERING,
-                    m.span,
-                    "isosurface grid is too fine",
-                    format!("cell {} needs {cells} grid cells", ir::dump_num(*cell)),
-                )
-                .with_note(format!("an isosurface may use at most {} cells", isosurface::MAX_CELLS))
-                .with_hint(format!("try `cell = {}` or more", ir::dump_num((min_cell * 1.001 * 1e6).ceil() / 1e6))),
-                isosurface::IsoError::NoSurface => Diagnostic::error(
-                    codes::LOWERING,
-                    m.span,
-                    "isosurface found no surface",
-                    format!("no sign change on a grid of cell {}", ir::dump_num(*cell)),
-                )
-                .with_note("the shape is thinner than a cell everywhere, so the mesh would be empty")
-                .with_hint("try a smaller `cell`"),
-            })?;
-            let per_triangle = mesh
-                .triangles
-                .iter()
-                .map(|t| {
-                    let c =
-                        (mesh.positions[t[0] as usize] + mesh.positions[t[1] as usize] + mesh.positions[t[2] as usize])
-                            / 3.0;
-                    mat(c.as_vec3a()).1
-                })
-                .collect();
-            return Ok(MeshObject::new(&mesh, xf, material, Some(per_triangle), m.smooth));
+            return isosurface_object(
+                shape,
+                DAffine3::IDENTITY,
+                xf,
+                material,
+                *cell,
+                m.smooth,
+                m.span,
+                CellFrom::Scene,
+                builder,
+            );
         }
         MeshSource::File { path, written } => {
             let text = loader.read(path).map_err(|e| {

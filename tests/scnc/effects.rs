@@ -5,7 +5,7 @@ use std::path::Path;
 
 use glam::Vec3A;
 use scnc::effects::{self, Effects};
-use scnc::render::{Counters, Frame, Geometry, Image, Ray};
+use scnc::render::{Counters, Geometry, Image, Ray};
 use scnc::world::Mode;
 
 fn scene(text: &str) -> scnc::ir::Scene {
@@ -19,9 +19,7 @@ fn render(mut s: scnc::ir::Scene, size: u32, effects: Option<Effects>) -> (Image
     s.settings.width = size;
     s.settings.height = size;
     let effects = effects.unwrap_or_else(|| effects::derive(&s));
-    let mut frame = Frame::with_effects(&s, effects);
-    let params = scnc::sdf::MarchParams { epsilon: s.settings.epsilon as f32, max_steps: s.settings.max_steps };
-    let world = scnc::world::lower(&s, &mut frame, Mode::Sdf, params, &scnc::check::FsLoader).expect("lowering");
+    let (frame, world) = scnc::world::prepare(&s, effects, Mode::Sdf, &scnc::check::FsLoader).expect("lowering");
     let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().expect("pool");
     let (img, c) = pool.install(|| scnc::render::render(&world, &frame, &|| {}));
     let mut scratch = Counters::default();
@@ -170,11 +168,13 @@ object sphere(0.8) at [0, -0.2, 6] with material(color = rgb(255, 60, 60))
     let mut s = scene(&base.replace("RADIUS", "0.8"));
     s.settings.width = 48;
     s.settings.height = 48;
-    let mut frame = Frame::new(&s);
-    let params = scnc::sdf::MarchParams { epsilon: 1e-4, max_steps: 512 };
-    let world =
-        scnc::world::lower(&s, &mut frame, Mode::Mesh(scnc::world::Detail::High), params, &scnc::check::FsLoader)
-            .expect("lowering");
+    let (frame, world) = scnc::world::prepare(
+        &s,
+        scnc::effects::derive(&s),
+        Mode::Mesh(scnc::world::Detail::High),
+        &scnc::check::FsLoader,
+    )
+    .expect("lowering");
     let (_, mc) = scnc::render::render(&world, &frame, &|| {});
     assert_eq!(mc.shadow_rays % 16, 0, "meshes sample the light with 16 rays");
     assert!(mc.shadow_rays > 0);
@@ -199,11 +199,13 @@ object sphere(0.7) at [0, -0.3, 6.5] with material(color = rgb(200, 200, 200))
     let mut s = scene(text);
     s.settings.width = 40;
     s.settings.height = 40;
-    let mut frame = Frame::new(&s);
-    let params = scnc::sdf::MarchParams { epsilon: 1e-4, max_steps: 512 };
-    let world =
-        scnc::world::lower(&s, &mut frame, Mode::Mesh(scnc::world::Detail::High), params, &scnc::check::FsLoader)
-            .expect("lowering");
+    let (frame, world) = scnc::world::prepare(
+        &s,
+        scnc::effects::derive(&s),
+        Mode::Mesh(scnc::world::Detail::High),
+        &scnc::check::FsLoader,
+    )
+    .expect("lowering");
     let (_, mc) = scnc::render::render(&world, &frame, &|| {});
     assert!(hits > 0 && mc.occlusion_rays > 0 && mc.occlusion_rays % 16 == 0);
     // Without ambient light there is nothing to occlude, so the effect is not built.

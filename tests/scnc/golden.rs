@@ -120,9 +120,8 @@ fn lowering_diagnostics() {
             failures.push(format!("{}: did not compile", path.display()));
             continue;
         };
-        let mut frame = scnc::render::Frame::new(scene);
-        let params = scnc::sdf::MarchParams { epsilon: 1e-4, max_steps: 64 };
-        match scnc::world::lower(scene, &mut frame, scnc::world::Mode::Sdf, params, &scnc::check::FsLoader) {
+        let effects = scnc::effects::derive(scene);
+        match scnc::world::prepare(scene, effects, scnc::world::Mode::Sdf, &scnc::check::FsLoader) {
             Ok(_) => failures.push(format!("{}: lowered without an error", path.display())),
             Err(d) => failures.extend(check_golden(&path.with_extension("txt"), &d.render(&c.map, false))),
         }

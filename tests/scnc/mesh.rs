@@ -2,7 +2,7 @@
 
 use glam::{DAffine3, DVec3, Vec3A};
 use scnc::mesh::{tessellate, triangle, MeshObject, TriMesh};
-use scnc::render::{Counters, Frame, Geometry, Ray};
+use scnc::render::{Counters, Geometry, Ray};
 use scnc::world::{Detail, Mode};
 
 use crate::support::{compile, Rng};
@@ -123,9 +123,8 @@ fn coverage(path: &std::path::Path, mode: Mode, size: u32) -> Vec<bool> {
     let mut scene = c.scene.expect("seed scene compiles");
     scene.settings.width = size;
     scene.settings.height = size;
-    let mut frame = Frame::new(&scene);
-    let params = scnc::sdf::MarchParams { epsilon: scene.settings.epsilon as f32, max_steps: scene.settings.max_steps };
-    let world = scnc::world::lower(&scene, &mut frame, mode, params, &scnc::check::FsLoader).expect("lowering");
+    let (frame, world) =
+        scnc::world::prepare(&scene, scnc::effects::derive(&scene), mode, &scnc::check::FsLoader).expect("lowering");
     let mut counters = Counters::default();
     (0..size * size)
         .map(|i| {

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use glam::Vec3A;
-use scnc::render::{Counters, Frame, Image};
+use scnc::render::{Counters, Image};
 use scnc::world::{Detail, Mode};
 
 use crate::support::{cases, finish, updating, Rng};
@@ -24,11 +24,10 @@ pub fn render_scene(scene: scnc::ir::Scene, w: u32, h: u32, threads: usize) -> (
 pub fn render_mode(mut scene: scnc::ir::Scene, w: u32, h: u32, threads: usize, mode: Mode) -> (Image, Counters) {
     scene.settings.width = w;
     scene.settings.height = h;
-    let mut frame = Frame::new(&scene);
-    let params = scnc::sdf::MarchParams { epsilon: scene.settings.epsilon as f32, max_steps: scene.settings.max_steps };
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool");
     pool.install(|| {
-        let geometry = scnc::world::lower(&scene, &mut frame, mode, params, &scnc::check::FsLoader).expect("lowering");
+        let effects = scnc::effects::derive(&scene);
+        let (frame, geometry) = scnc::world::prepare(&scene, effects, mode, &scnc::check::FsLoader).expect("lowering");
         scnc::render::render(&geometry, &frame, &|| {})
     })
 }
@@ -181,9 +180,8 @@ fn every_evaluator_is_a_distance_bound() {
         let text = format!("light ambient(1)\nobject {shape} at [0, 0, 5]\n");
         let c = scnc::compile_source("t.scn", Path::new("t.scn"), text, &scnc::check::FsLoader);
         let scene = c.scene.unwrap_or_else(|| panic!("{shape}: {}", scnc::diag::render_all(&c.diagnostics, &c.map)));
-        let mut frame = Frame::new(&scene);
-        let params = scnc::sdf::MarchParams { epsilon: 1e-4, max_steps: 100 };
-        let g = scnc::world::lower(&scene, &mut frame, Mode::Sdf, params, &scnc::check::FsLoader).expect("lower");
+        let (_, g) = scnc::world::prepare(&scene, scnc::effects::derive(&scene), Mode::Sdf, &scnc::check::FsLoader)
+            .expect("lower");
         for _ in 0..4000 {
             let centre = Vec3A::new(0.0, 0.0, 5.0);
             let p = centre + rng.vec(3.0);

@@ -18,9 +18,8 @@ fn lower(s: &scnc::ir::Scene, size: u32, mode: Mode) -> (Frame, World) {
     let mut s = s.clone();
     s.settings.width = size;
     s.settings.height = size;
-    let mut frame = Frame::new(&s);
-    let params = scnc::sdf::MarchParams { epsilon: s.settings.epsilon as f32, max_steps: s.settings.max_steps };
-    let world = scnc::world::lower(&s, &mut frame, mode, params, &scnc::check::FsLoader).expect("lowering");
+    let (frame, world) =
+        scnc::world::prepare(&s, scnc::effects::derive(&s), mode, &scnc::check::FsLoader).expect("lowering");
     (frame, world)
 }
 
