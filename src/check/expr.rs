@@ -467,6 +467,11 @@ impl Ctx<'_> {
             let _ = self.eval_args(args);
             return Value::Error;
         };
+        self.apply_builtin(builtin, args, span)
+    }
+
+    /// Evaluates the arguments, binds them and builds the builtin's value.
+    fn apply_builtin(&mut self, builtin: &Builtin, args: &[ast::Arg], span: Span) -> Value {
         let args = self.eval_args(args);
         match self.bind_builtin(builtin, args, span) {
             Some(bound) => self.construct(builtin, bound),
@@ -499,14 +504,9 @@ impl Ctx<'_> {
             let _ = self.eval_args(args);
             return Value::Error;
         };
-        let args = self.eval_args(args);
-        match self.bind_builtin(builtin, args, span) {
-            Some(bound) => self.construct(builtin, bound),
-            None => Value::Error,
-        }
+        self.apply_builtin(builtin, args, span)
     }
 
-    /// Binds arguments to a builtin's parameters; `None` after reporting (or on poison).
     /// Matches arguments to parameter slots: positional ones in order (or all into `rest`
     /// for a variadic callee), named ones by name. Reports too many arguments, unknown
     /// names (with a suggestion) and arguments given twice; returns the slots, the extra
