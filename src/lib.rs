@@ -11,6 +11,7 @@
 //!
 //! Every stage reports problems as [`diag::Diagnostic`] values; only the binary prints.
 
+pub mod accuracy;
 pub mod bvh;
 pub mod check;
 pub mod diag;
@@ -21,6 +22,7 @@ pub mod render;
 pub mod sdf;
 pub mod source;
 pub mod span;
+pub mod sweep;
 pub mod syntax;
 pub mod world;
 

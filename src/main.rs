@@ -39,6 +39,9 @@ enum Command {
     },
     /// Render a scene to an image (written whole or not at all).
     Render(RenderArgs),
+    /// Render a scene across a ladder of accuracy settings for both back-ends and write
+    /// time, work, memory and error for each to DIR/sweep.csv and DIR/sweep.md.
+    Sweep(SweepArgs),
     /// Print the evaluated scene IR.
     Ir {
         /// The scene file.
@@ -124,6 +127,91 @@ struct RenderArgs {
     /// How to print diagnostics.
     #[arg(long, value_enum, default_value = "human")]
     message_format: MessageFormat,
+}
+
+#[derive(clap::Args)]
+struct SweepArgs {
+    /// The scene file.
+    file: PathBuf,
+    /// Directory for sweep.csv and sweep.md (created if missing).
+    #[arg(long)]
+    out: PathBuf,
+    /// Image width for the sweep.
+    #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    width: u32,
+    /// Image height for the sweep.
+    #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    height: u32,
+    /// Timed renders per setting (after one warm-up); the median is reported.
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u16).range(1..=100))]
+    runs: u16,
+    /// Two settings per back-end instead of the full ladder.
+    #[arg(long)]
+    quick: bool,
+    /// How to print diagnostics.
+    #[arg(long, value_enum, default_value = "human")]
+    message_format: MessageFormat,
+}
+
+fn sweep_cmd(args: SweepArgs) -> ExitCode {
+    if let Err(e) = std::fs::create_dir_all(&args.out) {
+        return usage_error(&format!("cannot create `{}`: {e}", args.out.display()));
+    }
+    let compiled = compile(&args.file);
+    if report(&compiled, args.message_format) {
+        return ExitCode::from(1);
+    }
+    let Some(mut scene) = compiled.scene else { return ExitCode::from(1) };
+    scene.settings.width = args.width;
+    scene.settings.height = args.height;
+    let ladder = scnc::sweep::ladder(args.quick);
+    let bar = std::io::stderr().is_terminal().then(|| {
+        let bar = indicatif::ProgressBar::new(ladder.len() as u64);
+        if let Ok(style) = indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} settings, {msg}") {
+            bar.set_style(style);
+        }
+        bar
+    });
+    let progress = |s: &scnc::sweep::Setting| {
+        if let Some(bar) = &bar {
+            bar.set_message(format!("{} {}", s.backend(), s.label()));
+            bar.inc(1);
+        }
+    };
+    let rows = match scnc::sweep::run(&scene, &ladder, args.runs as usize, &FsLoader, &progress) {
+        Ok(rows) => rows,
+        Err(d) => {
+            let c = Compiled { map: compiled.map, scene: None, diagnostics: vec![d] };
+            report(&c, args.message_format);
+            return ExitCode::from(1);
+        }
+    };
+    if let Some(bar) = &bar {
+        bar.finish_and_clear();
+    }
+    let title = format!("{} at {}×{}", args.file.display(), args.width, args.height);
+    for (name, text) in [("sweep.csv", scnc::sweep::csv(&rows)), ("sweep.md", scnc::sweep::markdown(&rows, &title))] {
+        let path = args.out.join(name);
+        if let Err(e) = write_atomic(&path, text.as_bytes()) {
+            let _ = writeln!(std::io::stderr(), "error: cannot write `{}`: {e}", path.display());
+            return ExitCode::from(1);
+        }
+    }
+    let _ = writeln!(std::io::stderr(), "swept {} settings: {}", rows.len(), args.out.join("sweep.md").display());
+    ExitCode::SUCCESS
+}
+
+/// Writes bytes to a temporary file beside `path`, then renames it into place.
+fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::Builder::new().prefix(".scnc-").suffix(".tmp").tempfile_in(dir)?;
+    tmp.write_all(bytes)?;
+    tmp.as_file().sync_all()?;
+    tmp.persist(path).map_err(|e| e.error)?;
+    Ok(())
 }
 
 fn parse_epsilon(s: &str) -> Result<f64, String> {
@@ -418,6 +506,7 @@ impl Progress {
 fn run(cli: Cli) -> ExitCode {
     match cli.command {
         Command::Render(args) => render_cmd(args),
+        Command::Sweep(args) => sweep_cmd(args),
         Command::Check { files, message_format } => {
             let mut failed = false;
             for file in &files {

@@ -142,3 +142,39 @@ fn render_rejects_bad_flags_with_exit_2() {
     assert_eq!(o.status.code(), Some(2));
     assert!(std::fs::read_dir(dir.path()).expect("dir").next().is_none(), "nothing may be written");
 }
+
+/// The sweep runs on a seed scene at a tiny size with two settings per back-end, writes
+/// the expected columns, and errors fall where the maths says they must.
+#[test]
+fn sweep_writes_csv_with_monotone_errors() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().to_str().unwrap_or_default();
+    let o = scnc(&[
+        "sweep",
+        "examples/seed/01-sphere.scn",
+        "--out",
+        out,
+        "--width",
+        "48",
+        "--height",
+        "48",
+        "--runs",
+        "1",
+        "--quick",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(dir.path().join("sweep.csv")).expect("sweep.csv");
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some(scnc::sweep::CSV_HEADER));
+    let rows: Vec<Vec<String>> = lines.map(|l| l.split(',').map(str::to_string).collect()).collect();
+    assert_eq!(rows.len(), 4);
+    let col = |name: &str| scnc::sweep::CSV_HEADER.split(',').position(|c| c == name).expect("column");
+    let geo_max = |row: usize| rows[row][col("geo_error_max")].parse::<f64>().expect("number");
+    assert!(rows.iter().all(|r| r.len() == scnc::sweep::CSV_HEADER.split(',').count()));
+    // A coarser hit threshold never gives a closer hit; more tessellation never a larger
+    // chord error of the UV sphere.
+    assert!(geo_max(0) >= geo_max(1), "sdf: epsilon 1e-2 should not beat 1e-4");
+    assert!(geo_max(2) >= geo_max(3), "mesh: low detail should not beat high");
+    assert!(geo_max(2) > 0.0 && geo_max(1) < 1e-3, "errors in the expected ranges");
+    assert!(std::fs::read_to_string(dir.path().join("sweep.md")).expect("sweep.md").contains("| mesh | detail high |"));
+}
