@@ -39,6 +39,15 @@ pub fn geometric_error(hits: &[Option<Vec3A>], distance: &dyn Fn(Vec3A) -> f32) 
     (mean, errors.iter().copied().fold(0.0, f64::max))
 }
 
+/// The largest geometric error in pixels: `|distance(p)|` over the footprint of a pixel
+/// at the hit's distance from the camera (`pixel_angle · |p|` in render space).
+pub fn geometric_error_pixels(hits: &[Option<Vec3A>], distance: &dyn Fn(Vec3A) -> f32, pixel_angle: f64) -> f64 {
+    hits.iter()
+        .flatten()
+        .map(|p| distance(*p).abs() as f64 / (pixel_angle * p.length() as f64).max(f64::MIN_POSITIVE))
+        .fold(0.0, f64::max)
+}
+
 /// Pixels where exactly one of the two renders hits geometry.
 pub fn coverage_error(a: &[Option<Vec3A>], b: &[Option<Vec3A>]) -> usize {
     a.iter().zip(b).filter(|(x, y)| x.is_some() != y.is_some()).count()

@@ -24,6 +24,7 @@ pub mod source;
 pub mod span;
 pub mod sweep;
 pub mod syntax;
+pub mod tolerance;
 pub mod world;
 
 use std::path::Path;

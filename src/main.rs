@@ -110,6 +110,10 @@ struct RenderArgs {
     /// Samples per pixel (antialiasing).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=256))]
     samples: Option<u32>,
+    /// Pick the cheapest setting expected to keep geometric error under this many world
+    /// units, or under a pixel's footprint with `pixel` (sets epsilon, or detail with meshes).
+    #[arg(long, conflicts_with_all = ["epsilon", "detail"])]
+    tolerance: Option<scnc::tolerance::Tolerance>,
     /// Geometry back-end for shapes (explicit meshes are always meshes).
     #[arg(long, value_enum, default_value = "sdf")]
     geometry: GeometryKind,
@@ -148,6 +152,10 @@ struct SweepArgs {
     /// Two settings per back-end instead of the full ladder.
     #[arg(long)]
     quick: bool,
+    /// Sweep only the settings `render --tolerance` would pick (world units or `pixel`),
+    /// to check that they hold.
+    #[arg(long, conflicts_with = "quick")]
+    tolerance: Option<scnc::tolerance::Tolerance>,
     /// How to print diagnostics.
     #[arg(long, value_enum, default_value = "human")]
     message_format: MessageFormat,
@@ -164,7 +172,10 @@ fn sweep_cmd(args: SweepArgs) -> ExitCode {
     let Some(mut scene) = compiled.scene else { return ExitCode::from(1) };
     scene.settings.width = args.width;
     scene.settings.height = args.height;
-    let ladder = scnc::sweep::ladder(args.quick);
+    let ladder = match args.tolerance {
+        Some(tol) => scnc::sweep::picked(&scene, tol),
+        None => scnc::sweep::ladder(args.quick),
+    };
     let bar = std::io::stderr().is_terminal().then(|| {
         let bar = indicatif::ProgressBar::new(ladder.len() as u64);
         if let Ok(style) = indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} settings, {msg}") {
@@ -330,9 +341,21 @@ fn render_cmd(args: RenderArgs) -> ExitCode {
         Ok(p) => p,
         Err(e) => return usage_error(&format!("cannot start worker threads: {e}")),
     };
+    let mut detail = args.detail;
+    if let Some(tol) = args.tolerance {
+        match args.geometry {
+            GeometryKind::Sdf => scene.settings.epsilon = scnc::tolerance::sdf_epsilon(&scene, tol),
+            GeometryKind::Mesh => detail = scnc::tolerance::mesh_detail(&scene, tol),
+        }
+        let picked = match args.geometry {
+            GeometryKind::Sdf => format!("epsilon {:.3e}", scene.settings.epsilon),
+            GeometryKind::Mesh => format!("detail {}", detail.rings()),
+        };
+        let _ = writeln!(std::io::stderr(), "tolerance {tol:?}: picked {picked}");
+    }
     let mode = match args.geometry {
         GeometryKind::Sdf => scnc::world::Mode::Sdf,
-        GeometryKind::Mesh => scnc::world::Mode::Mesh(args.detail),
+        GeometryKind::Mesh => scnc::world::Mode::Mesh(detail),
     };
     let started = Instant::now();
     let effects = match args.effects {

@@ -39,12 +39,29 @@ impl Setting {
     /// The setting as a short label.
     pub fn label(&self) -> String {
         match self {
-            Setting::Sdf { epsilon, max_steps } => format!("epsilon {epsilon:e} steps {max_steps}"),
+            Setting::Sdf { epsilon, max_steps } => format!("epsilon {} steps {max_steps}", short_exp(*epsilon)),
             Setting::Mesh(Detail::Low) => "detail low".into(),
             Setting::Mesh(Detail::High) => "detail high".into(),
             Setting::Mesh(Detail::N(n)) => format!("detail {n}"),
         }
     }
+}
+
+/// `x` in exponent form with at most four significant digits: `2e-3`, `1.485e-4`.
+fn short_exp(x: f64) -> String {
+    let s = format!("{x:.3e}");
+    match s.split_once('e') {
+        Some((mantissa, exp)) => format!("{}e{exp}", mantissa.trim_end_matches('0').trim_end_matches('.')),
+        None => s,
+    }
+}
+
+/// The settings `--tolerance` picks for each back-end.
+pub fn picked(scene: &Scene, tol: crate::tolerance::Tolerance) -> Vec<Setting> {
+    vec![
+        Setting::Sdf { epsilon: crate::tolerance::sdf_epsilon(scene, tol), max_steps: scene.settings.max_steps },
+        Setting::Mesh(crate::tolerance::mesh_detail(scene, tol)),
+    ]
 }
 
 /// The default ladder: SDF thresholds from coarse to fine and two small step budgets;
@@ -92,6 +109,8 @@ pub struct Row {
     pub geo_mean: f64,
     /// Max `|d|` at primary hit points, world units.
     pub geo_max: f64,
+    /// Max `|d|` at primary hit points, in pixel footprints at the hit's depth.
+    pub geo_max_px: f64,
     /// Pixels whose coverage differs from the reference.
     pub coverage: usize,
     /// RMSE of the image against the reference.
@@ -164,6 +183,7 @@ pub fn run(
         let (s, mode) = with_setting(scene, setting);
         let m = measure(&s, mode, runs, loader)?;
         let (geo_mean, geo_max) = accuracy::geometric_error(&m.hits, &distance);
+        let geo_max_px = accuracy::geometric_error_pixels(&m.hits, &distance, crate::tolerance::pixel_angle(scene));
         let c = &m.counters;
         let rays = c.rays().max(1) as f64;
         let rmse = accuracy::rmse(&m.image, &ref_image);
@@ -178,6 +198,7 @@ pub fn run(
             triangles: m.triangles,
             geo_mean,
             geo_max,
+            geo_max_px,
             coverage: accuracy::coverage_error(&m.hits, &ref_hits),
             rmse,
             psnr: accuracy::psnr(rmse),
@@ -188,7 +209,7 @@ pub fn run(
 }
 
 /// The columns of `sweep.csv`.
-pub const CSV_HEADER: &str = "backend,setting,wall_ms,rays_per_s,sdf_evals_per_ray,node_visits_per_ray,triangle_tests_per_ray,geometry_bytes,triangles,geo_error_mean,geo_error_max,coverage_error_px,rmse,psnr_db";
+pub const CSV_HEADER: &str = "backend,setting,wall_ms,rays_per_s,sdf_evals_per_ray,node_visits_per_ray,triangle_tests_per_ray,geometry_bytes,triangles,geo_error_mean,geo_error_max,geo_error_max_pixels,coverage_error_px,rmse,psnr_db";
 
 /// Rows as CSV.
 pub fn csv(rows: &[Row]) -> String {
@@ -196,7 +217,7 @@ pub fn csv(rows: &[Row]) -> String {
     for r in rows {
         let _ = writeln!(
             out,
-            "{},{},{:.3},{:.0},{:.3},{:.3},{:.3},{},{},{:e},{:e},{},{:.4},{:.2}",
+            "{},{},{:.3},{:.0},{:.3},{:.3},{:.3},{},{},{:e},{:e},{:.4},{},{:.4},{:.2}",
             r.setting.backend(),
             r.setting.label(),
             r.wall_ms,
@@ -208,6 +229,7 @@ pub fn csv(rows: &[Row]) -> String {
             r.triangles,
             r.geo_mean,
             r.geo_max,
+            r.geo_max_px,
             r.coverage,
             r.rmse,
             r.psnr
@@ -218,11 +240,11 @@ pub fn csv(rows: &[Row]) -> String {
 
 /// Rows as a Markdown table.
 pub fn markdown(rows: &[Row], title: &str) -> String {
-    let mut out = format!("# Sweep: {title}\n\nReference: the SDF render at epsilon 1e-6 with a 100 000-step budget. Geometric error is |d| at primary hits, in world units.\n\n| back-end | setting | wall | rays/s | evals/ray | visits/ray | tri tests/ray | bytes | triangles | geo error mean | geo error max | coverage px | RMSE | PSNR |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    let mut out = format!("# Sweep: {title}\n\nReference: the SDF render at epsilon 1e-6 with a 100 000-step budget. Geometric error is |d| at primary hits, in world units.\n\n| back-end | setting | wall | rays/s | evals/ray | visits/ray | tri tests/ray | bytes | triangles | geo error mean | geo error max | max in pixels | coverage px | RMSE | PSNR |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for r in rows {
         let _ = writeln!(
             out,
-            "| {} | {} | {:.1} ms | {:.2} M | {:.2} | {:.2} | {:.2} | {} | {} | {:.2e} | {:.2e} | {} | {:.2} | {:.1} dB |",
+            "| {} | {} | {:.1} ms | {:.2} M | {:.2} | {:.2} | {:.2} | {} | {} | {:.2e} | {:.2e} | {:.3} | {} | {:.2} | {:.1} dB |",
             r.setting.backend(),
             r.setting.label(),
             r.wall_ms,
@@ -234,6 +256,7 @@ pub fn markdown(rows: &[Row], title: &str) -> String {
             r.triangles,
             r.geo_mean,
             r.geo_max,
+            r.geo_max_px,
             r.coverage,
             r.rmse,
             r.psnr

@@ -178,3 +178,71 @@ fn sweep_writes_csv_with_monotone_errors() {
     assert!(geo_max(2) > 0.0 && geo_max(1) < 1e-3, "errors in the expected ranges");
     assert!(std::fs::read_to_string(dir.path().join("sweep.md")).expect("sweep.md").contains("| mesh | detail high |"));
 }
+
+/// `--tolerance pixel` picks settings whose measured geometric error stays within a
+/// pixel's footprint, for both back-ends, and `render` reports what it picked.
+#[test]
+fn tolerance_picks_hold() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().to_str().unwrap_or_default();
+    let o = scnc(&[
+        "sweep",
+        "examples/seed/07-box-sphere-cylinder.scn",
+        "--out",
+        out,
+        "--width",
+        "64",
+        "--height",
+        "64",
+        "--runs",
+        "1",
+        "--tolerance",
+        "pixel",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(dir.path().join("sweep.csv")).expect("sweep.csv");
+    let col = scnc::sweep::CSV_HEADER.split(',').position(|c| c == "geo_error_max_pixels").expect("column");
+    let rows: Vec<f64> =
+        csv.lines().skip(1).map(|l| l.split(',').nth(col).and_then(|v| v.parse().ok()).expect("number")).collect();
+    assert_eq!(rows.len(), 2);
+    assert!(rows.iter().all(|&px| px <= 1.0 + 1e-3), "an error over a pixel: {rows:?}");
+    let png = dir.path().join("t.png");
+    let o = scnc(&[
+        "render",
+        "examples/seed/01-sphere.scn",
+        "-o",
+        png.to_str().unwrap_or_default(),
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--tolerance",
+        "0.001",
+        "--geometry",
+        "mesh",
+    ]);
+    assert_eq!(o.status.code(), Some(0));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("picked detail"));
+    let o = scnc(&[
+        "render",
+        "examples/seed/01-sphere.scn",
+        "-o",
+        png.to_str().unwrap_or_default(),
+        "--tolerance",
+        "0",
+        "--width",
+        "8",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "a tolerance of 0 is a usage error");
+    let o = scnc(&[
+        "render",
+        "examples/seed/01-sphere.scn",
+        "-o",
+        png.to_str().unwrap_or_default(),
+        "--tolerance",
+        "pixel",
+        "--epsilon",
+        "0.01",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "--tolerance and --epsilon conflict");
+}

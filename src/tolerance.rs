@@ -1,0 +1,116 @@
+//! `--tolerance`: the cheapest setting expected to keep geometric error under a bound,
+//! from the same error model the sweep measures.
+//!
+//! - **SDF**: a hit is accepted where `d < epsilon · t`, so for an exact SDF the error at a
+//!   primary hit is below `epsilon · t`. For an absolute bound `T`, `epsilon = T / t_far`
+//!   with `t_far` the farthest point of any bounded object from the camera (the far limit
+//!   when something is unbounded). For `pixel`, `epsilon` is the angular size of a pixel,
+//!   `2·tan(fov/2) / height`, so the error is below a pixel's footprint at every depth.
+//! - **Mesh**: a polygon of `N` sides inscribed in a circle of radius `r` deviates from it by
+//!   at most `r·(1 − cos(π/N))`; every curved primitive is tessellated with at least
+//!   `rings` sides per turn, so the detail is the smallest `rings` that keeps
+//!   `r·(1 − cos(π/rings))` under the bound for every object (for `pixel`, the bound at the
+//!   object's nearest distance). Boxes are exact. Isosurfaces (CSG and modifiers) use a
+//!   cell of `diameter / (4·rings)` and deviate by at most half a cell.
+
+use crate::ir::{self, Geometry, Scene, Shape, ShapeKind};
+use crate::world::Detail;
+
+/// A geometric error bound.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Tolerance {
+    /// World units.
+    Absolute(f64),
+    /// A pixel's footprint at the surface's depth.
+    Pixel,
+}
+
+impl std::str::FromStr for Tolerance {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Tolerance, String> {
+        if s == "pixel" {
+            return Ok(Tolerance::Pixel);
+        }
+        match s.parse::<f64>() {
+            Ok(t) if t > 0.0 && t.is_finite() => Ok(Tolerance::Absolute(t)),
+            _ => Err("expected `pixel` or a distance greater than 0".into()),
+        }
+    }
+}
+
+/// The angular size of one pixel (radians per pixel at distance 1).
+pub fn pixel_angle(scene: &Scene) -> f64 {
+    2.0 * (scene.camera.fov.to_radians() * 0.5).tan() / scene.settings.height as f64
+}
+
+/// Nearest and farthest distance of an object's bounds from the camera, if bounded.
+fn depth_range(scene: &Scene, g: &Geometry) -> Option<(f64, f64)> {
+    let (c, r) = ir::bounding_sphere(g)?;
+    let d = (c - scene.camera.position).length();
+    Some(((d - r).max(0.0), d + r))
+}
+
+/// The SDF hit threshold for `tol`.
+pub fn sdf_epsilon(scene: &Scene, tol: Tolerance) -> f64 {
+    let eps = match tol {
+        Tolerance::Pixel => pixel_angle(scene),
+        Tolerance::Absolute(t) => {
+            let far = scene
+                .objects
+                .iter()
+                .map(|o| depth_range(scene, &o.geometry).map_or(scene.settings.max_distance, |(_, f)| f))
+                .fold(0.0, f64::max);
+            t / far.max(f64::MIN_POSITIVE)
+        }
+    };
+    eps.clamp(1e-7, 0.5)
+}
+
+/// Largest radius of curvature among the curved parts of a shape, in world units, and
+/// whether it needs an isosurface (its diameter then matters instead).
+fn curvature_radius(shape: &Shape, scale: f64) -> (f64, Option<f64>) {
+    match &shape.kind {
+        ShapeKind::Sphere { radius } | ShapeKind::Cylinder { radius, .. } | ShapeKind::Cone { radius, .. } => {
+            (radius * scale, None)
+        }
+        ShapeKind::Torus { major, minor } => ((major + minor) * scale, None),
+        ShapeKind::Box { .. } | ShapeKind::Plane { .. } => (0.0, None),
+        ShapeKind::Transform { child, xf } => {
+            let k = xf.matrix3.to_cols_array().iter().fold(0.0f64, |a, x| a.max(x.abs())) * 3f64.sqrt();
+            curvature_radius(child, scale * k)
+        }
+        ShapeKind::Paint { child, .. } => curvature_radius(child, scale),
+        _ => {
+            let diameter = ir::shape_bounds(shape).map_or(0.0, |b| (b.max - b.min).length()) * scale;
+            (0.0, Some(diameter))
+        }
+    }
+}
+
+/// The mesh detail for `tol`.
+pub fn mesh_detail(scene: &Scene, tol: Tolerance) -> Detail {
+    let mut rings = 3u32;
+    for o in &scene.objects {
+        let Geometry::Shape(shape) = &o.geometry else { continue };
+        let bound = match tol {
+            Tolerance::Absolute(t) => t,
+            Tolerance::Pixel => {
+                pixel_angle(scene) * depth_range(scene, &o.geometry).map_or(1.0, |(near, _)| near.max(1e-6))
+            }
+        };
+        let (radius, iso) = curvature_radius(shape, 1.0);
+        if radius > 0.0 {
+            // r·(1 − cos(π/N)) ≤ bound  ⇔  N ≥ π / acos(1 − bound/r).
+            let ratio = (1.0 - bound / radius).clamp(-1.0, 1.0);
+            let n = (std::f64::consts::PI / ratio.acos().max(1e-9)).ceil();
+            rings = rings.max(n.min(2048.0) as u32);
+        }
+        if let Some(diameter) = iso {
+            // Half a cell of diameter / (4·rings) under the bound.
+            let n = (diameter / (8.0 * bound)).ceil();
+            rings = rings.max(n.min(2048.0) as u32);
+        }
+    }
+    Detail::N(rings.clamp(3, 2048))
+}
