@@ -13,6 +13,7 @@
 
 pub mod accuracy;
 pub mod bvh;
+pub mod chart;
 pub mod check;
 pub mod diag;
 pub mod effects;

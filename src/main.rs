@@ -208,6 +208,18 @@ fn sweep_cmd(args: SweepArgs) -> ExitCode {
             return ExitCode::from(1);
         }
     }
+    for (name, axis) in
+        [("time-vs-error.png", scnc::chart::Axis::Time), ("memory-vs-error.png", scnc::chart::Axis::Memory)]
+    {
+        let path = args.out.join(name);
+        let written = scnc::chart::error_chart(&rows, axis, &title)
+            .map_err(std::io::Error::other)
+            .and_then(|img| write_png(&path, &img));
+        if let Err(e) = written {
+            let _ = writeln!(std::io::stderr(), "error: cannot write `{}`: {e}", path.display());
+            return ExitCode::from(1);
+        }
+    }
     let _ = writeln!(std::io::stderr(), "swept {} settings: {}", rows.len(), args.out.join("sweep.md").display());
     ExitCode::SUCCESS
 }

@@ -177,6 +177,13 @@ fn sweep_writes_csv_with_monotone_errors() {
     assert!(geo_max(2) >= geo_max(3), "mesh: low detail should not beat high");
     assert!(geo_max(2) > 0.0 && geo_max(1) < 1e-3, "errors in the expected ranges");
     assert!(std::fs::read_to_string(dir.path().join("sweep.md")).expect("sweep.md").contains("| mesh | detail high |"));
+    for chart in ["time-vs-error.png", "memory-vs-error.png"] {
+        let img = image::open(dir.path().join(chart)).expect("a chart was written").to_rgb8();
+        assert!(
+            img.pixels().any(|p| p.0 == [255, 0, 0]) && img.pixels().any(|p| p.0 == [0, 0, 255]),
+            "{chart} has both curves"
+        );
+    }
 }
 
 /// `--tolerance pixel` picks settings whose measured geometric error stays within a
