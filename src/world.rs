@@ -381,3 +381,43 @@ impl Geometry for World {
         self.memory().total()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The perpendicular-distance form stays accurate where `b² − c` cancels: a unit
+    /// sphere 1e4 and 1e5 away, hit near its silhouette, against the same maths in f64.
+    #[test]
+    fn sphere_interval_is_stable_far_away() {
+        for dist in [10.0f64, 1e4, 1e5] {
+            for offset in [0.0f64, 0.5, 0.9, 0.999] {
+                let centre = glam::DVec3::new(offset, 0.0, dist);
+                let dir = glam::DVec3::Z;
+                let b = centre.dot(dir);
+                let perp = (centre - dir * b).length_squared();
+                let s = (1.0 - perp).sqrt();
+                let (t0, t1) = (b - s, b + s);
+                let ray = Ray::new(Vec3A::ZERO, Vec3A::Z, f32::MAX);
+                let (a0, a1) = sphere_interval(&ray, centre.as_vec3a(), 1.0).expect("the ray hits the sphere");
+                // Within a few f32 ulps of the distance, not the much larger cancellation error.
+                let tol = dist * 4.0 * f32::EPSILON as f64;
+                assert!(
+                    (a0 as f64 - t0).abs() <= tol && (a1 as f64 - t1).abs() <= tol,
+                    "at {dist}, offset {offset}: ({a0}, {a1}) vs ({t0}, {t1})"
+                );
+                // The naive form b² − c loses the chord entirely this far away.
+                if dist >= 1e4 && offset > 0.9 {
+                    let c32 = (centre.as_vec3().length_squared() - 1.0) as f32;
+                    let b32 = b as f32;
+                    let naive = b32 * b32 - c32;
+                    let truth = 1.0 - perp;
+                    assert!(
+                        (naive as f64 - truth).abs() > 0.5 * truth,
+                        "this case should defeat the naive form ({naive} vs {truth})"
+                    );
+                }
+            }
+        }
+    }
+}
