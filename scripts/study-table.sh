@@ -24,13 +24,14 @@ for scene in examples/seed/0*.scn; do
       for (i = 2; i <= n; i++) if (setting[i] == "detail low") low = i
       for (i = 2; i <= n; i++) if (setting[i] == "detail high") high = i
       match_row = 0
-      for (i = 2; i <= n; i++) if (backend[i] == "mesh" && geo[i] + 0 <= geo[sdf] + 0 && (match_row == 0 || wall[i] + 0 < wall[match_row] + 0)) match_row = i
-      cell = "%s: %.1f ms, %d B, error %.1e"
+      # Mesh rows come in increasing detail: the first within the SDF's error is the match.
+      for (i = 2; i <= n; i++) if (backend[i] == "mesh" && geo[i] + 0 <= geo[sdf] + 0 && match_row == 0) match_row = i
+      cell = "%.1f ms, %d B, error %.1e"
       printf "| %s | ", name
-      printf cell " | ", "", wall[sdf], bytes[sdf], geo[sdf]
-      printf cell " | ", "", wall[low], bytes[low], geo[low]
-      printf cell " | ", "", wall[high], bytes[high], geo[high]
-      if (match_row) printf cell " |\n", setting[match_row], wall[match_row], bytes[match_row], geo[match_row]
+      printf cell " | ", wall[sdf], bytes[sdf], geo[sdf]
+      printf cell " | ", wall[low], bytes[low], geo[low]
+      printf cell " | ", wall[high], bytes[high], geo[high]
+      if (match_row) printf "%s: " cell " |\n", setting[match_row], wall[match_row], bytes[match_row], geo[match_row]
       else printf "none up to detail 112 |\n"
     }' "$out/sweep.csv"
 done

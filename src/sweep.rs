@@ -105,6 +105,9 @@ pub struct Row {
     pub bytes: usize,
     /// Triangles (0 for SDF).
     pub triangles: usize,
+    /// Peak resident memory of the process while this setting was measured, in KiB
+    /// (Linux: the high-water mark is reset before each setting); `None` elsewhere.
+    pub peak_rss_kib: Option<u64>,
     /// Mean `|d|` at primary hit points, world units.
     pub geo_mean: f64,
     /// Max `|d|` at primary hit points, world units.
@@ -181,7 +184,9 @@ pub fn run(
     let mut rows = Vec::with_capacity(settings.len());
     for &setting in settings {
         let (s, mode) = with_setting(scene, setting);
+        reset_peak_rss();
         let m = measure(&s, mode, runs, loader)?;
+        let peak_rss_kib = peak_rss_kib();
         let (geo_mean, geo_max) = accuracy::geometric_error(&m.hits, &distance);
         let geo_max_px = accuracy::geometric_error_pixels(&m.hits, &distance, crate::tolerance::pixel_angle(scene));
         let c = &m.counters;
@@ -196,6 +201,7 @@ pub fn run(
             tests_per_ray: c.triangle_tests as f64 / rays,
             bytes: m.bytes,
             triangles: m.triangles,
+            peak_rss_kib,
             geo_mean,
             geo_max,
             geo_max_px,
@@ -208,8 +214,23 @@ pub fn run(
     Ok(rows)
 }
 
+/// Resets the process's peak resident set size (Linux ≥ 4.0); a no-op elsewhere.
+fn reset_peak_rss() {
+    // Writing 5 to clear_refs resets VmHWM to the current RSS. Failure only means the
+    // column is the peak since an earlier point, which `peak_rss_kib` cannot tell; on
+    // systems without procfs both calls do nothing.
+    let _ = std::fs::write("/proc/self/clear_refs", "5");
+}
+
+/// The process's peak resident set size in KiB, from /proc/self/status (Linux).
+fn peak_rss_kib() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    line.split_whitespace().nth(1)?.parse().ok()
+}
+
 /// The columns of `sweep.csv`.
-pub const CSV_HEADER: &str = "backend,setting,wall_ms,rays_per_s,sdf_evals_per_ray,node_visits_per_ray,triangle_tests_per_ray,geometry_bytes,triangles,geo_error_mean,geo_error_max,geo_error_max_pixels,coverage_error_px,rmse,psnr_db";
+pub const CSV_HEADER: &str = "backend,setting,wall_ms,rays_per_s,sdf_evals_per_ray,node_visits_per_ray,triangle_tests_per_ray,geometry_bytes,triangles,peak_rss_kib,geo_error_mean,geo_error_max,geo_error_max_pixels,coverage_error_px,rmse,psnr_db";
 
 /// Rows as CSV.
 pub fn csv(rows: &[Row]) -> String {
@@ -217,7 +238,7 @@ pub fn csv(rows: &[Row]) -> String {
     for r in rows {
         let _ = writeln!(
             out,
-            "{},{},{:.3},{:.0},{:.3},{:.3},{:.3},{},{},{:e},{:e},{:.4},{},{:.4},{:.2}",
+            "{},{},{:.3},{:.0},{:.3},{:.3},{:.3},{},{},{},{:e},{:e},{:.4},{},{:.4},{:.2}",
             r.setting.backend(),
             r.setting.label(),
             r.wall_ms,
@@ -227,6 +248,7 @@ pub fn csv(rows: &[Row]) -> String {
             r.tests_per_ray,
             r.bytes,
             r.triangles,
+            r.peak_rss_kib.map_or(String::new(), |k| k.to_string()),
             r.geo_mean,
             r.geo_max,
             r.geo_max_px,
@@ -240,11 +262,11 @@ pub fn csv(rows: &[Row]) -> String {
 
 /// Rows as a Markdown table.
 pub fn markdown(rows: &[Row], title: &str) -> String {
-    let mut out = format!("# Sweep: {title}\n\nReference: the SDF render at epsilon 1e-6 with a 100 000-step budget. Geometric error is |d| at primary hits, in world units.\n\n| back-end | setting | wall | rays/s | evals/ray | visits/ray | tri tests/ray | bytes | triangles | geo error mean | geo error max | max in pixels | coverage px | RMSE | PSNR |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    let mut out = format!("# Sweep: {title}\n\nReference: the SDF render at epsilon 1e-6 with a 100 000-step budget. Geometric error is |d| at primary hits, in world units.\n\n| back-end | setting | wall | rays/s | evals/ray | visits/ray | tri tests/ray | bytes | triangles | peak RSS | geo error mean | geo error max | max in pixels | coverage px | RMSE | PSNR |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for r in rows {
         let _ = writeln!(
             out,
-            "| {} | {} | {:.1} ms | {:.2} M | {:.2} | {:.2} | {:.2} | {} | {} | {:.2e} | {:.2e} | {:.3} | {} | {:.2} | {:.1} dB |",
+            "| {} | {} | {:.1} ms | {:.2} M | {:.2} | {:.2} | {:.2} | {} | {} | {} | {:.2e} | {:.2e} | {:.3} | {} | {:.2} | {:.1} dB |",
             r.setting.backend(),
             r.setting.label(),
             r.wall_ms,
@@ -254,6 +276,7 @@ pub fn markdown(rows: &[Row], title: &str) -> String {
             r.tests_per_ray,
             r.bytes,
             r.triangles,
+            r.peak_rss_kib.map_or("n/a".to_string(), |k| format!("{:.1} MiB", k as f64 / 1024.0)),
             r.geo_mean,
             r.geo_max,
             r.geo_max_px,
