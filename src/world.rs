@@ -408,7 +408,7 @@ mod tests {
                 );
                 // The naive form b² − c loses the chord entirely this far away.
                 if dist >= 1e4 && offset > 0.9 {
-                    let c32 = (centre.as_vec3().length_squared() - 1.0) as f32;
+                    let c32 = centre.as_vec3().length_squared() - 1.0;
                     let b32 = b as f32;
                     let naive = b32 * b32 - c32;
                     let truth = 1.0 - perp;
