@@ -24,7 +24,7 @@ for scene in examples/seed/0*.scn; do
       for (i = 2; i <= n; i++) if (setting[i] == "detail low") low = i
       for (i = 2; i <= n; i++) if (setting[i] == "detail high") high = i
       match_row = 0
-      # Mesh rows come in increasing detail: the first within the SDF's error is the match.
+      # Mesh rows come in increasing detail: the first within the SDF error is the match.
       for (i = 2; i <= n; i++) if (backend[i] == "mesh" && geo[i] + 0 <= geo[sdf] + 0 && match_row == 0) match_row = i
       cell = "%.1f ms, %d B, error %.1e"
       printf "| %s | ", name
