@@ -3,11 +3,22 @@
 //! The pipeline, one module per stage, each with one entry point:
 //!
 //! ```text
-//! source text ──syntax::parse──▶ ast::File ──check::check──▶ ir::Scene ──sdf::lower──▶ SdfScene ─┐
-//!     (logos + chumsky;            (names, types, ranges;     (f64, spans)   (closures, f32,       │
-//!      errors → Diagnostic)         evaluates loops/functions)                camera-relative)      │
-//!                                                 render::Frame::new ──▶ Frame ──render::render(&dyn Geometry)──▶ Image
+//! text ─syntax::parse─▶ ast::File ─check::check─▶ ir::Scene ─effects::derive─▶ Effects
+//!                                                    │
+//!                    world::prepare(scene, effects, Mode::Sdf | Mode::Mesh(detail))
+//!                                                    ▼
+//!      Frame (camera, lights, materials) + World (SdfObject | MeshObject under one BVH)
+//!                                                    │
+//!                          render::render(&dyn Geometry, &Frame) ─▶ Image, Counters
 //! ```
+//!
+//! - [`syntax`]: logos tokens and a chumsky parser that recovers, so one run reports many errors.
+//! - [`check`]: names, types, arity and ranges, by evaluating the pure language to the IR.
+//! - [`ir`]: the evaluated scene in f64 with source spans; bounds; a stable text dump.
+//! - [`sdf`] and [`mesh`]: the two geometry back-ends; [`world`] puts their objects, in
+//!   camera-relative f32, under one top-level [`bvh`].
+//! - [`render`]: the one Whitted tracer, built for the scene's [`effects`].
+//! - [`accuracy`], [`sweep`], [`tolerance`] and [`chart`]: what accuracy costs.
 //!
 //! Every stage reports problems as [`diag::Diagnostic`] values; only the binary prints.
 

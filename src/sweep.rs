@@ -1,6 +1,6 @@
 //! `scnc sweep`: render one scene across a ladder of accuracy settings for both back-ends
 //! and measure, for each, time, work, memory and error against a reference (see
-//! [`accuracy`](crate::accuracy) for the metrics and the reference).
+//! [`crate::accuracy`] for the metrics and the reference).
 
 use std::fmt::Write as _;
 use std::time::Instant;

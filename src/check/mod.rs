@@ -1,4 +1,4 @@
-//! Checking and evaluation: an [`ast::File`](crate::syntax::ast::File) (and everything it
+//! Checking and evaluation: a [`File`](crate::syntax::ast::File) (and everything it
 //! includes) to an [`ir::Scene`] plus diagnostics.
 //!
 //! The language is pure and evaluated at compile time, so the checker *is* an evaluator
