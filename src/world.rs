@@ -141,6 +141,7 @@ pub fn lower(
     let to_render = DAffine3::from_translation(-frame.origin);
     let max_distance = frame.max_distance as f64;
     let mut builder = sdf::Builder { materials: &mut frame.materials, bytes: 0 };
+    let mut budget = mesh::lower::MAX_SCENE_TRIANGLES;
     let mut objects = Vec::with_capacity(scene.objects.len());
     for obj in &scene.objects {
         let (kind, bounds, sphere) = match (&obj.geometry, mode) {
@@ -154,14 +155,18 @@ pub fn lower(
                 (ObjectKind::Sdf(SdfObject::new(shape, to_render, &mut builder)), bounds, sphere)
             }
             (ir::Geometry::Shape(shape), Mode::Mesh(detail)) => {
-                let m = mesh::lower::tessellate(shape, to_render, detail, max_distance, &mut builder)?;
+                let m = mesh::lower::tessellate(shape, to_render, detail, max_distance, &mut budget, &mut builder)?;
                 let (b, s) = (m.bounds(), m.sphere());
                 (ObjectKind::Mesh(m), Some(b), s)
             }
             (ir::Geometry::Mesh(m), _) => {
-                let m = mesh::lower::explicit(m, to_render, &mut builder, loader)?;
-                let (b, s) = (m.bounds(), m.sphere());
-                (ObjectKind::Mesh(m), Some(b), s)
+                let object = mesh::lower::explicit(m, to_render, &mut budget, &mut builder, loader)?;
+                // Isosurfaces and files are counted once made (their own limits bound them).
+                if matches!(m.source, ir::MeshSource::Isosurface { .. } | ir::MeshSource::File { .. }) {
+                    mesh::lower::spend(&mut budget, object.triangle_count() as u64, m.span)?;
+                }
+                let (b, s) = (object.bounds(), object.sphere());
+                (ObjectKind::Mesh(object), Some(b), s)
             }
         };
         objects.push(Object { kind, bounds, sphere, span: obj.span });

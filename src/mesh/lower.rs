@@ -19,6 +19,7 @@ pub fn tessellate(
     xf: DAffine3,
     detail: Detail,
     max_distance: f64,
+    budget: &mut u64,
     builder: &mut Builder<'_>,
 ) -> Result<MeshObject, Diagnostic> {
     // Walk down through transforms and materials to a primitive that has a generator.
@@ -37,6 +38,15 @@ pub fn tessellate(
         }
     }
     let (rings, circle) = (detail.rings(), detail.circle());
+    let (r, c) = (rings as u64, circle as u64);
+    let expected = match node.kind {
+        ShapeKind::Sphere { .. } => 4 * r * (r - 1),
+        ShapeKind::Cylinder { .. } => 4 * c,
+        ShapeKind::Cone { .. } => 2 * c,
+        ShapeKind::Torus { .. } => 2 * c * r,
+        _ => 12,
+    };
+    spend(budget, expected, shape.span)?;
     let generated = match node.kind {
         ShapeKind::Sphere { radius } => Some(tessellate::uvsphere(radius, rings, 2 * rings)),
         ShapeKind::Box { half } => Some(tessellate::cuboid(half)),
@@ -67,6 +77,26 @@ pub fn tessellate(
     let cell = (bounds.max - bounds.min).length() / (4.0 * rings as f64);
     // Sampled in render space, so the vertices need no further placing.
     isosurface_object(node, xf, DAffine3::IDENTITY, material, cell, false, node.span, CellFrom::Detail, builder)
+}
+
+/// Most triangles all meshes of one scene may have together (about 2.4 GB with BVHs).
+pub const MAX_SCENE_TRIANGLES: u64 = 50_000_000;
+
+/// Takes `triangles` from the scene's remaining budget, or reports the object that would
+/// exceed it, before anything is allocated.
+pub fn spend(budget: &mut u64, triangles: u64, span: Span) -> Result<(), Diagnostic> {
+    if triangles > *budget {
+        return Err(Diagnostic::error(
+            codes::LOWERING,
+            span,
+            "the scene's meshes would have too many triangles",
+            format!("this object needs {triangles} more triangles"),
+        )
+        .with_note(format!("a scene may have at most {MAX_SCENE_TRIANGLES} triangles in all its meshes"))
+        .with_hint("try a lower `--detail`, or fewer or coarser meshes"));
+    }
+    *budget -= triangles;
+    Ok(())
 }
 
 fn unbounded(span: Span) -> Diagnostic {
@@ -146,11 +176,23 @@ fn isosurface_object(
 pub fn explicit(
     m: &ir::Mesh,
     to_render: DAffine3,
+    budget: &mut u64,
     builder: &mut Builder<'_>,
     loader: &dyn Loader,
 ) -> Result<MeshObject, Diagnostic> {
     let xf = to_render * m.xf;
     let material = m.material.as_ref().map_or(0, |mat| builder.materials.intern(mat));
+    let expected = match &m.source {
+        MeshSource::UvSphere { rings, segments, .. } => 2 * *segments as u64 * (*rings as u64 - 1),
+        MeshSource::IcoSphere { subdivisions, .. } => 20 * 4u64.pow(*subdivisions),
+        MeshSource::Box { .. } => 12,
+        MeshSource::Cylinder { segments, .. } => 4 * *segments as u64,
+        MeshSource::Torus { segments, sides, .. } => 2 * *segments as u64 * *sides as u64,
+        MeshSource::Plane { .. } => 2,
+        // Bounded by the grid-cell and OBJ-size limits; counted once made, below.
+        MeshSource::Isosurface { .. } | MeshSource::File { .. } => 0,
+    };
+    spend(budget, expected, m.span)?;
     let local: TriMesh = match &m.source {
         MeshSource::UvSphere { radius, rings, segments } => tessellate::uvsphere(*radius, *rings, *segments),
         MeshSource::IcoSphere { radius, subdivisions } => tessellate::icosphere(*radius, *subdivisions),
@@ -197,4 +239,24 @@ pub fn explicit(
         }
     };
     Ok(MeshObject::new(&local, xf, material, None, m.smooth))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The budget is spent before anything is allocated, and exceeding it is an error at
+    /// the object's span, never a partial spend.
+    #[test]
+    fn triangle_budget_is_checked_before_spending() {
+        let span = Span::new(3, 9);
+        let mut budget = 10;
+        assert!(spend(&mut budget, 4, span).is_ok());
+        assert_eq!(budget, 6);
+        let err = spend(&mut budget, 7, span).expect_err("over budget");
+        assert_eq!((err.code, err.span()), (codes::LOWERING, span));
+        assert_eq!(budget, 6, "a refused spend takes nothing");
+        assert!(spend(&mut budget, 6, span).is_ok());
+        assert_eq!(budget, 0);
+    }
 }
