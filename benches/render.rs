@@ -59,10 +59,9 @@ fn primitives(c: &mut Criterion) {
 fn march(c: &mut Criterion) {
     let mut group = c.benchmark_group("primary rays");
     let modes = [("sdf", scnc::world::Mode::Sdf), ("mesh-high", scnc::world::Mode::Mesh(scnc::world::Detail::High))];
-    for (path, (mode_name, mode)) in ["examples/seed/01-sphere.scn", "examples/seed/06-many-spheres.scn"]
-        .into_iter()
-        .flat_map(|p| modes.into_iter().map(move |m| (p, m)))
-    {
+    let scenes =
+        ["examples/seed/01-sphere.scn", "examples/seed/06-many-spheres.scn", "benches/scenes/full-frame-sphere.scn"];
+    for (path, (mode_name, mode)) in scenes.into_iter().flat_map(|p| modes.into_iter().map(move |m| (p, m))) {
         let (frame, g) = lower_mode(path, 256, 256, mode);
         let dirs: Vec<Vec3A> =
             (0..256 * 256).map(|i| frame.direction((i % 256) as f32 + 0.5, (i / 256) as f32 + 0.5)).collect();
