@@ -165,7 +165,7 @@ fn sweep_cmd(args: SweepArgs) -> ExitCode {
     if let Err(e) = std::fs::create_dir_all(&args.out) {
         return usage_error(&format!("cannot create `{}`: {e}", args.out.display()));
     }
-    let compiled = compile(&args.file);
+    let Some(compiled) = compile(&args.file, args.message_format) else { return ExitCode::from(1) };
     if report(&compiled, args.message_format) {
         return ExitCode::from(1);
     }
@@ -255,24 +255,25 @@ fn parse_positive(s: &str) -> Result<f64, String> {
     }
 }
 
-fn compile(path: &Path) -> Compiled {
+/// Reads and compiles a file. A file that cannot be read has no source to point into, so
+/// it is reported here, in the requested format, and `None` returned (exit 1).
+fn compile(path: &Path, format: MessageFormat) -> Option<Compiled> {
     let name = path.display().to_string();
     match FsLoader.read(path) {
-        Ok(text) => scnc::with_big_stack(|| scnc::compile_source(&name, path, text, &FsLoader)),
+        Ok(text) => Some(scnc::with_big_stack(|| scnc::compile_source(&name, path, text, &FsLoader))),
         Err(e) => {
-            let mut map = scnc::source::SourceMap::new();
-            let _ = map.add(name.clone(), path, String::new());
-            let reason = match e.kind() {
-                std::io::ErrorKind::NotFound => "no such file".to_string(),
-                _ => e.to_string(),
+            let code = scnc::diag::codes::INCLUDE_READ;
+            let message = format!("cannot read `{name}`: {}", scnc::check::io_reason(&e));
+            let line = match format {
+                MessageFormat::Human => format!("error[{code}]: {message}"),
+                MessageFormat::Json => serde_json::json!({
+                    "severity": "error", "code": code, "message": message,
+                    "span": { "file": name }, "related": [], "notes": [], "hints": [],
+                })
+                .to_string(),
             };
-            let d = Diagnostic::error(
-                scnc::diag::codes::INCLUDE_READ,
-                scnc::span::Span::default(),
-                format!("cannot read `{name}`: {reason}"),
-                reason,
-            );
-            Compiled { map, scene: None, diagnostics: vec![d] }
+            let _ = writeln!(std::io::stderr(), "{line}");
+            None
         }
     }
 }
@@ -283,12 +284,6 @@ fn report(c: &Compiled, format: MessageFormat) -> bool {
     let mut err = std::io::stderr().lock();
     for d in &c.diagnostics {
         let text = match format {
-            MessageFormat::Human
-                if c.map.files().next().is_some_and(|(_, f)| f.text.is_empty())
-                    && d.span() == scnc::span::Span::default() =>
-            {
-                format!("error[{}]: {}\n", d.code, d.message)
-            }
             MessageFormat::Human => d.render(&c.map, color),
             MessageFormat::Json => format!("{}\n", d.to_json(&c.map)),
         };
@@ -322,7 +317,7 @@ fn render_cmd(args: RenderArgs) -> ExitCode {
             out_dir.display()
         ));
     }
-    let compiled = compile(&args.file);
+    let Some(compiled) = compile(&args.file, args.message_format) else { return ExitCode::from(1) };
     if report(&compiled, args.message_format) {
         return ExitCode::from(1);
     }
@@ -545,8 +540,7 @@ fn run(cli: Cli) -> ExitCode {
         Command::Check { files, message_format } => {
             let mut failed = false;
             for file in &files {
-                let compiled = compile(file);
-                failed |= report(&compiled, message_format);
+                failed |= compile(file, message_format).is_none_or(|c| report(&c, message_format));
             }
             if failed {
                 ExitCode::from(1)
@@ -555,7 +549,7 @@ fn run(cli: Cli) -> ExitCode {
             }
         }
         Command::Ir { file, message_format } => {
-            let compiled = compile(&file);
+            let Some(compiled) = compile(&file, message_format) else { return ExitCode::from(1) };
             if report(&compiled, message_format) {
                 return ExitCode::from(1);
             }

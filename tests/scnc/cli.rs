@@ -253,3 +253,22 @@ fn tolerance_picks_hold() {
     ]);
     assert_eq!(o.status.code(), Some(2), "--tolerance and --epsilon conflict");
 }
+
+/// An empty scene is a warning (rendered with its source, exit 0), not an error; an
+/// unreadable file is one error, also as a JSON line.
+#[test]
+fn empty_and_unreadable_files_are_reported_for_what_they_are() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let empty = dir.path().join("empty.scn");
+    std::fs::write(&empty, "").expect("write");
+    let o = scnc(&["check", empty.to_str().unwrap_or_default()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(err.contains("[W0004] Warning: the scene has no objects") && !err.contains("error["), "{err}");
+    let o = scnc(&["check", "--message-format", "json", "no/such/file.scn"]);
+    assert_eq!(o.status.code(), Some(1));
+    let line: serde_json::Value =
+        serde_json::from_str(String::from_utf8_lossy(&o.stderr).trim()).expect("one JSON line");
+    assert_eq!((line["code"].as_str(), line["severity"].as_str()), (Some("E0600"), Some("error")));
+    assert_eq!(line["span"]["file"], "no/such/file.scn");
+}
