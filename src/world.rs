@@ -79,6 +79,8 @@ pub struct World {
     unbounded: Vec<u32>,
     params: MarchParams,
     closure_bytes: usize,
+    /// Whether any object is a mesh: then soft shadows and occlusion need rays, not estimates.
+    has_meshes: bool,
 }
 
 /// Memory of the world by structure, for `--stats`.
@@ -179,7 +181,8 @@ pub fn lower(
     let boxes: Vec<Aabb> = bounded.iter().map(|&i| objects[i as usize].bounds.unwrap_or(Aabb::EMPTY)).collect();
     let bvh = Bvh::build(&boxes, 2);
     debug_assert!(bvh.validate(&boxes).is_ok());
-    Ok(World { objects, bvh, bounded, unbounded, params, closure_bytes })
+    let has_meshes = objects.iter().any(|o| matches!(o.kind, ObjectKind::Mesh(_)));
+    Ok(World { objects, bvh, bounded, unbounded, params, closure_bytes, has_meshes })
 }
 
 impl World {
@@ -228,13 +231,32 @@ impl World {
         (t0 <= t1).then_some((t0, t1))
     }
 
-    fn hit_object(&self, i: u32, q: &mut Query<'_>, t_max: f32, c: &mut Counters) -> Option<Hit> {
+    /// The closest surface of object `i` before `t_max`, without its shading data.
+    fn find(&self, i: u32, q: &mut Query<'_>, t_max: f32, c: &mut Counters) -> Option<Found> {
         let o = &self.objects[i as usize];
-        let (t0, t1) = self.interval(o, q.ray, t_max)?;
+        let interval = self.interval(o, q.ray, t_max)?;
         match &o.kind {
-            ObjectKind::Sdf(s) => s.intersect(q.ray, t0, t1, self.params, c, &mut q.evals),
+            ObjectKind::Sdf(s) => s
+                .closest(q.ray, interval, self.params, c, &mut q.evals)
+                .map(|(t, error)| Found::Sdf { object: i, t, error }),
             // Triangles are tested exactly; the interval only decides whether to look.
-            ObjectKind::Mesh(m) => m.intersect(q.ray, q.shear(), t_max, c),
+            ObjectKind::Mesh(m) => {
+                m.closest(q.ray, q.shear(), t_max, c).map(|(tri, hit)| Found::Mesh { object: i, tri, hit })
+            }
+        }
+    }
+
+    /// Normal, material and error of the winning surface, computed once per ray.
+    fn surface(&self, found: Found, ray: &Ray, c: &mut Counters) -> Option<Hit> {
+        match found {
+            Found::Sdf { object, t, error } => match &self.objects[object as usize].kind {
+                ObjectKind::Sdf(s) => Some(s.surface(ray, t, error, c)),
+                ObjectKind::Mesh(_) => None,
+            },
+            Found::Mesh { object, tri, hit } => match &self.objects[object as usize].kind {
+                ObjectKind::Mesh(m) => Some(m.surface(tri, hit)),
+                ObjectKind::Sdf(_) => None,
+            },
         }
     }
 
@@ -242,8 +264,26 @@ impl World {
         let o = &self.objects[i as usize];
         let Some((t0, t1)) = self.interval(o, q.ray, t_max) else { return false };
         match &o.kind {
-            ObjectKind::Sdf(s) => s.occluded(q.ray, t0, t1, self.params, c, &mut q.evals),
+            ObjectKind::Sdf(s) => s.closest(q.ray, (t0, t1), self.params, c, &mut q.evals).is_some(),
             ObjectKind::Mesh(m) => m.occluded(q.ray, q.shear(), t_max, c),
+        }
+    }
+}
+
+/// A surface found along a ray, before its shading data is computed.
+#[derive(Clone, Copy)]
+enum Found {
+    /// An SDF hit: distance and the threshold there.
+    Sdf { object: u32, t: f32, error: f32 },
+    /// A triangle hit.
+    Mesh { object: u32, tri: u32, hit: mesh::triangle::TriHit },
+}
+
+impl Found {
+    fn t(&self) -> f32 {
+        match self {
+            Found::Sdf { t, .. } => *t,
+            Found::Mesh { hit, .. } => hit.t,
         }
     }
 }
@@ -255,11 +295,20 @@ struct Query<'a> {
     shear: Option<mesh::triangle::Shear>,
     /// SDF evaluations so far.
     evals: u64,
+    /// Top-level BVH nodes visited.
+    visits: u64,
 }
 
 impl<'a> Query<'a> {
     fn new(ray: &'a Ray) -> Query<'a> {
-        Query { ray, shear: None, evals: 0 }
+        Query { ray, shear: None, evals: 0, visits: 0 }
+    }
+
+    /// Adds this query's work to the counters.
+    fn settle(self, c: &mut Counters) {
+        c.node_visits += self.visits;
+        c.sdf_evals += self.evals;
+        c.max_evals_per_ray = c.max_evals_per_ray.max(self.evals);
     }
 
     fn shear(&mut self) -> &mesh::triangle::Shear {
@@ -288,22 +337,21 @@ impl Geometry for World {
     fn intersect(&self, ray: &Ray, c: &mut Counters) -> Option<Hit> {
         let mut q = Query::new(ray);
         let mut visits = 0u64;
-        let mut best: Option<Hit> = None;
+        let mut best: Option<Found> = None;
         self.bvh.closest(ray.origin, ray.inv_dir, ray.t_min, ray.t_max, &mut visits, |k, t_max| {
-            let hit = self.hit_object(self.bounded[k as usize], &mut q, t_max, c)?;
-            best = Some(hit);
-            Some(hit.t)
+            let found = self.find(self.bounded[k as usize], &mut q, t_max, c)?;
+            best = Some(found);
+            Some(found.t())
         });
         for &i in &self.unbounded {
-            let limit = best.map_or(ray.t_max, |h| h.t);
-            if let Some(hit) = self.hit_object(i, &mut q, limit, c) {
-                best = Some(hit);
+            let limit = best.map_or(ray.t_max, |f| f.t());
+            if let Some(found) = self.find(i, &mut q, limit, c) {
+                best = Some(found);
             }
         }
-        c.node_visits += visits;
-        c.sdf_evals += q.evals;
-        c.max_evals_per_ray = c.max_evals_per_ray.max(q.evals);
-        best
+        q.visits = visits;
+        q.settle(c);
+        self.surface(best?, ray, c)
     }
 
     fn occluded(&self, ray: &Ray, c: &mut Counters) -> bool {
@@ -312,20 +360,19 @@ impl Geometry for World {
         let hit = self.bvh.any(ray.origin, ray.inv_dir, ray.t_min, ray.t_max, &mut visits, |k, t_max| {
             self.blocks(self.bounded[k as usize], &mut q, t_max, c)
         }) || self.unbounded.iter().any(|&i| self.blocks(i, &mut q, ray.t_max, c));
-        c.node_visits += visits;
-        c.sdf_evals += q.evals;
-        c.max_evals_per_ray = c.max_evals_per_ray.max(q.evals);
+        q.visits = visits;
+        q.settle(c);
         hit
     }
 
     fn soft_visibility(&self, ray: &Ray, cone: f32, c: &mut Counters) -> Option<f32> {
-        if self.objects.iter().any(|o| matches!(o.kind, ObjectKind::Mesh(_))) {
+        if self.has_meshes {
             return None;
         }
         // The penumbra reaches `cone·t` beyond an object, so each object's bounding sphere
         // is widened by the cone's radius at the far end before it is skipped.
         let widen = cone * ray.t_max.min(1e6);
-        let mut evals = 0u64;
+        let mut q = Query::new(ray);
         let mut visibility = 1.0f32;
         for o in &self.objects {
             let ObjectKind::Sdf(s) = &o.kind else { continue };
@@ -339,18 +386,17 @@ impl Geometry for World {
             if t0 > t1 {
                 continue;
             }
-            visibility = visibility.min(s.penumbra(ray, (t0, t1), cone, self.params, c, &mut evals));
+            visibility = visibility.min(s.penumbra(ray, (t0, t1), cone, self.params, c, &mut q.evals));
             if visibility <= 0.0 {
                 break;
             }
         }
-        c.sdf_evals += evals;
-        c.max_evals_per_ray = c.max_evals_per_ray.max(evals);
+        q.settle(c);
         Some(visibility)
     }
 
     fn occlusion(&self, point: Vec3A, normal: Vec3A, reach: f32, c: &mut Counters) -> Option<f32> {
-        if self.objects.iter().any(|o| matches!(o.kind, ObjectKind::Mesh(_))) {
+        if self.has_meshes {
             return None;
         }
         // Five taps along the normal (Quilez): where the field is below the distance

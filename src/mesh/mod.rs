@@ -177,21 +177,31 @@ impl MeshObject {
         (self.positions[t[0] as usize], self.positions[t[1] as usize], self.positions[t[2] as usize])
     }
 
-    /// The closest hit within `(ray.t_min, t_max)`; `shear` is `Shear::new(ray.dir)`,
-    /// computed once per ray by the caller.
-    pub fn intersect(&self, ray: &Ray, shear: &triangle::Shear, t_max: f32, c: &mut Counters) -> Option<Hit> {
+    /// The closest triangle within `(ray.t_min, t_max)` and where on it the ray hits;
+    /// `shear` is `Shear::new(ray.dir)`, computed once per ray by the caller.
+    pub fn closest(
+        &self,
+        ray: &Ray,
+        shear: &triangle::Shear,
+        t_max: f32,
+        c: &mut Counters,
+    ) -> Option<(u32, triangle::TriHit)> {
         let mut best = None;
         let mut tests = 0u64;
-        let found = self.bvh.closest(ray.origin, ray.inv_dir, ray.t_min, t_max, &mut c.node_visits, |i, t_max| {
+        self.bvh.closest(ray.origin, ray.inv_dir, ray.t_min, t_max, &mut c.node_visits, |i, t_max| {
             tests += 1;
             let (a, b, cc) = self.tri(i);
             let hit = triangle::intersect(ray.origin, shear, a, b, cc, ray.t_min, t_max)?;
-            best = Some(hit);
+            best = Some((i, hit));
             Some(hit.t)
         });
         c.triangle_tests += tests;
-        let (i, _) = found?;
-        let hit = best?;
+        best
+    }
+
+    /// The surface at a hit found by [`closest`](Self::closest): point, normal (interpolated
+    /// when smooth, else the face's), material and error. Done once per ray, for the winner.
+    pub fn surface(&self, i: u32, hit: triangle::TriHit) -> Hit {
         let (a, b, cc) = self.tri(i);
         let point = a * hit.bary[0] + b * hit.bary[1] + cc * hit.bary[2];
         let normal = match &self.normals {
@@ -209,7 +219,12 @@ impl MeshObject {
         };
         // The interpolated point lies within a few ulps of the true plane.
         let error = point.abs().max_element() * 8.0 * f32::EPSILON;
-        Some(Hit { t: hit.t, point, normal, material, error })
+        Hit { t: hit.t, point, normal, material, error }
+    }
+
+    /// The closest hit within `(ray.t_min, t_max)`, with its surface.
+    pub fn intersect(&self, ray: &Ray, shear: &triangle::Shear, t_max: f32, c: &mut Counters) -> Option<Hit> {
+        self.closest(ray, shear, t_max, c).map(|(i, hit)| self.surface(i, hit))
     }
 
     /// Whether any triangle lies along the ray within `(ray.t_min, t_max)`.

@@ -33,36 +33,28 @@ impl SdfObject {
         SdfObject { dist, mat }
     }
 
-    /// Marches the ray over `[t0, t1]`; on a hit, the normal and material there.
-    pub fn intersect(
+    /// Marches the ray over `[t0, t1]`; on a hit, its distance and the threshold there
+    /// (the hit point's error bound).
+    pub fn closest(
         &self,
         ray: &Ray,
-        t0: f32,
-        t1: f32,
+        (t0, t1): (f32, f32),
         params: MarchParams,
         c: &mut Counters,
         evals: &mut u64,
-    ) -> Option<Hit> {
-        let (t, error) = march::march(&*self.dist, ray, t0, t1, params, c, evals)?;
+    ) -> Option<(f32, f32)> {
+        march::march(&*self.dist, ray, t0, t1, params, c, evals)
+    }
+
+    /// The surface at a hit found by [`closest`](Self::closest): normal from the gradient
+    /// and material from the material closure. Done once per ray, for the winner.
+    pub fn surface(&self, ray: &Ray, t: f32, error: f32, c: &mut Counters) -> Hit {
         let point = ray.at(t);
         let h = error.max(point.abs().max_element() * 8.0 * f32::EPSILON);
         let normal = march::normal(&*self.dist, point, h);
         let (_, material) = (self.mat)(point);
         c.sdf_shading_evals += 5;
-        Some(Hit { t, point, normal, material, error })
-    }
-
-    /// Whether the march finds the surface within `[t0, t1]`.
-    pub fn occluded(
-        &self,
-        ray: &Ray,
-        t0: f32,
-        t1: f32,
-        params: MarchParams,
-        c: &mut Counters,
-        evals: &mut u64,
-    ) -> bool {
-        march::march(&*self.dist, ray, t0, t1, params, c, evals).is_some()
+        Hit { t, point, normal, material, error }
     }
 
     /// The unblocked fraction of a cone of slope `cone` around the ray over `[t0, t1]`: the
