@@ -162,9 +162,7 @@ impl Ctx<'_> {
             ast::StmtKind::Error => {}
             ast::StmtKind::Let { name, params: None, value } => {
                 let v = self.expr(value);
-                if self.dry == 0 || !self.lets.contains_key(&name.span) {
-                    self.lets.entry(name.span).or_insert_with(|| (name.name.clone(), false));
-                }
+                self.lets.entry(name.span).or_insert_with(|| (name.name.clone(), false));
                 self.bind(name, Bound::Value(v));
             }
             ast::StmtKind::Let { name, params: Some(params), value } => self.define_function(name, params, value),

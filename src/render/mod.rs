@@ -151,7 +151,7 @@ pub fn render(geometry: &dyn Geometry, frame: &Frame, progress: &(dyn Fn() + Syn
     // Pick the tracer built for this effect set, once, before the first ray.
     macro_rules! pick {
         ($($s:literal $r:literal $p:literal $a:literal),*) => {
-            match (e.shadows(), e.reflections && frame.depth > 0, e.specular, e.ambient_occlusion.is_some()) {
+            match (e.shadows(), e.reflections, e.specular, e.ambient_occlusion.is_some()) {
                 $(($s, $r, $p, $a) => rows::<$s, $r, $p, $a>(geometry, frame, progress),)*
             }
         };
