@@ -45,6 +45,17 @@ pub struct Diagnostic {
     pub notes: Vec<String>,
     /// Suggested fixes, phrased "try …" or "did you mean …".
     pub hints: Vec<String>,
+    /// Machine-applicable replacements behind the hints (editor quick-fixes).
+    pub fixes: Vec<Fix>,
+}
+
+/// A replacement an editor can apply: put `text` where `span` is.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fix {
+    /// What to replace.
+    pub span: Span,
+    /// The replacement.
+    pub text: String,
 }
 
 impl Diagnostic {
@@ -72,6 +83,7 @@ impl Diagnostic {
             labels: vec![Label { span, message: label.into(), primary: true }],
             notes: Vec::new(),
             hints: Vec::new(),
+            fixes: Vec::new(),
         }
     }
 
@@ -90,6 +102,19 @@ impl Diagnostic {
     /// Adds a hint.
     pub fn with_hint(mut self, hint: impl Into<String>) -> Diagnostic {
         self.hints.push(hint.into());
+        self
+    }
+
+    /// Adds a "did you mean `text`?" hint with the replacement of `span` by `text`.
+    pub fn with_replacement(mut self, span: Span, text: &str) -> Diagnostic {
+        self.hints.push(format!("did you mean `{text}`?"));
+        self.fixes.push(Fix { span, text: text.to_string() });
+        self
+    }
+
+    /// Adds a replacement without a hint of its own (when one hint offers several).
+    pub fn with_fix(mut self, span: Span, text: &str) -> Diagnostic {
+        self.fixes.push(Fix { span, text: text.to_string() });
         self
     }
 
@@ -170,6 +195,15 @@ impl Diagnostic {
                 v
             })
             .collect();
+        let fixes: Vec<_> = self
+            .fixes
+            .iter()
+            .map(|f| {
+                let mut v = loc(f.span);
+                v["replacement"] = f.text.clone().into();
+                v
+            })
+            .collect();
         let json = serde_json::json!({
             "severity": match self.severity { Severity::Error => "error", Severity::Warning => "warning" },
             "code": self.code,
@@ -178,6 +212,7 @@ impl Diagnostic {
             "related": related,
             "notes": self.notes,
             "hints": self.hints,
+            "fixes": fixes,
         });
         json.to_string()
     }

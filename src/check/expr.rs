@@ -89,6 +89,9 @@ impl Ctx<'_> {
         self.expr_depth += 1;
         let v = self.expr_inner(e);
         self.expr_depth -= 1;
+        if let Some(ix) = &mut self.index {
+            ix.typed(e.span, (!v.is_error()).then(|| v.ty_name()));
+        }
         v
     }
 
@@ -155,7 +158,7 @@ impl Ctx<'_> {
     }
 
     fn ident(&mut self, id: &ast::Ident) -> Value {
-        if let Some(b) = self.lookup(&id.name) {
+        if let Some(b) = self.lookup(id) {
             return match &b.bound {
                 Bound::Value(v) => v.clone(),
                 Bound::Func(f) => {
@@ -207,7 +210,7 @@ impl Ctx<'_> {
             "not found in this scope",
         );
         if let Some(s) = suggest(&id.name, candidates.iter().map(String::as_str)) {
-            d = d.with_hint(format!("did you mean `{s}`?"));
+            d = d.with_replacement(id.span, s);
         } else if builtins::lookup(&id.name, Kind::MeshGenerator).is_some() {
             d = d.with_hint(format!("`{}` is a mesh generator: try `mesh {}(…)`", id.name, id.name));
         }
@@ -420,7 +423,7 @@ impl Ctx<'_> {
     }
 
     fn call(&mut self, callee: &ast::Ident, args: &[ast::Arg], span: Span) -> Value {
-        let binding = self.lookup(&callee.name);
+        let binding = self.lookup(callee);
         if let Some(b) = &binding {
             match &b.bound {
                 Bound::Func(f) => {
@@ -458,7 +461,7 @@ impl Ctx<'_> {
             if builtins::lookup(&callee.name, Kind::MeshGenerator).is_some() {
                 d = d.with_hint(format!("`{}` is a mesh generator: try `mesh {}(…)`", callee.name, callee.name));
             } else if let Some(s) = suggest(&callee.name, candidates.iter().map(String::as_str)) {
-                d = d.with_hint(format!("did you mean `{s}`?"));
+                d = d.with_replacement(callee.span, s);
             } else if matches!(callee.name.as_str(), "camera" | "render") {
                 d = d.with_note(format!("`{}(…)` is a statement, not an expression", callee.name));
             }
@@ -467,11 +470,19 @@ impl Ctx<'_> {
             let _ = self.eval_args(args);
             return Value::Error;
         };
+        self.note_builtin(callee.span, builtin);
         self.apply_builtin(builtin, args, span)
     }
 
+    /// Records in the index that `span` names `builtin`.
+    fn note_builtin(&mut self, span: Span, builtin: &'static Builtin) {
+        if let Some(ix) = &mut self.index {
+            ix.builtins.insert(span, super::index::BuiltinUse { span, builtin, param: None });
+        }
+    }
+
     /// Evaluates the arguments, binds them and builds the builtin's value.
-    fn apply_builtin(&mut self, builtin: &Builtin, args: &[ast::Arg], span: Span) -> Value {
+    fn apply_builtin(&mut self, builtin: &'static Builtin, args: &[ast::Arg], span: Span) -> Value {
         let args = self.eval_args(args);
         match self.bind_builtin(builtin, args, span) {
             Some(bound) => self.construct(builtin, bound),
@@ -488,9 +499,12 @@ impl Ctx<'_> {
                 "not a mesh generator",
             );
             if generator.name == "sphere" {
-                d = d.with_hint("did you mean `uvsphere` or `icosphere`?");
+                d = d
+                    .with_hint("did you mean `uvsphere` or `icosphere`?")
+                    .with_fix(generator.span, "uvsphere")
+                    .with_fix(generator.span, "icosphere");
             } else if let Some(s) = suggest(&generator.name, builtins::names(Kind::MeshGenerator)) {
-                d = d.with_hint(format!("did you mean `{s}`?"));
+                d = d.with_replacement(generator.span, s);
             } else {
                 d = d.with_note(format!(
                     "mesh generators: {}",
@@ -504,6 +518,7 @@ impl Ctx<'_> {
             let _ = self.eval_args(args);
             return Value::Error;
         };
+        self.note_builtin(generator.span, builtin);
         self.apply_builtin(builtin, args, span)
     }
 
@@ -567,7 +582,7 @@ impl Ctx<'_> {
                         let synonym =
                             SYNONYMS.iter().find(|(word, p)| *word == name.name && params.contains(p)).map(|(_, p)| *p);
                         if let Some(s) = synonym.or_else(|| suggest(&name.name, params.iter().copied())) {
-                            d = d.with_hint(format!("did you mean `{s}`?"));
+                            d = d.with_replacement(name.span, s);
                         }
                         self.report(with_note(d));
                         ok = false;
@@ -594,7 +609,20 @@ impl Ctx<'_> {
     }
 
     /// Binds arguments to a builtin's parameters; `None` after reporting (or on poison).
-    pub(super) fn bind_builtin(&mut self, b: &Builtin, mut args: Vec<ArgVal>, call: Span) -> Option<BoundArgs> {
+    pub(super) fn bind_builtin(
+        &mut self,
+        b: &'static Builtin,
+        mut args: Vec<ArgVal>,
+        call: Span,
+    ) -> Option<BoundArgs> {
+        if let Some(ix) = &mut self.index {
+            for name in args.iter().filter_map(|a| a.name.as_ref()) {
+                if let Some(param) = b.params.iter().find(|p| p.name == name.name) {
+                    let span = name.span;
+                    ix.builtins.insert(span, super::index::BuiltinUse { span, builtin: b, param: Some(param) });
+                }
+            }
+        }
         let recovered = args.iter().any(|a| a.value.is_error() && a.name.is_none());
         // `box(x, y, z)`: three numbers are one size vector.
         if b.name == "box"
@@ -704,6 +732,13 @@ impl Ctx<'_> {
     fn bind_user(&mut self, f: &Func, args: Vec<ArgVal>, call: Span, callee_span: Span) -> Option<Vec<Value>> {
         let recovered = args.iter().any(|a| a.value.is_error() && a.name.is_none());
         let names: Vec<&str> = f.params.iter().map(|p| p.name.as_str()).collect();
+        if let Some(ix) = &mut self.index {
+            for name in args.iter().filter_map(|a| a.name.as_ref()) {
+                if let Some(p) = f.params.iter().find(|p| p.name == name.name) {
+                    ix.refer(name.span, p.span);
+                }
+            }
+        }
         let (vals, _, mut ok) = self.bind_slots(&f.name, &names, false, args, callee_span, None);
         if recovered {
             return None;
@@ -741,6 +776,8 @@ impl Ctx<'_> {
         let mut frame = Vec::with_capacity(f.params.len());
         let mut seen = HashMap::new();
         for (p, v) in f.params.iter().zip(args) {
+            let ty = (!v.is_error()).then(|| v.ty_name());
+            self.note_def(p, super::index::DefKind::Param, ty, f.body.span.start, f.body.span.end);
             if seen.insert(p.name.clone(), ()).is_none() {
                 frame.push(Rc::new(super::Binding { name: p.name.clone(), span: p.span, bound: Bound::Value(v) }));
             }

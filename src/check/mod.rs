@@ -15,6 +15,7 @@
 pub mod builtins;
 pub mod construct;
 mod expr;
+pub mod index;
 mod value;
 
 use std::collections::{HashMap, HashSet};
@@ -118,6 +119,13 @@ struct Ctx<'a> {
     too_many_objects: bool,
     /// Set once "expression nests too deeply" was reported, so it is reported once.
     too_deep: bool,
+    /// Names and types for editor tooling, when asked for.
+    index: Option<index::Index>,
+    /// Where the innermost block being evaluated ends (global offset), for scopes in the index.
+    block_end: u32,
+    /// While evaluating a file included from the root file: the span in the root after
+    /// which the included top-level names are in scope, and the scope depth of that level.
+    export: Option<(u32, u32, usize)>,
 }
 
 impl Ctx<'_> {
@@ -127,12 +135,33 @@ impl Ctx<'_> {
         }
     }
 
-    fn lookup(&mut self, name: &str) -> Option<Rc<Binding>> {
-        let found = self.scopes.iter().rev().flat_map(|s| s.iter().rev()).find(|b| b.name == name).cloned()?;
+    fn lookup(&mut self, id: &ast::Ident) -> Option<Rc<Binding>> {
+        let found = self.scopes.iter().rev().flat_map(|s| s.iter().rev()).find(|b| b.name == id.name).cloned()?;
         if let Some(entry) = self.lets.get_mut(&found.span) {
             entry.1 = true;
         }
+        if let Some(ix) = &mut self.index {
+            ix.refer(id.span, found.span);
+        }
         Some(found)
+    }
+
+    /// Records a definition in the index (when there is one), in scope from `from` to
+    /// `to` when those are offsets of the root file.
+    fn note_def(&mut self, name: &ast::Ident, kind: index::DefKind, ty: Option<String>, from: u32, to: u32) {
+        if self.index.is_none() {
+            return;
+        }
+        let visible = if self.include_stack.len() <= 1 {
+            Some((from, to))
+        } else {
+            let exported = matches!(kind, index::DefKind::Value | index::DefKind::Function);
+            self.export.filter(|e| exported && e.2 == self.scopes.len()).map(|(f, t, _)| (f, t))
+        };
+        let def = index::Def { name: name.name.clone(), span: name.span, kind, ty, visible };
+        if let Some(ix) = &mut self.index {
+            ix.define(def);
+        }
     }
 
     fn bind(&mut self, name: &ast::Ident, bound: Bound) {
@@ -163,9 +192,16 @@ impl Ctx<'_> {
             ast::StmtKind::Let { name, params: None, value } => {
                 let v = self.expr(value);
                 self.lets.entry(name.span).or_insert_with(|| (name.name.clone(), false));
+                let ty = (!v.is_error()).then(|| v.ty_name());
+                self.note_def(name, index::DefKind::Value, ty, stmt.span.end, self.block_end);
                 self.bind(name, Bound::Value(v));
             }
-            ast::StmtKind::Let { name, params: Some(params), value } => self.define_function(name, params, value),
+            ast::StmtKind::Let { name, params: Some(params), value } => {
+                self.define_function(name, params, value);
+                let names: Vec<&str> = params.iter().map(|p| p.name.as_str()).collect();
+                let sig = format!("{}({})", name.name, names.join(", "));
+                self.note_def(name, index::DefKind::Function, Some(sig), stmt.span.end, self.block_end);
+            }
             ast::StmtKind::Object(e) => {
                 let v = self.expr(e);
                 self.object(v, e.span, stmt.span);
@@ -233,7 +269,15 @@ impl Ctx<'_> {
                 }
             }
             ast::StmtKind::For { var, start, end, body } => self.for_loop(var, start, end, body, stmt.span),
-            ast::StmtKind::Include { path, path_span } => self.include(path, *path_span),
+            ast::StmtKind::Include { path, path_span } => {
+                let root = self.include_stack.len() == 1;
+                let outer = self.export;
+                if root {
+                    self.export = Some((stmt.span.end, self.block_end, self.scopes.len()));
+                }
+                self.include(path, *path_span);
+                self.export = outer;
+            }
         }
     }
 
@@ -277,8 +321,12 @@ impl Ctx<'_> {
         let hi = self.int_operand(&hi, end.span, "the loop end");
         let run = |this: &mut Self, value: Value| {
             this.scopes.push(Vec::new());
+            let ty = (!value.is_error()).then(|| value.ty_name());
+            this.note_def(var, index::DefKind::LoopVar, ty, end.span.end, span.end);
             this.bind(var, Bound::Value(value));
+            let outer = std::mem::replace(&mut this.block_end, span.end);
             this.stmts(body);
+            this.block_end = outer;
             this.scopes.pop();
         };
         let (Some(lo), Some(hi)) = (lo, hi) else {
@@ -573,9 +621,13 @@ fn normalize(path: &Path) -> PathBuf {
     out
 }
 
-/// Checks and evaluates the file `root` of `map` (already added), loading includes
-/// through `loader`. Returns the scene when there are no errors, and every diagnostic.
-pub fn check(map: &mut SourceMap, root: FileId, loader: &dyn Loader) -> (Option<Scene>, Vec<Diagnostic>) {
+#[allow(clippy::type_complexity, reason = "the three results of one compile")]
+fn run(
+    map: &mut SourceMap,
+    root: FileId,
+    loader: &dyn Loader,
+    indexed: bool,
+) -> (Option<Scene>, Vec<Diagnostic>, Option<index::Index>) {
     let dir = map.file(root).path.parent().map(Path::to_path_buf).unwrap_or_default();
     let mut ctx = Ctx {
         map,
@@ -596,9 +648,31 @@ pub fn check(map: &mut SourceMap, root: FileId, loader: &dyn Loader) -> (Option<
         dry: 0,
         too_many_objects: false,
         too_deep: false,
+        index: indexed.then(index::Index::default),
+        block_end: u32::MAX,
+        export: None,
     };
     ctx.run_file(root);
-    ctx.finish()
+    let index = ctx.index.take();
+    let (scene, diags) = ctx.finish();
+    (scene, diags, index)
+}
+
+/// Checks and evaluates the file `root` of `map` (already added), loading includes
+/// through `loader`. Returns the scene when there are no errors, and every diagnostic.
+pub fn check(map: &mut SourceMap, root: FileId, loader: &dyn Loader) -> (Option<Scene>, Vec<Diagnostic>) {
+    let (scene, diags, _) = run(map, root, loader, false);
+    (scene, diags)
+}
+
+/// [`check`], also returning the [`index::Index`] of names and types for editor tooling.
+pub fn check_indexed(
+    map: &mut SourceMap,
+    root: FileId,
+    loader: &dyn Loader,
+) -> (Option<Scene>, Vec<Diagnostic>, index::Index) {
+    let (scene, diags, index) = run(map, root, loader, true);
+    (scene, diags, index.unwrap_or_default())
 }
 
 /// The unit vector along `v`, or `None` for a zero or non-finite vector.
