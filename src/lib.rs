@@ -29,6 +29,7 @@ pub mod check;
 pub mod diag;
 pub mod effects;
 pub mod ir;
+pub mod lsp;
 pub mod mesh;
 pub mod render;
 pub mod sdf;

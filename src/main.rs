@@ -42,6 +42,8 @@ enum Command {
     /// Render a scene across a ladder of accuracy settings for both back-ends and write
     /// time, work, memory and error for each to DIR/sweep.csv and DIR/sweep.md.
     Sweep(SweepArgs),
+    /// Run a Language Server Protocol server on stdin/stdout, for editors.
+    Lsp,
     /// Print the evaluated scene IR.
     Ir {
         /// The scene file.
@@ -537,6 +539,13 @@ fn run(cli: Cli) -> ExitCode {
     match cli.command {
         Command::Render(args) => render_cmd(args),
         Command::Sweep(args) => sweep_cmd(args),
+        Command::Lsp => match scnc::lsp::run_stdio() {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => {
+                let _ = writeln!(std::io::stderr(), "error: the language server stopped: {e}");
+                ExitCode::from(1)
+            }
+        },
         Command::Check { files, message_format } => {
             let mut failed = false;
             for file in &files {

@@ -111,6 +111,33 @@ pub struct Builtin {
     pub doc: &'static str,
 }
 
+impl Builtin {
+    /// The signature as users read it, such as `sphere(r: num)` or `min(num…)`.
+    pub fn signature(&self) -> String {
+        let mut parts = Vec::new();
+        if let Some(ty) = self.variadic {
+            parts.push(format!("{ty}…"));
+        }
+        parts.extend(self.params.iter().map(Param::describe));
+        format!("{}({})", self.name, parts.join(", "))
+    }
+}
+
+impl Param {
+    /// `name: type = default`, as in a signature.
+    pub fn describe(&self) -> String {
+        let default = match self.default {
+            Default::Required => String::new(),
+            Default::Num(x) => format!(" = {}", crate::ir::dump_num(x)),
+            Default::Vec3(v) => format!(" = {}", crate::ir::dump_vec(v.into())),
+            Default::Bool(b) => format!(" = {b}"),
+            Default::Color(c) => format!(" = rgb({}, {}, {})", c[0], c[1], c[2]),
+            Default::Derived => " = …".into(),
+        };
+        format!("{}: {}{default}", self.name, self.ty)
+    }
+}
+
 const fn p(name: &'static str, ty: Ty, default: Default) -> Param {
     Param { name, ty, default }
 }

@@ -41,25 +41,6 @@ const SYNONYMS: &[(&str, &str)] = &[
     ("direction", "towards"),
 ];
 
-fn signature(b: &Builtin) -> String {
-    let mut parts = Vec::new();
-    if let Some(ty) = b.variadic {
-        parts.push(format!("{ty}…"));
-    }
-    for p in b.params {
-        let default = match p.default {
-            builtins::Default::Required => String::new(),
-            builtins::Default::Num(x) => format!(" = {}", dump_num(x)),
-            builtins::Default::Vec3(v) => format!(" = {}", ir::dump_vec(DVec3::from(v))),
-            builtins::Default::Bool(b) => format!(" = {b}"),
-            builtins::Default::Color(c) => format!(" = rgb({}, {}, {})", c[0], c[1], c[2]),
-            builtins::Default::Derived => " = …".into(),
-        };
-        parts.push(format!("{}: {}{default}", p.name, p.ty));
-    }
-    format!("{}({})", b.name, parts.join(", "))
-}
-
 fn vec3_of(v: &Value) -> Option<DVec3> {
     match v {
         Value::Vec3(v) => Some(*v),
@@ -197,7 +178,7 @@ impl Ctx<'_> {
                     "used as a value here",
                 )
                 .with_hint(format!("try calling it: `{}({example})`", id.name))
-                .with_note(format!("signature: {}", signature(b))),
+                .with_note(format!("signature: {}", b.signature())),
             );
             return Value::Error;
         }
@@ -579,8 +560,10 @@ impl Ctx<'_> {
                             format!("`{callee}` has no parameter named `{}`", name.name),
                             "unknown parameter",
                         );
-                        let synonym =
-                            SYNONYMS.iter().find(|(word, p)| *word == name.name && params.contains(p)).map(|(_, p)| *p);
+                        // `radius` means `r`, and so does a misspelt `radus`.
+                        let known = SYNONYMS.iter().filter(|(_, p)| params.contains(p));
+                        let word = suggest(&name.name, known.clone().map(|(w, _)| *w));
+                        let synonym = known.clone().find(|(w, _)| *w == name.name || Some(*w) == word).map(|(_, p)| *p);
                         if let Some(s) = synonym.or_else(|| suggest(&name.name, params.iter().copied())) {
                             d = d.with_replacement(name.span, s);
                         }
@@ -609,12 +592,7 @@ impl Ctx<'_> {
     }
 
     /// Binds arguments to a builtin's parameters; `None` after reporting (or on poison).
-    pub(super) fn bind_builtin(
-        &mut self,
-        b: &'static Builtin,
-        mut args: Vec<ArgVal>,
-        call: Span,
-    ) -> Option<BoundArgs> {
+    pub(super) fn bind_builtin(&mut self, b: &'static Builtin, mut args: Vec<ArgVal>, call: Span) -> Option<BoundArgs> {
         if let Some(ix) = &mut self.index {
             for name in args.iter().filter_map(|a| a.name.as_ref()) {
                 if let Some(param) = b.params.iter().find(|p| p.name == name.name) {
@@ -635,9 +613,11 @@ impl Ctx<'_> {
             args = vec![ArgVal { name: None, value: Value::Vec3(v), span }];
         }
         let names: Vec<&str> = b.params.iter().map(|p| p.name).collect();
-        let note = Some(format!("signature: {}", signature(b)));
+        // A misspelt name is one mistake: the parameter it meant is not also "missing".
+        let misspelt = args.iter().any(|a| a.name.as_ref().is_some_and(|n| !names.contains(&n.name.as_str())));
+        let note = Some(format!("signature: {}", b.signature()));
         let (mut vals, mut rest, mut ok) = self.bind_slots(b.name, &names, b.variadic.is_some(), args, call, note);
-        if !recovered {
+        if !recovered && !misspelt {
             for (p, v) in b.params.iter().zip(&vals) {
                 if v.is_none() && p.default == builtins::Default::Required {
                     self.report(
@@ -647,7 +627,7 @@ impl Ctx<'_> {
                             format!("missing argument `{}` of `{}`", p.name, b.name),
                             format!("`{}` is required", p.name),
                         )
-                        .with_note(format!("signature: {}", signature(b))),
+                        .with_note(format!("signature: {}", b.signature())),
                     );
                     ok = false;
                 }
@@ -739,8 +719,9 @@ impl Ctx<'_> {
                 }
             }
         }
+        let misspelt = args.iter().any(|a| a.name.as_ref().is_some_and(|n| !names.contains(&n.name.as_str())));
         let (vals, _, mut ok) = self.bind_slots(&f.name, &names, false, args, callee_span, None);
-        if recovered {
+        if recovered || misspelt {
             return None;
         }
         for (p, v) in f.params.iter().zip(&vals) {

@@ -35,6 +35,8 @@ pub struct Def {
     /// The type of the value (the first one seen that was not poison), or for a
     /// function its signature, such as `ring(n, r) -> shape`.
     pub ty: Option<String>,
+    /// A function's parameter names (empty for other kinds).
+    pub params: Vec<String>,
     /// Global offsets in the root file between which the name is in scope; `None`
     /// when it is never in scope there (a loop variable of an included file).
     pub visible: Option<(u32, u32)>,
@@ -90,6 +92,13 @@ impl Index {
                 self.by_span.insert(def.span, self.defs.len());
                 self.defs.push(def);
             }
+        }
+    }
+
+    /// Sets the parameter names of the function defined at `span`.
+    pub(super) fn set_params(&mut self, span: Span, params: Vec<String>) {
+        if let Some(&i) = self.by_span.get(&span) {
+            self.defs[i].params = params;
         }
     }
 

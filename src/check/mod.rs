@@ -158,7 +158,8 @@ impl Ctx<'_> {
             let exported = matches!(kind, index::DefKind::Value | index::DefKind::Function);
             self.export.filter(|e| exported && e.2 == self.scopes.len()).map(|(f, t, _)| (f, t))
         };
-        let def = index::Def { name: name.name.clone(), span: name.span, kind, ty, visible };
+        let params = Vec::new();
+        let def = index::Def { name: name.name.clone(), span: name.span, kind, ty, params, visible };
         if let Some(ix) = &mut self.index {
             ix.define(def);
         }
@@ -201,6 +202,9 @@ impl Ctx<'_> {
                 let names: Vec<&str> = params.iter().map(|p| p.name.as_str()).collect();
                 let sig = format!("{}({})", name.name, names.join(", "));
                 self.note_def(name, index::DefKind::Function, Some(sig), stmt.span.end, self.block_end);
+                if let Some(ix) = &mut self.index {
+                    ix.set_params(name.span, names.iter().map(|n| n.to_string()).collect());
+                }
             }
             ast::StmtKind::Object(e) => {
                 let v = self.expr(e);

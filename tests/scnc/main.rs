@@ -3,6 +3,7 @@
 mod cli;
 mod effects;
 mod golden;
+mod lsp;
 mod mesh;
 mod nopanic;
 mod render;

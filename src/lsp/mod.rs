@@ -1,0 +1,393 @@
+//! `scnc lsp`: a Language Server Protocol server over stdio.
+//!
+//! Built on `lsp-server` and `lsp-types`, the synchronous crates under rust-analyzer:
+//! the compiler is synchronous and fast (a scene checks in milliseconds), so an async
+//! runtime would add weight and nothing else. Every request recompiles the document
+//! with the compiler's own front-end ([`check::check_indexed`](crate::check::check_indexed)),
+//! so the editor shows exactly what `scnc check` prints.
+
+pub mod analysis;
+pub mod text;
+
+use std::collections::{HashMap, HashSet};
+use std::path::{Path, PathBuf};
+
+use lsp_server::{Connection, Message, Notification, Request, Response};
+use lsp_types::notification::{
+    DidChangeTextDocument, DidCloseTextDocument, DidOpenTextDocument, Notification as _, PublishDiagnostics,
+};
+use lsp_types::request::{
+    CodeActionRequest, Completion, DocumentSymbolRequest, GotoDefinition, HoverRequest, References, Request as _,
+};
+use lsp_types::{self as lt, Uri};
+
+use self::analysis::{Analysis, CandidateKind, Symbol, SymbolKind};
+use self::text::{path_to_uri, uri_to_path, LineIndex};
+use crate::check::{FsLoader, Loader};
+use crate::diag::{Diagnostic, Severity};
+use crate::source::SourceMap;
+use crate::span::Span;
+
+/// Serves the protocol on stdin/stdout until the client asks to exit.
+pub fn run_stdio() -> Result<(), String> {
+    let (connection, io) = Connection::stdio();
+    serve(&connection)?;
+    drop(connection);
+    io.join().map_err(|e| e.to_string())
+}
+
+/// What the server offers.
+fn capabilities() -> lt::ServerCapabilities {
+    lt::ServerCapabilities {
+        text_document_sync: Some(lt::TextDocumentSyncCapability::Kind(lt::TextDocumentSyncKind::FULL)),
+        hover_provider: Some(lt::HoverProviderCapability::Simple(true)),
+        definition_provider: Some(lt::OneOf::Left(true)),
+        references_provider: Some(lt::OneOf::Left(true)),
+        completion_provider: Some(lt::CompletionOptions {
+            trigger_characters: Some(vec!["(".into(), ",".into()]),
+            ..Default::default()
+        }),
+        document_symbol_provider: Some(lt::OneOf::Left(true)),
+        code_action_provider: Some(lt::CodeActionProviderCapability::Options(lt::CodeActionOptions {
+            code_action_kinds: Some(vec![lt::CodeActionKind::QUICKFIX]),
+            ..Default::default()
+        })),
+        ..Default::default()
+    }
+}
+
+/// Runs the protocol on `connection`: the handshake, then requests until shutdown.
+pub fn serve(connection: &Connection) -> Result<(), String> {
+    let caps = serde_json::to_value(capabilities()).map_err(|e| e.to_string())?;
+    connection.initialize(caps).map_err(|e| e.to_string())?;
+    let mut server = Server { docs: HashMap::new(), published: HashMap::new() };
+    for msg in &connection.receiver {
+        match msg {
+            Message::Request(req) => {
+                if connection.handle_shutdown(&req).map_err(|e| e.to_string())? {
+                    return Ok(());
+                }
+                let resp = server.request(req);
+                connection.sender.send(resp.into()).map_err(|e| e.to_string())?;
+            }
+            Message::Notification(note) => {
+                for out in server.notification(note) {
+                    connection.sender.send(out.into()).map_err(|e| e.to_string())?;
+                }
+            }
+            Message::Response(_) => {}
+        }
+    }
+    Ok(())
+}
+
+/// An open document.
+struct Doc {
+    text: String,
+    version: i32,
+}
+
+struct Server {
+    /// Open documents by URI.
+    docs: HashMap<String, Doc>,
+    /// For each open document, the other files its last compile published diagnostics to.
+    published: HashMap<String, HashSet<String>>,
+}
+
+/// Reads open documents from the editor's buffers and other files from disk, so an
+/// included file shows its unsaved edits.
+struct Overlay {
+    open: HashMap<PathBuf, String>,
+}
+
+impl Loader for Overlay {
+    fn read(&self, path: &Path) -> std::io::Result<String> {
+        match self.open.get(path) {
+            Some(text) => Ok(text.clone()),
+            None => FsLoader.read(path),
+        }
+    }
+}
+
+fn doc_path(uri: &str) -> PathBuf {
+    uri_to_path(uri).unwrap_or_else(|| PathBuf::from(uri))
+}
+
+fn parse_uri(s: &str) -> Option<Uri> {
+    s.parse().ok()
+}
+
+fn range_of(map: &SourceMap, span: Span) -> (String, lt::Range) {
+    let (id, r) = map.local_range(span);
+    let file = map.file(id);
+    let uri = if id.0 == 0 { None } else { Some(path_to_uri(&file.path)) };
+    (uri.unwrap_or_default(), LineIndex::new(&file.text).range(r))
+}
+
+impl Server {
+    fn analyse(&self, uri: &str) -> Option<Analysis> {
+        let doc = self.docs.get(uri)?;
+        let open = self.docs.iter().map(|(u, d)| (doc_path(u), d.text.clone())).collect();
+        Some(Analysis::new(&doc_path(uri), doc.text.clone(), &Overlay { open }))
+    }
+
+    /// A location for `span`; spans in the document itself get the document's URI.
+    fn location(&self, uri: &str, map: &SourceMap, span: Span) -> Option<lt::Location> {
+        let (file_uri, range) = range_of(map, span);
+        let file_uri = if file_uri.is_empty() { uri.to_string() } else { file_uri };
+        Some(lt::Location { uri: parse_uri(&file_uri)?, range })
+    }
+
+    fn notification(&mut self, note: Notification) -> Vec<Notification> {
+        let uri = match note.method.as_str() {
+            DidOpenTextDocument::METHOD => {
+                let Ok(p) = serde_json::from_value::<lt::DidOpenTextDocumentParams>(note.params) else {
+                    return Vec::new();
+                };
+                let uri = p.text_document.uri.as_str().to_string();
+                self.docs.insert(uri.clone(), Doc { text: p.text_document.text, version: p.text_document.version });
+                uri
+            }
+            DidChangeTextDocument::METHOD => {
+                let Ok(p) = serde_json::from_value::<lt::DidChangeTextDocumentParams>(note.params) else {
+                    return Vec::new();
+                };
+                let uri = p.text_document.uri.as_str().to_string();
+                // Full sync: the last change holds the whole text.
+                let Some(change) = p.content_changes.into_iter().last() else {
+                    return Vec::new();
+                };
+                self.docs.insert(uri.clone(), Doc { text: change.text, version: p.text_document.version });
+                uri
+            }
+            DidCloseTextDocument::METHOD => {
+                let Ok(p) = serde_json::from_value::<lt::DidCloseTextDocumentParams>(note.params) else {
+                    return Vec::new();
+                };
+                let uri = p.text_document.uri.as_str().to_string();
+                self.docs.remove(&uri);
+                let mut out: Vec<Notification> = Vec::new();
+                for other in self.published.remove(&uri).unwrap_or_default().into_iter().chain([uri]) {
+                    out.extend(publish(&other, Vec::new(), None));
+                }
+                return out;
+            }
+            _ => return Vec::new(),
+        };
+        self.publish_all(&uri)
+    }
+
+    /// Compiles the document and publishes its diagnostics, and those in files it
+    /// includes; clears files that had diagnostics from its previous compile.
+    fn publish_all(&mut self, uri: &str) -> Vec<Notification> {
+        let Some(analysis) = self.analyse(uri) else {
+            return Vec::new();
+        };
+        let version = self.docs.get(uri).map(|d| d.version);
+        let mut by_file: HashMap<String, Vec<lt::Diagnostic>> = HashMap::new();
+        by_file.insert(uri.to_string(), Vec::new());
+        for d in &analysis.diagnostics {
+            let (file_uri, _) = range_of(&analysis.map, d.span());
+            let file_uri = if file_uri.is_empty() { uri.to_string() } else { file_uri };
+            by_file.entry(file_uri).or_default().push(to_lsp(uri, d, &analysis.map));
+        }
+        let others: HashSet<String> = by_file.keys().filter(|u| *u != uri).cloned().collect();
+        let stale = self.published.insert(uri.to_string(), others).unwrap_or_default();
+        let mut out = Vec::new();
+        for gone in stale.iter().filter(|u| !by_file.contains_key(*u)) {
+            out.extend(publish(gone, Vec::new(), None));
+        }
+        for (file_uri, diags) in by_file {
+            let v = if file_uri == uri { version } else { None };
+            out.extend(publish(&file_uri, diags, v));
+        }
+        out
+    }
+
+    fn request(&mut self, req: Request) -> Response {
+        let id = req.id.clone();
+        match self.answer(req) {
+            Ok(value) => Response::new_ok(id, value),
+            Err(message) => Response::new_err(id, lsp_server::ErrorCode::InvalidParams as i32, message),
+        }
+    }
+
+    fn answer(&mut self, req: Request) -> Result<serde_json::Value, String> {
+        fn params<P: serde::de::DeserializeOwned>(req: Request) -> Result<P, String> {
+            serde_json::from_value(req.params).map_err(|e| e.to_string())
+        }
+        match req.method.as_str() {
+            HoverRequest::METHOD => {
+                let p: lt::HoverParams = params(req)?;
+                let (uri, a, at) = self.at(&p.text_document_position_params)?;
+                let hover = a.hover(at).map(|(span, markdown)| lt::Hover {
+                    contents: lt::HoverContents::Markup(lt::MarkupContent {
+                        kind: lt::MarkupKind::Markdown,
+                        value: markdown,
+                    }),
+                    range: self.location(&uri, &a.map, span).map(|l| l.range),
+                });
+                Ok(json(&hover))
+            }
+            GotoDefinition::METHOD => {
+                let p: lt::GotoDefinitionParams = params(req)?;
+                let (uri, a, at) = self.at(&p.text_document_position_params)?;
+                let loc = a.definition(at).and_then(|d| self.location(&uri, &a.map, d));
+                Ok(json(&loc.map(lt::GotoDefinitionResponse::Scalar)))
+            }
+            References::METHOD => {
+                let p: lt::ReferenceParams = params(req)?;
+                let (uri, a, at) = self.at(&p.text_document_position)?;
+                let locs: Vec<lt::Location> = a
+                    .references(at, p.context.include_declaration)
+                    .into_iter()
+                    .filter_map(|s| self.location(&uri, &a.map, s))
+                    .collect();
+                Ok(json(&locs))
+            }
+            Completion::METHOD => {
+                let p: lt::CompletionParams = params(req)?;
+                let (_, a, at) = self.at(&p.text_document_position)?;
+                let items: Vec<lt::CompletionItem> = a
+                    .complete(at)
+                    .into_iter()
+                    .enumerate()
+                    .map(|(i, c)| lt::CompletionItem {
+                        insert_text: (c.kind == CandidateKind::Argument).then(|| format!("{} = ", c.label)),
+                        label: c.label,
+                        kind: Some(match c.kind {
+                            CandidateKind::Argument => lt::CompletionItemKind::FIELD,
+                            CandidateKind::Variable => lt::CompletionItemKind::VARIABLE,
+                            CandidateKind::Function | CandidateKind::Builtin => lt::CompletionItemKind::FUNCTION,
+                            CandidateKind::Constant => lt::CompletionItemKind::CONSTANT,
+                            CandidateKind::Keyword => lt::CompletionItemKind::KEYWORD,
+                        }),
+                        detail: Some(c.detail),
+                        documentation: c.doc.map(lt::Documentation::String),
+                        // Keep the analysis's order: arguments, then names in scope, then builtins.
+                        sort_text: Some(format!("{i:04}")),
+                        ..Default::default()
+                    })
+                    .collect();
+                Ok(json(&lt::CompletionResponse::Array(items)))
+            }
+            DocumentSymbolRequest::METHOD => {
+                let p: lt::DocumentSymbolParams = params(req)?;
+                let uri = p.text_document.uri.as_str().to_string();
+                let a = self.analyse(&uri).ok_or("the document is not open")?;
+                let index = LineIndex::new(a.text());
+                let symbols: Vec<lt::DocumentSymbol> = a.symbols().iter().map(|s| document_symbol(s, &index)).collect();
+                Ok(json(&lt::DocumentSymbolResponse::Nested(symbols)))
+            }
+            CodeActionRequest::METHOD => {
+                let p: lt::CodeActionParams = params(req)?;
+                let uri = p.text_document.uri.as_str().to_string();
+                let a = self.analyse(&uri).ok_or("the document is not open")?;
+                let index = LineIndex::new(a.text());
+                let range = index.offset(p.range.start) as u32..index.offset(p.range.end) as u32;
+                let actions: Vec<lt::CodeActionOrCommand> = a
+                    .fixable(range)
+                    .into_iter()
+                    .flat_map(|d| {
+                        let single = d.fixes.len() == 1;
+                        let diag = to_lsp(&uri, d, &a.map);
+                        d.fixes.iter().map(move |f| (f.clone(), diag.clone(), single))
+                    })
+                    .map(|(fix, diag, single)| {
+                        let edit = lt::TextEdit { range: index.range(fix.span.range()), new_text: fix.text.clone() };
+                        let changes = parse_uri(&uri).map(|u| HashMap::from([(u, vec![edit])]));
+                        lt::CodeActionOrCommand::CodeAction(lt::CodeAction {
+                            title: format!("Replace with `{}`", fix.text),
+                            kind: Some(lt::CodeActionKind::QUICKFIX),
+                            diagnostics: Some(vec![diag]),
+                            edit: Some(lt::WorkspaceEdit { changes, ..Default::default() }),
+                            is_preferred: Some(single),
+                            ..Default::default()
+                        })
+                    })
+                    .collect();
+                Ok(json(&actions))
+            }
+            other => Err(format!("scnc lsp does not handle `{other}`")),
+        }
+    }
+
+    /// The document, its analysis and the global offset of a position in it.
+    fn at(&self, p: &lt::TextDocumentPositionParams) -> Result<(String, Analysis, u32), String> {
+        let uri = p.text_document.uri.as_str().to_string();
+        let a = self.analyse(&uri).ok_or("the document is not open")?;
+        let at = LineIndex::new(a.text()).offset(p.position) as u32;
+        Ok((uri, a, at))
+    }
+}
+
+/// A response value as JSON; the lsp-types values always serialise.
+fn json<T: serde::Serialize>(value: &T) -> serde_json::Value {
+    serde_json::to_value(value).unwrap_or(serde_json::Value::Null)
+}
+
+fn publish(uri: &str, diagnostics: Vec<lt::Diagnostic>, version: Option<i32>) -> Option<Notification> {
+    let params = lt::PublishDiagnosticsParams { uri: parse_uri(uri)?, diagnostics, version };
+    Some(Notification::new(PublishDiagnostics::METHOD.to_string(), params))
+}
+
+/// One diagnostic as LSP has it: notes and hints follow the message, as `scnc check`
+/// prints them; secondary labels become related information.
+fn to_lsp(root_uri: &str, d: &Diagnostic, map: &SourceMap) -> lt::Diagnostic {
+    let located = |span: Span| {
+        let (uri, range) = range_of(map, span);
+        (if uri.is_empty() { root_uri.to_string() } else { uri }, range)
+    };
+    let mut message = d.message.clone();
+    for note in &d.notes {
+        message.push_str(&format!("\nnote: {note}"));
+    }
+    for hint in &d.hints {
+        message.push_str(&format!("\nhelp: {hint}"));
+    }
+    let related: Vec<lt::DiagnosticRelatedInformation> = d.labels[1..]
+        .iter()
+        .filter_map(|l| {
+            let (uri, range) = located(l.span);
+            Some(lt::DiagnosticRelatedInformation {
+                location: lt::Location { uri: parse_uri(&uri)?, range },
+                message: l.message.clone(),
+            })
+        })
+        .collect();
+    lt::Diagnostic {
+        range: located(d.span()).1,
+        severity: Some(match d.severity {
+            Severity::Error => lt::DiagnosticSeverity::ERROR,
+            Severity::Warning => lt::DiagnosticSeverity::WARNING,
+        }),
+        code: Some(lt::NumberOrString::String(d.code.to_string())),
+        source: Some("scnc".into()),
+        message,
+        related_information: (!related.is_empty()).then_some(related),
+        ..Default::default()
+    }
+}
+
+#[allow(deprecated, reason = "`deprecated` is a required field of DocumentSymbol in lsp-types")]
+fn document_symbol(s: &Symbol, index: &LineIndex<'_>) -> lt::DocumentSymbol {
+    let range = index.range(s.span.range());
+    let selection_range = index.range(s.name_span.range());
+    lt::DocumentSymbol {
+        name: s.name.clone(),
+        detail: None,
+        kind: match s.kind {
+            SymbolKind::Value => lt::SymbolKind::VARIABLE,
+            SymbolKind::Function => lt::SymbolKind::FUNCTION,
+            SymbolKind::Object => lt::SymbolKind::OBJECT,
+            SymbolKind::Light => lt::SymbolKind::EVENT,
+            SymbolKind::Setting => lt::SymbolKind::PROPERTY,
+            SymbolKind::Loop => lt::SymbolKind::NAMESPACE,
+        },
+        tags: None,
+        deprecated: None,
+        range,
+        selection_range,
+        children: (!s.children.is_empty()).then(|| s.children.iter().map(|c| document_symbol(c, index)).collect()),
+    }
+}

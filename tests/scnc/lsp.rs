@@ -1,0 +1,287 @@
+//! `scnc lsp` spoken to as an editor would: the binary is started and fed JSON-RPC over
+//! stdio. Every wait is bounded, so a hung server fails the test instead of hanging it.
+
+use std::io::{BufRead, BufReader, Write};
+use std::path::Path;
+use std::process::{Child, ChildStdin, Command, Stdio};
+use std::sync::mpsc::{self, Receiver};
+use std::time::{Duration, Instant};
+
+use serde_json::{json, Value};
+
+const TIMEOUT: Duration = Duration::from_secs(20);
+
+struct Client {
+    child: Child,
+    stdin: ChildStdin,
+    incoming: Receiver<Value>,
+    /// Notifications that arrived while waiting for something else.
+    pending: Vec<Value>,
+    next_id: i64,
+}
+
+fn read_message(r: &mut impl BufRead) -> Option<Value> {
+    let mut length = None;
+    loop {
+        let mut line = String::new();
+        if r.read_line(&mut line).ok()? == 0 {
+            return None;
+        }
+        let line = line.trim_end();
+        if line.is_empty() {
+            break;
+        }
+        if let Some(n) = line.strip_prefix("Content-Length: ") {
+            length = n.parse::<usize>().ok();
+        }
+    }
+    let mut body = vec![0; length?];
+    r.read_exact(&mut body).ok()?;
+    serde_json::from_slice(&body).ok()
+}
+
+impl Client {
+    fn start() -> Client {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_scnc"))
+            .arg("lsp")
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .expect("starting scnc lsp");
+        let stdin = child.stdin.take().expect("stdin");
+        let mut stdout = BufReader::new(child.stdout.take().expect("stdout"));
+        let (tx, incoming) = mpsc::channel();
+        std::thread::spawn(move || {
+            while let Some(msg) = read_message(&mut stdout) {
+                if tx.send(msg).is_err() {
+                    break;
+                }
+            }
+        });
+        let mut client = Client { child, stdin, incoming, pending: Vec::new(), next_id: 1 };
+        let caps = client.request("initialize", json!({ "processId": null, "rootUri": null, "capabilities": {} }));
+        assert_eq!(caps["capabilities"]["hoverProvider"], json!(true), "{caps}");
+        client.notify("initialized", json!({}));
+        client
+    }
+
+    fn send(&mut self, msg: Value) {
+        let body = msg.to_string();
+        write!(self.stdin, "Content-Length: {}\r\n\r\n{body}", body.len()).expect("writing to the server");
+        self.stdin.flush().expect("flushing");
+    }
+
+    fn notify(&mut self, method: &str, params: Value) {
+        self.send(json!({ "jsonrpc": "2.0", "method": method, "params": params }));
+    }
+
+    fn next(&mut self, deadline: Instant) -> Value {
+        let left = deadline.saturating_duration_since(Instant::now());
+        self.incoming.recv_timeout(left).expect("the server did not answer in time")
+    }
+
+    fn request(&mut self, method: &str, params: Value) -> Value {
+        let id = self.next_id;
+        self.next_id += 1;
+        self.send(json!({ "jsonrpc": "2.0", "id": id, "method": method, "params": params }));
+        let deadline = Instant::now() + TIMEOUT;
+        loop {
+            let msg = self.next(deadline);
+            if msg["id"] == json!(id) {
+                assert!(msg.get("error").is_none(), "{method} failed: {msg}");
+                return msg["result"].clone();
+            }
+            self.pending.push(msg);
+        }
+    }
+
+    /// The next diagnostics published for `uri`.
+    fn diagnostics(&mut self, uri: &str) -> Vec<Value> {
+        let deadline = Instant::now() + TIMEOUT;
+        loop {
+            let found = self
+                .pending
+                .iter()
+                .position(|m| m["method"] == "textDocument/publishDiagnostics" && m["params"]["uri"] == json!(uri));
+            if let Some(i) = found {
+                let msg = self.pending.remove(i);
+                return msg["params"]["diagnostics"].as_array().cloned().unwrap_or_default();
+            }
+            let msg = self.next(deadline);
+            self.pending.push(msg);
+        }
+    }
+
+    fn open(&mut self, uri: &str, text: &str) {
+        let doc = json!({ "uri": uri, "languageId": "scn", "version": 1, "text": text });
+        self.notify("textDocument/didOpen", json!({ "textDocument": doc }));
+    }
+
+    fn at(&mut self, method: &str, uri: &str, line: u32, character: u32) -> Value {
+        let mut params = json!({
+            "textDocument": { "uri": uri },
+            "position": { "line": line, "character": character },
+        });
+        if method == "textDocument/references" {
+            params["context"] = json!({ "includeDeclaration": true });
+        }
+        self.request(method, params)
+    }
+
+    fn stop(mut self) {
+        self.request("shutdown", Value::Null);
+        self.notify("exit", Value::Null);
+        let deadline = Instant::now() + TIMEOUT;
+        loop {
+            if let Some(status) = self.child.try_wait().expect("waiting for the server") {
+                assert!(status.success(), "scnc lsp exited with {status}");
+                return;
+            }
+            assert!(Instant::now() < deadline, "scnc lsp did not exit after `exit`");
+            std::thread::sleep(Duration::from_millis(10));
+        }
+    }
+}
+
+impl Drop for Client {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn uri(path: &Path) -> String {
+    scnc::lsp::text::path_to_uri(path)
+}
+
+fn range(line: u32, start: u32, end: u32) -> Value {
+    json!({ "start": { "line": line, "character": start }, "end": { "line": line, "character": end } })
+}
+
+/// A comment with a 4-byte, 2-unit character before the first mistake, so a server that
+/// counted bytes or characters instead of UTF-16 units would put it in the wrong place.
+const SCENE: &str = "light ambient(0.2)
+let ball = sphere(1)
+/* 𝄞 é */ object sphere(radus = 1) at [0, 0, 5]
+object bal at [2, 0, 5]
+object ball at [-2, 0, 5]
+";
+
+#[test]
+fn diagnostics_follow_edits_and_offer_fixes() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let doc = uri(&dir.path().join("scene.scn"));
+    let mut c = Client::start();
+    c.open(&doc, SCENE);
+    let diags = c.diagnostics(&doc);
+    assert_eq!(diags.len(), 2, "{diags:#?}");
+    assert_eq!(diags[0]["code"], "E0302");
+    assert_eq!(diags[0]["range"], range(2, 25, 30));
+    assert!(diags[0]["message"].as_str().is_some_and(|m| m.contains("did you mean `r`?")), "{}", diags[0]);
+    assert_eq!(diags[1]["code"], "E0200");
+    assert_eq!(diags[1]["range"], range(3, 7, 10));
+    assert_eq!(diags[1]["severity"], 1);
+
+    // The quick-fix for the misspelt argument.
+    let actions = c.request(
+        "textDocument/codeAction",
+        json!({ "textDocument": { "uri": doc }, "range": range(2, 26, 26), "context": { "diagnostics": [] } }),
+    );
+    let actions = actions.as_array().expect("a list of actions");
+    assert_eq!(actions.len(), 1, "{actions:#?}");
+    assert_eq!(actions[0]["title"], "Replace with `r`");
+    assert_eq!(actions[0]["edit"]["changes"][&doc], json!([{ "range": range(2, 25, 30), "newText": "r" }]));
+
+    // Fix one mistake: one diagnostic is left.
+    let fixed = SCENE.replace("object bal ", "object ball ");
+    let change = json!({ "textDocument": { "uri": doc, "version": 2 }, "contentChanges": [{ "text": fixed }] });
+    c.notify("textDocument/didChange", change);
+    let diags = c.diagnostics(&doc);
+    assert_eq!(diags.len(), 1, "{diags:#?}");
+    assert_eq!(diags[0]["code"], "E0302");
+    c.stop();
+}
+
+#[test]
+fn hover_definition_references_completion_and_symbols() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let lib = dir.path().join("lib.scn");
+    std::fs::write(&lib, "// shared parts\nlet post(h) = cylinder(0.1, h / 2)\n").expect("writing lib.scn");
+    let doc = uri(&dir.path().join("scene.scn"));
+    let text = "include \"lib.scn\"
+light ambient(0.2)
+let ball = sphere(1) with material(color = #ff0000)
+for i in 0..3 {
+  object post(2) at [i, 0, 5]
+}
+object ball at [0, 0, 5]
+object ball at [2, 0, 5]
+object sphere(
+";
+    let mut c = Client::start();
+    c.open(&doc, text);
+
+    // Hover: a builtin's signature and doc, a name's type, an expression's type, a parameter.
+    let h = c.at("textDocument/hover", &doc, 2, 12);
+    let h = h["contents"]["value"].as_str().unwrap_or_default().to_string();
+    assert!(h.contains("sphere(r: num)") && h.contains("radius"), "{h}");
+    let h = c.at("textDocument/hover", &doc, 6, 8);
+    assert!(h["contents"]["value"].as_str().is_some_and(|v| v.contains("let ball: shape")), "{h}");
+    assert_eq!(h["range"], range(6, 7, 11));
+    let h = c.at("textDocument/hover", &doc, 4, 20);
+    assert!(h["contents"]["value"].as_str().is_some_and(|v| v.contains("vec3")), "{h}");
+    let h = c.at("textDocument/hover", &doc, 2, 37);
+    assert!(h["contents"]["value"].as_str().is_some_and(|v| v.contains("color: color")), "{h}");
+
+    // Definition: a let, a loop variable, and a function in the included file.
+    let d = c.at("textDocument/definition", &doc, 7, 9);
+    assert_eq!(d, json!({ "uri": doc, "range": range(2, 4, 8) }));
+    let d = c.at("textDocument/definition", &doc, 4, 21);
+    assert_eq!(d, json!({ "uri": doc, "range": range(3, 4, 5) }));
+    let d = c.at("textDocument/definition", &doc, 4, 10);
+    assert_eq!(d, json!({ "uri": uri(&lib), "range": range(1, 4, 8) }));
+
+    // References: the definition and both uses.
+    let refs = c.at("textDocument/references", &doc, 2, 5);
+    let lines: Vec<&Value> = refs.as_array().expect("locations").iter().map(|l| &l["range"]["start"]["line"]).collect();
+    assert_eq!(lines, [&json!(2), &json!(6), &json!(7)]);
+
+    // Completion: the open call's arguments first, then names in scope and builtins.
+    let items = c.at("textDocument/completion", &doc, 8, 14);
+    let items = items.as_array().expect("items");
+    let labels: Vec<&str> = items.iter().filter_map(|i| i["label"].as_str()).collect();
+    assert_eq!(labels[0], "r", "{labels:?}");
+    assert_eq!(items[0]["detail"], "r: num");
+    assert_eq!(items[0]["insertText"], "r = ");
+    for name in ["ball", "post", "sphere", "torus", "pi"] {
+        assert!(labels.contains(&name), "{name} missing from {labels:?}");
+    }
+    assert!(!labels.contains(&"i"), "the loop variable is out of scope here: {labels:?}");
+    let inside = c.at("textDocument/completion", &doc, 4, 24);
+    let inside: Vec<&str> = inside.as_array().expect("items").iter().filter_map(|i| i["label"].as_str()).collect();
+    assert!(inside.contains(&"i"), "{inside:?}");
+
+    // The outline.
+    let symbols = c.request("textDocument/documentSymbol", json!({ "textDocument": { "uri": doc } }));
+    let names: Vec<&str> = symbols.as_array().expect("symbols").iter().filter_map(|s| s["name"].as_str()).collect();
+    assert_eq!(names, ["light ambient(…)", "ball", "for i in 0..3", "object ball", "object ball"]);
+    assert_eq!(symbols[2]["children"][0]["name"], "object post(…)");
+    c.stop();
+}
+
+#[test]
+fn diagnostics_in_an_included_file_go_to_that_file() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let lib = dir.path().join("lib.scn");
+    std::fs::write(&lib, "let post = cylindr(0.1, 1)\n").expect("writing lib.scn");
+    let doc = uri(&dir.path().join("scene.scn"));
+    let mut c = Client::start();
+    c.open(&doc, "include \"lib.scn\"\nlight ambient(1)\nobject post at [0, 0, 5]\n");
+    let diags = c.diagnostics(&uri(&lib));
+    assert_eq!(diags.len(), 1, "{diags:#?}");
+    assert_eq!(diags[0]["code"], "E0201");
+    assert_eq!(diags[0]["range"], range(0, 11, 18));
+    assert!(c.diagnostics(&doc).is_empty());
+    c.stop();
+}
