@@ -28,6 +28,7 @@ pub mod chart;
 pub mod check;
 pub mod diag;
 pub mod effects;
+pub mod fmt;
 pub mod ir;
 pub mod lsp;
 pub mod mesh;

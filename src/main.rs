@@ -44,6 +44,15 @@ enum Command {
     Sweep(SweepArgs),
     /// Run a Language Server Protocol server on stdin/stdout, for editors.
     Lsp,
+    /// Format files in place in the canonical layout (comments and blank lines kept).
+    Fmt {
+        /// The scene files.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// Change nothing; list the files that would change and exit 1 if there are any.
+        #[arg(long)]
+        check: bool,
+    },
     /// Print the evaluated scene IR.
     Ir {
         /// The scene file.
@@ -233,10 +242,57 @@ fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         _ => Path::new("."),
     };
     let mut tmp = tempfile::Builder::new().prefix(".scnc-").suffix(".tmp").tempfile_in(dir)?;
+    // Replacing a file keeps its permissions (a temporary file is private by default).
+    if let Ok(meta) = std::fs::metadata(path) {
+        tmp.as_file().set_permissions(meta.permissions())?;
+    }
     tmp.write_all(bytes)?;
     tmp.as_file().sync_all()?;
     tmp.persist(path).map_err(|e| e.error)?;
     Ok(())
+}
+
+/// Formats each file in place, or with `check` lists those that would change.
+fn fmt_cmd(files: &[PathBuf], check: bool) -> ExitCode {
+    let mut failed = false;
+    let mut unformatted = false;
+    for path in files {
+        let name = path.display().to_string();
+        let text = match FsLoader.read(path) {
+            Ok(text) => text,
+            Err(e) => {
+                let _ = writeln!(std::io::stderr(), "error: cannot read `{name}`: {}", scnc::check::io_reason(&e));
+                failed = true;
+                continue;
+            }
+        };
+        let formatted = match scnc::fmt::format(&text) {
+            Ok(f) => f,
+            Err(diagnostics) => {
+                let mut map = scnc::source::SourceMap::new();
+                let _ = map.add(&name, path, text);
+                report(&Compiled { map, scene: None, diagnostics }, MessageFormat::Human);
+                let _ = writeln!(std::io::stderr(), "error: `{name}` was not formatted: it has syntax errors");
+                failed = true;
+                continue;
+            }
+        };
+        if formatted == text {
+            continue;
+        }
+        if check {
+            let _ = writeln!(std::io::stdout(), "{name}");
+            unformatted = true;
+        } else if let Err(e) = write_atomic(path, formatted.as_bytes()) {
+            let _ = writeln!(std::io::stderr(), "error: cannot write `{name}`: {e}");
+            failed = true;
+        }
+    }
+    if failed || unformatted {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    }
 }
 
 fn parse_epsilon(s: &str) -> Result<f64, String> {
@@ -539,6 +595,7 @@ fn run(cli: Cli) -> ExitCode {
     match cli.command {
         Command::Render(args) => render_cmd(args),
         Command::Sweep(args) => sweep_cmd(args),
+        Command::Fmt { files, check } => fmt_cmd(&files, check),
         Command::Lsp => match scnc::lsp::run_stdio() {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {

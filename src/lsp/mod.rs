@@ -17,7 +17,8 @@ use lsp_types::notification::{
     DidChangeTextDocument, DidCloseTextDocument, DidOpenTextDocument, Notification as _, PublishDiagnostics,
 };
 use lsp_types::request::{
-    CodeActionRequest, Completion, DocumentSymbolRequest, GotoDefinition, HoverRequest, References, Request as _,
+    CodeActionRequest, Completion, DocumentSymbolRequest, Formatting, GotoDefinition, HoverRequest, References,
+    Request as _,
 };
 use lsp_types::{self as lt, Uri};
 
@@ -48,6 +49,7 @@ fn capabilities() -> lt::ServerCapabilities {
             ..Default::default()
         }),
         document_symbol_provider: Some(lt::OneOf::Left(true)),
+        document_formatting_provider: Some(lt::OneOf::Left(true)),
         code_action_provider: Some(lt::CodeActionProviderCapability::Options(lt::CodeActionOptions {
             code_action_kinds: Some(vec![lt::CodeActionKind::QUICKFIX]),
             ..Default::default()
@@ -307,6 +309,19 @@ impl Server {
                     })
                     .collect();
                 Ok(json(&actions))
+            }
+            Formatting::METHOD => {
+                let p: lt::DocumentFormattingParams = params(req)?;
+                let doc = self.docs.get(p.text_document.uri.as_str()).ok_or("the document is not open")?;
+                // A file with syntax errors is left as it is, as `scnc fmt` leaves it.
+                let edits = match crate::fmt::format(&doc.text) {
+                    Ok(formatted) if formatted != doc.text => {
+                        let index = LineIndex::new(&doc.text);
+                        vec![lt::TextEdit { range: index.range(0..doc.text.len()), new_text: formatted }]
+                    }
+                    _ => Vec::new(),
+                };
+                Ok(json(&edits))
             }
             other => Err(format!("scnc lsp does not handle `{other}`")),
         }

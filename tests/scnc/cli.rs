@@ -272,3 +272,32 @@ fn empty_and_unreadable_files_are_reported_for_what_they_are() {
     assert_eq!((line["code"].as_str(), line["severity"].as_str()), (Some("E0600"), Some("error")));
     assert_eq!(line["span"]["file"], "no/such/file.scn");
 }
+
+#[test]
+fn fmt_rewrites_in_place_and_check_lists_what_would_change() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let messy = dir.path().join("messy.scn");
+    let clean = dir.path().join("clean.scn");
+    let broken = dir.path().join("broken.scn");
+    std::fs::write(&messy, "light ambient(1)  object sphere( 1 )at[0,0,5]\n").expect("writing");
+    std::fs::write(&clean, "light ambient(1)\n").expect("writing");
+    std::fs::write(&broken, "object sphere(1 at [0, 0, 5]\n").expect("writing");
+    let path = |p: &std::path::Path| p.to_string_lossy().into_owned();
+
+    let out = scnc(&["fmt", "--check", &path(&messy), &path(&clean)]);
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(String::from_utf8_lossy(&out.stdout), format!("{}\n", path(&messy)));
+    assert!(std::fs::read_to_string(&messy).expect("reading").contains("sphere( 1 )"), "--check changed the file");
+
+    let out = scnc(&["fmt", &path(&messy), &path(&clean)]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let formatted = std::fs::read_to_string(&messy).expect("reading");
+    assert_eq!(formatted, "light ambient(1)\nobject sphere(1) at [0, 0, 5]\n");
+    assert_eq!(scnc(&["fmt", "--check", &path(&messy)]).status.code(), Some(0));
+
+    let out = scnc(&["fmt", &path(&broken)]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("E0100") && err.contains("was not formatted"), "{err}");
+    assert_eq!(std::fs::read_to_string(&broken).expect("reading"), "object sphere(1 at [0, 0, 5]\n");
+}

@@ -267,6 +267,22 @@ object sphere(
     let names: Vec<&str> = symbols.as_array().expect("symbols").iter().filter_map(|s| s["name"].as_str()).collect();
     assert_eq!(names, ["light ambient(…)", "ball", "for i in 0..3", "object ball", "object ball"]);
     assert_eq!(symbols[2]["children"][0]["name"], "object post(…)");
+
+    // Formatting replaces the whole document with `scnc fmt`'s layout.
+    let edits = c.request(
+        "textDocument/formatting",
+        json!({ "textDocument": { "uri": doc }, "options": { "tabSize": 4, "insertSpaces": true } }),
+    );
+    assert_eq!(edits, json!([]), "a file with a syntax error is not formatted");
+    let messy = "light  ambient(1)\nobject sphere( 1 ) at [0,0,5]\n";
+    let change = json!({ "textDocument": { "uri": doc, "version": 2 }, "contentChanges": [{ "text": messy }] });
+    c.notify("textDocument/didChange", change);
+    let edits = c.request(
+        "textDocument/formatting",
+        json!({ "textDocument": { "uri": doc }, "options": { "tabSize": 4, "insertSpaces": true } }),
+    );
+    assert_eq!(edits[0]["newText"], "light ambient(1)\nobject sphere(1) at [0, 0, 5]\n");
+    assert_eq!(edits[0]["range"]["end"], json!({ "line": 2, "character": 0 }));
     c.stop();
 }
 

@@ -2,6 +2,7 @@
 
 mod cli;
 mod effects;
+mod fmt;
 mod golden;
 mod lsp;
 mod mesh;

@@ -1,0 +1,86 @@
+//! `scnc fmt`: golden layouts, and on every example and golden input: formatting twice
+//! changes nothing, only whitespace changes, and the file means the same.
+
+use std::path::Path;
+
+use scnc::check::FsLoader;
+use scnc::syntax::{self, Token};
+
+use crate::support::{cases, check_golden, finish};
+
+/// `NAME.scn` formats to exactly `NAME.fmt`.
+#[test]
+fn fmt_goldens() {
+    let cases = cases("tests/data/fmt");
+    assert!(cases.len() >= 2, "expected fmt cases, found {}", cases.len());
+    let mut failures = Vec::new();
+    for path in cases {
+        let text = std::fs::read_to_string(&path).expect("reading the case");
+        match scnc::fmt::format(&text) {
+            Ok(out) => failures.extend(check_golden(&path.with_extension("fmt"), &out)),
+            Err(_) => failures.push(format!("{}: has syntax errors", path.display())),
+        }
+    }
+    finish(failures);
+}
+
+fn tokens(text: &str) -> Vec<Token<'_>> {
+    syntax::lex(text, 0).into_iter().map(|(t, _)| t).collect()
+}
+
+/// What a file means: its IR (without source positions) and effects, or its
+/// diagnostics' codes and messages.
+fn meaning(path: &Path, text: String) -> String {
+    let c = scnc::with_big_stack(|| scnc::compile_source("x.scn", path, text, &FsLoader));
+    let mut out: String = c.diagnostics.iter().map(|d| format!("{} {}\n", d.code, d.message)).collect();
+    if let Some(scene) = &c.scene {
+        for line in scnc::ir::dump(scene, &c.map).lines() {
+            // Source positions move when lines are re-broken; nothing else may change.
+            let line = line.split("  @").next().unwrap_or(line);
+            out.push_str(line);
+            out.push('\n');
+        }
+        out.push_str(&scnc::effects::derive(scene).to_string());
+    }
+    out
+}
+
+#[test]
+fn fmt_is_idempotent_and_changes_only_whitespace() {
+    let dirs = [
+        "examples/seed",
+        "examples/features",
+        "tests/data/ir",
+        "tests/data/diag",
+        "tests/data/render",
+        "tests/data/fmt",
+    ];
+    let mut failures = Vec::new();
+    let (mut formatted, mut refused) = (0, 0);
+    for dir in dirs {
+        for path in cases(dir) {
+            let text = std::fs::read_to_string(&path).expect("reading the case");
+            let Ok(once) = scnc::fmt::format(&text) else {
+                // Files with syntax errors are left alone; they must really have them.
+                assert!(!syntax::parse(&text, 0).1.is_empty(), "{}: refused without an error", path.display());
+                refused += 1;
+                continue;
+            };
+            formatted += 1;
+            let name = path.display();
+            match scnc::fmt::format(&once) {
+                Ok(twice) if twice == once => {}
+                Ok(twice) => failures.push(format!("{name}: not idempotent:\n{}", crate::support::diff(&once, &twice))),
+                Err(_) => failures.push(format!("{name}: formatting introduced a syntax error:\n{once}")),
+            }
+            if tokens(&once) != tokens(&text) {
+                failures.push(format!("{name}: tokens or comments changed:\n{once}"));
+            }
+            if meaning(&path, once.clone()) != meaning(&path, text.clone()) {
+                failures.push(format!("{name}: the formatted file means something else:\n{once}"));
+            }
+        }
+    }
+    assert!(formatted >= 100 && refused >= 5, "formatted {formatted}, refused {refused}");
+    finish(failures);
+}
