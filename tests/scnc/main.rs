@@ -4,6 +4,7 @@ mod cli;
 mod effects;
 mod fmt;
 mod golden;
+mod grammar;
 mod lsp;
 mod mesh;
 mod nopanic;
