@@ -39,6 +39,9 @@ enum Command {
     },
     /// Render a scene to an image (written whole or not at all).
     Render(RenderArgs),
+    /// Render, then render again whenever the scene or a file it includes changes;
+    /// on errors, print them and keep the last good image. Ctrl-C ends it.
+    Watch(RenderArgs),
     /// Render a scene across a ladder of accuracy settings for both back-ends and write
     /// time, work, memory and error for each to DIR/sweep.csv and DIR/sweep.md.
     Sweep(SweepArgs),
@@ -356,31 +359,150 @@ fn usage_error(msg: &str) -> ExitCode {
     ExitCode::from(2)
 }
 
-fn render_cmd(args: RenderArgs) -> ExitCode {
-    let ext = args.output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+/// The usage error for an output path scnc cannot write a PNG to.
+fn check_output(path: &Path) -> Result<(), String> {
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     if ext.as_deref() != Some("png") {
-        return usage_error(&format!(
-            "cannot write `{}`: scnc writes PNG images; try a `.png` file name",
-            args.output.display()
-        ));
+        return Err(format!("cannot write `{}`: scnc writes PNG images; try a `.png` file name", path.display()));
     }
-    let out_dir = match args.output.parent() {
+    let out_dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
     };
     if !out_dir.is_dir() {
-        return usage_error(&format!(
-            "cannot write `{}`: the directory `{}` does not exist",
-            args.output.display(),
-            out_dir.display()
-        ));
+        return Err(format!("cannot write `{}`: the directory `{}` does not exist", path.display(), out_dir.display()));
     }
-    let Some(compiled) = compile(&args.file, args.message_format) else { return ExitCode::from(1) };
+    Ok(())
+}
+
+fn worker_pool(threads: Option<u16>) -> Result<rayon::ThreadPool, String> {
+    let mut pool = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = threads {
+        pool = pool.num_threads(n as usize);
+    }
+    pool.build().map_err(|e| format!("cannot start worker threads: {e}"))
+}
+
+fn render_cmd(args: RenderArgs) -> ExitCode {
+    if let Err(e) = check_output(&args.output) {
+        return usage_error(&e);
+    }
+    let pool = match worker_pool(args.threads) {
+        Ok(p) => p,
+        Err(e) => return usage_error(&e),
+    };
+    match render_once(&args, &pool).result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(code) => code,
+    }
+}
+
+/// What wakes `watch` up.
+enum Wake {
+    /// These paths changed.
+    Changed(Vec<PathBuf>),
+    /// Ctrl-C.
+    Stop,
+}
+
+/// How long `watch` waits for more changes before rendering, so one save (often
+/// several file-system events) renders once.
+const DEBOUNCE: std::time::Duration = std::time::Duration::from_millis(150);
+
+fn watch_cmd(args: RenderArgs) -> ExitCode {
+    use notify::Watcher as _;
+    if let Err(e) = check_output(&args.output) {
+        return usage_error(&e);
+    }
+    let pool = match worker_pool(args.threads) {
+        Ok(p) => p,
+        Err(e) => return usage_error(&e),
+    };
+    let (tx, rx) = std::sync::mpsc::channel();
+    let stop = tx.clone();
+    // The handler only wakes the loop, so a render in progress finishes and its output
+    // is written whole (or not at all) before the process ends.
+    if let Err(e) = ctrlc::set_handler(move || {
+        let _ = stop.send(Wake::Stop);
+    }) {
+        let _ = writeln!(std::io::stderr(), "warning: Ctrl-C will stop watch abruptly: {e}");
+    }
+    let watcher = notify::recommended_watcher(move |event: notify::Result<notify::Event>| {
+        if let Ok(event) = event {
+            if !event.kind.is_access() {
+                let _ = tx.send(Wake::Changed(event.paths));
+            }
+        }
+    });
+    let mut watcher = match watcher {
+        Ok(w) => w,
+        Err(e) => return usage_error(&format!("cannot watch files: {e}")),
+    };
+    let mut watched_dirs: Vec<PathBuf> = Vec::new();
+    loop {
+        let attempt = render_once(&args, &pool);
+        if attempt.result.is_err() {
+            let _ = writeln!(
+                std::io::stderr(),
+                "not rendered; `{}` keeps the last good image. Watching for changes…",
+                args.output.display()
+            );
+        }
+        // Editors save by replacing files, which ends a watch on the file itself, so
+        // the directories are watched and events filtered by path.
+        let files: Vec<PathBuf> = attempt.files.iter().filter_map(|f| std::path::absolute(f).ok()).collect();
+        let mut dirs: Vec<PathBuf> = files.iter().filter_map(|f| f.parent().map(Path::to_path_buf)).collect();
+        dirs.sort();
+        dirs.dedup();
+        for dir in watched_dirs.iter().filter(|d| !dirs.contains(d)) {
+            let _ = watcher.unwatch(dir);
+        }
+        for dir in dirs.iter().filter(|d| !watched_dirs.contains(d)) {
+            if let Err(e) = watcher.watch(dir, notify::RecursiveMode::NonRecursive) {
+                let _ = writeln!(std::io::stderr(), "warning: cannot watch `{}`: {e}", dir.display());
+            }
+        }
+        watched_dirs = dirs;
+        // Wait for a change to one of the files, then for the burst of events to end.
+        loop {
+            match rx.recv() {
+                Ok(Wake::Changed(paths)) if paths.iter().any(|p| files.contains(p)) => break,
+                Ok(Wake::Changed(_)) => {}
+                Ok(Wake::Stop) | Err(_) => return ExitCode::SUCCESS,
+            }
+        }
+        loop {
+            match rx.recv_timeout(DEBOUNCE) {
+                Ok(Wake::Changed(_)) => {}
+                Ok(Wake::Stop) | Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => return ExitCode::SUCCESS,
+                Err(std::sync::mpsc::RecvTimeoutError::Timeout) => break,
+            }
+        }
+    }
+}
+
+/// One render: the files it read (for `watch`), and whether the image was written
+/// (the exit code otherwise, after the reason was printed).
+struct Attempt {
+    files: Vec<PathBuf>,
+    result: Result<(), ExitCode>,
+}
+
+fn render_once(args: &RenderArgs, pool: &rayon::ThreadPool) -> Attempt {
+    let Some(compiled) = compile(&args.file, args.message_format) else {
+        return Attempt { files: vec![args.file.clone()], result: Err(ExitCode::from(1)) };
+    };
+    let files: Vec<PathBuf> = compiled.map.files().map(|(_, f)| f.path.clone()).collect();
+    let result = render_compiled(args, pool, compiled);
+    Attempt { files, result }
+}
+
+fn render_compiled(args: &RenderArgs, pool: &rayon::ThreadPool, compiled: Compiled) -> Result<(), ExitCode> {
     if report(&compiled, args.message_format) {
-        return ExitCode::from(1);
+        return Err(ExitCode::from(1));
     }
     let Some(mut scene) = compiled.scene else {
-        return ExitCode::from(1);
+        return Err(ExitCode::from(1));
     };
     let s = &mut scene.settings;
     s.width = args.width.unwrap_or(s.width);
@@ -391,21 +513,13 @@ fn render_cmd(args: RenderArgs) -> ExitCode {
     s.depth = args.depth.unwrap_or(s.depth);
     s.samples = args.samples.unwrap_or(s.samples);
     if s.width as u64 * s.height as u64 > scnc::check::construct::MAX_PIXELS {
-        return usage_error(&format!(
+        return Err(usage_error(&format!(
             "{}×{} is too large: at most {} pixels",
             s.width,
             s.height,
             scnc::check::construct::MAX_PIXELS
-        ));
+        )));
     }
-    let mut pool = rayon::ThreadPoolBuilder::new();
-    if let Some(n) = args.threads {
-        pool = pool.num_threads(n as usize);
-    }
-    let pool = match pool.build() {
-        Ok(p) => p,
-        Err(e) => return usage_error(&format!("cannot start worker threads: {e}")),
-    };
     let mut detail = args.detail;
     if let Some(tol) = args.tolerance {
         match args.geometry {
@@ -433,7 +547,7 @@ fn render_cmd(args: RenderArgs) -> ExitCode {
         Err(d) => {
             let c = Compiled { map: compiled.map, scene: None, diagnostics: vec![d] };
             report(&c, args.message_format);
-            return ExitCode::from(1);
+            return Err(ExitCode::from(1));
         }
     };
     let lowered = started.elapsed();
@@ -443,7 +557,7 @@ fn render_cmd(args: RenderArgs) -> ExitCode {
     let traced = started.elapsed() - lowered;
     if let Err(e) = write_png(&args.output, &image) {
         let _ = writeln!(std::io::stderr(), "error: cannot write `{}`: {e}", args.output.display());
-        return ExitCode::from(1);
+        return Err(ExitCode::from(1));
     }
     let secs = traced.as_secs_f64();
     let mut err = std::io::stderr().lock();
@@ -461,7 +575,7 @@ fn render_cmd(args: RenderArgs) -> ExitCode {
         let _ = writeln!(err, "{}", frame.effects);
         let _ = write!(err, "{}", stats_text(&counters, &geometry, &compiled.map, lowered.as_secs_f64(), secs));
     }
-    ExitCode::SUCCESS
+    Ok(())
 }
 
 fn stats_text(
@@ -594,6 +708,7 @@ impl Progress {
 fn run(cli: Cli) -> ExitCode {
     match cli.command {
         Command::Render(args) => render_cmd(args),
+        Command::Watch(args) => watch_cmd(args),
         Command::Sweep(args) => sweep_cmd(args),
         Command::Fmt { files, check } => fmt_cmd(&files, check),
         Command::Lsp => match scnc::lsp::run_stdio() {

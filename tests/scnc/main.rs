@@ -11,3 +11,4 @@ mod nopanic;
 mod render;
 mod stability;
 mod support;
+mod watch;
