@@ -11,6 +11,7 @@ pub mod text;
 
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
+use std::rc::Rc;
 
 use lsp_server::{Connection, Message, Notification, Request, Response};
 use lsp_types::notification::{
@@ -62,7 +63,7 @@ fn capabilities() -> lt::ServerCapabilities {
 pub fn serve(connection: &Connection) -> Result<(), String> {
     let caps = serde_json::to_value(capabilities()).map_err(|e| e.to_string())?;
     connection.initialize(caps).map_err(|e| e.to_string())?;
-    let mut server = Server { docs: HashMap::new(), published: HashMap::new() };
+    let mut server = Server { docs: HashMap::new(), published: HashMap::new(), cache: Cache::default() };
     for msg in &connection.receiver {
         match msg {
             Message::Request(req) => {
@@ -89,11 +90,16 @@ struct Doc {
     version: i32,
 }
 
+/// The last analysis of each open document, dropped whenever any document changes
+/// (an open document may be included by another).
+type Cache = std::cell::RefCell<HashMap<String, Rc<Analysis>>>;
+
 struct Server {
     /// Open documents by URI.
     docs: HashMap<String, Doc>,
     /// For each open document, the other files its last compile published diagnostics to.
     published: HashMap<String, HashSet<String>>,
+    cache: Cache,
 }
 
 /// Reads open documents from the editor's buffers and other files from disk, so an
@@ -127,10 +133,15 @@ fn range_of(map: &SourceMap, span: Span) -> (String, lt::Range) {
 }
 
 impl Server {
-    fn analyse(&self, uri: &str) -> Option<Analysis> {
+    fn analyse(&self, uri: &str) -> Option<Rc<Analysis>> {
+        if let Some(a) = self.cache.borrow().get(uri) {
+            return Some(a.clone());
+        }
         let doc = self.docs.get(uri)?;
         let open = self.docs.iter().map(|(u, d)| (doc_path(u), d.text.clone())).collect();
-        Some(Analysis::new(&doc_path(uri), doc.text.clone(), &Overlay { open }))
+        let a = Rc::new(Analysis::new(&doc_path(uri), doc.text.clone(), &Overlay { open }));
+        self.cache.borrow_mut().insert(uri.to_string(), a.clone());
+        Some(a)
     }
 
     /// A location for `span`; spans in the document itself get the document's URI.
@@ -141,6 +152,7 @@ impl Server {
     }
 
     fn notification(&mut self, note: Notification) -> Vec<Notification> {
+        self.cache.borrow_mut().clear();
         let uri = match note.method.as_str() {
             DidOpenTextDocument::METHOD => {
                 let Ok(p) = serde_json::from_value::<lt::DidOpenTextDocumentParams>(note.params) else {
@@ -328,7 +340,7 @@ impl Server {
     }
 
     /// The document, its analysis and the global offset of a position in it.
-    fn at(&self, p: &lt::TextDocumentPositionParams) -> Result<(String, Analysis, u32), String> {
+    fn at(&self, p: &lt::TextDocumentPositionParams) -> Result<(String, Rc<Analysis>, u32), String> {
         let uri = p.text_document.uri.as_str().to_string();
         let a = self.analyse(&uri).ok_or("the document is not open")?;
         let at = LineIndex::new(a.text()).offset(p.position) as u32;

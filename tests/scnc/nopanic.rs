@@ -112,3 +112,31 @@ fn random_mutations_compile_or_report() {
         }
     });
 }
+
+/// The language server's questions at every position of every example and diagnostic
+/// case (many of them broken files) answer without panicking, and every answer points
+/// inside the compile's files.
+#[test]
+fn editor_queries_never_panic() {
+    let mut files = sources();
+    for path in crate::support::cases("tests/data/diag") {
+        files.push((path.display().to_string(), std::fs::read_to_string(&path).expect("diag case")));
+    }
+    for (path, text) in files {
+        let len = text.len() as u32;
+        let a = scnc::lsp::analysis::Analysis::new(Path::new(&path), text, &scnc::check::FsLoader);
+        let total: u32 = a.map.files().map(|(_, f)| f.base + f.text.len() as u32).max().unwrap_or(0);
+        for at in 0..=len {
+            if let Some((span, _)) = a.hover(at) {
+                assert!(span.end <= total, "{path}:{at}: hover span {span:?} outside the files");
+            }
+            if let Some(def) = a.definition(at) {
+                assert!(def.end <= total, "{path}:{at}: definition {def:?} outside the files");
+            }
+            let _ = a.references(at, true);
+            let _ = a.complete(at);
+        }
+        let _ = a.symbols();
+        let _ = a.fixable(0..len);
+    }
+}
