@@ -203,6 +203,10 @@ impl Server {
         for d in &analysis.diagnostics {
             let (file_uri, _) = range_of(&analysis.map, d.span());
             let file_uri = if file_uri.is_empty() { uri.to_string() } else { file_uri };
+            // An included file that is open itself gets its diagnostics from its own compile.
+            if file_uri != uri && self.docs.contains_key(&file_uri) {
+                continue;
+            }
             by_file.entry(file_uri).or_default().push(to_lsp(uri, d, &analysis.map));
         }
         let others: HashSet<String> = by_file.keys().filter(|u| *u != uri).cloned().collect();
