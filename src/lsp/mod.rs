@@ -125,13 +125,6 @@ fn parse_uri(s: &str) -> Option<Uri> {
     s.parse().ok()
 }
 
-fn range_of(map: &SourceMap, span: Span) -> (String, lt::Range) {
-    let (id, r) = map.local_range(span);
-    let file = map.file(id);
-    let uri = if id.0 == 0 { None } else { Some(path_to_uri(&file.path)) };
-    (uri.unwrap_or_default(), LineIndex::new(&file.text).range(r))
-}
-
 impl Server {
     fn analyse(&self, uri: &str) -> Option<Rc<Analysis>> {
         if let Some(a) = self.cache.borrow().get(uri) {
@@ -144,11 +137,23 @@ impl Server {
         Some(a)
     }
 
-    /// A location for `span`; spans in the document itself get the document's URI.
-    fn location(&self, uri: &str, map: &SourceMap, span: Span) -> Option<lt::Location> {
-        let (file_uri, range) = range_of(map, span);
-        let file_uri = if file_uri.is_empty() { uri.to_string() } else { file_uri };
-        Some(lt::Location { uri: parse_uri(&file_uri)?, range })
+    /// The URI and range of `span` in the compile of the document `root`: the document's
+    /// own URI for itself, the editor's URI for another open file, else a `file://` URI.
+    fn locate(&self, root: &str, map: &SourceMap, span: Span) -> (String, lt::Range) {
+        let (id, r) = map.local_range(span);
+        let file = map.file(id);
+        let uri = if id.0 == 0 {
+            root.to_string()
+        } else {
+            let open = self.docs.keys().find(|u| doc_path(u) == file.path);
+            open.cloned().unwrap_or_else(|| path_to_uri(&file.path))
+        };
+        (uri, LineIndex::new(&file.text).range(r))
+    }
+
+    fn location(&self, root: &str, map: &SourceMap, span: Span) -> Option<lt::Location> {
+        let (uri, range) = self.locate(root, map, span);
+        Some(lt::Location { uri: parse_uri(&uri)?, range })
     }
 
     fn notification(&mut self, note: Notification) -> Vec<Notification> {
@@ -201,13 +206,12 @@ impl Server {
         let mut by_file: HashMap<String, Vec<lt::Diagnostic>> = HashMap::new();
         by_file.insert(uri.to_string(), Vec::new());
         for d in &analysis.diagnostics {
-            let (file_uri, _) = range_of(&analysis.map, d.span());
-            let file_uri = if file_uri.is_empty() { uri.to_string() } else { file_uri };
+            let (file_uri, _) = self.locate(uri, &analysis.map, d.span());
             // An included file that is open itself gets its diagnostics from its own compile.
             if file_uri != uri && self.docs.contains_key(&file_uri) {
                 continue;
             }
-            by_file.entry(file_uri).or_default().push(to_lsp(uri, d, &analysis.map));
+            by_file.entry(file_uri).or_default().push(to_lsp(d, &|span| self.locate(uri, &analysis.map, span)));
         }
         let others: HashSet<String> = by_file.keys().filter(|u| *u != uri).cloned().collect();
         let stale = self.published.insert(uri.to_string(), others).unwrap_or_default();
@@ -308,7 +312,7 @@ impl Server {
                     .into_iter()
                     .flat_map(|d| {
                         let single = d.fixes.len() == 1;
-                        let diag = to_lsp(&uri, d, &a.map);
+                        let diag = to_lsp(d, &|span| self.locate(&uri, &a.map, span));
                         d.fixes.iter().map(move |f| (f.clone(), diag.clone(), single))
                     })
                     .map(|(fix, diag, single)| {
@@ -364,11 +368,7 @@ fn publish(uri: &str, diagnostics: Vec<lt::Diagnostic>, version: Option<i32>) ->
 
 /// One diagnostic as LSP has it: notes and hints follow the message, as `scnc check`
 /// prints them; secondary labels become related information.
-fn to_lsp(root_uri: &str, d: &Diagnostic, map: &SourceMap) -> lt::Diagnostic {
-    let located = |span: Span| {
-        let (uri, range) = range_of(map, span);
-        (if uri.is_empty() { root_uri.to_string() } else { uri }, range)
-    };
+fn to_lsp(d: &Diagnostic, located: &dyn Fn(Span) -> (String, lt::Range)) -> lt::Diagnostic {
     let mut message = d.message.clone();
     for note in &d.notes {
         message.push_str(&format!("\nnote: {note}"));
