@@ -137,7 +137,9 @@ impl MeshObject {
                 Aabb { min: a.min(b).min(c), max: a.max(b).max(c) }
             })
             .collect();
-        let bvh = Bvh::build(&boxes, 4);
+        let (bvh, order) = Bvh::build_ordered(&boxes, 4);
+        let triangles: Vec<[u32; 3]> = order.iter().map(|&k| triangles[k as usize]).collect();
+        let mats: Vec<u32> = if mats.is_empty() { mats } else { order.iter().map(|&k| mats[k as usize]).collect() };
         let bounds = boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(*b));
         let materials = match per_triangle {
             Some(_) if mats.iter().any(|&m| m != mats[0]) => Materials::PerTriangle(mats),
@@ -159,7 +161,8 @@ impl MeshObject {
 
     /// Memory by structure.
     pub fn memory(&self) -> MeshMemory {
-        let vertex_bytes = self.positions.len() * 12 + self.normals.as_ref().map_or(0, |n| n.len() * 12);
+        let vertex = std::mem::size_of::<Vec3A>();
+        let vertex_bytes = self.positions.len() * vertex + self.normals.as_ref().map_or(0, |n| n.len() * vertex);
         let index_bytes =
             self.triangles.len() * 12 + if let Materials::PerTriangle(m) = &self.materials { m.len() * 4 } else { 0 };
         MeshMemory {

@@ -6,17 +6,15 @@
 //! between them. Exactly-zero edge functions are recomputed in f64. Both faces are hit
 //! (closed meshes and reflections seen from inside need it); the tracer orients normals.
 
-use glam::Vec3A;
+use glam::{Mat3A, Vec3A};
 
-/// Per-ray constants of the shear transform.
+/// Per-ray constants of the shear transform, as the rows of a matrix: row `x` picks
+/// `p[kx] − sx·p[kz]`, row `y` picks `p[ky] − sy·p[kz]`, row `z` picks `sz·p[kz]`. Each
+/// row has one zero entry, so a row times a point rounds exactly as the paper's
+/// two-term formula does, without indexing vector lanes by a runtime axis.
 #[derive(Clone, Copy, Debug)]
 pub struct Shear {
-    kx: usize,
-    ky: usize,
-    kz: usize,
-    sx: f32,
-    sy: f32,
-    sz: f32,
+    m: Mat3A,
 }
 
 impl Shear {
@@ -40,7 +38,14 @@ impl Shear {
         if dir[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
-        Shear { kx, ky, kz, sx: dir[kx] / dir[kz], sy: dir[ky] / dir[kz], sz: 1.0 / dir[kz] }
+        let (sx, sy, sz) = (dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]);
+        let (mut rx, mut ry, mut rz) = (Vec3A::ZERO, Vec3A::ZERO, Vec3A::ZERO);
+        rx[kx] = 1.0;
+        rx[kz] = -sx;
+        ry[ky] = 1.0;
+        ry[kz] = -sy;
+        rz[kz] = sz;
+        Shear { m: Mat3A::from_cols(rx, ry, rz).transpose() }
     }
 }
 
@@ -65,21 +70,17 @@ pub fn intersect(
     t_min: f32,
     t_max: f32,
 ) -> Option<TriHit> {
-    let Shear { kx, ky, kz, sx, sy, sz } = *shear;
-    let a = v0 - origin;
-    let b = v1 - origin;
-    let c = v2 - origin;
-    let (ax, ay) = (a[kx] - sx * a[kz], a[ky] - sy * a[kz]);
-    let (bx, by) = (b[kx] - sx * b[kz], b[ky] - sy * b[kz]);
-    let (cx, cy) = (c[kx] - sx * c[kz], c[ky] - sy * c[kz]);
-    let mut u = cx * by - cy * bx;
-    let mut v = ax * cy - ay * cx;
-    let mut w = bx * ay - by * ax;
+    let a = shear.m * (v0 - origin);
+    let b = shear.m * (v1 - origin);
+    let c = shear.m * (v2 - origin);
+    let mut u = c.x * b.y - c.y * b.x;
+    let mut v = a.x * c.y - a.y * c.x;
+    let mut w = b.x * a.y - b.y * a.x;
     if u == 0.0 || v == 0.0 || w == 0.0 {
-        let (ax, ay, bx, by, cx, cy) = (ax as f64, ay as f64, bx as f64, by as f64, cx as f64, cy as f64);
-        u = (cx * by - cy * bx) as f32;
-        v = (ax * cy - ay * cx) as f32;
-        w = (bx * ay - by * ax) as f32;
+        let (a, b, c) = (a.as_dvec3(), b.as_dvec3(), c.as_dvec3());
+        u = (c.x * b.y - c.y * b.x) as f32;
+        v = (a.x * c.y - a.y * c.x) as f32;
+        w = (b.x * a.y - b.y * a.x) as f32;
     }
     if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
         return None;
@@ -88,8 +89,7 @@ pub fn intersect(
     if det == 0.0 || !det.is_finite() {
         return None;
     }
-    let (az, bz, cz) = (sz * a[kz], sz * b[kz], sz * c[kz]);
-    let t_scaled = u * az + v * bz + w * cz;
+    let t_scaled = u * a.z + v * b.z + w * c.z;
     let inv = 1.0 / det;
     let t = t_scaled * inv;
     if !(t > t_min && t < t_max) {
