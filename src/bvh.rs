@@ -55,8 +55,13 @@ impl Aabb {
         // The far distance is scaled by 1 + 2γ₃ (Ize 2013, "Robust BVH Ray Traversal") so
         // rounding never rejects a ray that touches the box, e.g. through a mesh vertex.
         const ROBUST: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON / (1.0 - 3.0 * f32::EPSILON));
-        let near = t0.min(t1).max_element().max(t_min);
-        let far = (t0.max(t1).min_element() * ROBUST).min(t_max);
+        let near = t0.min(t1).max_element();
+        let far = t0.max(t1).min_element() * ROBUST;
+        // Clamped by comparisons rather than `f32::max`/`min`, which spend instructions on
+        // a NaN in either operand: only `near` and `far` can be NaN, and then the bound wins
+        // just as `f32::max`/`min` would choose it.
+        let near = if near > t_min { near } else { t_min };
+        let far = if far < t_max { far } else { t_max };
         (near <= far).then_some((near, far))
     }
 }
@@ -84,8 +89,10 @@ pub struct Bvh {
     prims: Vec<u32>,
 }
 
-/// Deepest traversal stack; the builder never makes a deeper tree.
+/// Deepest tree the builder makes.
 const MAX_DEPTH: usize = 64;
+/// Deferred nodes kept on the call stack during a traversal (one per level at most).
+const STACK: usize = 24;
 const BINS: usize = 12;
 
 impl Bvh {
@@ -274,7 +281,10 @@ impl Bvh {
         }
         // Deferred children with their entry distances: a popped node is skipped when it
         // starts beyond the closest hit found since, without testing its box again.
-        let mut stack = [(0u32, 0f32); MAX_DEPTH];
+        // Deferred children: a fixed array covers every tree but degenerate ones, which
+        // spill to the heap (an empty `Vec` does not allocate).
+        let mut stack = [(0u32, 0f32); STACK];
+        let mut spill: Vec<(u32, f32)> = Vec::new();
         let mut sp = 0;
         let mut idx = 0usize;
         loop {
@@ -295,8 +305,12 @@ impl Bvh {
                 match (hl, hr) {
                     (Some((tl, _)), Some((tr, _))) => {
                         let (near, far, t_far) = if tl <= tr { (l, r, tr) } else { (r, l, tl) };
-                        stack[sp] = (far as u32, t_far);
-                        sp += 1;
+                        if sp < STACK {
+                            stack[sp] = (far as u32, t_far);
+                            sp += 1;
+                        } else {
+                            spill.push((far as u32, t_far));
+                        }
                         idx = near;
                         continue;
                     }
@@ -312,11 +326,14 @@ impl Bvh {
                 }
             }
             loop {
-                if sp == 0 {
-                    return;
-                }
-                sp -= 1;
-                let (next, t_near) = stack[sp];
+                let (next, t_near) = match spill.pop() {
+                    Some(entry) => entry,
+                    None if sp > 0 => {
+                        sp -= 1;
+                        stack[sp]
+                    }
+                    None => return,
+                };
                 if t_near <= *t_max {
                     idx = next as usize;
                     break;
@@ -407,47 +424,75 @@ impl Bvh {
 mod tests {
     use super::*;
 
-    fn boxes(n: usize) -> Vec<Aabb> {
-        // A deterministic scatter of small boxes, some coinciding.
+    /// Every primitive whose box the ray passes through, by brute force.
+    fn brute(boxes: &[Aabb], origin: Vec3A, dir: Vec3A) -> Vec<u32> {
+        let mut out: Vec<u32> = (0..boxes.len() as u32)
+            .filter(|&i| boxes[i as usize].slab(origin, dir.recip(), 0.0, f32::MAX).is_some())
+            .collect();
+        out.sort();
+        out
+    }
+
+    fn visited(bvh: &Bvh, origin: Vec3A, dir: Vec3A, order: Option<&[u32]>) -> Vec<u32> {
+        let mut seen = Vec::new();
+        let mut visits = 0;
+        bvh.any(origin, dir.recip(), 0.0, f32::MAX, &mut visits, |p, _| {
+            seen.push(order.map_or(p, |o| o[p as usize]));
+            false
+        });
+        seen.sort();
+        seen
+    }
+
+    #[test]
+    fn ordered_and_indexed_trees_find_what_brute_force_finds() {
         let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
+        let mut next = move || {
             state ^= state << 13;
             state ^= state >> 7;
             state ^= state << 17;
             (state >> 40) as f32 / (1u64 << 24) as f32
         };
-        (0..n)
+        let boxes: Vec<Aabb> = (0..500)
             .map(|i| {
                 let c = if i % 7 == 0 { Vec3A::ONE } else { Vec3A::new(next(), next(), next()) * 10.0 };
                 Aabb { min: c, max: c + Vec3A::new(next(), next(), next()) * 0.5 }
             })
-            .collect()
-    }
-
-    #[test]
-    fn ordered_and_indexed_trees_are_valid_and_visit_the_same() {
-        let b = boxes(500);
-        let indexed = Bvh::build(&b, 4);
-        indexed.validate(&b).expect("indexed tree");
-        let (ordered, order) = Bvh::build_ordered(&b, 4);
-        let reordered: Vec<Aabb> = order.iter().map(|&k| b[k as usize]).collect();
+            .collect();
+        let indexed = Bvh::build(&boxes, 4);
+        indexed.validate(&boxes).expect("indexed tree");
+        let (ordered, order) = Bvh::build_ordered(&boxes, 4);
+        let reordered: Vec<Aabb> = order.iter().map(|&k| boxes[k as usize]).collect();
         ordered.validate(&reordered).expect("ordered tree");
-        assert_eq!(ordered.bytes() + 4 * b.len(), indexed.bytes());
-        // Every ray sees the same boxes in the same order through both.
         for i in 0..200 {
             let dir = Vec3A::new((i as f32 * 0.37).sin(), (i as f32 * 0.11).cos(), 1.0).normalize();
             let origin = Vec3A::new(5.0, 5.0, -20.0);
-            let (mut seen_a, mut seen_b) = (Vec::new(), Vec::new());
-            let mut v = 0;
-            indexed.any(origin, dir.recip(), 0.0, f32::MAX, &mut v, |p, _| {
-                seen_a.push(p);
-                false
-            });
-            ordered.any(origin, dir.recip(), 0.0, f32::MAX, &mut v, |p, _| {
-                seen_b.push(order[p as usize]);
-                false
-            });
-            assert_eq!(seen_a, seen_b);
+            // Leaves are visited whole, so every box the ray meets is among those visited.
+            let expected = brute(&boxes, origin, dir);
+            let (a, b) = (visited(&indexed, origin, dir, None), visited(&ordered, origin, dir, Some(&order)));
+            assert_eq!(a, b, "the ordered tree visits what the indexed one does");
+            assert!(expected.iter().all(|p| a.contains(p)), "ray {i} missed a box: {expected:?} ⊄ {a:?}");
         }
+    }
+
+    /// Boxes 12.5× farther out each: all but the farthest fall in the first of the 12
+    /// bins, so SAH peels one box off per level, making a tree deeper than the fixed
+    /// traversal stack, whose overflow goes to the heap.
+    #[test]
+    fn trees_deeper_than_the_fixed_stack_are_walked_completely() {
+        let n = 35;
+        let boxes: Vec<Aabb> = (0..n)
+            .map(|i| {
+                let x = 12.5f32.powi(i);
+                Aabb { min: Vec3A::new(x, -1.0, -1.0), max: Vec3A::new(x * 1.01, 1.0, 1.0) }
+            })
+            .collect();
+        let bvh = Bvh::build(&boxes, 1);
+        bvh.validate(&boxes).expect("valid");
+        assert!(bvh.depth() > STACK + 1, "depth {} does not exceed the stack", bvh.depth());
+        // A ray along +x from the near end meets every box; at each level the nearer
+        // child is the deep one and the peeled box is deferred, so the stack overflows.
+        let origin = Vec3A::new(0.5, 0.0, 0.0);
+        assert_eq!(visited(&bvh, origin, Vec3A::X, None), (0..n as u32).collect::<Vec<u32>>());
     }
 }

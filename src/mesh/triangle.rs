@@ -39,13 +39,12 @@ impl Shear {
             std::mem::swap(&mut kx, &mut ky);
         }
         let (sx, sy, sz) = (dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]);
-        let (mut rx, mut ry, mut rz) = (Vec3A::ZERO, Vec3A::ZERO, Vec3A::ZERO);
-        rx[kx] = 1.0;
-        rx[kz] = -sx;
-        ry[ky] = 1.0;
-        ry[kz] = -sy;
-        rz[kz] = sz;
-        Shear { m: Mat3A::from_cols(rx, ry, rz).transpose() }
+        // Column `k` of the matrix holds what row x, y and z take from coordinate `k`.
+        let mut cols = [Vec3A::ZERO; 3];
+        cols[kx] = Vec3A::X;
+        cols[ky] = Vec3A::Y;
+        cols[kz] = Vec3A::new(-sx, -sy, sz);
+        Shear { m: Mat3A::from_cols(cols[0], cols[1], cols[2]) }
     }
 }
 
