@@ -23,6 +23,7 @@ for scene in examples/seed/0*.scn; do
   rays=$(grep -oE '[0-9.]+ M rays/s' "$out/stats" | head -1)
   read -r primary shadow reflection < <(grep -E '^  rays ' "$out/stats" | grep -oE '[0-9]+ (primary|shadow|reflection)' | cut -d' ' -f1 | tr '\n' ' ') || true
   evals=$(grep -oE '\(([0-9.]+) per ray' "$out/stats" | head -1 | grep -oE '[0-9.]+')
-  bytes=$(grep -E '^  memory' "$out/stats" | grep -oE '[0-9]+ bytes' | cut -d' ' -f1 | paste -sd+ | bc)
+  # The first figure of the memory line is the total; the others are parts of it.
+  bytes=$(grep -E '^  memory' "$out/stats" | grep -oE '[0-9]+ bytes in total' | cut -d' ' -f1)
   echo "| $(basename "$scene" .scn) | ${median} s | $((rss / 1024)) MiB | $rays | $primary | $shadow | $reflection | $evals | $bytes |"
 done
