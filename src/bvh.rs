@@ -1,13 +1,14 @@
 //! A flat bounding-volume hierarchy over axis-aligned boxes, built with binned SAH.
 //!
-//! Used as the top-level structure over objects and over each mesh's triangles. Nodes
-//! are stored depth-first, a 32-byte box and an 8-byte link each, in two parallel
-//! `Vec`s: an interior node's left child follows it, its right child is at `right`.
+//! Used as the top-level structure over objects and over each mesh's triangles. Each
+//! interior node stores the boxes of both its children in one 64-byte cache line, so a
+//! traversal step is one load and one 4-wide slab test; leaves are ranges of primitives
+//! named in their parent. The builder makes the usual one-box-per-node tree first.
 //!
 //! **Invariant:** every node's box contains the boxes of all primitives below it, and
 //! every primitive index appears in exactly one leaf ([`Bvh::validate`] checks both).
 
-use glam::Vec3A;
+use glam::{Vec3A, Vec4, Vec4Swizzles};
 
 /// An axis-aligned box in render space (f32).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -66,49 +67,147 @@ impl Aabb {
     }
 }
 
-/// A node's links: 8 bytes. Its box lives in a parallel array of [`Aabb`]s, whose
-/// 16-byte-aligned corners load in one instruction each; keeping the integers out of
-/// the vectors' spare lanes keeps denormal bit patterns out of the slab arithmetic.
-#[derive(Clone, Copy, Debug)]
-struct Link {
-    /// Leaf: first index into `prims`. Interior: index of the right child.
-    first_or_right: u32,
+/// A reference to a child: an interior node, or a leaf's range of primitives.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Child {
+    /// Leaf: first primitive. Interior: index into `nodes`.
+    index: u32,
     /// Leaf: number of primitives (> 0). Interior: 0.
     count: u32,
 }
 
+/// An interior node holding both children's boxes, one cache line in all. The boxes
+/// are stored across lanes, `[left.min, right.min, left.max, right.max]` per axis, so
+/// one pass of 4-wide arithmetic tests both children: a visit loads one line and
+/// decides which children the ray enters and in which order.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+struct Node {
+    x: Vec4,
+    y: Vec4,
+    z: Vec4,
+    children: [Child; 2],
+}
+
+impl Node {
+    fn new(left: Aabb, right: Aabb, children: [Child; 2]) -> Node {
+        Node {
+            x: Vec4::new(left.min.x, right.min.x, left.max.x, right.max.x),
+            y: Vec4::new(left.min.y, right.min.y, left.max.y, right.max.y),
+            z: Vec4::new(left.min.z, right.min.z, left.max.z, right.max.z),
+            children,
+        }
+    }
+
+    fn child_box(&self, k: usize) -> Aabb {
+        Aabb {
+            min: Vec3A::new(self.x[k], self.y[k], self.z[k]),
+            max: Vec3A::new(self.x[k + 2], self.y[k + 2], self.z[k + 2]),
+        }
+    }
+}
+
+/// Per-ray constants of the two-box slab test, splat across lanes.
+struct RaySplat {
+    origin: [Vec4; 3],
+    inv_dir: [Vec4; 3],
+    t_min: Vec4,
+}
+
+impl RaySplat {
+    fn new(origin: Vec3A, inv_dir: Vec3A, t_min: f32) -> RaySplat {
+        RaySplat {
+            origin: [Vec4::splat(origin.x), Vec4::splat(origin.y), Vec4::splat(origin.z)],
+            inv_dir: [Vec4::splat(inv_dir.x), Vec4::splat(inv_dir.y), Vec4::splat(inv_dir.z)],
+            t_min: Vec4::splat(t_min),
+        }
+    }
+
+    /// Which of the node's two children the ray enters before `t_max` (bit 0 left,
+    /// bit 1 right) and the entry distances (lanes 0 and 1). The same slab test as
+    /// [`Aabb::slab`], including its robust far bound. A ray lying exactly in a face
+    /// plane of a box makes `0 × ∞ = NaN` there and may miss that box, as it may in
+    /// [`Aabb::slab`]: it could only graze what the box holds, edge-on.
+    #[inline(always)]
+    fn enters(&self, node: &Node, t_max: f32) -> (u32, Vec4) {
+        const ROBUST: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON / (1.0 - 3.0 * f32::EPSILON));
+        let mut near = self.t_min;
+        let mut far = Vec4::INFINITY;
+        for (axis, planes) in [node.x, node.y, node.z].into_iter().enumerate() {
+            let t = (planes - self.origin[axis]) * self.inv_dir[axis];
+            // Lanes 2 and 3 moved to 0 and 1: each child's two planes side by side.
+            let swapped = t.zwxy();
+            near = max_or(t.min(swapped), near);
+            far = min_or(t.max(swapped), far);
+        }
+        let far = min_or(far * ROBUST, Vec4::splat(t_max));
+        (near.cmple(far).bitmask() & 0b11, near)
+    }
+}
+
+/// `a.max(b)`, or `b` where `a` is NaN: glam's `max` is `maxps(a, b)` on x86_64, which
+/// returns its second operand when either is NaN. (Where it propagates NaN instead, a
+/// NaN lane makes the child a miss, on the same measure-zero set of rays.)
+#[inline(always)]
+fn max_or(a: Vec4, b: Vec4) -> Vec4 {
+    a.max(b)
+}
+
+/// `a.min(b)`, or `b` where `a` is NaN (see [`max_or`]).
+#[inline(always)]
+fn min_or(a: Vec4, b: Vec4) -> Vec4 {
+    a.min(b)
+}
+
 /// The hierarchy.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct Bvh {
-    /// Node boxes, depth-first.
-    boxes: Vec<Aabb>,
-    /// Node links, parallel to `boxes`.
-    links: Vec<Link>,
+    /// Interior nodes, parents before children.
+    nodes: Vec<Node>,
+    /// The root's box.
+    root_box: Aabb,
+    /// The root: interior node 0, or a leaf when there are few primitives; an empty
+    /// tree has neither nodes nor a leaf.
+    root: Child,
     /// Primitive indices of the leaves; empty when the caller ordered its primitives
     /// by the leaves ([`Bvh::build_ordered`]).
+    prims: Vec<u32>,
+}
+
+/// The state of a build: the nodes so far and the primitive order being partitioned.
+struct Builder {
+    nodes: Vec<Node>,
     prims: Vec<u32>,
 }
 
 /// Deepest tree the builder makes.
 const MAX_DEPTH: usize = 64;
 /// Deferred nodes kept on the call stack during a traversal (one per level at most).
-const STACK: usize = 24;
+const STACK: usize = 16;
 const BINS: usize = 12;
 
+impl Default for Bvh {
+    fn default() -> Bvh {
+        Bvh { nodes: Vec::new(), root_box: Aabb::EMPTY, root: Child { index: 0, count: 0 }, prims: Vec::new() }
+    }
+}
+
 impl Bvh {
+    /// The root's box and reference, unless the tree is empty.
+    fn root(&self) -> Option<(Aabb, Child)> {
+        (self.root.count > 0 || !self.nodes.is_empty()).then_some((self.root_box, self.root))
+    }
+
     /// Builds over the given boxes (primitive `i` has box `boxes[i]`); leaves hold at
     /// most `leaf_size` primitives unless SAH finds no useful split.
     pub fn build(boxes: &[Aabb], leaf_size: usize) -> Bvh {
-        let mut bvh = Bvh {
-            boxes: Vec::with_capacity(boxes.len() * 2),
-            links: Vec::with_capacity(boxes.len() * 2),
-            prims: (0..boxes.len() as u32).collect(),
-        };
-        if !boxes.is_empty() {
-            let centres: Vec<Vec3A> = boxes.iter().map(|b| b.centre()).collect();
-            bvh.build_node(boxes, &centres, 0, boxes.len(), 0, leaf_size.max(1));
+        if boxes.is_empty() {
+            return Bvh::default();
         }
-        bvh
+        let mut b = Builder { nodes: Vec::with_capacity(boxes.len() / 2), prims: (0..boxes.len() as u32).collect() };
+        let centres: Vec<Vec3A> = boxes.iter().map(|b| b.centre()).collect();
+        let (root_box, root) = b.node(boxes, &centres, 0, boxes.len(), 0, leaf_size.max(1));
+        Bvh { nodes: b.nodes, root_box, root, prims: b.prims }
     }
 
     /// Builds like [`build`](Self::build) and returns the leaves' primitive order: the
@@ -119,8 +218,11 @@ impl Bvh {
         let order = std::mem::take(&mut bvh.prims);
         (bvh, order)
     }
+}
 
-    fn build_node(
+impl Builder {
+    /// Builds the subtree over `prims[start..end]`; returns its box and reference.
+    fn node(
         &mut self,
         boxes: &[Aabb],
         centres: &[Vec3A],
@@ -128,26 +230,27 @@ impl Bvh {
         end: usize,
         depth: usize,
         leaf_size: usize,
-    ) -> usize {
-        let idx = self.links.len();
+    ) -> (Aabb, Child) {
         // One pass for the node's bounds and the bounds of the primitives' centres.
         let (bounds, cb) = self.prims[start..end].iter().fold((Aabb::EMPTY, Aabb::EMPTY), |(b, c), &p| {
             let centre = centres[p as usize];
             (b.union(boxes[p as usize]), c.union(Aabb { min: centre, max: centre }))
         });
-        self.boxes.push(bounds);
-        self.links.push(Link { first_or_right: start as u32, count: (end - start) as u32 });
         let n = end - start;
+        let leaf = (bounds, Child { index: start as u32, count: n as u32 });
         if n <= leaf_size || depth + 1 >= MAX_DEPTH {
-            return idx;
+            return leaf;
         }
         let Some(mid) = self.split(boxes, centres, start, end, bounds, cb) else {
-            return idx;
+            return leaf;
         };
-        self.build_node(boxes, centres, start, mid, depth + 1, leaf_size);
-        let right = self.build_node(boxes, centres, mid, end, depth + 1, leaf_size);
-        self.links[idx] = Link { first_or_right: right as u32, count: 0 };
-        idx
+        // The slot is taken before the children's, so a parent precedes its subtree.
+        let at = self.nodes.len();
+        self.nodes.push(Node::new(Aabb::EMPTY, Aabb::EMPTY, [Child { index: 0, count: 0 }; 2]));
+        let (left_box, left) = self.node(boxes, centres, start, mid, depth + 1, leaf_size);
+        let (right_box, right) = self.node(boxes, centres, mid, end, depth + 1, leaf_size);
+        self.nodes[at] = Node::new(left_box, right_box, [left, right]);
+        (bounds, Child { index: at as u32, count: 0 })
     }
 
     /// Binned SAH split of `prims[start..end]` (all three axes binned in one pass);
@@ -220,7 +323,9 @@ impl Bvh {
             _ => None,
         }
     }
+}
 
+impl Bvh {
     /// Visits leaves front to back along the ray. `visit(prim, t_max)` tests one primitive
     /// and returns its hit distance if closer than `t_max`; the closest hit wins.
     /// Returns the closest hit (primitive, t) and counts nodes visited into `visits`.
@@ -235,10 +340,13 @@ impl Bvh {
         mut visit: impl FnMut(u32, f32) -> Option<f32>,
     ) -> Option<(u32, f32)> {
         let mut best = None;
-        self.walk(origin, inv_dir, t_min, &mut t_max, visits, |prim, t_max| {
-            if let Some(t) = visit(prim, *t_max) {
-                *t_max = t;
-                best = Some((prim, t));
+        self.leaves(origin, inv_dir, t_min, &mut t_max, visits, |first, count, t_max| {
+            for k in first..first + count {
+                let p = self.prim(k);
+                if let Some(t) = visit(p, *t_max) {
+                    *t_max = t;
+                    best = Some((p, t));
+                }
             }
             false
         });
@@ -257,72 +365,74 @@ impl Bvh {
         mut visit: impl FnMut(u32, f32) -> bool,
     ) -> bool {
         let mut found = false;
-        self.walk(origin, inv_dir, t_min, &mut t_max, visits, |prim, t_max| {
-            found = visit(prim, *t_max);
+        self.leaves(origin, inv_dir, t_min, &mut t_max, visits, |first, count, t_max| {
+            found = (first..first + count).any(|k| visit(self.prim(k), *t_max));
             found
         });
         found
     }
 
+    /// The primitive in leaf slot `k`.
+    #[inline(always)]
+    fn prim(&self, k: u32) -> u32 {
+        if self.prims.is_empty() {
+            k
+        } else {
+            self.prims[k as usize]
+        }
+    }
+
+    /// Visits leaves front to back along the ray: `leaf(first, count, t_max)` gets the
+    /// leaf's slots `first..first + count`, may lower `t_max` to the closest hit so far,
+    /// and returns true to stop the walk.
     #[inline]
-    fn walk(
+    fn leaves(
         &self,
         origin: Vec3A,
         inv_dir: Vec3A,
         t_min: f32,
         t_max: &mut f32,
         visits: &mut u64,
-        mut leaf: impl FnMut(u32, &mut f32) -> bool,
+        mut leaf: impl FnMut(u32, u32, &mut f32) -> bool,
     ) {
-        let Some(root) = self.boxes.first() else { return };
-        if root.slab(origin, inv_dir, t_min, *t_max).is_none() {
-            *visits += 1;
+        let Some((root_box, root)) = self.root() else { return };
+        *visits += 1;
+        if root_box.slab(origin, inv_dir, t_min, *t_max).is_none() {
             return;
         }
-        // Deferred children with their entry distances: a popped node is skipped when it
-        // starts beyond the closest hit found since, without testing its box again.
-        // Deferred children: a fixed array covers every tree but degenerate ones, which
-        // spill to the heap (an empty `Vec` does not allocate).
-        let mut stack = [(0u32, 0f32); STACK];
-        let mut spill: Vec<(u32, f32)> = Vec::new();
+        let ray = RaySplat::new(origin, inv_dir, t_min);
+        // Deferred children with their entry distances: a popped child is skipped when it
+        // starts beyond the closest hit found since, without testing its box again. A
+        // fixed array covers every tree but degenerate ones, which spill to the heap (an
+        // empty `Vec` does not allocate). Its extra slot takes the unconditional write below.
+        let mut stack = [(Child { index: 0, count: 0 }, 0f32); STACK + 1];
+        let mut spill: Vec<(Child, f32)> = Vec::new();
         let mut sp = 0;
-        let mut idx = 0usize;
+        let mut cur = root;
         loop {
-            *visits += 1;
-            let Link { first_or_right, count } = self.links[idx];
-            if count > 0 {
-                let first = first_or_right;
-                for k in first..first + count {
-                    let p = if self.prims.is_empty() { k } else { self.prims[k as usize] };
-                    if leaf(p, t_max) {
-                        return;
-                    }
+            if cur.count > 0 {
+                if leaf(cur.index, cur.count, t_max) {
+                    return;
                 }
             } else {
-                let (l, r) = (idx + 1, first_or_right as usize);
-                let hl = self.boxes[l].slab(origin, inv_dir, t_min, *t_max);
-                let hr = self.boxes[r].slab(origin, inv_dir, t_min, *t_max);
-                match (hl, hr) {
-                    (Some((tl, _)), Some((tr, _))) => {
-                        let (near, far, t_far) = if tl <= tr { (l, r, tr) } else { (r, l, tl) };
+                *visits += 1;
+                let node = &self.nodes[cur.index as usize];
+                let (enters, near) = ray.enters(node, *t_max);
+                if enters != 0 {
+                    // The nearer child is chosen, and the other written to the stack, without
+                    // branching on their order, which depends on the ray and mispredicts.
+                    let first = (enters == 0b10 || (enters == 0b11 && near.y < near.x)) as usize;
+                    let deferred = (node.children[1 - first], near[1 - first]);
+                    cur = node.children[first];
+                    stack[sp] = deferred;
+                    if enters == 0b11 {
                         if sp < STACK {
-                            stack[sp] = (far as u32, t_far);
                             sp += 1;
                         } else {
-                            spill.push((far as u32, t_far));
+                            spill.push(deferred);
                         }
-                        idx = near;
-                        continue;
                     }
-                    (Some(_), None) => {
-                        idx = l;
-                        continue;
-                    }
-                    (None, Some(_)) => {
-                        idx = r;
-                        continue;
-                    }
-                    (None, None) => {}
+                    continue;
                 }
             }
             loop {
@@ -335,54 +445,50 @@ impl Bvh {
                     None => return,
                 };
                 if t_near <= *t_max {
-                    idx = next as usize;
+                    cur = next;
                     break;
                 }
             }
         }
     }
 
-    /// Bytes of the node and index arrays.
+    /// Bytes of the nodes, the root and the index array.
     pub fn bytes(&self) -> usize {
-        self.boxes.len() * std::mem::size_of::<Aabb>()
-            + self.links.len() * std::mem::size_of::<Link>()
-            + self.prims.len() * 4
+        self.nodes.len() * std::mem::size_of::<Node>() + std::mem::size_of::<(Aabb, Child)>() + self.prims.len() * 4
     }
 
-    /// Number of nodes.
+    /// Number of nodes in the tree, leaves included.
     pub fn node_count(&self) -> usize {
-        self.links.len()
+        // A binary tree with `n` interior nodes has `n + 1` leaves.
+        if self.root().is_some() {
+            2 * self.nodes.len() + 1
+        } else {
+            0
+        }
     }
 
     /// Depth of the deepest leaf (a single leaf has depth 1).
     pub fn depth(&self) -> usize {
-        fn go(links: &[Link], i: usize) -> usize {
-            let n = links[i];
-            if n.count > 0 {
+        fn go(nodes: &[Node], c: Child) -> usize {
+            if c.count > 0 {
                 1
             } else {
-                1 + go(links, i + 1).max(go(links, n.first_or_right as usize))
+                let n = &nodes[c.index as usize];
+                1 + go(nodes, n.children[0]).max(go(nodes, n.children[1]))
             }
         }
-        if self.links.is_empty() {
-            0
-        } else {
-            go(&self.links, 0)
-        }
+        self.root().map_or(0, |(_, root)| go(&self.nodes, root))
     }
 
     /// Checks the invariants against the boxes it was built from.
     pub fn validate(&self, boxes: &[Aabb]) -> Result<(), String> {
         let mut seen = vec![false; boxes.len()];
-        fn go(bvh: &Bvh, boxes: &[Aabb], seen: &mut [bool], i: usize, depth: usize) -> Result<Aabb, String> {
-            let n = *bvh.links.get(i).ok_or(format!("node {i} out of range"))?;
+        fn go(bvh: &Bvh, boxes: &[Aabb], seen: &mut [bool], b: Aabb, c: Child, depth: usize) -> Result<(), String> {
             if depth > MAX_DEPTH {
-                return Err("tree deeper than the traversal stack".into());
+                return Err("tree deeper than the builder makes".into());
             }
-            let b = bvh.boxes[i];
-            if n.count > 0 {
-                let first = n.first_or_right as usize;
-                let range = first..first + n.count as usize;
+            if c.count > 0 {
+                let range = c.index as usize..c.index as usize + c.count as usize;
                 let prims: Vec<u32> = if bvh.prims.is_empty() {
                     range.clone().map(|p| p as u32).filter(|&p| (p as usize) < boxes.len()).collect()
                 } else {
@@ -397,21 +503,23 @@ impl Bvh {
                         return Err(format!("primitive {p} in two leaves"));
                     }
                     if !b.contains(boxes[p]) {
-                        return Err(format!("leaf {i} does not contain primitive {p}"));
+                        return Err(format!("a leaf does not contain primitive {p}"));
                     }
                 }
-            } else {
-                for c in [i + 1, n.first_or_right as usize] {
-                    let cb = go(bvh, boxes, seen, c, depth + 1)?;
-                    if !b.contains(cb) {
-                        return Err(format!("node {i} does not contain child {c}"));
-                    }
-                }
+                return Ok(());
             }
-            Ok(b)
+            let n = bvh.nodes.get(c.index as usize).ok_or(format!("node {} out of range", c.index))?;
+            for k in 0..2 {
+                let cb = n.child_box(k);
+                if !b.contains(cb) {
+                    return Err(format!("node {} does not contain its child {k}", c.index));
+                }
+                go(bvh, boxes, seen, cb, n.children[k], depth + 1)?;
+            }
+            Ok(())
         }
-        if !self.links.is_empty() {
-            go(self, boxes, &mut seen, 0, 1)?;
+        if let Some((b, root)) = self.root() {
+            go(self, boxes, &mut seen, b, root, 1)?;
         }
         match seen.iter().position(|s| !s) {
             Some(p) => Err(format!("primitive {p} is in no leaf")),

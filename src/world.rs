@@ -219,30 +219,32 @@ impl World {
     /// The interval of the ray inside object `i`'s bounds, clipped to `[ray.t_min, t_max]`.
     #[inline]
     fn interval(&self, o: &Object, ray: &Ray, t_max: f32) -> Option<(f32, f32)> {
-        let (mut t0, mut t1) = match o.bounds {
+        let (t0, t1) = match o.bounds {
             Some(b) => b.slab(ray.origin, ray.inv_dir, ray.t_min, t_max)?,
             None => (ray.t_min, t_max),
         };
-        if let Some((centre, radius)) = o.sphere {
-            let (s0, s1) = sphere_interval(ray, centre, radius)?;
-            t0 = t0.max(s0);
-            t1 = t1.min(s1);
-        }
-        (t0 <= t1).then_some((t0, t1))
+        clip_to_sphere(o, ray, (t0, t1))
+    }
+
+    /// Whether the ray can reach mesh object `o` before `t_max`. Only its sphere is
+    /// tested: its box is the root of the mesh's own BVH, whose walk tests it anyway.
+    #[inline]
+    fn may_reach_mesh(&self, o: &Object, ray: &Ray, t_max: f32) -> bool {
+        clip_to_sphere(o, ray, (ray.t_min, t_max)).is_some()
     }
 
     /// The closest surface of object `i` before `t_max`, without its shading data.
     fn find(&self, i: u32, q: &mut Query<'_>, t_max: f32, c: &mut Counters) -> Option<Found> {
         let o = &self.objects[i as usize];
-        let interval = self.interval(o, q.ray, t_max)?;
         match &o.kind {
             ObjectKind::Sdf(s) => s
-                .closest(q.ray, interval, self.params, c, &mut q.evals)
+                .closest(q.ray, self.interval(o, q.ray, t_max)?, self.params, c, &mut q.evals)
                 .map(|(t, error)| Found::Sdf { object: i, t, error }),
-            // Triangles are tested exactly; the interval only decides whether to look.
-            ObjectKind::Mesh(m) => {
+            // Triangles are tested exactly; the sphere only decides whether to look.
+            ObjectKind::Mesh(m) if self.may_reach_mesh(o, q.ray, t_max) => {
                 m.closest(q.ray, q.shear(), t_max, c).map(|(tri, hit)| Found::Mesh { object: i, tri, hit })
             }
+            ObjectKind::Mesh(_) => None,
         }
     }
 
@@ -262,10 +264,11 @@ impl World {
 
     fn blocks(&self, i: u32, q: &mut Query<'_>, t_max: f32, c: &mut Counters) -> bool {
         let o = &self.objects[i as usize];
-        let Some((t0, t1)) = self.interval(o, q.ray, t_max) else { return false };
         match &o.kind {
-            ObjectKind::Sdf(s) => s.closest(q.ray, (t0, t1), self.params, c, &mut q.evals).is_some(),
-            ObjectKind::Mesh(m) => m.occluded(q.ray, q.shear(), t_max, c),
+            ObjectKind::Sdf(s) => self
+                .interval(o, q.ray, t_max)
+                .is_some_and(|interval| s.closest(q.ray, interval, self.params, c, &mut q.evals).is_some()),
+            ObjectKind::Mesh(m) => self.may_reach_mesh(o, q.ray, t_max) && m.occluded(q.ray, q.shear(), t_max, c),
         }
     }
 }
@@ -315,6 +318,19 @@ impl<'a> Query<'a> {
         let dir = self.ray.dir;
         self.shear.get_or_insert_with(|| mesh::triangle::Shear::new(dir))
     }
+}
+
+/// `(t0, t1)` narrowed to where the ray is inside the object's bounding sphere, if it has one.
+#[inline]
+fn clip_to_sphere(o: &Object, ray: &Ray, (t0, t1): (f32, f32)) -> Option<(f32, f32)> {
+    let (t0, t1) = match o.sphere {
+        Some((centre, radius)) => {
+            let (s0, s1) = sphere_interval(ray, centre, radius)?;
+            (t0.max(s0), t1.min(s1))
+        }
+        None => (t0, t1),
+    };
+    (t0 <= t1).then_some((t0, t1))
 }
 
 /// Where the ray is inside the sphere, or `None`. The discriminant is computed from the
