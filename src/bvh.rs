@@ -400,12 +400,17 @@ impl Bvh {
         if root_box.slab(origin, inv_dir, t_min, *t_max).is_none() {
             return;
         }
+        // A lone leaf (a one-object scene, a tiny mesh) needs no stack.
+        if root.count > 0 {
+            leaf(root.index, root.count, t_max);
+            return;
+        }
         let ray = RaySplat::new(origin, inv_dir, t_min);
         // Deferred children with their entry distances: a popped child is skipped when it
         // starts beyond the closest hit found since, without testing its box again. A
         // fixed array covers every tree but degenerate ones, which spill to the heap (an
-        // empty `Vec` does not allocate). Its extra slot takes the unconditional write below.
-        let mut stack = [(Child { index: 0, count: 0 }, 0f32); STACK + 1];
+        // empty `Vec` does not allocate).
+        let mut stack = [(Child { index: 0, count: 0 }, 0f32); STACK];
         let mut spill: Vec<(Child, f32)> = Vec::new();
         let mut sp = 0;
         let mut cur = root;
@@ -418,15 +423,18 @@ impl Bvh {
                 *visits += 1;
                 let node = &self.nodes[cur.index as usize];
                 let (enters, near) = ray.enters(node, *t_max);
+                let (next, deferred) = match enters {
+                    0b01 => (node.children[0], None),
+                    0b10 => (node.children[1], None),
+                    0b11 if near.x <= near.y => (node.children[0], Some((node.children[1], near.y))),
+                    0b11 => (node.children[1], Some((node.children[0], near.x))),
+                    _ => (cur, None),
+                };
                 if enters != 0 {
-                    // The nearer child is chosen, and the other written to the stack, without
-                    // branching on their order, which depends on the ray and mispredicts.
-                    let first = (enters == 0b10 || (enters == 0b11 && near.y < near.x)) as usize;
-                    let deferred = (node.children[1 - first], near[1 - first]);
-                    cur = node.children[first];
-                    stack[sp] = deferred;
-                    if enters == 0b11 {
+                    cur = next;
+                    if let Some(deferred) = deferred {
                         if sp < STACK {
+                            stack[sp] = deferred;
                             sp += 1;
                         } else {
                             spill.push(deferred);
