@@ -1,13 +1,13 @@
-//! Criterion benchmarks: one SDF evaluation per primitive, the march (primary rays only,
-//! shading off) over seed scenes 1 and 6, and whole renders of every seed scene at a
-//! reduced size on one thread.
+//! Criterion benchmarks: one SDF evaluation per primitive, primary rays (one by one and
+//! in 2×2 packets, shading off) over seed scenes 1 and 6 and a frame-filling sphere, and
+//! whole renders of every seed scene at a reduced size on one thread.
 
 use std::hint::black_box;
 use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glam::Vec3A;
-use scnc::render::{Counters, Frame, Geometry, Ray};
+use scnc::render::{Counters, Frame, Geometry, Packet, Ray};
 
 fn lower(path: &str, w: u32, h: u32) -> (Frame, scnc::world::World) {
     lower_mode(path, w, h, scnc::world::Mode::Sdf)
@@ -67,12 +67,32 @@ fn march(c: &mut Criterion) {
             (0..256 * 256).map(|i| frame.direction((i % 256) as f32 + 0.5, (i / 256) as f32 + 0.5)).collect();
         group.throughput(Throughput::Elements(dirs.len() as u64));
         let name = Path::new(path).file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-        group.bench_function(BenchmarkId::new(format!("intersect {mode_name}"), name), |b| {
+        group.bench_function(BenchmarkId::new(format!("intersect {mode_name}"), &name), |b| {
             b.iter(|| {
                 let mut counters = Counters::default();
                 dirs.iter()
                     .filter(|d| g.intersect(&Ray::new(Vec3A::ZERO, **d, frame.max_distance), &mut counters).is_some())
                     .count()
+            })
+        });
+        // The same rays as the tracer casts them: 2×2 pixel blocks, one packet each.
+        let blocks: Vec<Packet> = (0..128 * 128)
+            .map(|b| {
+                let (bx, by) = (2 * (b % 128), 2 * (b / 128));
+                let rays: Vec<Ray> = [(0, 0), (1, 0), (0, 1), (1, 1)]
+                    .iter()
+                    .map(|(dx, dy)| Ray::new(Vec3A::ZERO, dirs[(by + dy) * 256 + bx + dx], frame.max_distance))
+                    .collect();
+                Packet::new(&rays)
+            })
+            .collect();
+        group.bench_function(BenchmarkId::new(format!("packets {mode_name}"), &name), |b| {
+            b.iter(|| {
+                let mut counters = Counters::default();
+                blocks
+                    .iter()
+                    .map(|p| g.intersect4(p, &mut counters).iter().filter(|h| h.is_some()).count())
+                    .sum::<usize>()
             })
         });
     }

@@ -145,6 +145,49 @@ impl RaySplat {
     }
 }
 
+/// Four rays in SIMD lanes (structure of arrays) for the packet walk
+/// [`Bvh::each4`]: lane `k` holds ray `k`'s origin, `1 / dir` and `t_min`.
+#[derive(Clone, Copy, Debug)]
+pub struct Rays4 {
+    /// Origin components, one vector per axis.
+    pub origin: [Vec4; 3],
+    /// `1 / dir` components, one vector per axis.
+    pub inv_dir: [Vec4; 3],
+    /// Nearest accepted distance per lane.
+    pub t_min: Vec4,
+}
+
+impl Rays4 {
+    /// Which lanes of `mask` enter `b` before their `t_max`, and the entry distances. Per
+    /// lane this is exactly [`RaySplat::enters`]'s arithmetic for one child (same operand
+    /// order in every `min`/`max`), so a lane enters a box here exactly when the same ray
+    /// traced alone would.
+    #[inline(always)]
+    fn enters(&self, min: [Vec4; 3], max: [Vec4; 3], t_max: Vec4, mask: u32) -> (u32, Vec4) {
+        const ROBUST: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON / (1.0 - 3.0 * f32::EPSILON));
+        let mut near = self.t_min;
+        let mut far = Vec4::INFINITY;
+        for axis in 0..3 {
+            let t0 = (min[axis] - self.origin[axis]) * self.inv_dir[axis];
+            let t1 = (max[axis] - self.origin[axis]) * self.inv_dir[axis];
+            near = max_or(t0.min(t1), near);
+            far = min_or(t0.max(t1), far);
+        }
+        let far = min_or(far * ROBUST, t_max);
+        (near.cmple(far).bitmask() & mask, near)
+    }
+}
+
+/// The planes of child `k` of a node, splat across lanes: `(min, max)` per axis.
+#[inline(always)]
+fn child_planes(node: &Node, k: usize) -> ([Vec4; 3], [Vec4; 3]) {
+    let splat = |v: Vec4, lane: usize| Vec4::splat(v[lane]);
+    (
+        [splat(node.x, k), splat(node.y, k), splat(node.z, k)],
+        [splat(node.x, k + 2), splat(node.y, k + 2), splat(node.z, k + 2)],
+    )
+}
+
 /// `a.max(b)`, or `b` where `a` is NaN: glam's `max` is `maxps(a, b)` on x86_64, which
 /// returns its second operand when either is NaN. (Where it propagates NaN instead, a
 /// NaN lane makes the child a miss, on the same measure-zero set of rays.)
@@ -457,6 +500,100 @@ impl Bvh {
                 };
                 if t_near <= *t_max {
                     cur = next;
+                    break;
+                }
+            }
+        }
+    }
+
+    /// Visits the primitives along four rays at once (a packet of coherent rays):
+    /// `visit(prim, lanes, t_max)` gets each primitive with the mask of lanes that reach
+    /// its leaf, and may lower those lanes' `t_max` to a hit. Each lane is pruned by its
+    /// own `t_max` with the single-ray test's arithmetic, so it reaches every primitive
+    /// it would reach traced alone with its final `t_max`: its closest hit is the one
+    /// [`closest`](Self::closest) finds up to rounding, since leaves come in another
+    /// order (front to back for the packet's lowest lane). Counts one visit per lane per node.
+    #[inline]
+    pub fn each4(
+        &self,
+        rays: &Rays4,
+        mask: u32,
+        t_max: &mut Vec4,
+        visits: &mut u64,
+        mut visit: impl FnMut(u32, u32, &mut Vec4),
+    ) {
+        let Some((root_box, root)) = self.root() else { return };
+        let mut leaf = |first: u32, count: u32, lanes: u32, t_max: &mut Vec4| {
+            for k in first..first + count {
+                visit(self.prim(k), lanes, t_max);
+            }
+        };
+        *visits += u64::from(mask.count_ones());
+        let min = [Vec4::splat(root_box.min.x), Vec4::splat(root_box.min.y), Vec4::splat(root_box.min.z)];
+        let max = [Vec4::splat(root_box.max.x), Vec4::splat(root_box.max.y), Vec4::splat(root_box.max.z)];
+        let (mask, _) = rays.enters(min, max, *t_max, mask);
+        if mask == 0 {
+            return;
+        }
+        if root.count > 0 {
+            leaf(root.index, root.count, mask, t_max);
+            return;
+        }
+        // Deferred children with the lanes that entered them and their entry distances:
+        // on pop, a lane whose closest hit is now nearer than its entry drops out.
+        let mut stack = [(Child { index: 0, count: 0 }, 0u32, Vec4::ZERO); STACK];
+        let mut spill: Vec<(Child, u32, Vec4)> = Vec::new();
+        let mut sp = 0;
+        let (mut cur, mut lanes) = (root, mask);
+        loop {
+            if cur.count > 0 {
+                leaf(cur.index, cur.count, lanes, t_max);
+            } else {
+                *visits += u64::from(lanes.count_ones());
+                let node = &self.nodes[cur.index as usize];
+                let (min0, max0) = child_planes(node, 0);
+                let (min1, max1) = child_planes(node, 1);
+                let (m0, near0) = rays.enters(min0, max0, *t_max, lanes);
+                let (m1, near1) = rays.enters(min1, max1, *t_max, lanes);
+                let entered = match (m0, m1) {
+                    (0, 0) => None,
+                    (_, 0) => Some(((node.children[0], m0), None)),
+                    (0, _) => Some(((node.children[1], m1), None)),
+                    _ => {
+                        // Nearer child first for the lowest lane that enters both; when no
+                        // lane enters both, order saves no lane any work.
+                        let both = m0 & m1;
+                        let (a, b) = ((node.children[0], m0, near0), (node.children[1], m1, near1));
+                        let lane = both.trailing_zeros() as usize & 3;
+                        let (first, second) = if both == 0 || near0[lane] <= near1[lane] { (a, b) } else { (b, a) };
+                        Some(((first.0, first.1), Some(second)))
+                    }
+                };
+                if let Some((next, deferred)) = entered {
+                    (cur, lanes) = next;
+                    if let Some(deferred) = deferred {
+                        if sp < STACK {
+                            stack[sp] = deferred;
+                            sp += 1;
+                        } else {
+                            spill.push(deferred);
+                        }
+                    }
+                    continue;
+                }
+            }
+            loop {
+                let (next, m, near) = match spill.pop() {
+                    Some(entry) => entry,
+                    None if sp > 0 => {
+                        sp -= 1;
+                        stack[sp]
+                    }
+                    None => return,
+                };
+                let m = m & near.cmple(*t_max).bitmask();
+                if m != 0 {
+                    (cur, lanes) = (next, m);
                     break;
                 }
             }

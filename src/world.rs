@@ -5,14 +5,15 @@
 //! **Invariant:** every object lies in render space (camera at the origin); each bounded
 //! object's box and sphere contain its surface, so a ray outside them cannot hit it.
 
-use glam::{DAffine3, Vec3A};
+use glam::{DAffine3, Mat4, Vec3A, Vec4};
 
-use crate::bvh::{Aabb, Bvh};
+use crate::bvh::{Aabb, Bvh, Rays4};
 use crate::check::Loader;
 use crate::diag::Diagnostic;
 use crate::ir;
+use crate::mesh::triangle::Shear4;
 use crate::mesh::{self, MeshMemory, MeshObject};
-use crate::render::{Counters, Frame, Geometry, Hit, Ray};
+use crate::render::{Counters, Frame, Geometry, Hit, Packet, Ray};
 use crate::sdf::{self, MarchParams, SdfObject};
 use crate::span::Span;
 
@@ -333,6 +334,26 @@ fn clip_to_sphere(o: &Object, ray: &Ray, (t0, t1): (f32, f32)) -> Option<(f32, f
     (t0 <= t1).then_some((t0, t1))
 }
 
+/// The lanes of a packet that may reach object `o` before their `t_max`: its bounding
+/// sphere tested for four rays at once, lane by lane the arithmetic of
+/// [`sphere_interval`] and [`clip_to_sphere`] (a mesh object's box is its BVH's root,
+/// which the walk tests anyway).
+#[inline]
+fn sphere_lanes(o: &Object, rays: &Rays4, dir: &[Vec4; 3], t_max: Vec4) -> u32 {
+    let Some((centre, radius)) = o.sphere else { return 0b1111 };
+    let oc = [
+        rays.origin[0] - Vec4::splat(centre.x),
+        rays.origin[1] - Vec4::splat(centre.y),
+        rays.origin[2] - Vec4::splat(centre.z),
+    ];
+    let b = oc[0] * dir[0] + oc[1] * dir[1] + oc[2] * dir[2];
+    let perp = [oc[0] - dir[0] * b, oc[1] - dir[1] * b, oc[2] - dir[2] * b];
+    let disc = Vec4::splat(radius * radius) - (perp[0] * perp[0] + perp[1] * perp[1] + perp[2] * perp[2]);
+    let s = disc.sqrt();
+    let (t0, t1) = (rays.t_min.max(-b - s), t_max.min(-b + s));
+    (disc.cmpge(Vec4::ZERO) & t0.cmple(t1)).bitmask()
+}
+
 /// Where the ray is inside the sphere, or `None`. The discriminant is computed from the
 /// perpendicular distance to the centre (Haines et al., *Ray Tracing Gems* ch. 7), which
 /// stays accurate for distant spheres where `b² − c` would cancel catastrophically.
@@ -368,6 +389,73 @@ impl Geometry for World {
         q.visits = visits;
         q.settle(c);
         self.surface(best?, ray, c)
+    }
+
+    fn intersect4(&self, packet: &Packet, c: &mut Counters) -> [Option<Hit>; 4] {
+        let rays = &packet.rays;
+        // Rays across lanes: each transpose turns four `Vec3A`s into one vector per axis.
+        let across = |f: fn(&Ray) -> Vec3A| {
+            let col = |l: usize| f(&rays[l]).extend(0.0);
+            let m = Mat4::from_cols(col(0), col(1), col(2), col(3)).transpose();
+            [m.x_axis, m.y_axis, m.z_axis]
+        };
+        let (origin, dir) = (across(|r| r.origin), across(|r| r.dir));
+        let Some(shear) = Shear4::new(origin, dir) else {
+            // Directions too far apart to share a shear: trace the lanes one by one.
+            return std::array::from_fn(|l| {
+                (packet.mask & (1 << l) != 0).then(|| self.intersect(&rays[l], c)).flatten()
+            });
+        };
+        let lanes4 = |f: fn(&Ray) -> f32| Vec4::new(f(&rays[0]), f(&rays[1]), f(&rays[2]), f(&rays[3]));
+        let rays4 = Rays4 { origin, inv_dir: across(|r| r.inv_dir), t_min: lanes4(|r| r.t_min) };
+        let mut t_max = lanes4(|r| r.t_max);
+        let mut best: [Option<Found>; 4] = [None; 4];
+        // SDF evaluations per lane; a lane's query is made only if it meets an SDF object.
+        let mut evals = [0u64; 4];
+        let mut visits = 0u64;
+        self.bvh.each4(&rays4, packet.mask, &mut t_max, &mut visits, |k, lanes, t_max| {
+            let i = self.bounded[k as usize];
+            let o = &self.objects[i as usize];
+            match &o.kind {
+                ObjectKind::Mesh(m) => {
+                    let reach = lanes & sphere_lanes(o, &rays4, &dir, *t_max);
+                    if reach == 0 {
+                        return;
+                    }
+                    for (l, hit) in m.closest4(&rays4, &shear, reach, *t_max, c).into_iter().enumerate() {
+                        if let Some((tri, hit)) = hit {
+                            t_max[l] = hit.t;
+                            best[l] = Some(Found::Mesh { object: i, tri, hit });
+                        }
+                    }
+                }
+                ObjectKind::Sdf(_) => {
+                    for l in (0..4).filter(|&l| lanes & (1 << l) != 0) {
+                        let mut q = Query { evals: evals[l], ..Query::new(&rays[l]) };
+                        if let Some(found) = self.find(i, &mut q, t_max[l], c) {
+                            t_max[l] = found.t();
+                            best[l] = Some(found);
+                        }
+                        evals[l] = q.evals;
+                    }
+                }
+            }
+        });
+        c.node_visits += visits;
+        std::array::from_fn(|l| {
+            if packet.mask & (1 << l) == 0 {
+                return None;
+            }
+            let mut q = Query { evals: evals[l], ..Query::new(&rays[l]) };
+            for &i in &self.unbounded {
+                let limit = best[l].map_or(rays[l].t_max, |f| f.t());
+                if let Some(found) = self.find(i, &mut q, limit, c) {
+                    best[l] = Some(found);
+                }
+            }
+            q.settle(c);
+            best[l].and_then(|found| self.surface(found, &rays[l], c))
+        })
     }
 
     fn occluded(&self, ray: &Ray, c: &mut Counters) -> bool {

@@ -13,9 +13,9 @@ pub mod obj;
 pub mod tessellate;
 pub mod triangle;
 
-use glam::{DAffine3, DVec3, Vec3A};
+use glam::{DAffine3, DVec3, Vec3A, Vec4};
 
-use crate::bvh::{Aabb, Bvh};
+use crate::bvh::{Aabb, Bvh, Rays4};
 use crate::render::{Counters, Hit, Ray};
 
 /// An indexed triangle mesh in some frame (local for generators, render space once lowered).
@@ -197,6 +197,33 @@ impl MeshObject {
             let hit = triangle::intersect(ray.origin, shear, a, b, cc, ray.t_min, t_max)?;
             best = Some((i, hit));
             Some(hit.t)
+        });
+        c.triangle_tests += tests;
+        best
+    }
+
+    /// [`closest`](Self::closest) for the rays of a packet in `lanes`, each with its own
+    /// `t_max`: per ray the same closest hit up to rounding, found in one walk of the BVH.
+    pub fn closest4(
+        &self,
+        rays: &Rays4,
+        shear: &triangle::Shear4,
+        lanes: u32,
+        mut t_max: Vec4,
+        c: &mut Counters,
+    ) -> [Option<(u32, triangle::TriHit)>; 4] {
+        let mut best = [None; 4];
+        let mut tests = 0u64;
+        self.bvh.each4(rays, lanes, &mut t_max, &mut c.node_visits, |i, lanes, t_max| {
+            tests += u64::from(lanes.count_ones());
+            let (a, b, cc) = self.tri(i);
+            let Some(hit) = triangle::intersect4(shear, a, b, cc, rays.t_min, *t_max, lanes) else { return };
+            for (l, slot) in best.iter_mut().enumerate() {
+                if hit.mask & (1 << l) != 0 {
+                    t_max[l] = hit.t[l];
+                    *slot = Some((i, hit.lane(l)));
+                }
+            }
         });
         c.triangle_tests += tests;
         best

@@ -6,7 +6,7 @@
 //! between them. Exactly-zero edge functions are recomputed in f64. Both faces are hit
 //! (closed meshes and reflections seen from inside need it); the tracer orients normals.
 
-use glam::{Mat3A, Vec3A};
+use glam::{Mat3A, Vec3A, Vec4};
 
 /// Per-ray constants of the shear transform, as the rows of a matrix: row `x` picks
 /// `p[kx] − sx·p[kz]`, row `y` picks `p[ky] − sy·p[kz]`, row `z` picks `sz·p[kz]`. Each
@@ -17,27 +17,34 @@ pub struct Shear {
     m: Mat3A,
 }
 
+/// The shear's axes for a direction: `kz` the dominant axis, `kx` and `ky` the other
+/// two, swapped when `dir[kz] < 0` to keep the winding consistent.
+#[inline]
+fn axes(dir: Vec3A) -> [usize; 3] {
+    let a = dir.abs();
+    let kz = if a.x > a.y {
+        if a.x > a.z {
+            0
+        } else {
+            2
+        }
+    } else if a.y > a.z {
+        1
+    } else {
+        2
+    };
+    let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
+    if dir[kz] < 0.0 {
+        [ky, kx, kz]
+    } else {
+        [kx, ky, kz]
+    }
+}
+
 impl Shear {
     /// Precomputes the shear for a direction.
     pub fn new(dir: Vec3A) -> Shear {
-        let a = dir.abs();
-        let kz = if a.x > a.y {
-            if a.x > a.z {
-                0
-            } else {
-                2
-            }
-        } else if a.y > a.z {
-            1
-        } else {
-            2
-        };
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        // Swap to keep the winding consistent when the dominant axis points backwards.
-        if dir[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
+        let [kx, ky, kz] = axes(dir);
         let (sx, sy, sz) = (dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]);
         // Column `k` of the matrix holds what row x, y and z take from coordinate `k`.
         let mut cols = [Vec3A::ZERO; 3];
@@ -46,6 +53,120 @@ impl Shear {
         cols[kz] = Vec3A::new(-sx, -sy, sz);
         Shear { m: Mat3A::from_cols(cols[0], cols[1], cols[2]) }
     }
+}
+
+/// The shear of four rays in SIMD lanes, for a packet whose directions share their
+/// dominant axis and its sign (coherent camera rays almost always do).
+#[derive(Clone, Copy, Debug)]
+pub struct Shear4 {
+    k: [usize; 3],
+    /// `sx`, `sy`, `sz` per lane.
+    s: [Vec4; 3],
+    origin: [Vec4; 3],
+}
+
+impl Shear4 {
+    /// The packet shear of four rays given as components across lanes (`origin[axis]`,
+    /// `dir[axis]`), or `None` when their shear axes differ.
+    pub fn new(origin: [Vec4; 3], dir: [Vec4; 3]) -> Option<Shear4> {
+        // `axes` for four lanes at once: the same comparisons, as masks.
+        let [ax, ay, az] = dir.map(Vec4::abs);
+        let (x_over_y, x_over_z, y_over_z) = (ax.cmpgt(ay), ax.cmpgt(az), ay.cmpgt(az));
+        let (x_major, y_major) = ((x_over_y & x_over_z).bitmask(), (!x_over_y & y_over_z).bitmask());
+        let kz = match (x_major, y_major) {
+            (0b1111, _) => 0,
+            (_, 0b1111) => 1,
+            (0, 0) => 2,
+            _ => return None,
+        };
+        let backwards = dir[kz].cmplt(Vec4::ZERO).bitmask();
+        let (kx, ky) = match backwards {
+            0 => ((kz + 1) % 3, (kz + 2) % 3),
+            0b1111 => ((kz + 2) % 3, (kz + 1) % 3),
+            _ => return None,
+        };
+        // Lane-wise the same divisions as `Shear::new`.
+        Some(Shear4 { k: [kx, ky, kz], s: [dir[kx] / dir[kz], dir[ky] / dir[kz], Vec4::ONE / dir[kz]], origin })
+    }
+
+    /// A vertex relative to each lane's origin, sheared (the packet form of `m * (v − o)`).
+    /// The scalar matrix product adds `0·p` terms that this skips; they can only change
+    /// the sign of a zero, never a value, so every lane gets the scalar test's numbers.
+    #[inline(always)]
+    fn apply(&self, v: Vec3A) -> [Vec4; 3] {
+        let d =
+            [Vec4::splat(v.x) - self.origin[0], Vec4::splat(v.y) - self.origin[1], Vec4::splat(v.z) - self.origin[2]];
+        let [kx, ky, kz] = self.k;
+        [d[kx] - self.s[0] * d[kz], d[ky] - self.s[1] * d[kz], self.s[2] * d[kz]]
+    }
+}
+
+/// Hits of four rays on one triangle: the lanes that hit, their distances and barycentric weights.
+#[derive(Clone, Copy, Debug)]
+pub struct TriHit4 {
+    /// Lanes that hit within their `(t_min, t_max)`.
+    pub mask: u32,
+    /// Distance per lane (meaningful where `mask` is set).
+    pub t: Vec4,
+    /// Weights of vertices 0, 1, 2 per lane.
+    pub bary: [Vec4; 3],
+}
+
+impl TriHit4 {
+    /// Lane `l` as a single-ray hit.
+    pub fn lane(&self, l: usize) -> TriHit {
+        TriHit { t: self.t[l], bary: [self.bary[0][l], self.bary[1][l], self.bary[2][l]] }
+    }
+}
+
+/// [`intersect`] for four rays at once, for the lanes in `lanes`: per lane the same
+/// arithmetic, so the same hits, distances and weights as four single tests.
+#[inline]
+pub fn intersect4(
+    shear: &Shear4,
+    v0: Vec3A,
+    v1: Vec3A,
+    v2: Vec3A,
+    t_min: Vec4,
+    t_max: Vec4,
+    lanes: u32,
+) -> Option<TriHit4> {
+    let [ax, ay, az] = shear.apply(v0);
+    let [bx, by, bz] = shear.apply(v1);
+    let [cx, cy, cz] = shear.apply(v2);
+    let mut u = cx * by - cy * bx;
+    let mut v = ax * cy - ay * cx;
+    let mut w = bx * ay - by * ax;
+    let zero = (u.cmpeq(Vec4::ZERO) | v.cmpeq(Vec4::ZERO) | w.cmpeq(Vec4::ZERO)).bitmask() & lanes;
+    if zero != 0 {
+        // Rare: the ray passes through an edge or vertex's projection; redo those lanes in f64.
+        for l in 0..4 {
+            if zero & (1 << l) != 0 {
+                let (a, b, c) = (
+                    glam::DVec3::new(ax[l].into(), ay[l].into(), az[l].into()),
+                    glam::DVec3::new(bx[l].into(), by[l].into(), bz[l].into()),
+                    glam::DVec3::new(cx[l].into(), cy[l].into(), cz[l].into()),
+                );
+                u[l] = (c.x * b.y - c.y * b.x) as f32;
+                v[l] = (a.x * c.y - a.y * c.x) as f32;
+                w[l] = (b.x * a.y - b.y * a.x) as f32;
+            }
+        }
+    }
+    let neg = u.cmplt(Vec4::ZERO) | v.cmplt(Vec4::ZERO) | w.cmplt(Vec4::ZERO);
+    let pos = u.cmpgt(Vec4::ZERO) | v.cmpgt(Vec4::ZERO) | w.cmpgt(Vec4::ZERO);
+    let inside = !(neg & pos).bitmask() & lanes;
+    if inside & 0b1111 == 0 {
+        return None;
+    }
+    let det = u + v + w;
+    let t_scaled = u * az + v * bz + w * cz;
+    let inv = Vec4::ONE / det;
+    let t = t_scaled * inv;
+    // `det` finite and non-zero, `t` inside the open interval; NaN lanes compare false.
+    let ok = det.cmpne(Vec4::ZERO) & det.abs().cmplt(Vec4::INFINITY) & t.cmpgt(t_min) & t.cmplt(t_max);
+    let mask = ok.bitmask() & inside;
+    (mask != 0).then_some(TriHit4 { mask, t, bary: [u * inv, v * inv, w * inv] })
 }
 
 /// A hit: distance and barycentric weights of the three vertices.
@@ -134,5 +255,38 @@ mod tests {
                 assert!(hit, "ray through the shared edge at s = {s} from {origin} slipped through");
             }
         }
+    }
+
+    /// Four lanes give exactly the single test's hits, distances and weights, also for
+    /// rays through a shared edge (where an edge function is zero and f64 decides).
+    #[test]
+    fn four_lanes_match_the_single_test() {
+        let (a, b) = (Vec3A::new(-1.0, -1.0, 3.0), Vec3A::new(1.0, 1.0, 3.0));
+        let (c, d) = (Vec3A::new(1.0, -1.0, 3.0), Vec3A::new(-1.0, 1.0, 3.0));
+        let origin = Vec3A::new(0.3, -0.7, -2.0);
+        let mut checked = [0usize; 2];
+        for i in 0..200 {
+            // Lanes 0 and 1 aim at the shared edge, 2 and 3 around the quad and beyond it.
+            let s = i as f32 / 200.0;
+            let targets = [
+                a + (b - a) * s,
+                a + (b - a) * (1.0 - s),
+                Vec3A::new(2.4 * s - 1.2, 0.7 - 1.3 * s, 3.0),
+                Vec3A::new(0.9 - 2.0 * s, 1.1 * s - 0.2, 3.0),
+            ];
+            let dirs = targets.map(|t| (t - origin).normalize());
+            let across = |v: [Vec3A; 4]| [0, 1, 2].map(|k| Vec4::new(v[0][k], v[1][k], v[2][k], v[3][k]));
+            let shear = Shear4::new(across([origin; 4]), across(dirs)).expect("one dominant axis");
+            for (v0, v1, v2) in [(a, c, b), (a, b, d), (c, b, a)] {
+                let hits = intersect4(&shear, v0, v1, v2, Vec4::ZERO, Vec4::splat(f32::MAX), 0b1111);
+                for (l, dir) in dirs.iter().enumerate() {
+                    let single = intersect(origin, &Shear::new(*dir), v0, v1, v2, 0.0, f32::MAX);
+                    let lane = hits.filter(|h| h.mask & (1 << l) != 0).map(|h| h.lane(l));
+                    assert_eq!(single, lane, "target {} lane {l}", targets[l]);
+                    checked[usize::from(single.is_some())] += 1;
+                }
+            }
+        }
+        assert!(checked[0] > 100 && checked[1] > 100, "hits and misses both tested: {checked:?}");
     }
 }

@@ -45,6 +45,25 @@ impl Ray {
     }
 }
 
+/// Up to four rays traced together (a 2×2 block of camera rays). Lane `k` is wanted when
+/// bit `k` of `mask` is set; an unwanted lane holds a copy of a wanted ray, so every lane
+/// is a valid ray and a back-end may trace all four.
+#[derive(Clone, Copy, Debug)]
+pub struct Packet {
+    /// The rays, one per lane.
+    pub rays: [Ray; 4],
+    /// Wanted lanes.
+    pub mask: u32,
+}
+
+impl Packet {
+    /// A packet of one to four rays (lanes beyond `rays.len()` are unwanted copies of the last).
+    pub fn new(rays: &[Ray]) -> Packet {
+        assert!((1..=4).contains(&rays.len()), "a packet holds one to four rays");
+        Packet { rays: std::array::from_fn(|l| rays[l.min(rays.len() - 1)]), mask: (1 << rays.len()) - 1 }
+    }
+}
+
 /// A surface hit.
 #[derive(Clone, Copy, Debug)]
 pub struct Hit {
@@ -80,9 +99,10 @@ pub struct Counters {
     pub max_evals_per_ray: u64,
     /// Marches that ran out of steps before deciding (counted as misses).
     pub budget_misses: u64,
-    /// BVH nodes visited.
+    /// BVH nodes visited (a node a packet visits counts once for each ray in it that
+    /// enters it, so per-ray numbers compare with single rays).
     pub node_visits: u64,
-    /// Ray–triangle tests (mesh back-end).
+    /// Ray–triangle tests (mesh back-end; a packet's test counts once per ray in it).
     pub triangle_tests: u64,
     /// Samples whose colour was not finite (always 0 unless there is a bug; such a
     /// sample is written as black).
@@ -115,6 +135,15 @@ impl Counters {
 pub trait Geometry: Sync {
     /// The closest hit along the ray within `[t_min, t_max]`.
     fn intersect(&self, ray: &Ray, counters: &mut Counters) -> Option<Hit>;
+    /// [`intersect`](Self::intersect) for each wanted lane of a packet (`None` for the
+    /// others). A back-end may share work between the lanes, but each lane must hit or
+    /// miss as its ray does alone, at the same distance up to rounding; only where two
+    /// surfaces tie within rounding (a ray through an edge) may it return the other one.
+    fn intersect4(&self, packet: &Packet, counters: &mut Counters) -> [Option<Hit>; 4] {
+        std::array::from_fn(|l| {
+            (packet.mask & (1 << l) != 0).then(|| self.intersect(&packet.rays[l], counters)).flatten()
+        })
+    }
     /// Whether anything lies along the ray within `[t_min, t_max]` (for shadows).
     fn occluded(&self, ray: &Ray, counters: &mut Counters) -> bool;
     /// The unblocked fraction of a cone of half-angle `atan(cone)` around the ray (a soft
@@ -170,17 +199,28 @@ fn rows<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const AO
     progress: &(dyn Fn() + Sync),
 ) -> (Image, Counters) {
     let (w, h) = (frame.width, frame.height);
-    let rows: Vec<(Vec<u8>, Counters)> = (0..h)
+    // Rows go in pairs, so camera rays can be cast as 2×2 packets.
+    let rows: Vec<(Vec<u8>, Counters)> = (0..h.div_ceil(2))
         .into_par_iter()
-        .map(|y| {
+        .flat_map_iter(|pair| {
+            let (y, rows_here) = (2 * pair, (h - 2 * pair).min(2));
             let mut c = Counters::default();
-            let mut row = Vec::with_capacity(w as usize * 3);
-            for x in 0..w {
-                let colour = shade::pixel::<SHADOWS, REFLECT, SPECULAR, AO>(geometry, frame, x, y, &mut c);
-                row.extend_from_slice(&colour);
+            let mut top = Vec::with_capacity(w as usize * 3);
+            let mut bottom = Vec::with_capacity(if rows_here == 2 { w as usize * 3 } else { 0 });
+            for x in (0..w).step_by(2) {
+                let cols = (w - x).min(2);
+                let px =
+                    shade::block::<SHADOWS, REFLECT, SPECULAR, AO>(geometry, frame, (x, y), (cols, rows_here), &mut c);
+                top.extend(px[..cols as usize].iter().flatten());
+                if rows_here == 2 {
+                    bottom.extend(px[cols as usize..2 * cols as usize].iter().flatten());
+                }
             }
-            progress();
-            (row, c)
+            for _ in 0..rows_here {
+                progress();
+            }
+            let bottom = (rows_here == 2).then_some((bottom, Counters::default()));
+            std::iter::once((top, c)).chain(bottom)
         })
         .collect();
     let mut counters = Counters::default();

@@ -10,34 +10,46 @@
 
 use glam::Vec3A;
 
-use super::{spawn_offset, Counters, Frame, Geometry, Ray, ShadeLight};
+use super::{spawn_offset, Counters, Frame, Geometry, Hit, Packet, Ray, ShadeLight};
 
-/// The 8-bit colour of pixel `(x, y)`, averaging `frame.samples` deterministic samples.
-pub(super) fn pixel<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const AO: bool>(
+/// The 8-bit colours of a block of up to 2×2 pixels from `(x, y)`, `w` wide and `h` high,
+/// each averaging `frame.samples` deterministic samples. Each sample's camera rays go
+/// to the back-end as one packet; each pixel is then shaded on its own (secondary rays
+/// go one by one). Pixels come back row by row.
+pub(super) fn block<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const AO: bool>(
     g: &dyn Geometry,
     frame: &Frame,
-    x: u32,
-    y: u32,
+    (x, y): (u32, u32),
+    (w, h): (u32, u32),
     c: &mut Counters,
-) -> [u8; 3] {
+) -> [[u8; 3]; 4] {
     let n = frame.samples.max(1);
-    let mut sum = Vec3A::ZERO;
+    let count = (w * h) as usize;
+    let pixel = |l: usize| (x + l as u32 % w, y + l as u32 / w);
+    let mut sums = [Vec3A::ZERO; 4];
     for s in 0..n {
         let (ox, oy) = sample_offset(s, n);
-        let dir = frame.direction(x as f32 + ox, y as f32 + oy);
-        c.primary_rays += 1;
-        let ray = Ray::new(Vec3A::ZERO, dir, frame.max_distance);
-        let mut colour = trace::<SHADOWS, REFLECT, SPECULAR, AO>(g, frame, &ray, frame.depth, c);
-        if !colour.is_finite() {
-            c.nonfinite_samples += 1;
-            colour = Vec3A::ZERO;
+        let rays: [Ray; 4] = std::array::from_fn(|l| {
+            let (px, py) = pixel(l.min(count - 1));
+            Ray::new(Vec3A::ZERO, frame.direction(px as f32 + ox, py as f32 + oy), frame.max_distance)
+        });
+        c.primary_rays += count as u64;
+        let hits = g.intersect4(&Packet::new(&rays[..count]), c);
+        for l in 0..count {
+            let mut colour = shade::<SHADOWS, REFLECT, SPECULAR, AO>(g, frame, &rays[l], hits[l], frame.depth, c);
+            if !colour.is_finite() {
+                c.nonfinite_samples += 1;
+                colour = Vec3A::ZERO;
+            }
+            sums[l] += colour.clamp(Vec3A::ZERO, Vec3A::splat(255.0));
         }
-        sum += colour.clamp(Vec3A::ZERO, Vec3A::splat(255.0));
     }
-    let avg = if n == 1 { sum } else { sum * (1.0 / n as f32) };
-    // Values are in [0, 255], so adding one half and truncating rounds to nearest.
-    let q = avg + 0.5;
-    [q.x as u8, q.y as u8, q.z as u8]
+    sums.map(|sum| {
+        let avg = if n == 1 { sum } else { sum * (1.0 / n as f32) };
+        // Values are in [0, 255], so adding one half and truncating rounds to nearest.
+        let q = avg + 0.5;
+        [q.x as u8, q.y as u8, q.z as u8]
+    })
 }
 
 /// Sample positions inside the pixel: its centre for one sample, else the R2
@@ -149,14 +161,27 @@ fn occlusion(g: &dyn Geometry, origin: Vec3A, normal: Vec3A, reach: f32, c: &mut
 }
 
 /// The colour seen along `ray`, 0–255 per channel but not yet clamped.
-pub(super) fn trace<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const AO: bool>(
+fn trace<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const AO: bool>(
     g: &dyn Geometry,
     frame: &Frame,
     ray: &Ray,
     depth: u32,
     c: &mut Counters,
 ) -> Vec3A {
-    let Some(hit) = g.intersect(ray, c) else {
+    let hit = g.intersect(ray, c);
+    shade::<SHADOWS, REFLECT, SPECULAR, AO>(g, frame, ray, hit, depth, c)
+}
+
+/// The colour seen along `ray` given what it hit (`None`: the background).
+fn shade<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const AO: bool>(
+    g: &dyn Geometry,
+    frame: &Frame,
+    ray: &Ray,
+    hit: Option<Hit>,
+    depth: u32,
+    c: &mut Counters,
+) -> Vec3A {
+    let Some(hit) = hit else {
         return frame.background;
     };
     let view = -ray.dir;

@@ -1,8 +1,9 @@
 //! The mesh back-end: BVH against brute force, watertightness, agreement with the SDF back-end.
 
 use glam::{DAffine3, DVec3, Vec3A};
+use scnc::bvh::Rays4;
 use scnc::mesh::{tessellate, triangle, MeshObject, TriMesh};
-use scnc::render::{Counters, Geometry, Ray};
+use scnc::render::{Counters, Geometry, Packet, Ray};
 use scnc::world::{Detail, Mode};
 
 use crate::support::{compile, Rng};
@@ -162,5 +163,121 @@ fn mesh_high_coverage_agrees_with_sdf() {
         }
         let allowed = (SIZE * SIZE) as usize / 200;
         assert!(differing <= allowed, "{}: {differing} pixels differ in coverage (at most {allowed})", path.display());
+    }
+}
+
+/// Each lane of a camera-ray packet finds what its ray finds traced alone, for every seed
+/// scene in all three modes, for full and partial packets: hit or miss exactly, the
+/// distance up to rounding, and the same surface except where a ray meets an edge and
+/// two faces tie within rounding (then either face is correct; the walks visit leaves
+/// in different orders). Rays from different points, or spread too wide to share a
+/// shear, take the single-ray path and agree exactly.
+#[test]
+fn packets_agree_with_single_rays() {
+    const SIZE: u32 = 128;
+    let mut rng = Rng(0x9ac4_e7a1);
+    for path in crate::support::cases("examples/seed") {
+        if path.file_name().is_some_and(|n| n == "lights.scn") {
+            continue;
+        }
+        for mode in [Mode::Sdf, Mode::Mesh(Detail::Low), Mode::Mesh(Detail::High)] {
+            let c = compile(&path);
+            let mut scene = c.scene.expect("seed scene compiles");
+            scene.settings.width = SIZE;
+            scene.settings.height = SIZE;
+            let (frame, world) =
+                scnc::world::prepare(&scene, scnc::effects::derive(&scene), mode, &scnc::check::FsLoader)
+                    .expect("lowering");
+            let ray = |x: u32, y: u32| {
+                Ray::new(Vec3A::ZERO, frame.direction(x as f32 + 0.5, y as f32 + 0.5), frame.max_distance)
+            };
+            let (mut lanes, mut ties) = (0usize, 0usize);
+            let mut c = Counters::default();
+            for by in (0..SIZE).step_by(2) {
+                for bx in (0..SIZE).step_by(2) {
+                    let mut rays = vec![ray(bx, by), ray(bx + 1, by), ray(bx, by + 1), ray(bx + 1, by + 1)];
+                    // Some packets partial, some spread over the whole frame (the fallback).
+                    match rng.below(8) {
+                        0 => rays.truncate(1 + rng.below(3)),
+                        1 => rays[3] = ray(rng.below(SIZE as usize) as u32, rng.below(SIZE as usize) as u32),
+                        _ => {}
+                    }
+                    let packet = Packet::new(&rays);
+                    let hits = world.intersect4(&packet, &mut c);
+                    for (l, r) in rays.iter().enumerate() {
+                        let alone = world.intersect(r, &mut c);
+                        lanes += 1;
+                        let at = format!("{} {mode:?} block ({bx}, {by}) lane {l}", path.display());
+                        match (alone, hits[l]) {
+                            (None, None) => {}
+                            (Some(a), Some(p)) => {
+                                assert!(
+                                    (a.t - p.t).abs() <= a.t * 1e-6,
+                                    "{at}: distance {} alone, {} in a packet",
+                                    a.t,
+                                    p.t
+                                );
+                                if a.normal != p.normal || a.material != p.material {
+                                    ties += 1;
+                                }
+                            }
+                            (a, p) => panic!("{at}: {} alone, {} in a packet", a.is_some(), p.is_some()),
+                        }
+                    }
+                    assert!(hits[rays.len()..].iter().all(Option::is_none), "unwanted lanes return nothing");
+                }
+            }
+            assert!(ties <= lanes / 1000, "{} {mode:?}: {ties} of {lanes} lanes found another surface", path.display());
+        }
+    }
+}
+
+/// The packet walk of a mesh finds exactly the brute-force closest hit for every lane,
+/// on random triangle soups, with coherent rays from one origin as the camera casts them.
+#[test]
+fn packet_closest_hit_equals_brute_force() {
+    let mut rng = Rng(0x5eed_4a11);
+    for (n, spread) in [(1usize, 1.0f32), (60, 2.0), (3000, 4.0)] {
+        let mut mesh = TriMesh::default();
+        for _ in 0..n {
+            let centre = rng.vec(spread);
+            let base = mesh.positions.len() as u32;
+            for _ in 0..3 {
+                mesh.positions.push((centre + rng.vec(0.3)).as_dvec3());
+            }
+            mesh.triangles.push([base, base + 1, base + 2]);
+        }
+        let obj = MeshObject::new(&mesh, DAffine3::IDENTITY, 0, None, false);
+        let (mut packets, mut fallbacks) = (0, 0);
+        for _ in 0..1000 {
+            let origin = rng.vec(spread * 2.0);
+            let aim = rng.vec(spread) - origin;
+            let rays: [Ray; 4] = std::array::from_fn(|_| {
+                Ray::new(origin, (aim + rng.vec(0.05 * spread)).try_normalize().unwrap_or(Vec3A::Z), 1e4)
+            });
+            let lanes4 = |f: &dyn Fn(&Ray) -> f32| glam::Vec4::new(f(&rays[0]), f(&rays[1]), f(&rays[2]), f(&rays[3]));
+            let origin4 = [lanes4(&|r| r.origin.x), lanes4(&|r| r.origin.y), lanes4(&|r| r.origin.z)];
+            let dir4 = [lanes4(&|r| r.dir.x), lanes4(&|r| r.dir.y), lanes4(&|r| r.dir.z)];
+            let Some(shear) = triangle::Shear4::new(origin4, dir4) else {
+                fallbacks += 1;
+                continue;
+            };
+            packets += 1;
+            let rays4 = Rays4 {
+                origin: origin4,
+                inv_dir: [lanes4(&|r| r.inv_dir.x), lanes4(&|r| r.inv_dir.y), lanes4(&|r| r.inv_dir.z)],
+                t_min: lanes4(&|r| r.t_min),
+            };
+            let mut c = Counters::default();
+            let hits = obj.closest4(&rays4, &shear, 0b1111, lanes4(&|r| r.t_max), &mut c);
+            for (l, ray) in rays.iter().enumerate() {
+                assert_eq!(hits[l].map(|(_, h)| h.t), brute_force(&mesh, ray), "{n} triangles, lane {l}: {ray:?}");
+            }
+        }
+        assert!(
+            packets > 10 * fallbacks,
+            "{n} triangles: {fallbacks} of {} packets could not share a shear",
+            packets + fallbacks
+        );
     }
 }
