@@ -202,6 +202,44 @@ fn min_or(a: Vec4, b: Vec4) -> Vec4 {
     a.min(b)
 }
 
+/// The children a walk deferred, last in first out: a fixed array covers every tree but
+/// degenerate ones, which spill to the heap (an empty `Vec` does not allocate).
+struct Deferred<T> {
+    fixed: [T; STACK],
+    len: usize,
+    spill: Vec<T>,
+}
+
+impl<T: Copy> Deferred<T> {
+    #[inline(always)]
+    fn new(fill: T) -> Deferred<T> {
+        Deferred { fixed: [fill; STACK], len: 0, spill: Vec::new() }
+    }
+
+    #[inline(always)]
+    fn push(&mut self, item: T) {
+        if self.len < STACK {
+            self.fixed[self.len] = item;
+            self.len += 1;
+        } else {
+            self.spill.push(item);
+        }
+    }
+
+    /// The last pushed: the spill holds the newest entries whenever it is not empty.
+    #[inline(always)]
+    fn pop(&mut self) -> Option<T> {
+        match self.spill.pop() {
+            Some(item) => Some(item),
+            None if self.len > 0 => {
+                self.len -= 1;
+                Some(self.fixed[self.len])
+            }
+            None => None,
+        }
+    }
+}
+
 /// The hierarchy.
 #[derive(Clone, Debug)]
 pub struct Bvh {
@@ -452,12 +490,8 @@ impl Bvh {
         }
         let ray = RaySplat::new(origin, inv_dir, t_min);
         // Deferred children with their entry distances: a popped child is skipped when it
-        // starts beyond the closest hit found since, without testing its box again. A
-        // fixed array covers every tree but degenerate ones, which spill to the heap (an
-        // empty `Vec` does not allocate).
-        let mut stack = [(Child { index: 0, count: 0 }, 0f32); STACK];
-        let mut spill: Vec<(Child, f32)> = Vec::new();
-        let mut sp = 0;
+        // starts beyond the closest hit found since, without testing its box again.
+        let mut deferred_children = Deferred::new((Child { index: 0, count: 0 }, 0f32));
         let mut cur = root;
         loop {
             if cur.count > 0 {
@@ -479,25 +513,13 @@ impl Bvh {
                     };
                     cur = next;
                     if let Some(deferred) = deferred {
-                        if sp < STACK {
-                            stack[sp] = deferred;
-                            sp += 1;
-                        } else {
-                            spill.push(deferred);
-                        }
+                        deferred_children.push(deferred);
                     }
                     continue;
                 }
             }
             loop {
-                let (next, t_near) = match spill.pop() {
-                    Some(entry) => entry,
-                    None if sp > 0 => {
-                        sp -= 1;
-                        stack[sp]
-                    }
-                    None => return,
-                };
+                let Some((next, t_near)) = deferred_children.pop() else { return };
                 if t_near <= *t_max {
                     cur = next;
                     break;
@@ -541,9 +563,7 @@ impl Bvh {
         }
         // Deferred children with the lanes that entered them and their entry distances:
         // on pop, a lane whose closest hit is now nearer than its entry drops out.
-        let mut stack = [(Child { index: 0, count: 0 }, 0u32, Vec4::ZERO); STACK];
-        let mut spill: Vec<(Child, u32, Vec4)> = Vec::new();
-        let mut sp = 0;
+        let mut deferred_children = Deferred::new((Child { index: 0, count: 0 }, 0u32, Vec4::ZERO));
         let (mut cur, mut lanes) = (root, mask);
         loop {
             if cur.count > 0 {
@@ -572,25 +592,13 @@ impl Bvh {
                 if let Some((next, deferred)) = entered {
                     (cur, lanes) = next;
                     if let Some(deferred) = deferred {
-                        if sp < STACK {
-                            stack[sp] = deferred;
-                            sp += 1;
-                        } else {
-                            spill.push(deferred);
-                        }
+                        deferred_children.push(deferred);
                     }
                     continue;
                 }
             }
             loop {
-                let (next, m, near) = match spill.pop() {
-                    Some(entry) => entry,
-                    None if sp > 0 => {
-                        sp -= 1;
-                        stack[sp]
-                    }
-                    None => return,
-                };
+                let Some((next, m, near)) = deferred_children.pop() else { return };
                 let m = m & near.cmple(*t_max).bitmask();
                 if m != 0 {
                     (cur, lanes) = (next, m);

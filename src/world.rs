@@ -268,6 +268,21 @@ impl World {
         }
     }
 
+    /// Completes a ray's closest-hit query: the unbounded objects (outside the top-level
+    /// tree) are tried up to the tree's closest hit, then the counters are settled and the
+    /// winner's surface is computed.
+    #[inline(always)]
+    fn finish(&self, q: &mut Query<'_>, mut best: Option<Found>, c: &mut Counters) -> Option<Hit> {
+        for &i in &self.unbounded {
+            let limit = best.map_or(q.ray.t_max, |f| f.t());
+            if let Some(found) = self.find(i, q, limit, c) {
+                best = Some(found);
+            }
+        }
+        q.settle(c);
+        self.surface(best?, q.ray, c)
+    }
+
     fn blocks(&self, i: u32, q: &mut Query<'_>, t_max: f32, c: &mut Counters) -> bool {
         let o = &self.objects[i as usize];
         match &o.kind {
@@ -314,7 +329,7 @@ impl<'a> Query<'a> {
     }
 
     /// Adds this query's work to the counters.
-    fn settle(self, c: &mut Counters) {
+    fn settle(&self, c: &mut Counters) {
         c.node_visits += self.visits;
         c.sdf_evals += self.evals;
         c.max_evals_per_ray = c.max_evals_per_ray.max(self.evals);
@@ -385,15 +400,8 @@ impl Geometry for World {
             best = Some(found);
             Some(found.t())
         });
-        for &i in &self.unbounded {
-            let limit = best.map_or(ray.t_max, |f| f.t());
-            if let Some(found) = self.find(i, &mut q, limit, c) {
-                best = Some(found);
-            }
-        }
         q.visits = visits;
-        q.settle(c);
-        self.surface(best?, ray, c)
+        self.finish(&mut q, best, c)
     }
 
     fn intersect4(&self, packet: &Packet, c: &mut Counters) -> [Option<Hit>; 4] {
@@ -451,15 +459,7 @@ impl Geometry for World {
         // A loop, not `array::from_fn` (see `intersect_each`).
         let mut hits = [None; 4];
         for (l, hit) in hits.iter_mut().enumerate().filter(|(l, _)| packet.mask & (1 << l) != 0) {
-            let mut q = Query { evals: evals[l], ..Query::new(&rays[l]) };
-            for &i in &self.unbounded {
-                let limit = best[l].map_or(rays[l].t_max, |f| f.t());
-                if let Some(found) = self.find(i, &mut q, limit, c) {
-                    best[l] = Some(found);
-                }
-            }
-            q.settle(c);
-            *hit = best[l].and_then(|found| self.surface(found, &rays[l], c));
+            *hit = self.finish(&mut Query { evals: evals[l], ..Query::new(&rays[l]) }, best[l], c);
         }
         hits
     }

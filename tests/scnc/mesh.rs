@@ -18,21 +18,27 @@ fn brute_force(mesh: &TriMesh, ray: &Ray) -> Option<f32> {
         .reduce(f32::min)
 }
 
+/// `n` separate random triangles about `spread` around the origin.
+fn soup(rng: &mut Rng, n: usize, spread: f32) -> TriMesh {
+    let mut mesh = TriMesh::default();
+    for _ in 0..n {
+        let centre = rng.vec(spread);
+        let base = mesh.positions.len() as u32;
+        for _ in 0..3 {
+            mesh.positions.push((centre + rng.vec(0.3)).as_dvec3());
+        }
+        mesh.triangles.push([base, base + 1, base + 2]);
+    }
+    mesh
+}
+
 /// The BVH's closest hit is exactly the brute-force closest hit, on random triangle soups
 /// of several sizes (so leaves, deep trees and empty space all occur).
 #[test]
 fn bvh_closest_hit_equals_brute_force() {
     let mut rng = Rng(0x0b5e_55ed);
     for (n, spread) in [(1usize, 1.0f32), (7, 1.0), (60, 2.0), (500, 3.0), (3000, 4.0)] {
-        let mut mesh = TriMesh::default();
-        for _ in 0..n {
-            let centre = rng.vec(spread);
-            let base = mesh.positions.len() as u32;
-            for _ in 0..3 {
-                mesh.positions.push((centre + rng.vec(0.3)).as_dvec3());
-            }
-            mesh.triangles.push([base, base + 1, base + 2]);
-        }
+        let mesh = soup(&mut rng, n, spread);
         let obj = MeshObject::new(&mesh, DAffine3::IDENTITY, 0, None, false);
         for _ in 0..2000 {
             let origin = rng.vec(spread * 2.0);
@@ -238,15 +244,7 @@ fn packets_agree_with_single_rays() {
 fn packet_closest_hit_equals_brute_force() {
     let mut rng = Rng(0x5eed_4a11);
     for (n, spread) in [(1usize, 1.0f32), (60, 2.0), (3000, 4.0)] {
-        let mut mesh = TriMesh::default();
-        for _ in 0..n {
-            let centre = rng.vec(spread);
-            let base = mesh.positions.len() as u32;
-            for _ in 0..3 {
-                mesh.positions.push((centre + rng.vec(0.3)).as_dvec3());
-            }
-            mesh.triangles.push([base, base + 1, base + 2]);
-        }
+        let mesh = soup(&mut rng, n, spread);
         let obj = MeshObject::new(&mesh, DAffine3::IDENTITY, 0, None, false);
         let (mut packets, mut fallbacks) = (0, 0);
         for _ in 0..1000 {
