@@ -178,6 +178,12 @@ impl Rays4 {
     }
 }
 
+/// A point in every lane: one vector per axis, as [`Rays4`] holds its components.
+#[inline(always)]
+pub fn splat3(p: Vec3A) -> [Vec4; 3] {
+    [Vec4::splat(p.x), Vec4::splat(p.y), Vec4::splat(p.z)]
+}
+
 /// The planes of child `k` of a node, splat across lanes: `(min, max)` per axis.
 #[inline(always)]
 fn child_planes(node: &Node, k: usize) -> ([Vec4; 3], [Vec4; 3]) {
@@ -551,9 +557,7 @@ impl Bvh {
             }
         };
         *visits += u64::from(mask.count_ones());
-        let min = [Vec4::splat(root_box.min.x), Vec4::splat(root_box.min.y), Vec4::splat(root_box.min.z)];
-        let max = [Vec4::splat(root_box.max.x), Vec4::splat(root_box.max.y), Vec4::splat(root_box.max.z)];
-        let (mask, _) = rays.enters(min, max, *t_max, mask);
+        let (mask, _) = rays.enters(splat3(root_box.min), splat3(root_box.max), *t_max, mask);
         if mask == 0 {
             return;
         }

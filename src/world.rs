@@ -7,7 +7,7 @@
 
 use glam::{DAffine3, Mat4, Vec3A, Vec4};
 
-use crate::bvh::{Aabb, Bvh, Rays4};
+use crate::bvh::{splat3, Aabb, Bvh, Rays4};
 use crate::check::Loader;
 use crate::diag::Diagnostic;
 use crate::ir;
@@ -361,11 +361,8 @@ fn clip_to_sphere(o: &Object, ray: &Ray, (t0, t1): (f32, f32)) -> Option<(f32, f
 #[inline]
 fn sphere_lanes(o: &Object, rays: &Rays4, dir: &[Vec4; 3], t_max: Vec4) -> u32 {
     let Some((centre, radius)) = o.sphere else { return 0b1111 };
-    let oc = [
-        rays.origin[0] - Vec4::splat(centre.x),
-        rays.origin[1] - Vec4::splat(centre.y),
-        rays.origin[2] - Vec4::splat(centre.z),
-    ];
+    let centre = splat3(centre);
+    let oc = [rays.origin[0] - centre[0], rays.origin[1] - centre[1], rays.origin[2] - centre[2]];
     let b = oc[0] * dir[0] + oc[1] * dir[1] + oc[2] * dir[2];
     let perp = [oc[0] - dir[0] * b, oc[1] - dir[1] * b, oc[2] - dir[2] * b];
     let disc = Vec4::splat(radius * radius) - (perp[0] * perp[0] + perp[1] * perp[1] + perp[2] * perp[2]);
@@ -416,43 +413,39 @@ impl Geometry for World {
             [m.x_axis, m.y_axis, m.z_axis]
         };
         let (origin, dir) = (across(|r| r.origin), across(|r| r.dir));
-        let Some(shear) = Shear4::new(origin, dir) else {
-            // Directions too far apart to share a shear: trace the lanes one by one.
-            return intersect_each(self, packet, c);
-        };
+        // Only the 4-wide triangle test needs the lanes to share a shear; without one
+        // (directions too far apart) meshes are tested lane by lane like SDF objects.
+        let shear = if self.has_meshes { Shear4::new(origin, dir) } else { None };
         let lanes4 = |f: fn(&Ray) -> f32| Vec4::new(f(&rays[0]), f(&rays[1]), f(&rays[2]), f(&rays[3]));
         let rays4 = Rays4 { origin, inv_dir: across(|r| r.inv_dir), t_min: lanes4(|r| r.t_min) };
         let mut t_max = lanes4(|r| r.t_max);
         let mut best: [Option<Found>; 4] = [None; 4];
-        // SDF evaluations per lane; a lane's query is made only if it meets an SDF object.
+        // SDF evaluations per lane; a lane's query is made only for an object tested lane by lane.
         let mut evals = [0u64; 4];
         let mut visits = 0u64;
         self.bvh.each4(&rays4, packet.mask, &mut t_max, &mut visits, |k, lanes, t_max| {
             let i = self.bounded[k as usize];
             let o = &self.objects[i as usize];
-            match &o.kind {
-                ObjectKind::Mesh(m) => {
-                    let reach = lanes & sphere_lanes(o, &rays4, &dir, *t_max);
-                    if reach == 0 {
-                        return;
-                    }
-                    for (l, hit) in m.closest4(&rays4, &shear, reach, *t_max, c).into_iter().enumerate() {
-                        if let Some((tri, hit)) = hit {
-                            t_max[l] = hit.t;
-                            best[l] = Some(Found::Mesh { object: i, tri, hit });
-                        }
+            if let (ObjectKind::Mesh(m), Some(shear)) = (&o.kind, &shear) {
+                let reach = lanes & sphere_lanes(o, &rays4, &dir, *t_max);
+                if reach == 0 {
+                    return;
+                }
+                for (l, hit) in m.closest4(&rays4, shear, reach, *t_max, c).into_iter().enumerate() {
+                    if let Some((tri, hit)) = hit {
+                        t_max[l] = hit.t;
+                        best[l] = Some(Found::Mesh { object: i, tri, hit });
                     }
                 }
-                ObjectKind::Sdf(_) => {
-                    for l in (0..4).filter(|&l| lanes & (1 << l) != 0) {
-                        let mut q = Query { evals: evals[l], ..Query::new(&rays[l]) };
-                        if let Some(found) = self.find(i, &mut q, t_max[l], c) {
-                            t_max[l] = found.t();
-                            best[l] = Some(found);
-                        }
-                        evals[l] = q.evals;
-                    }
+                return;
+            }
+            for l in (0..4).filter(|&l| lanes & (1 << l) != 0) {
+                let mut q = Query { evals: evals[l], ..Query::new(&rays[l]) };
+                if let Some(found) = self.find(i, &mut q, t_max[l], c) {
+                    t_max[l] = found.t();
+                    best[l] = Some(found);
                 }
+                evals[l] = q.evals;
             }
         });
         c.node_visits += visits;

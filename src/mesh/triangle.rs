@@ -6,6 +6,8 @@
 //! between them. Exactly-zero edge functions are recomputed in f64. Both faces are hit
 //! (closed meshes and reflections seen from inside need it); the tracer orients normals.
 
+use std::ops::{Mul, Sub};
+
 use glam::{Mat3A, Vec3A, Vec4};
 
 /// Per-ray constants of the shear transform, as the rows of a matrix: row `x` picks
@@ -53,6 +55,26 @@ impl Shear {
         cols[kz] = Vec3A::new(-sx, -sy, sz);
         Shear { m: Mat3A::from_cols(cols[0], cols[1], cols[2]) }
     }
+}
+
+/// The three edge functions of a sheared triangle `a b c` from the x and y of its
+/// vertices: one definition for the f32 test, its f64 redo and the 4-wide test, so that
+/// all three compute exactly the same expressions.
+#[inline(always)]
+fn edge_functions<T: Copy + Mul<Output = T> + Sub<Output = T>>(
+    (ax, ay): (T, T),
+    (bx, by): (T, T),
+    (cx, cy): (T, T),
+) -> [T; 3] {
+    [cx * by - cy * bx, ax * cy - ay * cx, bx * ay - by * ax]
+}
+
+/// The edge functions redone in f64, for a ray through an edge or vertex's projection,
+/// where f32 rounds one of them to exactly zero.
+#[inline(never)]
+fn edge_functions_f64(a: (f32, f32), b: (f32, f32), c: (f32, f32)) -> [f32; 3] {
+    let wide = |(x, y): (f32, f32)| (f64::from(x), f64::from(y));
+    edge_functions(wide(a), wide(b), wide(c)).map(|e| e as f32)
 }
 
 /// The shear of four rays in SIMD lanes, for a packet whose directions share their
@@ -134,29 +156,18 @@ pub fn intersect4(
     let [ax, ay, az] = shear.apply(v0);
     let [bx, by, bz] = shear.apply(v1);
     let [cx, cy, cz] = shear.apply(v2);
-    let mut u = cx * by - cy * bx;
-    let mut v = ax * cy - ay * cx;
-    let mut w = bx * ay - by * ax;
+    let [mut u, mut v, mut w] = edge_functions((ax, ay), (bx, by), (cx, cy));
     let zero = (u.cmpeq(Vec4::ZERO) | v.cmpeq(Vec4::ZERO) | w.cmpeq(Vec4::ZERO)).bitmask() & lanes;
     if zero != 0 {
-        // Rare: the ray passes through an edge or vertex's projection; redo those lanes in f64.
-        for l in 0..4 {
-            if zero & (1 << l) != 0 {
-                let (a, b, c) = (
-                    glam::DVec3::new(ax[l].into(), ay[l].into(), az[l].into()),
-                    glam::DVec3::new(bx[l].into(), by[l].into(), bz[l].into()),
-                    glam::DVec3::new(cx[l].into(), cy[l].into(), cz[l].into()),
-                );
-                u[l] = (c.x * b.y - c.y * b.x) as f32;
-                v[l] = (a.x * c.y - a.y * c.x) as f32;
-                w[l] = (b.x * a.y - b.y * a.x) as f32;
-            }
+        // Rare: the ray passes through an edge or vertex's projection.
+        for l in (0..4).filter(|l| zero & (1 << l) != 0) {
+            [u[l], v[l], w[l]] = edge_functions_f64((ax[l], ay[l]), (bx[l], by[l]), (cx[l], cy[l]));
         }
     }
     let neg = u.cmplt(Vec4::ZERO) | v.cmplt(Vec4::ZERO) | w.cmplt(Vec4::ZERO);
     let pos = u.cmpgt(Vec4::ZERO) | v.cmpgt(Vec4::ZERO) | w.cmpgt(Vec4::ZERO);
     let inside = !(neg & pos).bitmask() & lanes;
-    if inside & 0b1111 == 0 {
+    if inside == 0 {
         return None;
     }
     let det = u + v + w;
@@ -193,15 +204,11 @@ pub fn intersect(
     let a = shear.m * (v0 - origin);
     let b = shear.m * (v1 - origin);
     let c = shear.m * (v2 - origin);
-    let mut u = c.x * b.y - c.y * b.x;
-    let mut v = a.x * c.y - a.y * c.x;
-    let mut w = b.x * a.y - b.y * a.x;
-    if u == 0.0 || v == 0.0 || w == 0.0 {
-        let (a, b, c) = (a.as_dvec3(), b.as_dvec3(), c.as_dvec3());
-        u = (c.x * b.y - c.y * b.x) as f32;
-        v = (a.x * c.y - a.y * c.x) as f32;
-        w = (b.x * a.y - b.y * a.x) as f32;
+    let mut edges = edge_functions((a.x, a.y), (b.x, b.y), (c.x, c.y));
+    if edges.contains(&0.0) {
+        edges = edge_functions_f64((a.x, a.y), (b.x, b.y), (c.x, c.y));
     }
+    let [u, v, w] = edges;
     if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
         return None;
     }

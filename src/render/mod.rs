@@ -59,8 +59,14 @@ pub struct Packet {
 impl Packet {
     /// A packet of one to four rays (lanes beyond `rays.len()` are unwanted copies of the last).
     pub fn new(rays: &[Ray]) -> Packet {
-        assert!((1..=4).contains(&rays.len()), "a packet holds one to four rays");
-        Packet { rays: std::array::from_fn(|l| rays[l.min(rays.len() - 1)]), mask: (1 << rays.len()) - 1 }
+        Packet::from_fn(rays.len(), |l| rays[l])
+    }
+
+    /// A packet of `count` (one to four) rays, lane `l` being `ray(l)`; lanes beyond
+    /// `count` are unwanted copies of the last.
+    pub fn from_fn(count: usize, mut ray: impl FnMut(usize) -> Ray) -> Packet {
+        assert!((1..=4).contains(&count), "a packet holds one to four rays");
+        Packet { rays: std::array::from_fn(|l| ray(l.min(count - 1))), mask: (1 << count) - 1 }
     }
 }
 

@@ -29,14 +29,14 @@ pub(super) fn block<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bo
     let mut sums = [Vec3A::ZERO; 4];
     for s in 0..n {
         let (ox, oy) = sample_offset(s, n);
-        let rays: [Ray; 4] = std::array::from_fn(|l| {
-            let (px, py) = pixel(l.min(count - 1));
+        let packet = Packet::from_fn(count, |l| {
+            let (px, py) = pixel(l);
             Ray::new(Vec3A::ZERO, frame.direction(px as f32 + ox, py as f32 + oy), frame.max_distance)
         });
         c.primary_rays += count as u64;
-        let hits = g.intersect4(&Packet::new(&rays[..count]), c);
-        for l in 0..count {
-            let mut colour = shade::<SHADOWS, REFLECT, SPECULAR, AO>(g, frame, &rays[l], hits[l], frame.depth, c);
+        let hits = g.intersect4(&packet, c);
+        for (l, ray) in packet.rays[..count].iter().enumerate() {
+            let mut colour = shade::<SHADOWS, REFLECT, SPECULAR, AO>(g, frame, ray, hits[l], frame.depth, c);
             if !colour.is_finite() {
                 c.nonfinite_samples += 1;
                 colour = Vec3A::ZERO;

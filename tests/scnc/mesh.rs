@@ -176,8 +176,8 @@ fn mesh_high_coverage_agrees_with_sdf() {
 /// scene in all three modes, for full and partial packets: hit or miss exactly, the
 /// distance up to rounding, and the same surface except where a ray meets an edge and
 /// two faces tie within rounding (then either face is correct; the walks visit leaves
-/// in different orders). Rays from different points, or spread too wide to share a
-/// shear, take the single-ray path and agree exactly.
+/// in different orders). Packets spread too wide to share a shear still share the BVH
+/// walk and test meshes lane by lane.
 #[test]
 fn packets_agree_with_single_rays() {
     const SIZE: u32 = 128;
