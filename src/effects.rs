@@ -103,36 +103,6 @@ fn painted_everywhere(shape: &ir::Shape) -> bool {
     }
 }
 
-/// Whether a lone object is convex, so a ray reflected off it can never meet it again.
-fn convex(g: &Geometry) -> bool {
-    fn shape(s: &ir::Shape) -> bool {
-        match &s.kind {
-            ShapeKind::Sphere { .. }
-            | ShapeKind::Box { .. }
-            | ShapeKind::Cylinder { .. }
-            | ShapeKind::Capsule { .. }
-            | ShapeKind::Cone { .. }
-            | ShapeKind::Plane { .. } => true,
-            ShapeKind::Intersect { children, smooth } => *smooth == 0.0 && children.iter().all(|c| shape(c)),
-            ShapeKind::Round { child, .. } | ShapeKind::Paint { child, .. } | ShapeKind::Transform { child, .. } => {
-                shape(child)
-            }
-            _ => false,
-        }
-    }
-    match g {
-        Geometry::Shape(s) => shape(s),
-        Geometry::Mesh(m) => matches!(
-            m.source,
-            ir::MeshSource::UvSphere { .. }
-                | ir::MeshSource::IcoSphere { .. }
-                | ir::MeshSource::Box { .. }
-                | ir::MeshSource::Cylinder { .. }
-                | ir::MeshSource::Plane { .. }
-        ),
-    }
-}
-
 /// Derives the effect set of a scene.
 pub fn derive(scene: &Scene) -> Effects {
     let mut shadow_lights = Vec::new();
@@ -153,7 +123,7 @@ pub fn derive(scene: &Scene) -> Effects {
     // bounce is all that can show; otherwise every allowed bounce may matter.
     let useful_depth = if !reflections {
         0
-    } else if scene.objects.len() == 1 && convex(&scene.objects[0].geometry) {
+    } else if scene.objects.len() == 1 && scene.objects[0].geometry.is_convex() {
         1
     } else {
         scene.settings.depth

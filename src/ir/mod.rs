@@ -288,6 +288,55 @@ pub enum ShapeKind {
     },
 }
 
+impl Shape {
+    /// Whether the solid is convex, so a ray leaving its surface outward never meets it
+    /// again. Conservative: `false` unless it follows from the shape's form (primitives
+    /// other than the torus, a half-space, sharp intersections of convex solids, and
+    /// rounding, painting or transforming one).
+    pub fn is_convex(&self) -> bool {
+        match &self.kind {
+            ShapeKind::Sphere { .. }
+            | ShapeKind::Box { .. }
+            | ShapeKind::Cylinder { .. }
+            | ShapeKind::Capsule { .. }
+            | ShapeKind::Cone { .. }
+            | ShapeKind::Plane { .. } => true,
+            ShapeKind::Intersect { children, smooth } => *smooth == 0.0 && children.iter().all(|c| c.is_convex()),
+            // Rounding grows the solid by a ball: still convex (its distance is exact or a
+            // convex bound). An affine map keeps convexity; a material changes no shape.
+            ShapeKind::Round { child, .. } | ShapeKind::Paint { child, .. } | ShapeKind::Transform { child, .. } => {
+                child.is_convex()
+            }
+            _ => false,
+        }
+    }
+}
+
+impl Geometry {
+    /// Whether the object is convex as a solid (see [`Shape::is_convex`], [`Mesh::is_convex`]).
+    pub fn is_convex(&self) -> bool {
+        match self {
+            Geometry::Shape(s) => s.is_convex(),
+            Geometry::Mesh(m) => m.is_convex(),
+        }
+    }
+}
+
+impl Mesh {
+    /// Whether the generator makes a convex polytope (a square counts: it lies in one
+    /// plane); tested for every generator in `convex_generators_make_convex_polytopes`.
+    pub fn is_convex(&self) -> bool {
+        matches!(
+            self.source,
+            MeshSource::UvSphere { .. }
+                | MeshSource::IcoSphere { .. }
+                | MeshSource::Box { .. }
+                | MeshSource::Cylinder { .. }
+                | MeshSource::Plane { .. }
+        )
+    }
+}
+
 /// An explicit triangle mesh.
 #[derive(Clone, Debug)]
 pub struct Mesh {

@@ -279,3 +279,37 @@ fn packet_closest_hit_equals_brute_force() {
         );
     }
 }
+
+/// The generators the renderer treats as convex (a secondary ray leaving one of their
+/// faces outward skips the mesh) make convex polytopes: every vertex lies behind the
+/// plane of every face, at many sizes. The torus, the one that is not, is caught.
+#[test]
+fn convex_generators_make_convex_polytopes() {
+    fn worst_bulge(mesh: &TriMesh) -> f64 {
+        let mut worst = f64::NEG_INFINITY;
+        for t in &mesh.triangles {
+            let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+            let n = (b - a).cross(c - a).normalize();
+            for p in &mesh.positions {
+                worst = worst.max((*p - a).dot(n));
+            }
+        }
+        worst
+    }
+    let mut meshes = vec![("box".to_string(), tessellate::cuboid(DVec3::new(1.0, 0.7, 0.4)))];
+    for n in [3u32, 4, 5, 7, 10, 14, 25, 50, 64] {
+        meshes.push((format!("uvsphere {n}"), tessellate::uvsphere(1.0, n, 2 * n)));
+        meshes.push((format!("uvsphere {n}×3"), tessellate::uvsphere(2.0, n, 3)));
+        meshes.push((format!("cylinder {n}"), tessellate::cylinder(0.8, 1.0, n)));
+        meshes.push((format!("cone {n}"), tessellate::cone(0.8, 1.0, n)));
+    }
+    for s in 0..=4 {
+        meshes.push((format!("icosphere {s}"), tessellate::icosphere(1.0, s)));
+    }
+    for (name, mesh) in &meshes {
+        let bulge = worst_bulge(mesh);
+        assert!(bulge <= 1e-12, "{name}: a vertex lies {bulge} in front of a face");
+    }
+    let torus = worst_bulge(&tessellate::torus(1.0, 0.3, 16, 8));
+    assert!(torus > 0.1, "the torus is not convex, but its worst bulge is {torus}");
+}
