@@ -13,7 +13,7 @@ use crate::diag::Diagnostic;
 use crate::ir;
 use crate::mesh::triangle::Shear4;
 use crate::mesh::{self, MeshMemory, MeshObject};
-use crate::render::{intersect_each, Counters, Frame, Geometry, Hit, Packet, Ray};
+use crate::render::{intersect_each, Counters, Frame, Geometry, Hit, Packet, Ray, NO_OBJECT};
 use crate::sdf::{self, MarchParams, SdfObject};
 use crate::span::Span;
 
@@ -241,6 +241,9 @@ impl World {
 
     /// The closest surface of object `i` before `t_max`, without its shading data.
     fn find(&self, i: u32, q: &mut Query<'_>, t_max: f32, c: &mut Counters) -> Option<Found> {
+        if i == q.ray.skip {
+            return None;
+        }
         let o = &self.objects[i as usize];
         match &o.kind {
             ObjectKind::Sdf(s) => s
@@ -256,16 +259,17 @@ impl World {
 
     /// Normal, material and error of the winning surface, computed once per ray.
     fn surface(&self, found: Found, ray: &Ray, c: &mut Counters) -> Option<Hit> {
-        match found {
+        let (object, hit) = match found {
             Found::Sdf { object, t, error } => match &self.objects[object as usize].kind {
-                ObjectKind::Sdf(s) => Some(s.surface(ray, t, error, c)),
-                ObjectKind::Mesh(_) => None,
+                ObjectKind::Sdf(s) => (object, s.surface(ray, t, error, c)),
+                ObjectKind::Mesh(_) => return None,
             },
             Found::Mesh { object, tri, hit } => match &self.objects[object as usize].kind {
-                ObjectKind::Mesh(m) => Some(m.surface(tri, hit)),
-                ObjectKind::Sdf(_) => None,
+                ObjectKind::Mesh(m) => (object, m.surface(tri, hit)),
+                ObjectKind::Sdf(_) => return None,
             },
-        }
+        };
+        Some(Hit { object, ..hit })
     }
 
     /// Completes a ray's closest-hit query: the unbounded objects (outside the top-level
@@ -284,6 +288,9 @@ impl World {
     }
 
     fn blocks(&self, i: u32, q: &mut Query<'_>, t_max: f32, c: &mut Counters) -> bool {
+        if i == q.ray.skip {
+            return false;
+        }
         let o = &self.objects[i as usize];
         match &o.kind {
             ObjectKind::Sdf(s) => self
@@ -403,7 +410,8 @@ impl Geometry for World {
 
     fn intersect4(&self, packet: &Packet, c: &mut Counters) -> [Option<Hit>; 4] {
         let rays = &packet.rays;
-        if !self.share_walks {
+        // The shared walk knows no skips; packets of camera rays never have one.
+        if !self.share_walks || rays.iter().any(|r| r.skip != NO_OBJECT) {
             return intersect_each(self, packet, c);
         }
         // Rays across lanes: each transpose turns four `Vec3A`s into one vector per axis.

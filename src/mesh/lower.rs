@@ -64,12 +64,16 @@ pub fn tessellate(
             let frame = DAffine3::from_cols(u, normal, w, foot);
             // Scale by the inverse's stretch so the square reaches `max_distance` in render space.
             let reach = max_distance * inv.matrix3.to_cols_array().iter().fold(0.0f64, |a, x| a.max(x.abs())) * 2.0;
-            return Ok(MeshObject::new(&tessellate::square(reach.max(1.0)), xf * frame, material, None, false));
+            let square = MeshObject::new(&tessellate::square(reach.max(1.0)), xf * frame, material, None, false);
+            return Ok(square.with_convex(true));
         }
         _ => None,
     };
     if let Some(mesh) = generated {
-        return Ok(MeshObject::new(&mesh, xf, material, None, false));
+        // Every generator but the torus's makes a convex polytope; isosurfaces (below)
+        // may have small dents even for a convex shape, so they are never marked.
+        let convex = !matches!(node.kind, ShapeKind::Torus { .. });
+        return Ok(MeshObject::new(&mesh, xf, material, None, false).with_convex(convex));
     }
     // Everything else: an isosurface of the subtree in render space, at a cell size that
     // follows the detail (a 1/(4·rings) fraction of the bounding diameter).
@@ -238,7 +242,7 @@ pub fn explicit(
             })?
         }
     };
-    Ok(MeshObject::new(&local, xf, material, None, m.smooth))
+    Ok(MeshObject::new(&local, xf, material, None, m.smooth).with_convex(m.is_convex()))
 }
 
 #[cfg(test)]

@@ -16,7 +16,7 @@ pub mod triangle;
 use glam::{DAffine3, DVec3, Vec3A, Vec4};
 
 use crate::bvh::{Aabb, Bvh, Rays4};
-use crate::render::{Counters, Hit, Ray};
+use crate::render::{Counters, Hit, Ray, NO_OBJECT};
 
 /// An indexed triangle mesh in some frame (local for generators, render space once lowered).
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -72,6 +72,8 @@ pub struct MeshObject {
     materials: Materials,
     bvh: Bvh,
     bounds: Aabb,
+    /// Whether the triangles bound a convex polytope (or lie in one plane).
+    convex: bool,
 }
 
 enum Materials {
@@ -108,12 +110,15 @@ impl MeshObject {
         smooth: bool,
     ) -> MeshObject {
         let positions: Vec<Vec3A> = mesh.positions.iter().map(|p| xf.transform_point3(*p).as_vec3a()).collect();
+        // A mirroring map would turn the winding, and so every face normal, inward.
+        let mirrored = xf.matrix3.determinant() < 0.0;
         let mut triangles = Vec::with_capacity(mesh.triangles.len());
         let mut mats = Vec::new();
         for (i, t) in mesh.triangles.iter().enumerate() {
+            let t = if mirrored { [t[0], t[2], t[1]] } else { *t };
             let [a, b, c] = t.map(|k| positions[k as usize]);
             if (b - a).cross(c - a).length_squared() > 0.0 {
-                triangles.push(*t);
+                triangles.push(t);
                 if let Some(m) = &per_triangle {
                     mats.push(m[i]);
                 }
@@ -146,7 +151,20 @@ impl MeshObject {
             Some(_) => Materials::One(mats.first().copied().unwrap_or(material)),
             None => Materials::One(material),
         };
-        MeshObject { positions, triangles, normals, materials, bvh, bounds }
+        MeshObject { positions, triangles, normals, materials, bvh, bounds, convex: false }
+    }
+
+    /// Marks the mesh as a convex polytope (or a flat one) when `convex`, as its generator
+    /// guarantees: secondary rays leaving its faces outward may then skip it.
+    pub fn with_convex(mut self, convex: bool) -> MeshObject {
+        self.convex = convex;
+        self
+    }
+
+    /// Whether every hit's normal is the outward normal of a face of a convex polytope (or
+    /// of a flat mesh): interpolated normals are not, so a smooth mesh never is.
+    pub fn is_convex(&self) -> bool {
+        self.convex && self.normals.is_none()
     }
 
     /// Render-space bounds (empty for a mesh without triangles).
@@ -249,7 +267,7 @@ impl MeshObject {
         };
         // The interpolated point lies within a few ulps of the true plane.
         let error = point.abs().max_element() * 8.0 * f32::EPSILON;
-        Hit { t: hit.t, point, normal, material, error }
+        Hit { t: hit.t, point, normal, material, error, object: NO_OBJECT, convex: self.is_convex() }
     }
 
     /// The closest hit within `(ray.t_min, t_max)`, with its surface.

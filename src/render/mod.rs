@@ -30,13 +30,33 @@ pub struct Ray {
     pub t_min: f32,
     /// Farthest accepted hit distance.
     pub t_max: f32,
+    /// An object the ray cannot meet, which a back-end may leave out ([`NO_OBJECT`] for none):
+    /// the convex object a secondary ray leaves (see [`Ray::leaving`]).
+    pub skip: u32,
 }
+
+/// No object: the [`Ray::skip`] of a ray that may meet anything.
+pub const NO_OBJECT: u32 = u32::MAX;
 
 impl Ray {
     /// A ray from `origin` along the unit vector `dir`, accepting hits in `[0, t_max]`.
     pub fn new(origin: Vec3A, dir: Vec3A, t_max: f32) -> Ray {
         debug_assert!(origin.is_finite() && dir.is_finite(), "non-finite ray");
-        Ray { origin, dir, inv_dir: dir.recip(), t_min: 0.0, t_max }
+        Ray { origin, dir, inv_dir: dir.recip(), t_min: 0.0, t_max, skip: NO_OBJECT }
+    }
+
+    /// A secondary ray from `origin`, just off `hit`'s surface, along `dir`. When the hit
+    /// object lies wholly behind its tangent plane at the hit ([`Hit::convex`]) and the ray
+    /// starts in front of that plane and moves away from it, every point of the ray is in
+    /// front of the plane, so the ray cannot meet the object again and skips it: that
+    /// saves walking the object's own BVH, which every such ray starts inside, and makes
+    /// self-intersection there impossible rather than only guarded by the offset.
+    pub fn leaving(hit: &Hit, origin: Vec3A, dir: Vec3A, t_max: f32) -> Ray {
+        let mut ray = Ray::new(origin, dir, t_max);
+        if hit.convex && hit.normal.dot(origin - hit.point) > 0.0 && hit.normal.dot(dir) > 0.0 {
+            ray.skip = hit.object;
+        }
+        ray
     }
 
     /// The point at distance `t`.
@@ -84,6 +104,12 @@ pub struct Hit {
     /// A bound on how far `point` may lie from the true surface (the back-end's own
     /// tolerance); secondary rays start beyond it.
     pub error: f32,
+    /// The object hit, in the back-end's numbering ([`NO_OBJECT`] if it has none).
+    pub object: u32,
+    /// Whether the object lies wholly behind the plane through `point` normal to `normal`
+    /// (a convex solid with its geometric normal, or a flat surface), so a ray leaving the
+    /// front of that plane cannot meet it again.
+    pub convex: bool,
 }
 
 /// Work counters, summed over the whole render.
@@ -139,7 +165,9 @@ impl Counters {
 
 /// What a geometry back-end provides to the tracer.
 pub trait Geometry: Sync {
-    /// The closest hit along the ray within `[t_min, t_max]`.
+    /// The closest hit along the ray within `[t_min, t_max]`. A back-end may leave out
+    /// the object `ray.skip`: the tracer names one only when the ray leaves a hit of it
+    /// marked [`Hit::convex`] outward ([`Ray::leaving`]), so the ray cannot meet it.
     fn intersect(&self, ray: &Ray, counters: &mut Counters) -> Option<Hit>;
     /// [`intersect`](Self::intersect) for each wanted lane of a packet (`None` for the
     /// others). A back-end may share work between the lanes, but each lane must hit or

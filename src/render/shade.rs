@@ -107,7 +107,15 @@ const SOFT_SAMPLES: u32 = 16;
 /// The visible fraction of a round light of `radius` at distance `t_max` along `dir`:
 /// the back-end's one-query penumbra estimate if it has one (SDF scenes), else the
 /// fraction of [`SOFT_SAMPLES`] shadow rays to points spread over the light's disk.
-fn soft_visibility(g: &dyn Geometry, origin: Vec3A, dir: Vec3A, t_max: f32, radius: f32, c: &mut Counters) -> f32 {
+fn soft_visibility(
+    g: &dyn Geometry,
+    hit: &Hit,
+    origin: Vec3A,
+    dir: Vec3A,
+    t_max: f32,
+    radius: f32,
+    c: &mut Counters,
+) -> f32 {
     let cone = radius / t_max.max(f32::MIN_POSITIVE);
     c.shadow_rays += 1;
     if let Some(v) = g.soft_visibility(&Ray::new(origin, dir, t_max), cone, c) {
@@ -126,7 +134,7 @@ fn soft_visibility(g: &dyn Geometry, origin: Vec3A, dir: Vec3A, t_max: f32, radi
         let to = target - origin;
         let len = to.length();
         c.shadow_rays += 1;
-        if !g.occluded(&Ray::new(origin, to / len, len), c) {
+        if !g.occluded(&Ray::leaving(hit, origin, to / len, len), c) {
             visible += 1;
         }
     }
@@ -139,7 +147,7 @@ const AO_SAMPLES: u32 = 16;
 /// The open fraction of the hemisphere above `origin` within `reach`: the back-end's
 /// estimate if it has one (SDF scenes), else the fraction of [`AO_SAMPLES`]
 /// cosine-distributed rays (deterministic) that escape.
-fn occlusion(g: &dyn Geometry, origin: Vec3A, normal: Vec3A, reach: f32, c: &mut Counters) -> f32 {
+fn occlusion(g: &dyn Geometry, hit: &Hit, origin: Vec3A, normal: Vec3A, reach: f32, c: &mut Counters) -> f32 {
     if let Some(open) = g.occlusion(origin, normal, reach, c) {
         return open;
     }
@@ -153,7 +161,7 @@ fn occlusion(g: &dyn Geometry, origin: Vec3A, normal: Vec3A, reach: f32, c: &mut
         let (x, y) = (r2.sqrt() * a.cos(), r2.sqrt() * a.sin());
         let dir = (u * x + w * y + normal * (1.0 - r2).max(0.0).sqrt()).normalize();
         c.occlusion_rays += 1;
-        if !g.occluded(&Ray::new(origin, dir, reach), c) {
+        if !g.occluded(&Ray::leaving(hit, origin, dir, reach), c) {
             open += 1;
         }
     }
@@ -193,7 +201,7 @@ fn shade<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const A
 
     let mut intensity = frame.ambient;
     if AO {
-        intensity *= occlusion(g, origin, normal, frame.ao_reach, c);
+        intensity *= occlusion(g, &hit, origin, normal, frame.ao_reach, c);
     }
     if SHADOWS {
         for light in &frame.casting {
@@ -202,7 +210,7 @@ fn shade<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const A
                 continue;
             };
             c.shadow_rays += 1;
-            let shadow = Ray::new(origin, l_unit, (dist - offset).min(frame.max_distance));
+            let shadow = Ray::leaving(&hit, origin, l_unit, (dist - offset).min(frame.max_distance));
             if shadow.t_max > 0.0 && g.occluded(&shadow, c) {
                 continue;
             }
@@ -218,7 +226,7 @@ fn shade<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const A
                 intensity += amount;
                 continue;
             }
-            intensity += amount * soft_visibility(g, origin, l_unit, t_max, *radius, c);
+            intensity += amount * soft_visibility(g, &hit, origin, l_unit, t_max, *radius, c);
         }
     }
     for light in &frame.plain {
@@ -239,7 +247,7 @@ fn shade<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const A
     let reflected = trace::<SHADOWS, REFLECT, SPECULAR, AO>(
         g,
         frame,
-        &Ray::new(origin, reflected_dir, frame.max_distance),
+        &Ray::leaving(&hit, origin, reflected_dir, frame.max_distance),
         depth - 1,
         c,
     );

@@ -16,7 +16,7 @@ pub use build::{min_singular_value, Builder, MatSdf, Sdf};
 pub use march::MarchParams;
 
 use crate::ir;
-use crate::render::{Counters, Hit, Ray};
+use crate::render::{Counters, Hit, Ray, NO_OBJECT};
 
 /// One shape object ready for marching, in render space.
 pub struct SdfObject {
@@ -24,13 +24,15 @@ pub struct SdfObject {
     pub dist: Sdf,
     /// Distance and material, evaluated once per hit.
     pub mat: MatSdf,
+    /// Whether the shape is a convex solid ([`ir::Shape::is_convex`]).
+    convex: bool,
 }
 
 impl SdfObject {
     /// Lowers a shape seen through `xf` (render from world) into closures.
     pub fn new(shape: &ir::Shape, xf: DAffine3, builder: &mut Builder<'_>) -> SdfObject {
         let (dist, mat) = builder.build(shape, xf, 0);
-        SdfObject { dist, mat }
+        SdfObject { dist, mat, convex: shape.is_convex() }
     }
 
     /// Marches the ray over `[t0, t1]`; on a hit, its distance and the threshold there
@@ -55,9 +57,12 @@ impl SdfObject {
         let point = ray.at(t);
         let h = error.max(point.abs().max_element() * 8.0 * f32::EPSILON);
         let normal = march::normal(&*self.dist, point, h);
-        let (_, material) = (self.mat)(point);
+        let (d, material) = (self.mat)(point);
         c.sdf_shading_evals += 5;
-        Hit { t, point, normal, material, error }
+        // The gradient of a convex solid's field is its outward normal, but only on the
+        // surface: a ray starting inside the solid "hits" where it starts, below it.
+        let convex = self.convex && d > -error;
+        Hit { t, point, normal, material, error, object: NO_OBJECT, convex }
     }
 
     /// The unblocked fraction of a cone of slope `cone` around the ray over `[t0, t1]`: the

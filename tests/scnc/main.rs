@@ -9,6 +9,7 @@ mod lsp;
 mod mesh;
 mod nopanic;
 mod render;
+mod skip;
 mod stability;
 mod support;
 mod watch;
