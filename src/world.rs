@@ -6,6 +6,7 @@
 //! object's box and sphere contain its surface, so a ray outside them cannot hit it.
 
 use glam::{DAffine3, Mat4, Vec3A, Vec4};
+use rayon::prelude::*;
 
 use crate::bvh::{splat3, Aabb, Bvh, Rays4};
 use crate::check::Loader;
@@ -63,6 +64,12 @@ pub enum ObjectKind {
     Sdf(SdfObject),
     /// Triangles.
     Mesh(MeshObject),
+}
+
+/// An object between lowering and building: an SDF object with its bounds, or a mesh to build.
+enum Lowered {
+    Sdf(SdfObject, Option<Aabb>, Option<(Vec3A, f32)>),
+    Mesh(mesh::MeshJob),
 }
 
 struct Object {
@@ -149,9 +156,11 @@ pub fn lower(
     let max_distance = frame.max_distance as f64;
     let mut builder = sdf::Builder { materials: &mut frame.materials, bytes: 0 };
     let mut budget = mesh::lower::MAX_SCENE_TRIANGLES;
-    let mut objects = Vec::with_capacity(scene.objects.len());
+    // In scene order: materials are interned and the triangle budget spent as objects
+    // come, so ids and errors do not depend on timing. Meshes are built afterwards.
+    let mut lowered = Vec::with_capacity(scene.objects.len());
     for obj in &scene.objects {
-        let (kind, bounds, sphere) = match (&obj.geometry, mode) {
+        let part = match (&obj.geometry, mode) {
             (ir::Geometry::Shape(shape), Mode::Sdf) => {
                 let bounds = ir::shape_bounds(shape).map(|b| pad_box(b.transform(&to_render)));
                 let sphere = ir::shape_sphere(shape).map(|(c, r)| {
@@ -159,25 +168,39 @@ pub fn lower(
                     let pad = (c.abs().max_element() + r) * 1e-6 + 1e-6;
                     (c.as_vec3a(), (r + pad) as f32)
                 });
-                (ObjectKind::Sdf(SdfObject::new(shape, to_render, &mut builder)), bounds, sphere)
+                Lowered::Sdf(SdfObject::new(shape, to_render, &mut builder), bounds, sphere)
             }
-            (ir::Geometry::Shape(shape), Mode::Mesh(detail)) => {
-                let m = mesh::lower::tessellate(shape, to_render, detail, max_distance, &mut budget, &mut builder)?;
-                let (b, s) = (m.bounds(), m.sphere());
-                (ObjectKind::Mesh(m), Some(b), s)
-            }
+            (ir::Geometry::Shape(shape), Mode::Mesh(detail)) => Lowered::Mesh(mesh::lower::tessellate(
+                shape,
+                to_render,
+                detail,
+                max_distance,
+                &mut budget,
+                &mut builder,
+            )?),
             (ir::Geometry::Mesh(m), _) => {
-                let object = mesh::lower::explicit(m, to_render, &mut budget, &mut builder, loader)?;
+                let job = mesh::lower::explicit(m, to_render, &mut budget, &mut builder, loader)?;
                 // Isosurfaces and files are counted once made (their own limits bound them).
                 if matches!(m.source, ir::MeshSource::Isosurface { .. } | ir::MeshSource::File { .. }) {
-                    mesh::lower::spend(&mut budget, object.triangle_count() as u64, m.span)?;
+                    mesh::lower::spend(&mut budget, job.mesh.triangles.len() as u64, m.span)?;
                 }
-                let (b, s) = (object.bounds(), object.sphere());
-                (ObjectKind::Mesh(object), Some(b), s)
+                Lowered::Mesh(job)
             }
         };
-        objects.push(Object { kind, bounds, sphere, span: obj.span });
+        lowered.push((part, obj.span));
     }
+    // Building the meshes (vertices to render space, BVHs) is most of the lowering time
+    // of a scene of many meshes; they are independent, so they are built in parallel.
+    let objects: Vec<Object> = lowered
+        .into_par_iter()
+        .map(|(part, span)| match part {
+            Lowered::Sdf(s, bounds, sphere) => Object { kind: ObjectKind::Sdf(s), bounds, sphere, span },
+            Lowered::Mesh(job) => {
+                let m = job.build();
+                Object { bounds: Some(m.bounds()), sphere: m.sphere(), kind: ObjectKind::Mesh(m), span }
+            }
+        })
+        .collect();
     let closure_bytes = builder.bytes;
     let bounded: Vec<u32> = (0..objects.len() as u32)
         .filter(|&i| objects[i as usize].bounds.is_some_and(|b| b.min.cmple(b.max).all()))

@@ -5,7 +5,7 @@
 
 use glam::{DAffine3, DVec3};
 
-use super::{isosurface, obj, tessellate, MeshObject, TriMesh};
+use super::{isosurface, obj, tessellate, MeshJob, TriMesh};
 use crate::check::Loader;
 use crate::diag::{codes, Diagnostic};
 use crate::ir::{self, MeshSource, Shape, ShapeKind};
@@ -21,7 +21,7 @@ pub fn tessellate(
     max_distance: f64,
     budget: &mut u64,
     builder: &mut Builder<'_>,
-) -> Result<MeshObject, Diagnostic> {
+) -> Result<MeshJob, Diagnostic> {
     // Walk down through transforms and materials to a primitive that has a generator.
     let (mut node, mut xf, mut material) = (shape, xf, 0u32);
     loop {
@@ -64,8 +64,15 @@ pub fn tessellate(
             let frame = DAffine3::from_cols(u, normal, w, foot);
             // Scale by the inverse's stretch so the square reaches `max_distance` in render space.
             let reach = max_distance * inv.matrix3.to_cols_array().iter().fold(0.0f64, |a, x| a.max(x.abs())) * 2.0;
-            let square = MeshObject::new(&tessellate::square(reach.max(1.0)), xf * frame, material, None, false);
-            return Ok(square.with_convex(true));
+            let square = tessellate::square(reach.max(1.0));
+            return Ok(MeshJob {
+                mesh: square,
+                xf: xf * frame,
+                material,
+                per_triangle: None,
+                smooth: false,
+                convex: true,
+            });
         }
         _ => None,
     };
@@ -73,7 +80,7 @@ pub fn tessellate(
         // Every generator but the torus's makes a convex polytope; isosurfaces (below)
         // may have small dents even for a convex shape, so they are never marked.
         let convex = !matches!(node.kind, ShapeKind::Torus { .. });
-        return Ok(MeshObject::new(&mesh, xf, material, None, false).with_convex(convex));
+        return Ok(MeshJob { mesh, xf, material, per_triangle: None, smooth: false, convex });
     }
     // Everything else: an isosurface of the subtree in render space, at a cell size that
     // follows the detail (a 1/(4·rings) fraction of the bounding diameter).
@@ -132,7 +139,7 @@ fn isosurface_object(
     span: Span,
     from: CellFrom,
     builder: &mut Builder<'_>,
-) -> Result<MeshObject, Diagnostic> {
+) -> Result<MeshJob, Diagnostic> {
     let bounds = ir::shape_bounds(shape).ok_or_else(|| unbounded(shape.span))?.transform(&grid);
     let (dist, mat) = builder.build(shape, grid, material);
     let mesh = isosurface::extract(&*dist, bounds.min, bounds.max, cell).map_err(|e| match e {
@@ -173,7 +180,7 @@ fn isosurface_object(
             mat(((a + b + c) / 3.0).as_vec3a()).1
         })
         .collect();
-    Ok(MeshObject::new(&mesh, place, material, Some(per_triangle), smooth))
+    Ok(MeshJob { mesh, xf: place, material, per_triangle: Some(per_triangle), smooth, convex: false })
 }
 
 /// Lowers an explicit `mesh …` object.
@@ -183,7 +190,7 @@ pub fn explicit(
     budget: &mut u64,
     builder: &mut Builder<'_>,
     loader: &dyn Loader,
-) -> Result<MeshObject, Diagnostic> {
+) -> Result<MeshJob, Diagnostic> {
     let xf = to_render * m.xf;
     let material = m.material.as_ref().map_or(0, |mat| builder.materials.intern(mat));
     let expected = match &m.source {
@@ -242,7 +249,7 @@ pub fn explicit(
             })?
         }
     };
-    Ok(MeshObject::new(&local, xf, material, None, m.smooth).with_convex(m.is_convex()))
+    Ok(MeshJob { mesh: local, xf, material, per_triangle: None, smooth: m.smooth, convex: m.is_convex() })
 }
 
 #[cfg(test)]

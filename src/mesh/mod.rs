@@ -62,6 +62,33 @@ impl TriMesh {
     }
 }
 
+/// What a mesh object is made from. Lowering makes these in scene order (interning
+/// materials and spending the triangle budget as it goes); the world then builds them
+/// into [`MeshObject`]s in parallel, where the time goes (vertices to render space, BVH).
+pub struct MeshJob {
+    /// The triangles, in the frame `xf` maps from.
+    pub mesh: TriMesh,
+    /// Render space from the mesh's frame.
+    pub xf: DAffine3,
+    /// The material of every triangle, unless `per_triangle` gives one each.
+    pub material: u32,
+    /// One material per triangle of `mesh`.
+    pub per_triangle: Option<Vec<u32>>,
+    /// Interpolated vertex normals.
+    pub smooth: bool,
+    /// Whether the triangles bound a convex polytope (or lie in one plane), as the
+    /// generator guarantees: secondary rays leaving a face outward may then skip the mesh.
+    pub convex: bool,
+}
+
+impl MeshJob {
+    /// The mesh object, ready for tracing.
+    pub fn build(self) -> MeshObject {
+        let object = MeshObject::new(&self.mesh, self.xf, self.material, self.per_triangle, self.smooth);
+        MeshObject { convex: self.convex, ..object }
+    }
+}
+
 /// A mesh object ready for tracing.
 pub struct MeshObject {
     positions: Vec<Vec3A>,
@@ -152,13 +179,6 @@ impl MeshObject {
             None => Materials::One(material),
         };
         MeshObject { positions, triangles, normals, materials, bvh, bounds, convex: false }
-    }
-
-    /// Marks the mesh as a convex polytope (or a flat one) when `convex`, as its generator
-    /// guarantees: secondary rays leaving its faces outward may then skip it.
-    pub fn with_convex(mut self, convex: bool) -> MeshObject {
-        self.convex = convex;
-        self
     }
 
     /// Whether every hit's normal is the outward normal of a face of a convex polytope (or
