@@ -20,7 +20,8 @@ const MODES: [Mode; 3] = [Mode::Sdf, Mode::Mesh(Detail::Low), Mode::Mesh(Detail:
 
 /// A hit is marked convex exactly when the object is a convex solid *as lowered*: an SDF
 /// shape by its form, a tessellated shape only when a generator made it (an isosurface
-/// may dent), an explicit mesh by its generator and only with flat normals.
+/// may dent), an explicit mesh by its generator and only with flat normals. Every normal
+/// points outward (a plane's square, laid in a left-handed frame, once pointed down).
 #[test]
 fn convexity_follows_the_lowered_object() {
     // (object, aim point, convex as an SDF, convex as a mesh)
@@ -52,6 +53,8 @@ fn convexity_follows_the_lowered_object() {
             let hit = world.intersect(&ray, &mut Counters::default()).unwrap_or_else(|| panic!("{object}: missed"));
             assert_eq!(hit.object, 0, "{object}: the only object is object 0");
             assert_eq!(hit.convex, expected, "{object} in {mode:?}");
+            // Seen from outside, an outward normal faces the viewer (the skip relies on it).
+            assert!(hit.normal.dot(ray.dir) < 0.0, "{object} in {mode:?}: the normal {} points inward", hit.normal);
         }
     }
 }
