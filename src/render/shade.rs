@@ -118,6 +118,8 @@ fn soft_visibility(
 ) -> f32 {
     let cone = radius / t_max.max(f32::MIN_POSITIVE);
     c.shadow_rays += 1;
+    // The cone, unlike a ray leaving the surface, may graze the object it starts on (its
+    // own horizon hides part of the light near the terminator), so it skips nothing.
     if let Some(v) = g.soft_visibility(&Ray::new(origin, dir, t_max), cone, c) {
         return v;
     }
