@@ -282,17 +282,16 @@ impl World {
 
     /// Normal, material and error of the winning surface, computed once per ray.
     fn surface(&self, found: Found, ray: &Ray, c: &mut Counters) -> Option<Hit> {
-        let (object, hit) = match found {
+        match found {
             Found::Sdf { object, t, error } => match &self.objects[object as usize].kind {
-                ObjectKind::Sdf(s) => (object, s.surface(ray, t, error, c)),
-                ObjectKind::Mesh(_) => return None,
+                ObjectKind::Sdf(s) => Some(s.surface(ray, t, error, object, c)),
+                ObjectKind::Mesh(_) => None,
             },
             Found::Mesh { object, tri, hit } => match &self.objects[object as usize].kind {
-                ObjectKind::Mesh(m) => (object, m.surface(tri, hit)),
-                ObjectKind::Sdf(_) => return None,
+                ObjectKind::Mesh(m) => Some(m.surface(tri, hit, object)),
+                ObjectKind::Sdf(_) => None,
             },
-        };
-        Some(Hit { object, ..hit })
+        }
     }
 
     /// Completes a ray's closest-hit query: the unbounded objects (outside the top-level

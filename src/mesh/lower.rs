@@ -65,22 +65,22 @@ pub fn tessellate(
             // Scale by the inverse's stretch so the square reaches `max_distance` in render space.
             let reach = max_distance * inv.matrix3.to_cols_array().iter().fold(0.0f64, |a, x| a.max(x.abs())) * 2.0;
             let square = tessellate::square(reach.max(1.0));
+            // Flat: a ray leaving its front never meets it again.
             return Ok(MeshJob {
                 mesh: square,
                 xf: xf * frame,
                 material,
                 per_triangle: None,
                 smooth: false,
-                convex: true,
+                convex: node.is_convex(),
             });
         }
         _ => None,
     };
     if let Some(mesh) = generated {
-        // Every generator but the torus's makes a convex polytope; isosurfaces (below)
-        // may have small dents even for a convex shape, so they are never marked.
-        let convex = !matches!(node.kind, ShapeKind::Torus { .. });
-        return Ok(MeshJob { mesh, xf, material, per_triangle: None, smooth: false, convex });
+        // A generator's polytope is convex exactly when its shape is (tested for each);
+        // isosurfaces (below) may dent even a convex shape, so they are never marked.
+        return Ok(MeshJob { mesh, xf, material, per_triangle: None, smooth: false, convex: node.is_convex() });
     }
     // Everything else: an isosurface of the subtree in render space, at a cell size that
     // follows the detail (a 1/(4·rings) fraction of the bounding diameter).

@@ -268,8 +268,9 @@ impl MeshObject {
     }
 
     /// The surface at a hit found by [`closest`](Self::closest): point, normal (interpolated
-    /// when smooth, else the face's), material and error. Done once per ray, for the winner.
-    pub fn surface(&self, i: u32, hit: triangle::TriHit) -> Hit {
+    /// when smooth, else the face's), material and error, numbered `object`. Done once per
+    /// ray, for the winner.
+    pub fn surface(&self, i: u32, hit: triangle::TriHit, object: u32) -> Hit {
         let (a, b, cc) = self.tri(i);
         let point = a * hit.bary[0] + b * hit.bary[1] + cc * hit.bary[2];
         let normal = match &self.normals {
@@ -287,12 +288,12 @@ impl MeshObject {
         };
         // The interpolated point lies within a few ulps of the true plane.
         let error = point.abs().max_element() * 8.0 * f32::EPSILON;
-        Hit { t: hit.t, point, normal, material, error, object: NO_OBJECT, convex: self.is_convex() }
+        Hit { t: hit.t, point, normal, material, error, object, convex: self.is_convex() }
     }
 
     /// The closest hit within `(ray.t_min, t_max)`, with its surface.
     pub fn intersect(&self, ray: &Ray, shear: &triangle::Shear, t_max: f32, c: &mut Counters) -> Option<Hit> {
-        self.closest(ray, shear, t_max, c).map(|(i, hit)| self.surface(i, hit))
+        self.closest(ray, shear, t_max, c).map(|(i, hit)| self.surface(i, hit, NO_OBJECT))
     }
 
     /// Whether any triangle lies along the ray within `(ray.t_min, t_max)`.

@@ -16,7 +16,7 @@ pub use build::{min_singular_value, Builder, MatSdf, Sdf};
 pub use march::MarchParams;
 
 use crate::ir;
-use crate::render::{Counters, Hit, Ray, NO_OBJECT};
+use crate::render::{Counters, Hit, Ray};
 
 /// One shape object ready for marching, in render space.
 pub struct SdfObject {
@@ -49,11 +49,11 @@ impl SdfObject {
     }
 
     /// The surface at a hit found by [`closest`](Self::closest): normal from the gradient
-    /// and material from the material closure. Done once per ray, for the winner.
+    /// and material from the material closure, numbered `object`. Done once per ray, for the winner.
     // Kept out of line: inlined into `World::intersect` it bloated the march loop's caller
     // and cost a one-object SDF scene ~10% of its primary-ray throughput (criterion A/B).
     #[inline(never)]
-    pub fn surface(&self, ray: &Ray, t: f32, error: f32, c: &mut Counters) -> Hit {
+    pub fn surface(&self, ray: &Ray, t: f32, error: f32, object: u32, c: &mut Counters) -> Hit {
         let point = ray.at(t);
         let h = error.max(point.abs().max_element() * 8.0 * f32::EPSILON);
         let normal = march::normal(&*self.dist, point, h);
@@ -62,7 +62,7 @@ impl SdfObject {
         // The gradient of a convex solid's field is its outward normal, but only on the
         // surface: a ray starting inside the solid "hits" where it starts, below it.
         let convex = self.convex && d > -error;
-        Hit { t, point, normal, material, error, object: NO_OBJECT, convex }
+        Hit { t, point, normal, material, error, object, convex }
     }
 
     /// The unblocked fraction of a cone of slope `cone` around the ray over `[t0, t1]`: the
