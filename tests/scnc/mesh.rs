@@ -6,7 +6,7 @@ use scnc::mesh::{tessellate, triangle, MeshObject, TriMesh};
 use scnc::render::{Counters, Geometry, Packet, Ray};
 use scnc::world::{Detail, Mode};
 
-use crate::support::{compile, Rng};
+use crate::support::{compile, lower, Rng};
 
 fn brute_force(mesh: &TriMesh, ray: &Ray) -> Option<f32> {
     let shear = triangle::Shear::new(ray.dir);
@@ -126,12 +126,7 @@ fn rays_through_shared_edges_and_vertices_never_miss() {
 }
 
 fn coverage(path: &std::path::Path, mode: Mode, size: u32) -> Vec<bool> {
-    let c = compile(path);
-    let mut scene = c.scene.expect("seed scene compiles");
-    scene.settings.width = size;
-    scene.settings.height = size;
-    let (frame, world) =
-        scnc::world::prepare(&scene, scnc::effects::derive(&scene), mode, &scnc::check::FsLoader).expect("lowering");
+    let (frame, world) = lower(&compile(path).scene.expect("seed scene compiles"), size, mode);
     let mut counters = Counters::default();
     (0..size * size)
         .map(|i| {
@@ -187,13 +182,7 @@ fn packets_agree_with_single_rays() {
             continue;
         }
         for mode in [Mode::Sdf, Mode::Mesh(Detail::Low), Mode::Mesh(Detail::High)] {
-            let c = compile(&path);
-            let mut scene = c.scene.expect("seed scene compiles");
-            scene.settings.width = SIZE;
-            scene.settings.height = SIZE;
-            let (frame, world) =
-                scnc::world::prepare(&scene, scnc::effects::derive(&scene), mode, &scnc::check::FsLoader)
-                    .expect("lowering");
+            let (frame, world) = lower(&compile(&path).scene.expect("seed scene compiles"), SIZE, mode);
             let ray = |x: u32, y: u32| {
                 Ray::new(Vec3A::ZERO, frame.direction(x as f32 + 0.5, y as f32 + 0.5), frame.max_distance)
             };

@@ -2,19 +2,11 @@
 //! as convex in each mode, that a skipped object is never one the ray would have met,
 //! and that the skip saves the work it is for.
 
-use std::path::Path;
-
 use glam::Vec3A;
-use scnc::render::{spawn_offset, Counters, Frame, Geometry, Hit, Ray, NO_OBJECT};
-use scnc::world::{Detail, Mode, World};
+use scnc::render::{spawn_offset, Counters, Geometry, Hit, Ray, NO_OBJECT};
+use scnc::world::{Detail, Mode};
 
-fn lower(text: &str, size: u32, mode: Mode) -> (Frame, World) {
-    let c = scnc::compile_source("t.scn", Path::new("t.scn"), text.to_string(), &scnc::check::FsLoader);
-    let mut scene = c.scene.unwrap_or_else(|| panic!("{}\n{text}", scnc::diag::render_all(&c.diagnostics, &c.map)));
-    scene.settings.width = size;
-    scene.settings.height = size;
-    scnc::world::prepare(&scene, scnc::effects::derive(&scene), mode, &scnc::check::FsLoader).expect("lowering")
-}
+use crate::support::{compile, lower, scene};
 
 const MODES: [Mode; 3] = [Mode::Sdf, Mode::Mesh(Detail::Low), Mode::Mesh(Detail::High)];
 
@@ -48,7 +40,7 @@ fn convexity_follows_the_lowered_object() {
     for (object, [x, y, z], sdf, mesh) in cases {
         let text = format!("light ambient(1)\nobject {object} at [0, 0, 5]\n");
         for (mode, expected) in [(Mode::Sdf, sdf), (Mode::Mesh(Detail::High), mesh)] {
-            let (_, world) = lower(&text, 16, mode);
+            let (_, world) = lower(&scene(&text), 16, mode);
             let ray = Ray::new(Vec3A::ZERO, Vec3A::new(x, y, z).normalize(), 100.0);
             let hit = world.intersect(&ray, &mut Counters::default()).unwrap_or_else(|| panic!("{object}: missed"));
             assert_eq!(hit.object, 0, "{object}: the only object is object 0");
@@ -98,21 +90,17 @@ fn a_skipped_object_is_never_met_again() {
         object union(sphere(0.6), box(0.5) at [0.6, 0, 0]) at [1.5, 0.5, 7]\n\
         object subtract(box(1), sphere(1.1) at [0, 0, -1]) at [0.5, -2, 8]\n\
         object mesh uvsphere(r = 0.5, smooth = true) at [1.5, -1, 5]\n";
-    let mut scenes: Vec<(String, String)> = crate::support::cases("examples/seed")
+    let mut scenes: Vec<(String, scnc::ir::Scene)> = crate::support::cases("examples/seed")
         .into_iter()
         .filter(|p| p.file_name().is_some_and(|n| n != "lights.scn"))
-        .map(|p| {
-            let text = std::fs::read_to_string(&p).expect("seed scene");
-            let lights = std::fs::read_to_string(p.with_file_name("lights.scn")).expect("lights");
-            (p.display().to_string(), text.replace("include \"lights.scn\"", &lights))
-        })
+        .map(|p| (p.display().to_string(), compile(&p).scene.expect("seed scene compiles")))
         .collect();
-    scenes.push(("non-convex objects".into(), non_convex.into()));
+    scenes.push(("non-convex objects".into(), scene(non_convex)));
     // Seen from inside, a convex solid is met again by every ray leaving its wall.
-    scenes.push(("inside a box".into(), "light ambient(1)\nobject box(4, 3, 5) rotate [0, 20, 0]\n".into()));
-    for (name, text) in &scenes {
+    scenes.push(("inside a box".into(), scene("light ambient(1)\nobject box(4, 3, 5) rotate [0, 20, 0]\n")));
+    for (name, s) in &scenes {
         for mode in MODES {
-            let (frame, world) = lower(text, SIZE, mode);
+            let (frame, world) = lower(s, SIZE, mode);
             let mut c = Counters::default();
             let (mut skipped, mut grazed_back, mut met_again_unskipped) = (0usize, 0usize, 0usize);
             for i in 0..SIZE * SIZE {
@@ -176,15 +164,15 @@ fn a_skipped_object_is_never_met_again() {
 /// rays test no triangle at all, so turning them on adds no triangle tests.
 #[test]
 fn rays_leaving_a_lone_convex_mesh_test_no_triangles() {
-    let scene = |extra: &str, material: &str| {
+    let text = |extra: &str, material: &str| {
         format!("render(depth = 3)\nlight ambient(0.3)\n{extra}object sphere(1) at [0, 0, 5] with {material}\n")
     };
     let count = |text: &str| {
-        let (frame, world) = lower(text, 48, Mode::Mesh(Detail::High));
+        let (frame, world) = lower(&scene(text), 48, Mode::Mesh(Detail::High));
         scnc::render::render(&world, &frame, &|| {}).1
     };
-    let plain = count(&scene("", "material(color = rgb(200, 0, 0))"));
-    let shaded = count(&scene(
+    let plain = count(&text("", "material(color = rgb(200, 0, 0))"));
+    let shaded = count(&text(
         "light point(0.6) at [2, 3, 0]\nlight directional(0.3, towards = [1, 1, -1])\n",
         "material(color = rgb(200, 0, 0), reflective = 0.5)",
     ));

@@ -1,27 +1,11 @@
 //! Hard cases stay numerically stable: each test states what correct looks like.
 
-use std::path::Path;
-
 use glam::{DVec3, Vec3A};
 use proptest::prelude::*;
-use scnc::render::{Counters, Frame, Geometry, Image, Ray};
-use scnc::world::{Detail, Mode, World};
+use scnc::render::{Counters, Geometry, Image, Ray};
+use scnc::world::{Detail, Mode};
 
-use crate::support::Rng;
-
-fn scene(text: &str) -> scnc::ir::Scene {
-    let c = scnc::compile_source("t.scn", Path::new("t.scn"), text.to_string(), &scnc::check::FsLoader);
-    c.scene.unwrap_or_else(|| panic!("{}\n{text}", scnc::diag::render_all(&c.diagnostics, &c.map)))
-}
-
-fn lower(s: &scnc::ir::Scene, size: u32, mode: Mode) -> (Frame, World) {
-    let mut s = s.clone();
-    s.settings.width = size;
-    s.settings.height = size;
-    let (frame, world) =
-        scnc::world::prepare(&s, scnc::effects::derive(&s), mode, &scnc::check::FsLoader).expect("lowering");
-    (frame, world)
-}
+use crate::support::{lower, scene, Rng};
 
 fn render(s: &scnc::ir::Scene, size: u32, mode: Mode, threads: usize) -> (Image, Counters) {
     let (frame, world) = lower(s, size, mode);
@@ -278,7 +262,7 @@ fn degenerate_input_is_an_error_or_defined() {
     ] {
         let c = scnc::compile_source(
             "t.scn",
-            Path::new("t.scn"),
+            std::path::Path::new("t.scn"),
             format!("light ambient(1)\n{text}\n"),
             &scnc::check::FsLoader,
         );

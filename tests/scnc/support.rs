@@ -23,6 +23,21 @@ pub fn compile(path: &Path) -> Compiled {
     scnc::with_big_stack(|| scnc::compile_source(&name, path, text, &FsLoader))
 }
 
+/// Scene text compiled as the file `t.scn`, or a panic showing its diagnostics.
+pub fn scene(text: &str) -> scnc::ir::Scene {
+    let c = scnc::compile_source("t.scn", Path::new("t.scn"), text.to_string(), &FsLoader);
+    c.scene.unwrap_or_else(|| panic!("{}\n{text}", scnc::diag::render_all(&c.diagnostics, &c.map)))
+}
+
+/// The scene at `size × size` with its derived effects, lowered by `mode`: the frame and
+/// world the renderer would get.
+pub fn lower(scene: &scnc::ir::Scene, size: u32, mode: scnc::world::Mode) -> (scnc::render::Frame, scnc::world::World) {
+    let mut s = scene.clone();
+    s.settings.width = size;
+    s.settings.height = size;
+    scnc::world::prepare(&s, scnc::effects::derive(&s), mode, &FsLoader).expect("lowering")
+}
+
 /// Whether golden files should be rewritten (`UPDATE_EXPECT=1`).
 pub fn updating() -> bool {
     std::env::var_os("UPDATE_EXPECT").is_some_and(|v| v == "1")
