@@ -323,6 +323,123 @@ impl World {
     }
 }
 
+impl World {
+    /// [`Geometry::intersect4`] for `N` packets of four traced together: one walk of the
+    /// top-level tree and of each mesh's tree for all of their rays.
+    #[inline]
+    fn intersect_packet<const N: usize>(&self, quads: &[Packet; N], c: &mut Counters) -> [[Option<Hit>; 4]; N] {
+        // The shared walk knows no skips; packets of camera rays never have one.
+        if !self.share_walks || quads.iter().any(|q| q.rays.iter().any(|r| r.skip != NO_OBJECT)) {
+            return self.each_quad(quads, c);
+        }
+        let mut mask = 0;
+        let mut rays4 = [Rays4 { origin: [Vec4::ZERO; 3], inv_dir: [Vec4::ZERO; 3], t_min: Vec4::ZERO }; N];
+        let mut dirs = [[Vec4::ZERO; 3]; N];
+        let mut t_max = [Vec4::ZERO; N];
+        for (g, quad) in quads.iter().enumerate() {
+            let rays = &quad.rays;
+            // Rays across lanes: each transpose turns four `Vec3A`s into one vector per axis.
+            let across = |f: fn(&Ray) -> Vec3A| {
+                let col = |l: usize| f(&rays[l]).extend(0.0);
+                let m = Mat4::from_cols(col(0), col(1), col(2), col(3)).transpose();
+                [m.x_axis, m.y_axis, m.z_axis]
+            };
+            let lanes4 = |f: fn(&Ray) -> f32| Vec4::new(f(&rays[0]), f(&rays[1]), f(&rays[2]), f(&rays[3]));
+            rays4[g] =
+                Rays4 { origin: across(|r| r.origin), inv_dir: across(|r| r.inv_dir), t_min: lanes4(|r| r.t_min) };
+            dirs[g] = across(|r| r.dir);
+            t_max[g] = lanes4(|r| r.t_max);
+            mask |= (quad.mask & 0b1111) << (4 * g);
+        }
+        // Only the 4-wide triangle test needs each group's lanes to share a shear; without
+        // one (directions too far apart) meshes are tested lane by lane like SDF objects.
+        let shears = if self.has_meshes {
+            let mut shears = [None; N];
+            for g in 0..N {
+                shears[g] = Shear4::new(rays4[g].origin, dirs[g]);
+            }
+            shears.iter().all(Option::is_some).then(|| shears.map(|s| s.expect("all some")))
+        } else {
+            None
+        };
+        let mut best: [[Option<Found>; 4]; N] = [[None; 4]; N];
+        // SDF evaluations per lane; a lane's query is made only for an object tested lane by lane.
+        let mut evals = [[0u64; 4]; N];
+        let mut visits = 0u64;
+        self.bvh.each_packet(&rays4, mask, &mut t_max, &mut visits, |k, lanes, t_max| {
+            let i = self.bounded[k as usize];
+            let o = &self.objects[i as usize];
+            if let (ObjectKind::Mesh(m), Some(shears)) = (&o.kind, &shears) {
+                let mut reach = 0;
+                for g in 0..N {
+                    reach |= sphere_lanes(o, &rays4[g], &dirs[g], t_max[g]) << (4 * g);
+                }
+                let reach = lanes & reach;
+                if reach == 0 {
+                    return;
+                }
+                for (g, hits) in m.closest_packet(&rays4, shears, reach, *t_max, c).into_iter().enumerate() {
+                    for (l, hit) in hits.into_iter().enumerate() {
+                        if let Some((tri, hit)) = hit {
+                            t_max[g][l] = hit.t;
+                            best[g][l] = Some(Found::Mesh { object: i, tri, hit });
+                        }
+                    }
+                }
+                return;
+            }
+            self.find_each(i, quads, lanes, t_max, &mut best, &mut evals, c);
+        });
+        c.node_visits += visits;
+        // A loop, not `array::from_fn` (see `intersect_each`).
+        let mut hits = [[None; 4]; N];
+        for lane in (0..4 * N).filter(|&lane| mask & (1 << lane) != 0) {
+            let (g, l) = (lane / 4, lane % 4);
+            let ray = &quads[g].rays[l];
+            hits[g][l] = self.finish(&mut Query { evals: evals[g][l], ..Query::new(ray) }, best[g][l], c);
+        }
+        hits
+    }
+}
+
+impl World {
+    /// Each packet's rays traced alone: out of line, like [`World::find_each`].
+    #[inline(never)]
+    fn each_quad<const N: usize>(&self, quads: &[Packet; N], c: &mut Counters) -> [[Option<Hit>; 4]; N] {
+        let mut hits = [[None; 4]; N];
+        for (hits, quad) in hits.iter_mut().zip(quads) {
+            *hits = intersect_each(self, quad, c);
+        }
+        hits
+    }
+
+    /// Object `i` tested for each lane of `lanes` alone, as the packet walk does for SDF
+    /// objects: out of line, so the walk's loop stays small enough for the instruction
+    /// cache (inlined, the march loop made it four times larger).
+    #[inline(never)]
+    #[allow(clippy::too_many_arguments)]
+    fn find_each<const N: usize>(
+        &self,
+        i: u32,
+        quads: &[Packet; N],
+        lanes: u32,
+        t_max: &mut [Vec4; N],
+        best: &mut [[Option<Found>; 4]; N],
+        evals: &mut [[u64; 4]; N],
+        c: &mut Counters,
+    ) {
+        for lane in (0..4 * N).filter(|&lane| lanes & (1 << lane) != 0) {
+            let (g, l) = (lane / 4, lane % 4);
+            let mut q = Query { evals: evals[g][l], ..Query::new(&quads[g].rays[l]) };
+            if let Some(found) = self.find(i, &mut q, t_max[g][l], c) {
+                t_max[g][l] = found.t();
+                best[g][l] = Some(found);
+            }
+            evals[g][l] = q.evals;
+        }
+    }
+}
+
 /// A surface found along a ray, before its shading data is computed.
 #[derive(Clone, Copy)]
 enum Found {
@@ -431,60 +548,12 @@ impl Geometry for World {
     }
 
     fn intersect4(&self, packet: &Packet, c: &mut Counters) -> [Option<Hit>; 4] {
-        let rays = &packet.rays;
-        // The shared walk knows no skips; packets of camera rays never have one.
-        if !self.share_walks || rays.iter().any(|r| r.skip != NO_OBJECT) {
-            return intersect_each(self, packet, c);
-        }
-        // Rays across lanes: each transpose turns four `Vec3A`s into one vector per axis.
-        let across = |f: fn(&Ray) -> Vec3A| {
-            let col = |l: usize| f(&rays[l]).extend(0.0);
-            let m = Mat4::from_cols(col(0), col(1), col(2), col(3)).transpose();
-            [m.x_axis, m.y_axis, m.z_axis]
-        };
-        let (origin, dir) = (across(|r| r.origin), across(|r| r.dir));
-        // Only the 4-wide triangle test needs the lanes to share a shear; without one
-        // (directions too far apart) meshes are tested lane by lane like SDF objects.
-        let shear = if self.has_meshes { Shear4::new(origin, dir) } else { None };
-        let lanes4 = |f: fn(&Ray) -> f32| Vec4::new(f(&rays[0]), f(&rays[1]), f(&rays[2]), f(&rays[3]));
-        let rays4 = Rays4 { origin, inv_dir: across(|r| r.inv_dir), t_min: lanes4(|r| r.t_min) };
-        let mut t_max = lanes4(|r| r.t_max);
-        let mut best: [Option<Found>; 4] = [None; 4];
-        // SDF evaluations per lane; a lane's query is made only for an object tested lane by lane.
-        let mut evals = [0u64; 4];
-        let mut visits = 0u64;
-        self.bvh.each4(&rays4, packet.mask, &mut t_max, &mut visits, |k, lanes, t_max| {
-            let i = self.bounded[k as usize];
-            let o = &self.objects[i as usize];
-            if let (ObjectKind::Mesh(m), Some(shear)) = (&o.kind, &shear) {
-                let reach = lanes & sphere_lanes(o, &rays4, &dir, *t_max);
-                if reach == 0 {
-                    return;
-                }
-                for (l, hit) in m.closest4(&rays4, shear, reach, *t_max, c).into_iter().enumerate() {
-                    if let Some((tri, hit)) = hit {
-                        t_max[l] = hit.t;
-                        best[l] = Some(Found::Mesh { object: i, tri, hit });
-                    }
-                }
-                return;
-            }
-            for l in (0..4).filter(|&l| lanes & (1 << l) != 0) {
-                let mut q = Query { evals: evals[l], ..Query::new(&rays[l]) };
-                if let Some(found) = self.find(i, &mut q, t_max[l], c) {
-                    t_max[l] = found.t();
-                    best[l] = Some(found);
-                }
-                evals[l] = q.evals;
-            }
-        });
-        c.node_visits += visits;
-        // A loop, not `array::from_fn` (see `intersect_each`).
-        let mut hits = [None; 4];
-        for (l, hit) in hits.iter_mut().enumerate().filter(|(l, _)| packet.mask & (1 << l) != 0) {
-            *hit = self.finish(&mut Query { evals: evals[l], ..Query::new(&rays[l]) }, best[l], c);
-        }
+        let [hits] = self.intersect_packet(std::slice::from_ref(packet).try_into().expect("one quad"), c);
         hits
+    }
+
+    fn intersect16(&self, quads: &[Packet; 4], c: &mut Counters) -> [[Option<Hit>; 4]; 4] {
+        self.intersect_packet(quads, c)
     }
 
     fn occluded(&self, ray: &Ray, c: &mut Counters) -> bool {

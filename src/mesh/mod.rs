@@ -240,26 +240,35 @@ impl MeshObject {
         best
     }
 
-    /// [`closest`](Self::closest) for the rays of a packet in `lanes`, each with its own
-    /// `t_max`: per ray the same closest hit up to rounding, found in one walk of the BVH.
-    pub fn closest4(
+    /// [`closest`](Self::closest) for the rays of a packet in `lanes` (groups of four,
+    /// as [`Bvh::each_packet`] numbers them), each with its own `t_max`: per ray the same
+    /// closest hit up to rounding, found in one walk of the BVH.
+    pub fn closest_packet<const N: usize>(
         &self,
-        rays: &Rays4,
-        shear: &triangle::Shear4,
+        rays: &[Rays4; N],
+        shears: &[triangle::Shear4; N],
         lanes: u32,
-        mut t_max: Vec4,
+        mut t_max: [Vec4; N],
         c: &mut Counters,
-    ) -> [Option<(u32, triangle::TriHit)>; 4] {
-        let mut best = [None; 4];
+    ) -> [[Option<(u32, triangle::TriHit)>; 4]; N] {
+        let mut best = [[None; 4]; N];
         let mut tests = 0u64;
-        self.bvh.each4(rays, lanes, &mut t_max, &mut c.node_visits, |i, lanes, t_max| {
+        self.bvh.each_packet(rays, lanes, &mut t_max, &mut c.node_visits, |i, lanes, t_max| {
             tests += u64::from(lanes.count_ones());
             let (a, b, cc) = self.tri(i);
-            let Some(hit) = triangle::intersect4(shear, a, b, cc, rays.t_min, *t_max, lanes) else { return };
-            for (l, slot) in best.iter_mut().enumerate() {
-                if hit.mask & (1 << l) != 0 {
-                    t_max[l] = hit.t[l];
-                    *slot = Some((i, hit.lane(l)));
+            for g in 0..N {
+                let lanes = (lanes >> (4 * g)) & 0b1111;
+                if lanes == 0 {
+                    continue;
+                }
+                let Some(hit) = triangle::intersect4(&shears[g], a, b, cc, rays[g].t_min, t_max[g], lanes) else {
+                    continue;
+                };
+                for (l, slot) in best[g].iter_mut().enumerate() {
+                    if hit.mask & (1 << l) != 0 {
+                        t_max[g][l] = hit.t[l];
+                        *slot = Some((i, hit.lane(l)));
+                    }
                 }
             }
         });

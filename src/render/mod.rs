@@ -65,7 +65,8 @@ impl Ray {
     }
 }
 
-/// Up to four rays traced together (a 2×2 block of camera rays). Lane `k` is wanted when
+/// Up to four rays traced together (a 2×2 block of camera rays; the tracer sends four
+/// as a 4×4 block, [`Geometry::intersect16`]). Lane `k` is wanted when
 /// bit `k` of `mask` is set; an unwanted lane holds a copy of a wanted ray, so every lane
 /// is a valid ray and a back-end may trace all four.
 #[derive(Clone, Copy, Debug)]
@@ -131,10 +132,11 @@ pub struct Counters {
     pub max_evals_per_ray: u64,
     /// Marches that ran out of steps before deciding (counted as misses).
     pub budget_misses: u64,
-    /// BVH nodes visited (a node a packet visits counts once for each ray in it that
-    /// enters it, so per-ray numbers compare with single rays).
+    /// BVH nodes visited (a node a packet visits counts once for each ray the walk
+    /// carries into it: every wanted ray from its first active one, see
+    /// [`Bvh::each_packet`](crate::bvh::Bvh::each_packet)).
     pub node_visits: u64,
-    /// Ray–triangle tests (mesh back-end; a packet's test counts once per ray in it).
+    /// Ray–triangle tests (mesh back-end; a packet's test counts once per ray it tests).
     pub triangle_tests: u64,
     /// Samples whose colour was not finite (always 0 unless there is a bug; such a
     /// sample is written as black).
@@ -175,6 +177,16 @@ pub trait Geometry: Sync {
     /// surfaces tie within rounding (a ray through an edge) may it return the other one.
     fn intersect4(&self, packet: &Packet, counters: &mut Counters) -> [Option<Hit>; 4] {
         intersect_each(self, packet, counters)
+    }
+    /// [`intersect4`](Self::intersect4) for a 4×4 block given as four 2×2 packets (a
+    /// packet may want no lane), under the same contract; a back-end may share work
+    /// between all sixteen rays.
+    fn intersect16(&self, quads: &[Packet; 4], counters: &mut Counters) -> [[Option<Hit>; 4]; 4] {
+        let mut hits = [[None; 4]; 4];
+        for (hits, quad) in hits.iter_mut().zip(quads) {
+            *hits = self.intersect4(quad, counters);
+        }
+        hits
     }
     /// Whether anything lies along the ray within `[t_min, t_max]` (for shadows).
     fn occluded(&self, ray: &Ray, counters: &mut Counters) -> bool;
@@ -242,28 +254,27 @@ fn rows<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const AO
     progress: &(dyn Fn() + Sync),
 ) -> (Image, Counters) {
     let (w, h) = (frame.width, frame.height);
-    // Rows go in pairs, so camera rays can be cast as 2×2 packets.
-    let rows: Vec<(Vec<u8>, Counters)> = (0..h.div_ceil(2))
+    // Rows go in fours, so camera rays can be cast in 4×4 blocks.
+    let rows: Vec<(Vec<u8>, Counters)> = (0..h.div_ceil(4))
         .into_par_iter()
-        .flat_map_iter(|pair| {
-            let (y, rows_here) = (2 * pair, (h - 2 * pair).min(2));
+        .flat_map_iter(|strip| {
+            let (y, rows_here) = (4 * strip, (h - 4 * strip).min(4));
             let mut c = Counters::default();
-            let mut top = Vec::with_capacity(w as usize * 3);
-            let mut bottom = Vec::with_capacity(if rows_here == 2 { w as usize * 3 } else { 0 });
-            for x in (0..w).step_by(2) {
-                let cols = (w - x).min(2);
+            let mut rows: Vec<Vec<u8>> = (0..rows_here).map(|_| Vec::with_capacity(w as usize * 3)).collect();
+            for x in (0..w).step_by(4) {
+                let cols = (w - x).min(4);
                 let px =
                     shade::block::<SHADOWS, REFLECT, SPECULAR, AO>(geometry, frame, (x, y), (cols, rows_here), &mut c);
-                top.extend(px[..cols as usize].iter().flatten());
-                if rows_here == 2 {
-                    bottom.extend(px[cols as usize..2 * cols as usize].iter().flatten());
+                for (dy, row) in rows.iter_mut().enumerate() {
+                    row.extend(px[4 * dy..4 * dy + cols as usize].iter().flatten());
                 }
             }
             for _ in 0..rows_here {
                 progress();
             }
-            let bottom = (rows_here == 2).then_some((bottom, Counters::default()));
-            std::iter::once((top, c)).chain(bottom)
+            // The strip's counters travel with its first row.
+            let mut counters = Some(c);
+            rows.into_iter().map(move |row| (row, counters.take().unwrap_or_default()))
         })
         .collect();
     let mut counters = Counters::default();

@@ -12,36 +12,45 @@ use glam::Vec3A;
 
 use super::{spawn_offset, Counters, Frame, Geometry, Hit, Packet, Ray, ShadeLight};
 
-/// The 8-bit colours of a block of up to 2×2 pixels from `(x, y)`, `w` wide and `h` high,
+/// The 8-bit colours of a block of up to 4×4 pixels from `(x, y)`, `w` wide and `h` high,
 /// each averaging `frame.samples` deterministic samples. Each sample's camera rays go
-/// to the back-end as one packet; each pixel is then shaded on its own (secondary rays
-/// go one by one). Pixels come back row by row.
+/// to the back-end together, as four 2×2 packets; each pixel is then shaded on its own
+/// (secondary rays go one by one). Pixel `(dx, dy)` of the block is entry `4·dy + dx`.
 pub(super) fn block<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const AO: bool>(
     g: &dyn Geometry,
     frame: &Frame,
     (x, y): (u32, u32),
     (w, h): (u32, u32),
     c: &mut Counters,
-) -> [[u8; 3]; 4] {
+) -> [[u8; 3]; 16] {
     let n = frame.samples.max(1);
-    let count = (w * h) as usize;
-    let pixel = |l: usize| (x + l as u32 % w, y + l as u32 / w);
-    let mut sums = [Vec3A::ZERO; 4];
+    // Lane `l` of packet `q` is pixel `(dx, dy)` of the block; outside `w × h` it traces
+    // the nearest pixel inside, unwanted.
+    let offset = |q: usize, l: usize| ((2 * (q % 2) + l % 2) as u32, (2 * (q / 2) + l / 2) as u32);
+    let mut sums = [Vec3A::ZERO; 16];
     for s in 0..n {
         let (ox, oy) = sample_offset(s, n);
-        let packet = Packet::from_fn(count, |l| {
-            let (px, py) = pixel(l);
-            Ray::new(Vec3A::ZERO, frame.direction(px as f32 + ox, py as f32 + oy), frame.max_distance)
+        let quads: [Packet; 4] = std::array::from_fn(|q| {
+            let ray = |l: usize| {
+                let (dx, dy) = offset(q, l);
+                let (px, py) = (x + dx.min(w - 1), y + dy.min(h - 1));
+                Ray::new(Vec3A::ZERO, frame.direction(px as f32 + ox, py as f32 + oy), frame.max_distance)
+            };
+            let wanted = (0..4).filter(|&l| offset(q, l).0 < w && offset(q, l).1 < h).fold(0, |m, l| m | 1 << l);
+            Packet { rays: std::array::from_fn(ray), mask: wanted }
         });
-        c.primary_rays += count as u64;
-        let hits = g.intersect4(&packet, c);
-        for (l, ray) in packet.rays[..count].iter().enumerate() {
-            let mut colour = shade::<SHADOWS, REFLECT, SPECULAR, AO>(g, frame, ray, hits[l], frame.depth, c);
-            if !colour.is_finite() {
-                c.nonfinite_samples += 1;
-                colour = Vec3A::ZERO;
+        c.primary_rays += u64::from(w * h);
+        let hits = g.intersect16(&quads, c);
+        for (q, quad) in quads.iter().enumerate() {
+            for (l, ray) in quad.rays.iter().enumerate().filter(|(l, _)| quad.mask & (1 << l) != 0) {
+                let mut colour = shade::<SHADOWS, REFLECT, SPECULAR, AO>(g, frame, ray, hits[q][l], frame.depth, c);
+                if !colour.is_finite() {
+                    c.nonfinite_samples += 1;
+                    colour = Vec3A::ZERO;
+                }
+                let (dx, dy) = offset(q, l);
+                sums[(4 * dy + dx) as usize] += colour.clamp(Vec3A::ZERO, Vec3A::splat(255.0));
             }
-            sums[l] += colour.clamp(Vec3A::ZERO, Vec3A::splat(255.0));
         }
     }
     sums.map(|sum| {

@@ -1,9 +1,9 @@
 //! The mesh back-end: BVH against brute force, watertightness, agreement with the SDF back-end.
 
-use glam::{DAffine3, DVec3, Vec3A};
+use glam::{DAffine3, DVec3, Vec3A, Vec4};
 use scnc::bvh::Rays4;
 use scnc::mesh::{tessellate, triangle, MeshObject, TriMesh};
-use scnc::render::{Counters, Geometry, Packet, Ray};
+use scnc::render::{Counters, Geometry, Hit, Packet, Ray};
 use scnc::world::{Detail, Mode};
 
 use crate::support::{compile, lower, Rng};
@@ -168,11 +168,11 @@ fn mesh_high_coverage_agrees_with_sdf() {
 }
 
 /// Each lane of a camera-ray packet finds what its ray finds traced alone, for every seed
-/// scene in all three modes, for full and partial packets: hit or miss exactly, the
-/// distance up to rounding, and the same surface except where a ray meets an edge and
-/// two faces tie within rounding (then either face is correct; the walks visit leaves
-/// in different orders). Packets spread too wide to share a shear still share the BVH
-/// walk and test meshes lane by lane.
+/// scene in all three modes, for 2×2 packets and 4×4 blocks of four, full and partial:
+/// hit or miss exactly, the distance up to rounding, and the same surface except where a
+/// ray meets an edge and two faces tie within rounding (then either face is correct; the
+/// walks visit leaves in different orders). Packets spread too wide to share a shear
+/// still share the BVH walk and test meshes lane by lane.
 #[test]
 fn packets_agree_with_single_rays() {
     const SIZE: u32 = 128;
@@ -188,38 +188,52 @@ fn packets_agree_with_single_rays() {
             };
             let (mut lanes, mut ties) = (0usize, 0usize);
             let mut c = Counters::default();
-            for by in (0..SIZE).step_by(2) {
-                for bx in (0..SIZE).step_by(2) {
-                    let mut rays = vec![ray(bx, by), ray(bx + 1, by), ray(bx, by + 1), ray(bx + 1, by + 1)];
-                    // Some packets partial, some spread over the whole frame (the fallback).
-                    match rng.below(8) {
-                        0 => rays.truncate(1 + rng.below(3)),
-                        1 => rays[3] = ray(rng.below(SIZE as usize) as u32, rng.below(SIZE as usize) as u32),
-                        _ => {}
+            let mut check = |packet: &Packet, hits: &[Option<Hit>; 4], at: &str, c: &mut Counters| {
+                for (l, r) in packet.rays.iter().enumerate() {
+                    if packet.mask & (1 << l) == 0 {
+                        assert!(hits[l].is_none(), "{at} lane {l}: an unwanted lane returns nothing");
+                        continue;
                     }
-                    let packet = Packet::new(&rays);
-                    let hits = world.intersect4(&packet, &mut c);
-                    for (l, r) in rays.iter().enumerate() {
-                        let alone = world.intersect(r, &mut c);
-                        lanes += 1;
-                        let at = format!("{} {mode:?} block ({bx}, {by}) lane {l}", path.display());
-                        match (alone, hits[l]) {
-                            (None, None) => {}
-                            (Some(a), Some(p)) => {
-                                assert!(
-                                    (a.t - p.t).abs() <= a.t * 1e-6,
-                                    "{at}: distance {} alone, {} in a packet",
-                                    a.t,
-                                    p.t
-                                );
-                                if a.normal != p.normal || a.material != p.material {
-                                    ties += 1;
-                                }
+                    let alone = world.intersect(r, c);
+                    lanes += 1;
+                    match (alone, hits[l]) {
+                        (None, None) => {}
+                        (Some(a), Some(p)) => {
+                            assert!(
+                                (a.t - p.t).abs() <= a.t * 1e-6,
+                                "{at} lane {l}: distance {} alone, {} in a packet",
+                                a.t,
+                                p.t
+                            );
+                            if a.normal != p.normal || a.material != p.material {
+                                ties += 1;
                             }
-                            (a, p) => panic!("{at}: {} alone, {} in a packet", a.is_some(), p.is_some()),
                         }
+                        (a, p) => panic!("{at} lane {l}: {} alone, {} in a packet", a.is_some(), p.is_some()),
                     }
-                    assert!(hits[rays.len()..].iter().all(Option::is_none), "unwanted lanes return nothing");
+                }
+            };
+            for by in (0..SIZE).step_by(4) {
+                for bx in (0..SIZE).step_by(4) {
+                    let quads: [Packet; 4] = std::array::from_fn(|q| {
+                        let (qx, qy) = (bx + 2 * (q as u32 % 2), by + 2 * (q as u32 / 2));
+                        let mut rays = vec![ray(qx, qy), ray(qx + 1, qy), ray(qx, qy + 1), ray(qx + 1, qy + 1)];
+                        // Some packets partial or wanting nothing (a block at the frame's
+                        // edge), some spread over the whole frame (the fallback).
+                        match rng.below(10) {
+                            0 => rays.truncate(1 + rng.below(3)),
+                            1 => rays[3] = ray(rng.below(SIZE as usize) as u32, rng.below(SIZE as usize) as u32),
+                            2 => return Packet { mask: 0, ..Packet::new(&rays) },
+                            _ => {}
+                        }
+                        Packet::new(&rays)
+                    });
+                    let at = format!("{} {mode:?} block ({bx}, {by})", path.display());
+                    let block = world.intersect16(&quads, &mut c);
+                    for (q, quad) in quads.iter().enumerate() {
+                        check(quad, &block[q], &format!("{at} 4×4 packet {q}"), &mut c);
+                        check(quad, &world.intersect4(quad, &mut c), &format!("{at} 2×2 packet {q}"), &mut c);
+                    }
                 }
             }
             assert!(ties <= lanes / 1000, "{} {mode:?}: {ties} of {lanes} lanes found another surface", path.display());
@@ -228,37 +242,48 @@ fn packets_agree_with_single_rays() {
 }
 
 /// The packet walk of a mesh finds exactly the brute-force closest hit for every lane,
-/// on random triangle soups, with coherent rays from one origin as the camera casts them.
+/// on random triangle soups, with coherent rays from one origin as the camera casts them,
+/// in packets of one and of four groups of four, some lanes unwanted.
 #[test]
 fn packet_closest_hit_equals_brute_force() {
-    let mut rng = Rng(0x5eed_4a11);
-    for (n, spread) in [(1usize, 1.0f32), (60, 2.0), (3000, 4.0)] {
-        let mesh = soup(&mut rng, n, spread);
+    fn check<const N: usize>(rng: &mut Rng, n: usize, spread: f32) {
+        let mesh = soup(rng, n, spread);
         let obj = MeshObject::new(&mesh, DAffine3::IDENTITY, 0, None, false);
         let (mut packets, mut fallbacks) = (0, 0);
         for _ in 0..1000 {
             let origin = rng.vec(spread * 2.0);
             let aim = rng.vec(spread) - origin;
-            let rays: [Ray; 4] = std::array::from_fn(|_| {
-                Ray::new(origin, (aim + rng.vec(0.05 * spread)).try_normalize().unwrap_or(Vec3A::Z), 1e4)
+            let groups: [[Ray; 4]; N] = std::array::from_fn(|_| {
+                std::array::from_fn(|_| {
+                    Ray::new(origin, (aim + rng.vec(0.05 * spread)).try_normalize().unwrap_or(Vec3A::Z), 1e4)
+                })
             });
-            let lanes4 = |f: &dyn Fn(&Ray) -> f32| glam::Vec4::new(f(&rays[0]), f(&rays[1]), f(&rays[2]), f(&rays[3]));
-            let origin4 = [lanes4(&|r| r.origin.x), lanes4(&|r| r.origin.y), lanes4(&|r| r.origin.z)];
-            let dir4 = [lanes4(&|r| r.dir.x), lanes4(&|r| r.dir.y), lanes4(&|r| r.dir.z)];
-            let Some(shear) = triangle::Shear4::new(origin4, dir4) else {
+            let mut rays4 = [Rays4 { origin: [Vec4::ZERO; 3], inv_dir: [Vec4::ZERO; 3], t_min: Vec4::ZERO }; N];
+            let mut shears = Vec::new();
+            for (g, rays) in groups.iter().enumerate() {
+                let lanes4 = |f: &dyn Fn(&Ray) -> f32| Vec4::new(f(&rays[0]), f(&rays[1]), f(&rays[2]), f(&rays[3]));
+                let across = |f: &dyn Fn(&Ray) -> Vec3A| [0, 1, 2].map(|k| lanes4(&|r| f(r)[k]));
+                rays4[g] = Rays4 {
+                    origin: across(&|r| r.origin),
+                    inv_dir: across(&|r| r.inv_dir),
+                    t_min: lanes4(&|r| r.t_min),
+                };
+                shears.extend(triangle::Shear4::new(rays4[g].origin, across(&|r| r.dir)));
+            }
+            let Ok(shears) = <[triangle::Shear4; N]>::try_from(shears) else {
                 fallbacks += 1;
                 continue;
             };
             packets += 1;
-            let rays4 = Rays4 {
-                origin: origin4,
-                inv_dir: [lanes4(&|r| r.inv_dir.x), lanes4(&|r| r.inv_dir.y), lanes4(&|r| r.inv_dir.z)],
-                t_min: lanes4(&|r| r.t_min),
-            };
+            let t_max = groups.map(|rays| Vec4::from_array(rays.map(|r| r.t_max)));
+            // Every lane wanted, or a random subset (never none).
+            let all = (1u32 << (4 * N)) - 1;
+            let mask = if rng.below(2) == 0 { all } else { (rng.below(all as usize) as u32 + 1) & all };
             let mut c = Counters::default();
-            let hits = obj.closest4(&rays4, &shear, 0b1111, lanes4(&|r| r.t_max), &mut c);
-            for (l, ray) in rays.iter().enumerate() {
-                assert_eq!(hits[l].map(|(_, h)| h.t), brute_force(&mesh, ray), "{n} triangles, lane {l}: {ray:?}");
+            let hits = obj.closest_packet(&rays4, &shears, mask, t_max, &mut c);
+            for (lane, ray) in groups.iter().flatten().enumerate().filter(|(lane, _)| mask & (1 << lane) != 0) {
+                let found = hits[lane / 4][lane % 4].map(|(_, h)| h.t);
+                assert_eq!(found, brute_force(&mesh, ray), "{n} triangles, {N} groups, lane {lane}: {ray:?}");
             }
         }
         assert!(
@@ -266,6 +291,11 @@ fn packet_closest_hit_equals_brute_force() {
             "{n} triangles: {fallbacks} of {} packets could not share a shear",
             packets + fallbacks
         );
+    }
+    let mut rng = Rng(0x5eed_4a11);
+    for (n, spread) in [(1usize, 1.0f32), (60, 2.0), (3000, 4.0)] {
+        check::<1>(&mut rng, n, spread);
+        check::<4>(&mut rng, n, spread);
     }
 }
 
