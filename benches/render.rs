@@ -1,5 +1,5 @@
-//! Criterion benchmarks: one SDF evaluation per primitive, primary rays (one by one and
-//! in 2×2 packets, shading off) over seed scenes 1 and 6 and a frame-filling sphere, and
+//! Criterion benchmarks: one SDF evaluation per primitive, primary rays (one by one, in
+//! 2×2 packets and in 4×4 blocks, shading off) over seed scenes 1 and 6 and a frame-filling sphere, and
 //! whole renders of every seed scene at a reduced size on one thread.
 
 use std::hint::black_box;
@@ -84,7 +84,7 @@ fn march(c: &mut Criterion) {
                     .count()
             })
         });
-        // The same rays as the tracer casts them: 2×2 pixel blocks, one packet each.
+        // 2×2 pixel blocks, one packet each.
         let half = n / 2;
         let blocks: Vec<Packet> = (0..half * half)
             .map(|b| {
@@ -102,6 +102,33 @@ fn march(c: &mut Criterion) {
                 blocks
                     .iter()
                     .map(|p| g.intersect4(p, &mut counters).iter().filter(|h| h.is_some()).count())
+                    .sum::<usize>()
+            })
+        });
+        // The same rays as the tracer casts them: 4×4 pixel blocks as four 2×2 packets,
+        // traced together.
+        let quarter = n / 4;
+        let blocks16: Vec<[Packet; 4]> = (0..quarter * quarter)
+            .map(|b| {
+                let (bx, by) = (4 * (b % quarter), 4 * (b / quarter));
+                std::array::from_fn(|g| {
+                    let rays: Vec<Ray> = [(0, 0), (1, 0), (0, 1), (1, 1)]
+                        .iter()
+                        .map(|(dx, dy)| {
+                            let (x, y) = (bx + 2 * (g % 2) + dx, by + 2 * (g / 2) + dy);
+                            Ray::new(Vec3A::ZERO, dirs[y * n + x], frame.max_distance)
+                        })
+                        .collect();
+                    Packet::new(&rays)
+                })
+            })
+            .collect();
+        group.bench_function(BenchmarkId::new(format!("blocks {mode_name}"), &name), |b| {
+            b.iter(|| {
+                let mut counters = Counters::default();
+                blocks16
+                    .iter()
+                    .map(|p| g.intersect16(p, &mut counters).iter().flatten().filter(|h| h.is_some()).count())
                     .sum::<usize>()
             })
         });
