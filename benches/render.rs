@@ -84,18 +84,12 @@ fn march(c: &mut Criterion) {
                     .count()
             })
         });
-        // 2×2 pixel blocks, one packet each.
+        // The packet of the 2×2 pixels from `(x, y)`.
+        let quad = |x: usize, y: usize| {
+            Packet::from_fn(4, |l| Ray::new(Vec3A::ZERO, dirs[(y + l / 2) * n + x + l % 2], frame.max_distance))
+        };
         let half = n / 2;
-        let blocks: Vec<Packet> = (0..half * half)
-            .map(|b| {
-                let (bx, by) = (2 * (b % half), 2 * (b / half));
-                let rays: Vec<Ray> = [(0, 0), (1, 0), (0, 1), (1, 1)]
-                    .iter()
-                    .map(|(dx, dy)| Ray::new(Vec3A::ZERO, dirs[(by + dy) * n + bx + dx], frame.max_distance))
-                    .collect();
-                Packet::new(&rays)
-            })
-            .collect();
+        let blocks: Vec<Packet> = (0..half * half).map(|b| quad(2 * (b % half), 2 * (b / half))).collect();
         group.bench_function(BenchmarkId::new(format!("packets {mode_name}"), &name), |b| {
             b.iter(|| {
                 let mut counters = Counters::default();
@@ -111,16 +105,7 @@ fn march(c: &mut Criterion) {
         let blocks16: Vec<[Packet; 4]> = (0..quarter * quarter)
             .map(|b| {
                 let (bx, by) = (4 * (b % quarter), 4 * (b / quarter));
-                std::array::from_fn(|g| {
-                    let rays: Vec<Ray> = [(0, 0), (1, 0), (0, 1), (1, 1)]
-                        .iter()
-                        .map(|(dx, dy)| {
-                            let (x, y) = (bx + 2 * (g % 2) + dx, by + 2 * (g / 2) + dy);
-                            Ray::new(Vec3A::ZERO, dirs[y * n + x], frame.max_distance)
-                        })
-                        .collect();
-                    Packet::new(&rays)
-                })
+                std::array::from_fn(|g| quad(bx + 2 * (g % 2), by + 2 * (g / 2)))
             })
             .collect();
         group.bench_function(BenchmarkId::new(format!("blocks {mode_name}"), &name), |b| {
