@@ -180,7 +180,7 @@ impl Rays4 {
 
 /// The four lanes of group `g` in a packet's mask.
 #[inline(always)]
-fn group(mask: u32, g: usize) -> u32 {
+pub fn group(mask: u32, g: usize) -> u32 {
     (mask >> (4 * g)) & 0b1111
 }
 
@@ -696,6 +696,7 @@ impl Bvh {
         // and where its box is (parent node, child slot) should that ray be done with it.
         let mut deferred_children = Deferred::new((Child { index: 0, count: 0 }, 0usize, 0f32, 0u32, 0usize));
         let mut ray = lane_splat(rays, first);
+        // For one group of four, testing the group itself costs what the frustum would.
         let frustum = if N > 1 { Frustum::new(rays, t_max) } else { None };
         let mut cur = root;
         loop {
@@ -711,28 +712,28 @@ impl Bvh {
                     Some(f) if enters != 0b11 => f.misses(node),
                     _ => 0,
                 };
-                // A child the first ray misses is the next entering ray's, if any.
-                let child = |k: usize| -> Option<(usize, f32)> {
-                    if enters & (1 << k) != 0 {
-                        Some((first, near[k]))
+                // A child the first ray misses is the next entering ray's, if any: the
+                // child, its first ray, that ray's entry and the child's slot.
+                let child = |k: usize| -> Option<(Child, usize, f32, usize)> {
+                    let (first, near) = if enters & (1 << k) != 0 {
+                        (first, near[k])
                     } else if missed & (1 << k) != 0 {
-                        None
+                        return None;
                     } else {
-                        first_entering(rays, child_planes(node, k), t_max, after(lanes, first))
-                    }
+                        first_entering(rays, child_planes(node, k), t_max, after(lanes, first))?
+                    };
+                    Some((node.children[k], first, near, k))
                 };
                 let entered = match (child(0), child(1)) {
                     (None, None) => None,
-                    (Some(a), None) => Some(((node.children[0], a), None)),
-                    (None, Some(b)) => Some(((node.children[1], b), None)),
+                    (Some(next), None) | (None, Some(next)) => Some((next, None)),
                     (Some(a), Some(b)) => {
                         // The child of the lower first ray, or of the nearer entry for one ray.
-                        let (a, b) = ((node.children[0], a, 0), (node.children[1], b, 1));
-                        let (next, later) = if (a.1 .0, a.1 .1) <= (b.1 .0, b.1 .1) { (a, b) } else { (b, a) };
-                        Some(((next.0, next.1), Some((later.0, later.1 .0, later.1 .1, cur.index, later.2))))
+                        let (next, later) = if (a.1, a.2) <= (b.1, b.2) { (a, b) } else { (b, a) };
+                        Some((next, Some((later.0, later.1, later.2, cur.index, later.3))))
                     }
                 };
-                if let Some(((next, (next_first, _)), later)) = entered {
+                if let Some(((next, next_first, _, _), later)) = entered {
                     if let Some(later) = later {
                         deferred_children.push(later);
                     }

@@ -321,9 +321,7 @@ impl World {
             ObjectKind::Mesh(m) => self.may_reach_mesh(o, q.ray, t_max) && m.occluded(q.ray, q.shear(), t_max, c),
         }
     }
-}
 
-impl World {
     /// [`Geometry::intersect4`] for `N` packets of four traced together: one walk of the
     /// top-level tree and of each mesh's tree for all of their rays.
     #[inline]
@@ -400,9 +398,7 @@ impl World {
         }
         hits
     }
-}
 
-impl World {
     /// Each packet's rays traced alone: out of line, like [`World::find_each`].
     #[inline(never)]
     fn each_quad<const N: usize>(&self, quads: &[Packet; N], c: &mut Counters) -> [[Option<Hit>; 4]; N] {

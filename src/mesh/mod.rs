@@ -257,7 +257,7 @@ impl MeshObject {
             tests += u64::from(lanes.count_ones());
             let (a, b, cc) = self.tri(i);
             for g in 0..N {
-                let lanes = (lanes >> (4 * g)) & 0b1111;
+                let lanes = crate::bvh::group(lanes, g);
                 if lanes == 0 {
                     continue;
                 }
