@@ -205,10 +205,9 @@ fn lane<const N: usize>(v: &[Vec4; N], lane: usize) -> f32 {
 /// The single-ray splat of one lane of a packet.
 #[inline]
 fn lane_splat<const N: usize>(rays: &[Rays4; N], lane: usize) -> RaySplat {
-    let r = &rays[lane / 4];
-    let l = lane % 4;
-    let pick = |v: &[Vec4; 3]| [Vec4::splat(v[0][l]), Vec4::splat(v[1][l]), Vec4::splat(v[2][l])];
-    RaySplat { origin: pick(&r.origin), inv_dir: pick(&r.inv_dir), t_min: Vec4::splat(r.t_min[l]) }
+    let (r, l) = (&rays[lane / 4], lane % 4);
+    let pick = |v: &[Vec4; 3]| Vec3A::new(v[0][l], v[1][l], v[2][l]);
+    RaySplat::new(pick(&r.origin), pick(&r.inv_dir), r.t_min[l])
 }
 
 /// The lowest lane of `lanes` that enters the box `(min, max)` before its `t_max`, with

@@ -544,7 +544,7 @@ impl Geometry for World {
     }
 
     fn intersect4(&self, packet: &Packet, c: &mut Counters) -> [Option<Hit>; 4] {
-        let [hits] = self.intersect_packet(std::slice::from_ref(packet).try_into().expect("one quad"), c);
+        let [hits] = self.intersect_packet(std::array::from_ref(packet), c);
         hits
     }
 

@@ -27,6 +27,9 @@ pub(super) fn block<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bo
     // Lane `l` of packet `q` is pixel `(dx, dy)` of the block; outside `w × h` it traces
     // the nearest pixel inside, unwanted.
     let offset = |q: usize, l: usize| ((2 * (q % 2) + l % 2) as u32, (2 * (q / 2) + l / 2) as u32);
+    let wanted: [u32; 4] = std::array::from_fn(|q| {
+        (0..4).filter(|&l| offset(q, l).0 < w && offset(q, l).1 < h).fold(0, |m, l| m | 1 << l)
+    });
     let mut sums = [Vec3A::ZERO; 16];
     for s in 0..n {
         let (ox, oy) = sample_offset(s, n);
@@ -36,8 +39,7 @@ pub(super) fn block<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bo
                 let (px, py) = (x + dx.min(w - 1), y + dy.min(h - 1));
                 Ray::new(Vec3A::ZERO, frame.direction(px as f32 + ox, py as f32 + oy), frame.max_distance)
             };
-            let wanted = (0..4).filter(|&l| offset(q, l).0 < w && offset(q, l).1 < h).fold(0, |m, l| m | 1 << l);
-            Packet { rays: std::array::from_fn(ray), mask: wanted }
+            Packet { rays: std::array::from_fn(ray), mask: wanted[q] }
         });
         c.primary_rays += u64::from(w * h);
         let hits = g.intersect16(&quads, c);
