@@ -12,7 +12,7 @@ use crate::bvh::{splat3, Aabb, Bvh, Rays4};
 use crate::check::Loader;
 use crate::diag::Diagnostic;
 use crate::ir;
-use crate::mesh::triangle::Shear4;
+use crate::mesh::triangle::PacketShear;
 use crate::mesh::{self, MeshMemory, MeshObject};
 use crate::render::{intersect_each, Counters, Frame, Geometry, Hit, Packet, Ray, NO_OBJECT};
 use crate::sdf::{self, MarchParams, SdfObject};
@@ -349,17 +349,12 @@ impl World {
             t_max[g] = lanes4(|r| r.t_max);
             mask |= (quad.mask & 0b1111) << (4 * g);
         }
-        // Only the 4-wide triangle test needs each group's lanes to share a shear; without
-        // one (directions too far apart) meshes are tested lane by lane like SDF objects.
-        let shears = if self.has_meshes {
-            let mut shears = [None; N];
-            for g in 0..N {
-                shears[g] = Shear4::new(rays4[g].origin, dirs[g]);
-            }
-            shears.iter().all(Option::is_some).then(|| shears.map(|s| s.expect("all some")))
-        } else {
-            None
-        };
+        // Only the 4-wide triangle test needs the rays to share their origin and shear
+        // axes; without (directions too far apart) meshes are tested lane by lane like
+        // SDF objects.
+        let origin = quads[0].rays[0].origin;
+        let shared = quads.iter().all(|q| q.rays.iter().all(|r| r.origin == origin));
+        let shear = (self.has_meshes && shared).then(|| PacketShear::new(origin, &dirs)).flatten();
         let mut best: [[Option<Found>; 4]; N] = [[None; 4]; N];
         // SDF evaluations per lane; a lane's query is made only for an object tested lane by lane.
         let mut evals = [[0u64; 4]; N];
@@ -367,7 +362,7 @@ impl World {
         self.bvh.each_packet(&rays4, mask, &mut t_max, &mut visits, |k, lanes, t_max| {
             let i = self.bounded[k as usize];
             let o = &self.objects[i as usize];
-            if let (ObjectKind::Mesh(m), Some(shears)) = (&o.kind, &shears) {
+            if let (ObjectKind::Mesh(m), Some(shear)) = (&o.kind, &shear) {
                 let mut reach = 0;
                 for g in 0..N {
                     reach |= sphere_lanes(o, &rays4[g], &dirs[g], t_max[g]) << (4 * g);
@@ -376,7 +371,7 @@ impl World {
                 if reach == 0 {
                     return;
                 }
-                for (g, hits) in m.closest_packet(&rays4, shears, reach, *t_max, c).into_iter().enumerate() {
+                for (g, hits) in m.closest_packet(&rays4, shear, reach, *t_max, c).into_iter().enumerate() {
                     for (l, hit) in hits.into_iter().enumerate() {
                         if let Some((tri, hit)) = hit {
                             t_max[g][l] = hit.t;

@@ -246,7 +246,7 @@ impl MeshObject {
     pub fn closest_packet<const N: usize>(
         &self,
         rays: &[Rays4; N],
-        shears: &[triangle::Shear4; N],
+        shear: &triangle::PacketShear<N>,
         lanes: u32,
         mut t_max: [Vec4; N],
         c: &mut Counters,
@@ -256,12 +256,13 @@ impl MeshObject {
         self.bvh.each_packet(rays, lanes, &mut t_max, &mut c.node_visits, |i, lanes, t_max| {
             tests += u64::from(lanes.count_ones());
             let (a, b, cc) = self.tri(i);
+            let tri = shear.triangle(a, b, cc);
             for g in 0..N {
                 let lanes = crate::bvh::group(lanes, g);
                 if lanes == 0 {
                     continue;
                 }
-                let Some(hit) = triangle::intersect4(&shears[g], a, b, cc, rays[g].t_min, t_max[g], lanes) else {
+                let Some(hit) = shear.intersect4(g, &tri, rays[g].t_min, t_max[g], lanes) else {
                     continue;
                 };
                 for (l, slot) in best[g].iter_mut().enumerate() {

@@ -77,49 +77,99 @@ fn edge_functions_f64(a: (f32, f32), b: (f32, f32), c: (f32, f32)) -> [f32; 3] {
     edge_functions(wide(a), wide(b), wide(c)).map(|e| e as f32)
 }
 
-/// The shear of four rays in SIMD lanes, for a packet whose directions share their
-/// dominant axis and its sign (coherent camera rays almost always do).
-#[derive(Clone, Copy, Debug)]
-pub struct Shear4 {
-    k: [usize; 3],
-    /// `sx`, `sy`, `sz` per lane.
-    s: [Vec4; 3],
-    origin: [Vec4; 3],
+/// The shear axes of four rays given as components across lanes (`axes` for four lanes
+/// at once, the same comparisons as masks), or `None` when the lanes' axes differ.
+fn axes4(dir: &[Vec4; 3]) -> Option<[usize; 3]> {
+    let [ax, ay, az] = dir.map(Vec4::abs);
+    let (x_over_y, x_over_z, y_over_z) = (ax.cmpgt(ay), ax.cmpgt(az), ay.cmpgt(az));
+    let (x_major, y_major) = ((x_over_y & x_over_z).bitmask(), (!x_over_y & y_over_z).bitmask());
+    let kz = match (x_major, y_major) {
+        (0b1111, _) => 0,
+        (_, 0b1111) => 1,
+        (0, 0) => 2,
+        _ => return None,
+    };
+    match dir[kz].cmplt(Vec4::ZERO).bitmask() {
+        0 => Some([(kz + 1) % 3, (kz + 2) % 3, kz]),
+        0b1111 => Some([(kz + 2) % 3, (kz + 1) % 3, kz]),
+        _ => None,
+    }
 }
 
-impl Shear4 {
-    /// The packet shear of four rays given as components across lanes (`origin[axis]`,
-    /// `dir[axis]`), or `None` when their shear axes differ.
-    pub fn new(origin: [Vec4; 3], dir: [Vec4; 3]) -> Option<Shear4> {
-        // `axes` for four lanes at once: the same comparisons, as masks.
-        let [ax, ay, az] = dir.map(Vec4::abs);
-        let (x_over_y, x_over_z, y_over_z) = (ax.cmpgt(ay), ax.cmpgt(az), ay.cmpgt(az));
-        let (x_major, y_major) = ((x_over_y & x_over_z).bitmask(), (!x_over_y & y_over_z).bitmask());
-        let kz = match (x_major, y_major) {
-            (0b1111, _) => 0,
-            (_, 0b1111) => 1,
-            (0, 0) => 2,
-            _ => return None,
-        };
-        let backwards = dir[kz].cmplt(Vec4::ZERO).bitmask();
-        let (kx, ky) = match backwards {
-            0 => ((kz + 1) % 3, (kz + 2) % 3),
-            0b1111 => ((kz + 2) % 3, (kz + 1) % 3),
-            _ => return None,
-        };
+/// The shear of a packet: `N` groups of four rays from one origin whose directions share
+/// their dominant axis and its sign, as coherent camera rays almost always do. Sharing
+/// both, a triangle's vertices are moved to the origin and put in shear-axis order once
+/// for the whole packet ([`PacketShear::triangle`]); only the shear itself is per lane.
+#[derive(Clone, Copy, Debug)]
+pub struct PacketShear<const N: usize> {
+    origin: Vec3A,
+    k: [usize; 3],
+    /// `sx`, `sy`, `sz` per group, across its lanes.
+    s: [[Vec4; 3]; N],
+}
+
+/// A triangle as a [`PacketShear`] sees it: each vertex relative to the packet's origin,
+/// its coordinates in shear-axis order, each in all four lanes.
+#[derive(Clone, Copy, Debug)]
+pub struct PacketTriangle([[Vec4; 3]; 3]);
+
+impl<const N: usize> PacketShear<N> {
+    /// The shear of rays from `origin` with directions `dirs` (per group, components
+    /// across lanes), or `None` when their shear axes differ.
+    pub fn new(origin: Vec3A, dirs: &[[Vec4; 3]; N]) -> Option<PacketShear<N>> {
+        let k = axes4(&dirs[0])?;
+        if dirs[1..].iter().any(|dir| axes4(dir) != Some(k)) {
+            return None;
+        }
+        let [kx, ky, kz] = k;
         // Lane-wise the same divisions as `Shear::new`.
-        Some(Shear4 { k: [kx, ky, kz], s: [dir[kx] / dir[kz], dir[ky] / dir[kz], Vec4::ONE / dir[kz]], origin })
+        let s = dirs.map(|dir| [dir[kx] / dir[kz], dir[ky] / dir[kz], Vec4::ONE / dir[kz]]);
+        Some(PacketShear { origin, k, s })
     }
 
-    /// A vertex relative to each lane's origin, sheared (the packet form of `m * (v − o)`).
-    /// The scalar matrix product adds `0·p` terms that this skips; they can only change
-    /// the sign of a zero, never a value, so every lane gets the scalar test's numbers.
+    /// Triangle `v0 v1 v2` for [`intersect4`](Self::intersect4): `v − o` is the scalar
+    /// test's own subtraction, done once for every lane.
     #[inline(always)]
-    fn apply(&self, v: Vec3A) -> [Vec4; 3] {
-        let d =
-            [Vec4::splat(v.x) - self.origin[0], Vec4::splat(v.y) - self.origin[1], Vec4::splat(v.z) - self.origin[2]];
-        let [kx, ky, kz] = self.k;
-        [d[kx] - self.s[0] * d[kz], d[ky] - self.s[1] * d[kz], self.s[2] * d[kz]]
+    pub fn triangle(&self, v0: Vec3A, v1: Vec3A, v2: Vec3A) -> PacketTriangle {
+        let splat = |v: Vec3A| {
+            // Four entries so that `k & 3` needs no bounds check (`k` is below 3).
+            let d = (v - self.origin).extend(0.0).to_array();
+            self.k.map(|k| Vec4::splat(d[k & 3]))
+        };
+        PacketTriangle([splat(v0), splat(v1), splat(v2)])
+    }
+
+    /// [`intersect`] for the four rays of group `g` at once, for the lanes in `lanes`:
+    /// per lane the same arithmetic, so the same hits, distances and weights as four
+    /// single tests. The scalar matrix product adds `0·p` terms that this skips; they
+    /// can only change the sign of a zero, never a value.
+    #[inline(always)]
+    pub fn intersect4(&self, g: usize, tri: &PacketTriangle, t_min: Vec4, t_max: Vec4, lanes: u32) -> Option<TriHit4> {
+        let s = &self.s[g];
+        let shear = |[dx, dy, dz]: [Vec4; 3]| [dx - s[0] * dz, dy - s[1] * dz, s[2] * dz];
+        let [[ax, ay, az], [bx, by, bz], [cx, cy, cz]] = tri.0.map(shear);
+        let [mut u, mut v, mut w] = edge_functions((ax, ay), (bx, by), (cx, cy));
+        let zero = (u.cmpeq(Vec4::ZERO) | v.cmpeq(Vec4::ZERO) | w.cmpeq(Vec4::ZERO)).bitmask() & lanes;
+        if zero != 0 {
+            // Rare: the ray passes through an edge or vertex's projection.
+            for l in (0..4).filter(|l| zero & (1 << l) != 0) {
+                [u[l], v[l], w[l]] = edge_functions_f64((ax[l], ay[l]), (bx[l], by[l]), (cx[l], cy[l]));
+            }
+        }
+        let neg = u.cmplt(Vec4::ZERO) | v.cmplt(Vec4::ZERO) | w.cmplt(Vec4::ZERO);
+        let pos = u.cmpgt(Vec4::ZERO) | v.cmpgt(Vec4::ZERO) | w.cmpgt(Vec4::ZERO);
+        let inside = !(neg & pos).bitmask() & lanes;
+        if inside == 0 {
+            return None;
+        }
+        let det = u + v + w;
+        let t_scaled = u * az + v * bz + w * cz;
+        let inv = Vec4::ONE / det;
+        let t = t_scaled * inv;
+        // `det` finite and non-zero, `t` inside the open interval; NaN lanes compare false.
+        let ok = det.cmpne(Vec4::ZERO) & det.abs().cmplt(Vec4::INFINITY) & t.cmpgt(t_min) & t.cmplt(t_max);
+        let mask = ok.bitmask() & inside;
+        (mask != 0).then_some(TriHit4 { mask, t, bary: [u * inv, v * inv, w * inv] })
     }
 }
 
@@ -139,45 +189,6 @@ impl TriHit4 {
     pub fn lane(&self, l: usize) -> TriHit {
         TriHit { t: self.t[l], bary: [self.bary[0][l], self.bary[1][l], self.bary[2][l]] }
     }
-}
-
-/// [`intersect`] for four rays at once, for the lanes in `lanes`: per lane the same
-/// arithmetic, so the same hits, distances and weights as four single tests.
-#[inline]
-pub fn intersect4(
-    shear: &Shear4,
-    v0: Vec3A,
-    v1: Vec3A,
-    v2: Vec3A,
-    t_min: Vec4,
-    t_max: Vec4,
-    lanes: u32,
-) -> Option<TriHit4> {
-    let [ax, ay, az] = shear.apply(v0);
-    let [bx, by, bz] = shear.apply(v1);
-    let [cx, cy, cz] = shear.apply(v2);
-    let [mut u, mut v, mut w] = edge_functions((ax, ay), (bx, by), (cx, cy));
-    let zero = (u.cmpeq(Vec4::ZERO) | v.cmpeq(Vec4::ZERO) | w.cmpeq(Vec4::ZERO)).bitmask() & lanes;
-    if zero != 0 {
-        // Rare: the ray passes through an edge or vertex's projection.
-        for l in (0..4).filter(|l| zero & (1 << l) != 0) {
-            [u[l], v[l], w[l]] = edge_functions_f64((ax[l], ay[l]), (bx[l], by[l]), (cx[l], cy[l]));
-        }
-    }
-    let neg = u.cmplt(Vec4::ZERO) | v.cmplt(Vec4::ZERO) | w.cmplt(Vec4::ZERO);
-    let pos = u.cmpgt(Vec4::ZERO) | v.cmpgt(Vec4::ZERO) | w.cmpgt(Vec4::ZERO);
-    let inside = !(neg & pos).bitmask() & lanes;
-    if inside == 0 {
-        return None;
-    }
-    let det = u + v + w;
-    let t_scaled = u * az + v * bz + w * cz;
-    let inv = Vec4::ONE / det;
-    let t = t_scaled * inv;
-    // `det` finite and non-zero, `t` inside the open interval; NaN lanes compare false.
-    let ok = det.cmpne(Vec4::ZERO) & det.abs().cmplt(Vec4::INFINITY) & t.cmpgt(t_min) & t.cmplt(t_max);
-    let mask = ok.bitmask() & inside;
-    (mask != 0).then_some(TriHit4 { mask, t, bary: [u * inv, v * inv, w * inv] })
 }
 
 /// A hit: distance and barycentric weights of the three vertices.
@@ -283,9 +294,10 @@ mod tests {
             ];
             let dirs = targets.map(|t| (t - origin).normalize());
             let across = |v: [Vec3A; 4]| [0, 1, 2].map(|k| Vec4::new(v[0][k], v[1][k], v[2][k], v[3][k]));
-            let shear = Shear4::new(across([origin; 4]), across(dirs)).expect("one dominant axis");
+            let shear = PacketShear::new(origin, &[across(dirs)]).expect("one dominant axis");
             for (v0, v1, v2) in [(a, c, b), (a, b, d), (c, b, a)] {
-                let hits = intersect4(&shear, v0, v1, v2, Vec4::ZERO, Vec4::splat(f32::MAX), 0b1111);
+                let tri = shear.triangle(v0, v1, v2);
+                let hits = shear.intersect4(0, &tri, Vec4::ZERO, Vec4::splat(f32::MAX), 0b1111);
                 for (l, dir) in dirs.iter().enumerate() {
                     let single = intersect(origin, &Shear::new(*dir), v0, v1, v2, 0.0, f32::MAX);
                     let lane = hits.filter(|h| h.mask & (1 << l) != 0).map(|h| h.lane(l));

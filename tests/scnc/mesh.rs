@@ -259,7 +259,7 @@ fn packet_closest_hit_equals_brute_force() {
                 })
             });
             let mut rays4 = [Rays4 { origin: [Vec4::ZERO; 3], inv_dir: [Vec4::ZERO; 3], t_min: Vec4::ZERO }; N];
-            let mut shears = Vec::new();
+            let mut dirs = [[Vec4::ZERO; 3]; N];
             for (g, rays) in groups.iter().enumerate() {
                 let lanes4 = |f: &dyn Fn(&Ray) -> f32| Vec4::new(f(&rays[0]), f(&rays[1]), f(&rays[2]), f(&rays[3]));
                 let across = |f: &dyn Fn(&Ray) -> Vec3A| [0, 1, 2].map(|k| lanes4(&|r| f(r)[k]));
@@ -268,9 +268,9 @@ fn packet_closest_hit_equals_brute_force() {
                     inv_dir: across(&|r| r.inv_dir),
                     t_min: lanes4(&|r| r.t_min),
                 };
-                shears.extend(triangle::Shear4::new(rays4[g].origin, across(&|r| r.dir)));
+                dirs[g] = across(&|r| r.dir);
             }
-            let Ok(shears) = <[triangle::Shear4; N]>::try_from(shears) else {
+            let Some(shear) = triangle::PacketShear::new(origin, &dirs) else {
                 fallbacks += 1;
                 continue;
             };
@@ -280,7 +280,7 @@ fn packet_closest_hit_equals_brute_force() {
             let all = (1u32 << (4 * N)) - 1;
             let mask = if rng.below(2) == 0 { all } else { (rng.below(all as usize) as u32 + 1) & all };
             let mut c = Counters::default();
-            let hits = obj.closest_packet(&rays4, &shears, mask, t_max, &mut c);
+            let hits = obj.closest_packet(&rays4, &shear, mask, t_max, &mut c);
             for (lane, ray) in groups.iter().flatten().enumerate().filter(|(lane, _)| mask & (1 << lane) != 0) {
                 let found = hits[lane / 4][lane % 4].map(|(_, h)| h.t);
                 assert_eq!(found, brute_force(&mesh, ray), "{n} triangles, {N} groups, lane {lane}: {ray:?}");
