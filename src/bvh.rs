@@ -259,18 +259,20 @@ impl Frustum {
             }
             (t_min, t_far) = (t_min.min(rays[g].t_min), t_far.max(t_max[g]));
         }
-        let lo = |v: [Vec4; 3]| splat3(Vec3A::new(v[0].min_element(), v[1].min_element(), v[2].min_element()));
-        let hi = |v: [Vec4; 3]| splat3(Vec3A::new(v[0].max_element(), v[1].max_element(), v[2].max_element()));
-        let f = Frustum {
-            origin: [lo(o_lo), hi(o_hi)],
-            inv_dir: [lo(i_lo), hi(i_hi)],
-            t_min: Vec4::splat(t_min.min_element()),
-            t_max: Vec4::splat(t_far.max_element()),
-        };
-        let finite = f.origin.iter().chain(&f.inv_dir).flatten().all(|v| v.is_finite())
-            && f.t_min.is_finite()
-            && !f.t_max.is_nan_mask().any();
-        finite.then_some(f)
+        let lo = |v: [Vec4; 3]| Vec3A::new(v[0].min_element(), v[1].min_element(), v[2].min_element());
+        let hi = |v: [Vec4; 3]| Vec3A::new(v[0].max_element(), v[1].max_element(), v[2].max_element());
+        let (origin, inv_dir) = ([lo(o_lo), hi(o_hi)], [lo(i_lo), hi(i_hi)]);
+        let (t_min, t_max) = (t_min.min_element(), t_far.max_element());
+        // Checked on the four bounds, not on their splats: this runs once per walk.
+        let finite = (origin[0].is_finite() & origin[1].is_finite())
+            & (inv_dir[0].is_finite() & inv_dir[1].is_finite())
+            & (t_min.is_finite() & !t_max.is_nan());
+        finite.then(|| Frustum {
+            origin: origin.map(splat3),
+            inv_dir: inv_dir.map(splat3),
+            t_min: Vec4::splat(t_min),
+            t_max: Vec4::splat(t_max),
+        })
     }
 
     /// The node's children that no ray of the packet enters (bit 0 left, bit 1 right).

@@ -371,14 +371,9 @@ impl World {
                 if reach == 0 {
                     return;
                 }
-                for (g, hits) in m.closest_packet(&rays4, shear, reach, *t_max, c).into_iter().enumerate() {
-                    for (l, hit) in hits.into_iter().enumerate() {
-                        if let Some((tri, hit)) = hit {
-                            t_max[g][l] = hit.t;
-                            best[g][l] = Some(Found::Mesh { object: i, tri, hit });
-                        }
-                    }
-                }
+                m.closest_packet(&rays4, shear, reach, t_max, c, |g, l, tri, hit| {
+                    best[g][l] = Some(Found::Mesh { object: i, tri, hit });
+                });
                 return;
             }
             self.find_each(i, quads, lanes, t_max, &mut best, &mut evals, c);

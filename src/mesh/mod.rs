@@ -242,18 +242,20 @@ impl MeshObject {
 
     /// [`closest`](Self::closest) for the rays of a packet in `lanes` (groups of four,
     /// as [`Bvh::each_packet`] numbers them), each with its own `t_max`: per ray the same
-    /// closest hit up to rounding, found in one walk of the BVH.
+    /// closest hit up to rounding, found in one walk of the BVH. Each hit nearer than the
+    /// lane's `t_max` so far lowers it and goes to `hit(group, lane, triangle, hit)`; the
+    /// last one a lane gets is its closest.
     pub fn closest_packet<const N: usize>(
         &self,
         rays: &[Rays4; N],
         shear: &triangle::PacketShear<N>,
         lanes: u32,
-        mut t_max: [Vec4; N],
+        t_max: &mut [Vec4; N],
         c: &mut Counters,
-    ) -> [[Option<(u32, triangle::TriHit)>; 4]; N] {
-        let mut best = [[None; 4]; N];
+        mut hit: impl FnMut(usize, usize, u32, triangle::TriHit),
+    ) {
         let mut tests = 0u64;
-        self.bvh.each_packet(rays, lanes, &mut t_max, &mut c.node_visits, |i, lanes, t_max| {
+        self.bvh.each_packet(rays, lanes, t_max, &mut c.node_visits, |i, lanes, t_max| {
             tests += u64::from(lanes.count_ones());
             let (a, b, cc) = self.tri(i);
             let tri = shear.triangle(a, b, cc);
@@ -262,19 +264,16 @@ impl MeshObject {
                 if lanes == 0 {
                     continue;
                 }
-                let Some(hit) = shear.intersect4(g, &tri, rays[g].t_min, t_max[g], lanes) else {
+                let Some(found) = shear.intersect4(g, &tri, rays[g].t_min, t_max[g], lanes) else {
                     continue;
                 };
-                for (l, slot) in best[g].iter_mut().enumerate() {
-                    if hit.mask & (1 << l) != 0 {
-                        t_max[g][l] = hit.t[l];
-                        *slot = Some((i, hit.lane(l)));
-                    }
+                for l in (0..4).filter(|l| found.mask & (1 << l) != 0) {
+                    t_max[g][l] = found.t[l];
+                    hit(g, l, i, found.lane(l));
                 }
             }
         });
         c.triangle_tests += tests;
-        best
     }
 
     /// The surface at a hit found by [`closest`](Self::closest): point, normal (interpolated

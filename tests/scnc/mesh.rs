@@ -275,15 +275,18 @@ fn packet_closest_hit_equals_brute_force() {
                 continue;
             };
             packets += 1;
-            let t_max = groups.map(|rays| Vec4::from_array(rays.map(|r| r.t_max)));
+            let mut t_max = groups.map(|rays| Vec4::from_array(rays.map(|r| r.t_max)));
             // Every lane wanted, or a random subset (never none).
             let all = (1u32 << (4 * N)) - 1;
             let mask = if rng.below(2) == 0 { all } else { (rng.below(all as usize) as u32 + 1) & all };
             let mut c = Counters::default();
-            let hits = obj.closest_packet(&rays4, &shear, mask, t_max, &mut c);
+            let mut hits = [[None; 4]; N];
+            obj.closest_packet(&rays4, &shear, mask, &mut t_max, &mut c, |g, l, _, hit| hits[g][l] = Some(hit.t));
             for (lane, ray) in groups.iter().flatten().enumerate().filter(|(lane, _)| mask & (1 << lane) != 0) {
-                let found = hits[lane / 4][lane % 4].map(|(_, h)| h.t);
+                let found = hits[lane / 4][lane % 4];
                 assert_eq!(found, brute_force(&mesh, ray), "{n} triangles, {N} groups, lane {lane}: {ray:?}");
+                // The walk leaves each lane's `t_max` at its closest hit.
+                assert_eq!(t_max[lane / 4][lane % 4], found.unwrap_or(ray.t_max), "lane {lane}: {ray:?}");
             }
         }
         assert!(
