@@ -150,15 +150,20 @@ impl<const N: usize> PacketShear<N> {
         let [[ax, ay, az], [bx, by, bz], [cx, cy, cz]] = tri.0.map(shear);
         let [mut u, mut v, mut w] = edge_functions((ax, ay), (bx, by), (cx, cy));
         let zero = (u.cmpeq(Vec4::ZERO) | v.cmpeq(Vec4::ZERO) | w.cmpeq(Vec4::ZERO)).bitmask() & lanes;
-        if zero != 0 {
+        let inside = if zero == 0 {
+            // No edge function is zero, so a lane is inside exactly when the three share
+            // their sign bit (NaN lanes may pass; their `det` fails below).
+            let (su, sv, sw) = (u.is_negative_bitmask(), v.is_negative_bitmask(), w.is_negative_bitmask());
+            !((su ^ sv) | (su ^ sw)) & lanes
+        } else {
             // Rare: the ray passes through an edge or vertex's projection.
             for l in (0..4).filter(|l| zero & (1 << l) != 0) {
                 [u[l], v[l], w[l]] = edge_functions_f64((ax[l], ay[l]), (bx[l], by[l]), (cx[l], cy[l]));
             }
-        }
-        let neg = u.cmplt(Vec4::ZERO) | v.cmplt(Vec4::ZERO) | w.cmplt(Vec4::ZERO);
-        let pos = u.cmpgt(Vec4::ZERO) | v.cmpgt(Vec4::ZERO) | w.cmpgt(Vec4::ZERO);
-        let inside = !(neg & pos).bitmask() & lanes;
+            let neg = u.cmplt(Vec4::ZERO) | v.cmplt(Vec4::ZERO) | w.cmplt(Vec4::ZERO);
+            let pos = u.cmpgt(Vec4::ZERO) | v.cmpgt(Vec4::ZERO) | w.cmpgt(Vec4::ZERO);
+            !(neg & pos).bitmask() & lanes
+        };
         if inside == 0 {
             return None;
         }
