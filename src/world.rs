@@ -381,10 +381,18 @@ impl World {
         c.node_visits += visits;
         // A loop, not `array::from_fn` (see `intersect_each`).
         let mut hits = [[None; 4]; N];
-        for lane in (0..4 * N).filter(|&lane| mask & (1 << lane) != 0) {
+        let mut rest = mask;
+        while rest != 0 {
+            let lane = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
             let (g, l) = (lane / 4, lane % 4);
             let ray = &quads[g].rays[l];
-            hits[g][l] = self.finish(&mut Query { evals: evals[g][l], ..Query::new(ray) }, best[g][l], c);
+            hits[g][l] = if self.unbounded.is_empty() && evals[g][l] == 0 {
+                // No object left to try and no work to settle: only the winner's surface.
+                best[g][l].and_then(|found| self.surface(found, ray, c))
+            } else {
+                self.finish(&mut Query { evals: evals[g][l], ..Query::new(ray) }, best[g][l], c)
+            };
         }
         hits
     }
