@@ -353,8 +353,8 @@ impl World {
         // axes; without (directions too far apart) meshes are tested lane by lane like
         // SDF objects.
         let origin = quads[0].rays[0].origin;
-        let shared = quads.iter().all(|q| q.rays.iter().all(|r| r.origin == origin));
-        let shear = (self.has_meshes && shared).then(|| PacketShear::new(origin, &dirs)).flatten();
+        let shared = || quads.iter().all(|q| q.rays.iter().all(|r| r.origin == origin));
+        let shear = (self.has_meshes && shared()).then(|| PacketShear::new(origin, &dirs)).flatten();
         let mut best: [[Option<Found>; 4]; N] = [[None; 4]; N];
         // SDF evaluations per lane; a lane's query is made only for an object tested lane by lane.
         let mut evals = [[0u64; 4]; N];
