@@ -721,7 +721,7 @@ impl Bvh {
                     } else if missed & (1 << k) != 0 {
                         return None;
                     } else {
-                        first_entering(rays, child_planes(node, k), t_max, after(lanes, first))?
+                        first_entering(rays, child_planes(node, k), t_max, after(mask, first))?
                     };
                     Some((node.children[k], first, near, k))
                 };
@@ -753,7 +753,7 @@ impl Bvh {
                 } else {
                     // That ray has hit something nearer: the rays after it, if any enter.
                     let planes = child_planes(&self.nodes[parent as usize], k);
-                    match first_entering(rays, planes, t_max, after(from(mask, f), f)) {
+                    match first_entering(rays, planes, t_max, after(mask, f)) {
                         Some((f, _)) => f,
                         None => continue,
                     }

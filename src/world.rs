@@ -5,7 +5,7 @@
 //! **Invariant:** every object lies in render space (camera at the origin); each bounded
 //! object's box and sphere contain its surface, so a ray outside them cannot hit it.
 
-use glam::{DAffine3, Mat4, Vec3A, Vec4};
+use glam::{DAffine3, Vec3A, Vec4};
 use rayon::prelude::*;
 
 use crate::bvh::{splat3, Aabb, Bvh, Rays4};
@@ -14,7 +14,7 @@ use crate::diag::Diagnostic;
 use crate::ir;
 use crate::mesh::triangle::PacketShear;
 use crate::mesh::{self, MeshMemory, MeshObject};
-use crate::render::{intersect_each, Counters, Frame, Geometry, Hit, Packet, Ray, NO_OBJECT};
+use crate::render::{intersect_each, lanes, Counters, Frame, Geometry, Hit, Packet, Ray, NO_OBJECT};
 use crate::sdf::{self, MarchParams, SdfObject};
 use crate::span::Span;
 
@@ -335,18 +335,13 @@ impl World {
         let mut dirs = [[Vec4::ZERO; 3]; N];
         let mut t_max = [Vec4::ZERO; N];
         for (g, quad) in quads.iter().enumerate() {
-            let rays = &quad.rays;
-            // Rays across lanes: each transpose turns four `Vec3A`s into one vector per axis.
-            let across = |f: fn(&Ray) -> Vec3A| {
-                let col = |l: usize| f(&rays[l]).extend(0.0);
-                let m = Mat4::from_cols(col(0), col(1), col(2), col(3)).transpose();
-                [m.x_axis, m.y_axis, m.z_axis]
+            rays4[g] = Rays4 {
+                origin: quad.across(|r| r.origin),
+                inv_dir: quad.across(|r| r.inv_dir),
+                t_min: quad.each(|r| r.t_min),
             };
-            let lanes4 = |f: fn(&Ray) -> f32| Vec4::new(f(&rays[0]), f(&rays[1]), f(&rays[2]), f(&rays[3]));
-            rays4[g] =
-                Rays4 { origin: across(|r| r.origin), inv_dir: across(|r| r.inv_dir), t_min: lanes4(|r| r.t_min) };
-            dirs[g] = across(|r| r.dir);
-            t_max[g] = lanes4(|r| r.t_max);
+            dirs[g] = quad.across(|r| r.dir);
+            t_max[g] = quad.each(|r| r.t_max);
             mask |= (quad.mask & 0b1111) << (4 * g);
         }
         // Only the 4-wide triangle test needs the rays to share their origin and shear
@@ -381,10 +376,7 @@ impl World {
         c.node_visits += visits;
         // A loop, not `array::from_fn` (see `intersect_each`).
         let mut hits = [[None; 4]; N];
-        let mut rest = mask;
-        while rest != 0 {
-            let lane = rest.trailing_zeros() as usize;
-            rest &= rest - 1;
+        for lane in lanes(mask) {
             let (g, l) = (lane / 4, lane % 4);
             let ray = &quads[g].rays[l];
             hits[g][l] = if self.unbounded.is_empty() && evals[g][l] == 0 {
@@ -422,7 +414,7 @@ impl World {
         evals: &mut [[u64; 4]; N],
         c: &mut Counters,
     ) {
-        for lane in (0..4 * N).filter(|&lane| lanes & (1 << lane) != 0) {
+        for lane in crate::render::lanes(lanes) {
             let (g, l) = (lane / 4, lane % 4);
             let mut q = Query { evals: evals[g][l], ..Query::new(&quads[g].rays[l]) };
             if let Some(found) = self.find(i, &mut q, t_max[g][l], c) {

@@ -10,7 +10,7 @@
 
 use glam::Vec3A;
 
-use super::{spawn_offset, Counters, Frame, Geometry, Hit, Packet, Ray, ShadeLight};
+use super::{lanes, spawn_offset, Counters, Frame, Geometry, Hit, Packet, Ray, ShadeLight};
 
 /// The 8-bit colours of a block of up to 4×4 pixels from `(x, y)`, `w` wide and `h` high,
 /// each averaging `frame.samples` deterministic samples. Each sample's camera rays go
@@ -44,7 +44,8 @@ pub(super) fn block<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bo
         c.primary_rays += u64::from(w * h);
         let hits = g.intersect16(&quads, c);
         for (q, quad) in quads.iter().enumerate() {
-            for (l, ray) in quad.rays.iter().enumerate().filter(|(l, _)| quad.mask & (1 << l) != 0) {
+            for l in lanes(quad.mask) {
+                let ray = &quad.rays[l];
                 let mut colour = shade::<SHADOWS, REFLECT, SPECULAR, AO>(g, frame, ray, hits[q][l], frame.depth, c);
                 if !colour.is_finite() {
                     c.nonfinite_samples += 1;

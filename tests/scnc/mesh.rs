@@ -261,14 +261,13 @@ fn packet_closest_hit_equals_brute_force() {
             let mut rays4 = [Rays4 { origin: [Vec4::ZERO; 3], inv_dir: [Vec4::ZERO; 3], t_min: Vec4::ZERO }; N];
             let mut dirs = [[Vec4::ZERO; 3]; N];
             for (g, rays) in groups.iter().enumerate() {
-                let lanes4 = |f: &dyn Fn(&Ray) -> f32| Vec4::new(f(&rays[0]), f(&rays[1]), f(&rays[2]), f(&rays[3]));
-                let across = |f: &dyn Fn(&Ray) -> Vec3A| [0, 1, 2].map(|k| lanes4(&|r| f(r)[k]));
+                let packet = Packet::new(rays);
                 rays4[g] = Rays4 {
-                    origin: across(&|r| r.origin),
-                    inv_dir: across(&|r| r.inv_dir),
-                    t_min: lanes4(&|r| r.t_min),
+                    origin: packet.across(|r| r.origin),
+                    inv_dir: packet.across(|r| r.inv_dir),
+                    t_min: packet.each(|r| r.t_min),
                 };
-                dirs[g] = across(&|r| r.dir);
+                dirs[g] = packet.across(|r| r.dir);
             }
             let Some(shear) = triangle::PacketShear::new(origin, &dirs) else {
                 fallbacks += 1;
