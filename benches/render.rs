@@ -15,12 +15,12 @@ fn lower(path: &str, w: u32, h: u32) -> (Frame, scnc::world::World) {
 
 fn lower_mode(path: &str, w: u32, h: u32, mode: scnc::world::Mode) -> (Frame, scnc::world::World) {
     let text = std::fs::read_to_string(path).expect("seed scene");
-    let c = scnc::compile_source(path, Path::new(path), text, &scnc::check::FsLoader);
+    let c = scnc::compile_source(path, Path::new(path), text, &scnc::source::FsLoader);
     let mut scene = c.scene.expect("seed scenes compile");
     scene.settings.width = w;
     scene.settings.height = h;
     let (frame, g) =
-        scnc::world::prepare(&scene, scnc::effects::derive(&scene), mode, &scnc::check::FsLoader).expect("lowering");
+        scnc::world::prepare(&scene, scnc::effects::derive(&scene), mode, &scnc::source::FsLoader).expect("lowering");
     (frame, g)
 }
 
@@ -44,11 +44,15 @@ fn primitives(c: &mut Criterion) {
     group.throughput(Throughput::Elements(points.len() as u64));
     for shape in shapes {
         let text = format!("light ambient(1)\nobject {shape} at [0, 0, 5]\n");
-        let c2 = scnc::compile_source("b.scn", Path::new("b.scn"), text, &scnc::check::FsLoader);
+        let c2 = scnc::compile_source("b.scn", Path::new("b.scn"), text, &scnc::source::FsLoader);
         let scene = c2.scene.expect("compiles");
-        let (_, g) =
-            scnc::world::prepare(&scene, scnc::effects::derive(&scene), scnc::world::Mode::Sdf, &scnc::check::FsLoader)
-                .expect("lowers");
+        let (_, g) = scnc::world::prepare(
+            &scene,
+            scnc::effects::derive(&scene),
+            scnc::world::Mode::Sdf,
+            &scnc::source::FsLoader,
+        )
+        .expect("lowers");
         group.bench_function(shape, |b| {
             b.iter(|| points.iter().map(|p| g.sdf_eval(0, black_box(*p)).unwrap_or(0.0)).sum::<f32>())
         });
@@ -58,7 +62,7 @@ fn primitives(c: &mut Criterion) {
 
 fn march(c: &mut Criterion) {
     let mut group = c.benchmark_group("primary rays");
-    let modes = [("sdf", scnc::world::Mode::Sdf), ("mesh-high", scnc::world::Mode::Mesh(scnc::world::Detail::High))];
+    let modes = [("sdf", scnc::world::Mode::Sdf), ("mesh-high", scnc::world::Mode::Mesh(scnc::mesh::Detail::High))];
     // 256×256 for quick comparisons; the study's 1000×1000 (where the throughput
     // targets are stated) for the two scenes those targets name.
     let cases = [

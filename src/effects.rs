@@ -50,22 +50,10 @@ impl Effects {
 }
 
 fn materials_of_shape(shape: &ir::Shape, out: &mut Vec<ir::Material>) {
-    match &shape.kind {
-        ShapeKind::Paint { child, material } => {
-            out.push((**material).clone());
-            materials_of_shape(child, out);
-        }
-        ShapeKind::Union { children, .. }
-        | ShapeKind::Intersect { children, .. }
-        | ShapeKind::Subtract { children, .. } => {
-            children.iter().for_each(|c| materials_of_shape(c, out));
-        }
-        ShapeKind::Round { child, .. }
-        | ShapeKind::Shell { child, .. }
-        | ShapeKind::Repeat { child, .. }
-        | ShapeKind::Transform { child, .. } => materials_of_shape(child, out),
-        _ => {}
+    if let ShapeKind::Paint { material, .. } = &shape.kind {
+        out.push((**material).clone());
     }
+    shape.children().iter().for_each(|c| materials_of_shape(c, out));
 }
 
 /// Every material an object can show, plus the default grey when some part has none.
@@ -92,14 +80,12 @@ fn materials_of(geometry: &Geometry) -> Vec<ir::Material> {
 fn painted_everywhere(shape: &ir::Shape) -> bool {
     match &shape.kind {
         ShapeKind::Paint { .. } => true,
-        ShapeKind::Union { children, .. }
-        | ShapeKind::Intersect { children, .. }
-        | ShapeKind::Subtract { children, .. } => children.iter().all(|c| painted_everywhere(c)),
-        ShapeKind::Round { child, .. }
-        | ShapeKind::Shell { child, .. }
-        | ShapeKind::Repeat { child, .. }
-        | ShapeKind::Transform { child, .. } => painted_everywhere(child),
-        _ => false,
+        ShapeKind::Primitive(_) => false,
+        ShapeKind::Csg { .. }
+        | ShapeKind::Round { .. }
+        | ShapeKind::Shell { .. }
+        | ShapeKind::Repeat { .. }
+        | ShapeKind::Transform { .. } => shape.children().iter().all(|c| painted_everywhere(c)),
     }
 }
 
@@ -111,9 +97,9 @@ pub fn derive(scene: &Scene) -> Effects {
     for (i, l) in scene.lights.iter().enumerate() {
         match l.kind {
             LightKind::Ambient => ambient += l.intensity,
-            _ if l.intensity == 0.0 => {}
-            _ if l.shadows => shadow_lights.push(i),
-            _ => unshadowed_lights.push(i),
+            LightKind::Point { .. } | LightKind::Directional { .. } if l.intensity == 0.0 => {}
+            LightKind::Point { .. } | LightKind::Directional { .. } if l.shadows => shadow_lights.push(i),
+            LightKind::Point { .. } | LightKind::Directional { .. } => unshadowed_lights.push(i),
         }
     }
     let per_object: Vec<Vec<ir::Material>> = scene.objects.iter().map(|o| materials_of(&o.geometry)).collect();

@@ -43,8 +43,8 @@ pub mod world;
 
 use std::path::Path;
 
-use check::Loader;
 use diag::Diagnostic;
+use source::Loader;
 use source::SourceMap;
 
 /// The result of compiling one file: its sources (for rendering diagnostics), the

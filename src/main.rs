@@ -7,8 +7,8 @@ use std::time::Instant;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
-use scnc::check::{FsLoader, Loader};
 use scnc::diag::Diagnostic;
+use scnc::source::{FsLoader, Loader};
 use scnc::Compiled;
 
 #[derive(Parser)]
@@ -74,12 +74,12 @@ enum GeometryKind {
     Mesh,
 }
 
-fn parse_detail(s: &str) -> Result<scnc::world::Detail, String> {
+fn parse_detail(s: &str) -> Result<scnc::mesh::Detail, String> {
     match s {
-        "low" => Ok(scnc::world::Detail::Low),
-        "high" => Ok(scnc::world::Detail::High),
+        "low" => Ok(scnc::mesh::Detail::Low),
+        "high" => Ok(scnc::mesh::Detail::High),
         n => match n.parse::<u32>() {
-            Ok(n) if (3..=2048).contains(&n) => Ok(scnc::world::Detail::N(n)),
+            Ok(n) if (3..=2048).contains(&n) => Ok(scnc::mesh::Detail::N(n)),
             _ => Err("expected `low`, `high` or a number of rings from 3 to 2048".into()),
         },
     }
@@ -134,7 +134,7 @@ struct RenderArgs {
     /// Tessellation detail with `--geometry mesh`: `low` (7 rings, 10-point circles),
     /// `high` (14 rings, 50-point circles) or N (N rings, 2N-point circles).
     #[arg(long, value_parser = parse_detail, default_value = "high")]
-    detail: scnc::world::Detail,
+    detail: scnc::mesh::Detail,
     /// Print the effect set, ray counts, work per ray and memory.
     #[arg(long)]
     stats: bool,
@@ -264,7 +264,7 @@ fn fmt_cmd(files: &[PathBuf], check: bool) -> ExitCode {
         let text = match FsLoader.read(path) {
             Ok(text) => text,
             Err(e) => {
-                let _ = writeln!(std::io::stderr(), "error: cannot read `{name}`: {}", scnc::check::io_reason(&e));
+                let _ = writeln!(std::io::stderr(), "error: cannot read `{name}`: {}", scnc::source::io_reason(&e));
                 failed = true;
                 continue;
             }
@@ -324,7 +324,7 @@ fn compile(path: &Path, format: MessageFormat) -> Option<Compiled> {
         Ok(text) => Some(scnc::with_big_stack(|| scnc::compile_source(&name, path, text, &FsLoader))),
         Err(e) => {
             let code = scnc::diag::codes::INCLUDE_READ;
-            let message = format!("cannot read `{name}`: {}", scnc::check::io_reason(&e));
+            let message = format!("cannot read `{name}`: {}", scnc::source::io_reason(&e));
             let line = match format {
                 MessageFormat::Human => format!("error[{code}]: {message}"),
                 MessageFormat::Json => serde_json::json!({

@@ -4,6 +4,42 @@ use std::path::{Path, PathBuf};
 
 use crate::span::Span;
 
+/// Largest source file.
+pub const MAX_FILE_BYTES: usize = 4 * 1024 * 1024;
+
+/// Reads included files; the CLI reads the disk, tests may serve files from memory.
+pub trait Loader {
+    /// The text of the file at `path`.
+    fn read(&self, path: &Path) -> std::io::Result<String>;
+}
+
+/// Reads files from the file system.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FsLoader;
+
+impl Loader for FsLoader {
+    fn read(&self, path: &Path) -> std::io::Result<String> {
+        let meta = std::fs::metadata(path)?;
+        if meta.is_dir() {
+            return Err(std::io::Error::other("it is a directory"));
+        }
+        if meta.len() > MAX_FILE_BYTES as u64 {
+            return Err(std::io::Error::other(format!("it is larger than the {} MiB limit", MAX_FILE_BYTES >> 20)));
+        }
+        let bytes = std::fs::read(path)?;
+        String::from_utf8(bytes).map_err(|_| std::io::Error::other("it is not valid UTF-8"))
+    }
+}
+
+/// A short, lowercase reason for an I/O error.
+pub fn io_reason(e: &std::io::Error) -> String {
+    match e.kind() {
+        std::io::ErrorKind::NotFound => "no such file".into(),
+        std::io::ErrorKind::PermissionDenied => "permission denied".into(),
+        _ => e.to_string(),
+    }
+}
+
 /// Index of a file in a [`SourceMap`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct FileId(pub u32);

@@ -6,12 +6,13 @@ use std::fmt::Write as _;
 use std::time::Instant;
 
 use crate::accuracy;
-use crate::check::Loader;
 use crate::diag::Diagnostic;
 use crate::effects;
 use crate::ir::Scene;
+use crate::mesh::Detail;
 use crate::render::{self, Counters, Image};
-use crate::world::{self, Detail, Mode};
+use crate::source::Loader;
+use crate::world::{self, Mode};
 
 /// One accuracy setting.
 #[derive(Clone, Copy, Debug, PartialEq)]

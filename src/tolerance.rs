@@ -13,8 +13,8 @@
 //!   object's nearest distance). Boxes are exact. Isosurfaces (CSG and modifiers) use a
 //!   cell of `diameter / (4·rings)` and deviate by at most half a cell.
 
-use crate::ir::{self, Geometry, Scene, Shape, ShapeKind};
-use crate::world::Detail;
+use crate::ir::{self, Facets, Geometry, Scene, Shape, ShapeKind};
+use crate::mesh::Detail;
 
 /// A geometric error bound.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -70,20 +70,23 @@ pub fn sdf_epsilon(scene: &Scene, tol: Tolerance) -> f64 {
 /// Largest radius of curvature among the curved parts of a shape, in world units, and
 /// whether it needs an isosurface (its diameter then matters instead).
 fn curvature_radius(shape: &Shape, scale: f64) -> (f64, Option<f64>) {
+    let isosurface = || {
+        let diameter = ir::shape_bounds(shape).map_or(0.0, |b| (b.max - b.min).length()) * scale;
+        (0.0, Some(diameter))
+    };
     match &shape.kind {
-        ShapeKind::Sphere { radius } | ShapeKind::Cylinder { radius, .. } | ShapeKind::Cone { radius, .. } => {
-            (radius * scale, None)
-        }
-        ShapeKind::Torus { major, minor } => ((major + minor) * scale, None),
-        ShapeKind::Box { .. } | ShapeKind::Plane { .. } => (0.0, None),
+        ShapeKind::Primitive(p) => match p.facets() {
+            Facets::Inscribed(radius) => (radius * scale, None),
+            Facets::Exact => (0.0, None),
+            Facets::Isosurface => isosurface(),
+        },
         ShapeKind::Transform { child, xf } => {
             let k = xf.matrix3.to_cols_array().iter().fold(0.0f64, |a, x| a.max(x.abs())) * 3f64.sqrt();
             curvature_radius(child, scale * k)
         }
         ShapeKind::Paint { child, .. } => curvature_radius(child, scale),
-        _ => {
-            let diameter = ir::shape_bounds(shape).map_or(0.0, |b| (b.max - b.min).length()) * scale;
-            (0.0, Some(diameter))
+        ShapeKind::Csg { .. } | ShapeKind::Round { .. } | ShapeKind::Shell { .. } | ShapeKind::Repeat { .. } => {
+            isosurface()
         }
     }
 }

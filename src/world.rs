@@ -9,45 +9,14 @@ use glam::{DAffine3, Vec3A, Vec4};
 use rayon::prelude::*;
 
 use crate::bvh::{splat3, Aabb, Bvh, Rays4};
-use crate::check::Loader;
 use crate::diag::Diagnostic;
 use crate::ir;
 use crate::mesh::triangle::PacketShear;
-use crate::mesh::{self, MeshMemory, MeshObject};
+use crate::mesh::{self, Detail, MeshMemory, MeshObject};
 use crate::render::{intersect_each, lanes, Counters, Frame, Geometry, Hit, Packet, Ray, NO_OBJECT};
 use crate::sdf::{self, MarchParams, SdfObject};
+use crate::source::Loader;
 use crate::span::Span;
-
-/// How finely shapes are tessellated in mesh mode.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Detail {
-    /// The study's low detail: spheres of 7 rings, circles of 10 points.
-    Low,
-    /// The study's high detail: spheres of 14 rings, circles of 50 points.
-    High,
-    /// Spheres of `N` rings (and `2N` segments), circles of `2N` points.
-    N(u32),
-}
-
-impl Detail {
-    /// Rings of a UV sphere (segments are twice this) and sides of a torus tube.
-    pub fn rings(self) -> u32 {
-        match self {
-            Detail::Low => 7,
-            Detail::High => 14,
-            Detail::N(n) => n.max(3),
-        }
-    }
-
-    /// Points on a circle (cylinder and cone caps, torus rings).
-    pub fn circle(self) -> u32 {
-        match self {
-            Detail::Low => 10,
-            Detail::High => 50,
-            Detail::N(n) => 2 * n.max(3),
-        }
-    }
-}
 
 /// Which back-end renders shapes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -176,15 +145,10 @@ pub fn lower(
                 detail,
                 max_distance,
                 &mut budget,
-                &mut builder,
+                builder.materials,
             )?),
             (ir::Geometry::Mesh(m), _) => {
-                let job = mesh::lower::explicit(m, to_render, &mut budget, &mut builder, loader)?;
-                // Isosurfaces and files are counted once made (their own limits bound them).
-                if matches!(m.source, ir::MeshSource::Isosurface { .. } | ir::MeshSource::File { .. }) {
-                    mesh::lower::spend(&mut budget, job.mesh.triangles.len() as u64, m.span)?;
-                }
-                Lowered::Mesh(job)
+                Lowered::Mesh(mesh::lower::explicit(m, to_render, &mut budget, builder.materials, loader)?)
             }
         };
         lowered.push((part, obj.span));

@@ -4,6 +4,8 @@
 
 use std::fmt;
 
+use crate::ir::CsgOp;
+
 /// The types of the language.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Ty {
@@ -81,7 +83,7 @@ pub struct Param {
     pub default: Default,
 }
 
-/// Where a builtin may be used.
+/// Where a builtin may be used (follows from its [`Ctor`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kind {
     /// A function callable in expressions.
@@ -94,13 +96,108 @@ pub enum Kind {
     Render,
 }
 
+/// What a builtin makes: the checker's constructors match on it exhaustively, so an
+/// entry of [`BUILTINS`] cannot lack a constructor, nor a constructor its entry.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Ctor {
+    /// A primitive shape.
+    Primitive(Prim),
+    /// A CSG operator.
+    Csg(CsgOp),
+    /// A shape modifier.
+    Modifier(Modifier),
+    /// `material(…)`.
+    Material,
+    /// `rgb(…)`.
+    Rgb,
+    /// A light.
+    Light(LightFn),
+    /// A function of one number.
+    Math(MathFn),
+    /// `min` or `max` of numbers.
+    Extreme(Extreme),
+    /// `len(list)`.
+    Len,
+    /// A mesh generator.
+    Generator(Gen),
+    /// The `camera` statement's arguments.
+    Camera,
+    /// The `render` statement's arguments.
+    Render,
+}
+
+/// The primitive shape builtins.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(missing_docs, reason = "each variant is the builtin of the same name, documented in BUILTINS")]
+pub enum Prim {
+    Sphere,
+    Box,
+    Cylinder,
+    Torus,
+    Plane,
+    Capsule,
+    Cone,
+}
+
+/// The shape modifiers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(missing_docs, reason = "each variant is the builtin of the same name, documented in BUILTINS")]
+pub enum Modifier {
+    Round,
+    Shell,
+    Repeat,
+}
+
+/// The lights.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(missing_docs, reason = "each variant is the builtin of the same name, documented in BUILTINS")]
+pub enum LightFn {
+    Ambient,
+    Point,
+    Directional,
+}
+
+/// Functions of one number.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(missing_docs, reason = "each variant is the builtin of the same name, documented in BUILTINS")]
+pub enum MathFn {
+    Sin,
+    Cos,
+    Tan,
+    Sqrt,
+    Abs,
+    Floor,
+}
+
+/// `min` and `max`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(missing_docs, reason = "each variant is the builtin of the same name, documented in BUILTINS")]
+pub enum Extreme {
+    Min,
+    Max,
+}
+
+/// The mesh generators, one variant per entry of [`BUILTINS`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(missing_docs, reason = "each variant is the generator of the same name, documented in BUILTINS")]
+pub enum Gen {
+    UvSphere,
+    IcoSphere,
+    Box,
+    Cylinder,
+    Torus,
+    Plane,
+    Isosurface,
+    File,
+}
+
 /// A builtin.
 #[derive(Clone, Copy, Debug)]
 pub struct Builtin {
     /// Its name.
     pub name: &'static str,
-    /// Where it may be used.
-    pub kind: Kind,
+    /// What it makes, and so where it may be used.
+    pub ctor: Ctor,
     /// Its parameters, in positional order.
     pub params: &'static [Param],
     /// For variadic builtins: the type of the extra positional arguments (before `params`).
@@ -112,6 +209,24 @@ pub struct Builtin {
 }
 
 impl Builtin {
+    /// Where it may be used.
+    pub fn kind(&self) -> Kind {
+        match self.ctor {
+            Ctor::Primitive(_)
+            | Ctor::Csg(_)
+            | Ctor::Modifier(_)
+            | Ctor::Material
+            | Ctor::Rgb
+            | Ctor::Light(_)
+            | Ctor::Math(_)
+            | Ctor::Extreme(_)
+            | Ctor::Len => Kind::Function,
+            Ctor::Generator(_) => Kind::MeshGenerator,
+            Ctor::Camera => Kind::Camera,
+            Ctor::Render => Kind::Render,
+        }
+    }
+
     /// The signature as users read it, such as `sphere(r: num)` or `min(num…)`.
     pub fn signature(&self) -> String {
         let mut parts = Vec::new();
@@ -142,16 +257,23 @@ const fn p(name: &'static str, ty: Ty, default: Default) -> Param {
     Param { name, ty, default }
 }
 
-const fn f(name: &'static str, params: &'static [Param], result: Ty, doc: &'static str) -> Builtin {
-    Builtin { name, kind: Kind::Function, params, variadic: None, result, doc }
+const fn f(name: &'static str, ctor: Ctor, params: &'static [Param], result: Ty, doc: &'static str) -> Builtin {
+    Builtin { name, ctor, params, variadic: None, result, doc }
 }
 
-const fn variadic(name: &'static str, ty: Ty, params: &'static [Param], result: Ty, doc: &'static str) -> Builtin {
-    Builtin { name, kind: Kind::Function, params, variadic: Some(ty), result, doc }
+const fn variadic(
+    name: &'static str,
+    ctor: Ctor,
+    ty: Ty,
+    params: &'static [Param],
+    result: Ty,
+    doc: &'static str,
+) -> Builtin {
+    Builtin { name, ctor, params, variadic: Some(ty), result, doc }
 }
 
-const fn gen(name: &'static str, params: &'static [Param], doc: &'static str) -> Builtin {
-    Builtin { name, kind: Kind::MeshGenerator, params, variadic: None, result: Ty::Mesh, doc }
+const fn gen(name: &'static str, g: Gen, params: &'static [Param], doc: &'static str) -> Builtin {
+    Builtin { name, ctor: Ctor::Generator(g), params, variadic: None, result: Ty::Mesh, doc }
 }
 
 use self::Default::{Bool as B, Derived, Num as N, Required as Req, Vec3 as V};
@@ -161,70 +283,70 @@ const X: &[Param] = &[p("x", Ty::Num, Req)];
 /// Every builtin function, mesh generator and statement argument list.
 pub const BUILTINS: &[Builtin] = &[
     // Shapes.
-    f("sphere", &[p("r", Ty::Num, Req)], Ty::Shape, "sphere of radius `r` centred at the origin"),
+    f("sphere", Ctor::Primitive(Prim::Sphere), &[p("r", Ty::Num, Req)], Ty::Shape, "sphere of radius `r` centred at the origin"),
     f(
-        "box",
+        "box", Ctor::Primitive(Prim::Box),
         &[p("size", Ty::Size, Req)],
         Ty::Shape,
         "box with half-extents `size` (a number for a cube; `box(x, y, z)` also works)",
     ),
-    f("cylinder", &[p("r", Ty::Num, Req), p("half_height", Ty::Num, Req)], Ty::Shape, "capped cylinder along y"),
-    f("torus", &[p("major", Ty::Num, Req), p("minor", Ty::Num, Req)], Ty::Shape, "torus in the xz plane"),
+    f("cylinder", Ctor::Primitive(Prim::Cylinder), &[p("r", Ty::Num, Req), p("half_height", Ty::Num, Req)], Ty::Shape, "capped cylinder along y"),
+    f("torus", Ctor::Primitive(Prim::Torus), &[p("major", Ty::Num, Req), p("minor", Ty::Num, Req)], Ty::Shape, "torus in the xz plane"),
     f(
-        "plane",
+        "plane", Ctor::Primitive(Prim::Plane),
         &[p("normal", Ty::Vec3, V([0.0, 1.0, 0.0])), p("offset", Ty::Num, N(0.0))],
         Ty::Shape,
         "the half-space below `normal·p = offset`",
     ),
     f(
-        "capsule",
+        "capsule", Ctor::Primitive(Prim::Capsule),
         &[p("r", Ty::Num, Req), p("half_height", Ty::Num, Req)],
         Ty::Shape,
         "capsule along y: a segment of half-length `half_height` thickened by `r`",
     ),
     f(
-        "cone",
+        "cone", Ctor::Primitive(Prim::Cone),
         &[p("r", Ty::Num, Req), p("half_height", Ty::Num, Req)],
         Ty::Shape,
         "capped cone along y with base radius `r`, apex up",
     ),
     // Operators and modifiers.
     variadic(
-        "union",
+        "union", Ctor::Csg(CsgOp::Union),
         Ty::Shape,
         &[p("smooth", Ty::Num, N(0.0))],
         Ty::Shape,
         "everything inside any of the shapes; `smooth` blends the seams",
     ),
     variadic(
-        "intersect",
+        "intersect", Ctor::Csg(CsgOp::Intersect),
         Ty::Shape,
         &[p("smooth", Ty::Num, N(0.0))],
         Ty::Shape,
         "only what is inside all of the shapes",
     ),
-    variadic("subtract", Ty::Shape, &[p("smooth", Ty::Num, N(0.0))], Ty::Shape, "the first shape minus all the others"),
+    variadic("subtract", Ctor::Csg(CsgOp::Subtract), Ty::Shape, &[p("smooth", Ty::Num, N(0.0))], Ty::Shape, "the first shape minus all the others"),
     f(
-        "round",
+        "round", Ctor::Modifier(Modifier::Round),
         &[p("shape", Ty::Shape, Req), p("r", Ty::Num, Req)],
         Ty::Shape,
         "rounds edges by growing the shape by `r`",
     ),
     f(
-        "shell",
+        "shell", Ctor::Modifier(Modifier::Shell),
         &[p("shape", Ty::Shape, Req), p("thickness", Ty::Num, Req)],
         Ty::Shape,
         "a hollow wall of `thickness` around the surface",
     ),
     f(
-        "repeat",
+        "repeat", Ctor::Modifier(Modifier::Repeat),
         &[p("shape", Ty::Shape, Req), p("period", Ty::Size, Req), p("count", Ty::Size, Req)],
         Ty::Shape,
         "`count` copies per axis, `period` apart, centred at the origin",
     ),
     // Materials and colours.
     f(
-        "material",
+        "material", Ctor::Material,
         &[
             p("color", Ty::Color, Default::Color([200.0, 200.0, 200.0])),
             p("specular", Ty::Num, N(-1.0)),
@@ -234,38 +356,38 @@ pub const BUILTINS: &[Builtin] = &[
         "surface: colour, Phong exponent (−1 = none), reflectivity in [0, 1]",
     ),
     f(
-        "rgb",
+        "rgb", Ctor::Rgb,
         &[p("r", Ty::Num, Req), p("g", Ty::Num, Req), p("b", Ty::Num, Req)],
         Ty::Color,
         "a colour from 0–255 channels",
     ),
     // Lights.
-    f("ambient", &[p("intensity", Ty::Num, Req)], Ty::Light, "light reaching every point equally"),
+    f("ambient", Ctor::Light(LightFn::Ambient), &[p("intensity", Ty::Num, Req)], Ty::Light, "light reaching every point equally"),
     f(
-        "point",
+        "point", Ctor::Light(LightFn::Point),
         &[p("intensity", Ty::Num, Req), p("shadows", Ty::Bool, B(true)), p("radius", Ty::Num, N(0.0))],
         Ty::Light,
         "a point light, placed with `at`; `radius` > 0 gives soft shadows",
     ),
     f(
-        "directional",
+        "directional", Ctor::Light(LightFn::Directional),
         &[p("intensity", Ty::Num, Req), p("towards", Ty::Vec3, Req), p("shadows", Ty::Bool, B(true))],
         Ty::Light,
         "a light at infinity, shining from direction `towards`",
     ),
     // Maths (angles in degrees).
-    f("sin", X, Ty::Num, "sine of an angle in degrees"),
-    f("cos", X, Ty::Num, "cosine of an angle in degrees"),
-    f("tan", X, Ty::Num, "tangent of an angle in degrees"),
-    f("sqrt", X, Ty::Num, "square root of a non-negative number"),
-    f("abs", X, Ty::Num, "absolute value"),
-    f("floor", X, Ty::Num, "largest whole number not above `x`"),
-    variadic("min", Ty::Num, &[], Ty::Num, "smallest of the numbers"),
-    variadic("max", Ty::Num, &[], Ty::Num, "largest of the numbers"),
-    f("len", &[p("list", Ty::List, Req)], Ty::Int, "number of elements of a list"),
+    f("sin", Ctor::Math(MathFn::Sin), X, Ty::Num, "sine of an angle in degrees"),
+    f("cos", Ctor::Math(MathFn::Cos), X, Ty::Num, "cosine of an angle in degrees"),
+    f("tan", Ctor::Math(MathFn::Tan), X, Ty::Num, "tangent of an angle in degrees"),
+    f("sqrt", Ctor::Math(MathFn::Sqrt), X, Ty::Num, "square root of a non-negative number"),
+    f("abs", Ctor::Math(MathFn::Abs), X, Ty::Num, "absolute value"),
+    f("floor", Ctor::Math(MathFn::Floor), X, Ty::Num, "largest whole number not above `x`"),
+    variadic("min", Ctor::Extreme(Extreme::Min), Ty::Num, &[], Ty::Num, "smallest of the numbers"),
+    variadic("max", Ctor::Extreme(Extreme::Max), Ty::Num, &[], Ty::Num, "largest of the numbers"),
+    f("len", Ctor::Len, &[p("list", Ty::List, Req)], Ty::Int, "number of elements of a list"),
     // Mesh generators (after `mesh`).
     gen(
-        "uvsphere",
+        "uvsphere", Gen::UvSphere,
         &[
             p("r", Ty::Num, N(1.0)),
             p("rings", Ty::Int, N(14.0)),
@@ -275,17 +397,17 @@ pub const BUILTINS: &[Builtin] = &[
         "UV sphere; `segments` defaults to 2 × `rings`",
     ),
     gen(
-        "icosphere",
+        "icosphere", Gen::IcoSphere,
         &[p("r", Ty::Num, N(1.0)), p("subdivisions", Ty::Int, N(2.0)), p("smooth", Ty::Bool, B(false))],
         "subdivided icosahedron",
     ),
     gen(
-        "box",
+        "box", Gen::Box,
         &[p("size", Ty::Size, N(1.0)), p("smooth", Ty::Bool, B(false))],
         "box of 12 triangles with half-extents `size`",
     ),
     gen(
-        "cylinder",
+        "cylinder", Gen::Cylinder,
         &[
             p("r", Ty::Num, N(1.0)),
             p("half_height", Ty::Num, N(1.0)),
@@ -295,7 +417,7 @@ pub const BUILTINS: &[Builtin] = &[
         "capped cylinder along y, `segments` points per cap",
     ),
     gen(
-        "torus",
+        "torus", Gen::Torus,
         &[
             p("major", Ty::Num, N(1.0)),
             p("minor", Ty::Num, N(0.25)),
@@ -306,24 +428,24 @@ pub const BUILTINS: &[Builtin] = &[
         "torus in the xz plane",
     ),
     gen(
-        "plane",
+        "plane", Gen::Plane,
         &[p("size", Ty::Num, N(10.0)), p("smooth", Ty::Bool, B(false))],
         "a square of half-side `size` in the xz plane, facing +y",
     ),
     gen(
-        "isosurface",
+        "isosurface", Gen::Isosurface,
         &[p("shape", Ty::Shape, Req), p("cell", Ty::Num, N(0.02)), p("smooth", Ty::Bool, B(false))],
         "any shape triangulated on a grid of `cell`-sized cells",
     ),
     gen(
-        "file",
+        "file", Gen::File,
         &[p("path", Ty::Str, Req), p("smooth", Ty::Bool, B(false))],
         "a triangle mesh read from an OBJ file (relative to this file)",
     ),
     // Statements.
     Builtin {
         name: "camera",
-        kind: Kind::Camera,
+        ctor: Ctor::Camera,
         params: &[
             p("position", Ty::Vec3, V([0.0, 0.0, 0.0])),
             p("look_at", Ty::Vec3, V([0.0, 0.0, 1.0])),
@@ -336,7 +458,7 @@ pub const BUILTINS: &[Builtin] = &[
     },
     Builtin {
         name: "render",
-        kind: Kind::Render,
+        ctor: Ctor::Render,
         params: &[
             p("width", Ty::Int, N(500.0)),
             p("height", Ty::Int, N(500.0)),
@@ -359,10 +481,26 @@ pub const CONSTANTS: &[(&str, f64)] = &[("pi", std::f64::consts::PI)];
 
 /// Looks a builtin up by name and kind.
 pub fn lookup(name: &str, kind: Kind) -> Option<&'static Builtin> {
-    BUILTINS.iter().find(|b| b.name == name && b.kind == kind)
+    BUILTINS.iter().find(|b| b.name == name && b.kind() == kind)
 }
 
 /// Names of builtins of one kind (for suggestions).
 pub fn names(kind: Kind) -> impl Iterator<Item = &'static str> {
-    BUILTINS.iter().filter(move |b| b.kind == kind).map(|b| b.name)
+    BUILTINS.iter().filter(move |b| b.kind() == kind).map(|b| b.name)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each constructor belongs to one entry, and a name to one entry of each kind.
+    #[test]
+    fn constructors_and_names_are_unique() {
+        for (i, a) in BUILTINS.iter().enumerate() {
+            for b in &BUILTINS[i + 1..] {
+                assert_ne!(a.ctor, b.ctor, "`{}` and `{}` share a constructor", a.name, b.name);
+                assert!(a.name != b.name || a.kind() != b.kind(), "`{}` is listed twice", a.name);
+            }
+        }
+    }
 }

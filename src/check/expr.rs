@@ -936,7 +936,13 @@ fn apply_xf(shape: Arc<ir::Shape>, xf: DAffine3, span: Span) -> Arc<ir::Shape> {
             kind: ir::ShapeKind::Paint { child: apply_xf(child.clone(), xf, span), material: material.clone() },
             span: shape.span,
         }),
-        _ => Arc::new(ir::Shape { kind: ir::ShapeKind::Transform { child: shape, xf }, span }),
+        ir::ShapeKind::Primitive(_)
+        | ir::ShapeKind::Csg { .. }
+        | ir::ShapeKind::Round { .. }
+        | ir::ShapeKind::Shell { .. }
+        | ir::ShapeKind::Repeat { .. } => {
+            Arc::new(ir::Shape { kind: ir::ShapeKind::Transform { child: shape, xf }, span })
+        }
     }
 }
 

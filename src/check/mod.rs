@@ -26,7 +26,7 @@ use glam::DVec3;
 
 use crate::diag::{codes, Diagnostic};
 use crate::ir::{self, Camera, Scene, Settings};
-use crate::source::{FileId, SourceMap};
+use crate::source::{io_reason, FileId, Loader, SourceMap, MAX_FILE_BYTES};
 use crate::span::Span;
 use crate::syntax::{self, ast};
 pub use value::Value;
@@ -45,32 +45,6 @@ pub const MAX_LIGHTS: usize = 1_000;
 pub const MAX_LIST: usize = 100_000;
 /// Deepest expression nesting (operators, calls and transforms count).
 pub const MAX_EXPR_DEPTH: usize = 256;
-/// Largest source file.
-pub const MAX_FILE_BYTES: usize = 4 * 1024 * 1024;
-
-/// Reads included files; the CLI reads the disk, tests may serve files from memory.
-pub trait Loader {
-    /// The text of the file at `path`.
-    fn read(&self, path: &Path) -> std::io::Result<String>;
-}
-
-/// Reads files from the file system.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct FsLoader;
-
-impl Loader for FsLoader {
-    fn read(&self, path: &Path) -> std::io::Result<String> {
-        let meta = std::fs::metadata(path)?;
-        if meta.is_dir() {
-            return Err(std::io::Error::other("it is a directory"));
-        }
-        if meta.len() > MAX_FILE_BYTES as u64 {
-            return Err(std::io::Error::other(format!("it is larger than the {} MiB limit", MAX_FILE_BYTES >> 20)));
-        }
-        let bytes = std::fs::read(path)?;
-        String::from_utf8(bytes).map_err(|_| std::io::Error::other("it is not valid UTF-8"))
-    }
-}
 
 /// What a name is bound to.
 #[derive(Clone, Debug)]
@@ -597,15 +571,6 @@ fn behind_camera(obj: &ir::Object, camera: &Camera) -> Option<f64> {
     let forward = (camera.look_at - camera.position).normalize();
     let depth = (centre - camera.position).dot(forward);
     (depth + radius < 0.0).then_some(-(depth + radius))
-}
-
-/// A short, lowercase reason for an I/O error.
-pub fn io_reason(e: &std::io::Error) -> String {
-    match e.kind() {
-        std::io::ErrorKind::NotFound => "no such file".into(),
-        std::io::ErrorKind::PermissionDenied => "permission denied".into(),
-        _ => e.to_string(),
-    }
 }
 
 /// Lexically normalises `a/./b/../c` to `a/c`, for include-cycle detection.

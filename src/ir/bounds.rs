@@ -2,7 +2,7 @@
 
 use glam::{DAffine3, DVec3};
 
-use super::{Geometry, Mesh, MeshSource, Shape, ShapeKind};
+use super::{CsgOp, Geometry, Mesh, MeshSource, Shape, ShapeKind};
 
 /// An axis-aligned box.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -55,22 +55,17 @@ impl Aabb {
 pub fn shape_bounds(shape: &Shape) -> Option<Aabb> {
     let children = |kids: &[std::sync::Arc<Shape>]| kids.iter().map(|k| shape_bounds(k)).collect::<Vec<_>>();
     match &shape.kind {
-        ShapeKind::Sphere { radius } => Some(Aabb::centred(DVec3::splat(*radius))),
-        ShapeKind::Box { half } => Some(Aabb::centred(*half)),
-        ShapeKind::Cylinder { radius: r, half_height: h } | ShapeKind::Cone { radius: r, half_height: h } => {
-            Some(Aabb::centred(DVec3::new(*r, *h, *r)))
-        }
-        ShapeKind::Capsule { radius: r, half_height: h } => Some(Aabb::centred(DVec3::new(*r, h + r, *r))),
-        ShapeKind::Torus { major, minor } => Some(Aabb::centred(DVec3::new(major + minor, *minor, major + minor))),
-        ShapeKind::Plane { .. } => None,
-        ShapeKind::Union { children: kids, smooth } => {
+        ShapeKind::Primitive(p) => p.bounds(),
+        ShapeKind::Csg { op: CsgOp::Union, children: kids, smooth } => {
             let all: Option<Vec<Aabb>> = children(kids).into_iter().collect();
             all?.into_iter().reduce(Aabb::union).map(|b| b.grow(*smooth))
         }
-        ShapeKind::Intersect { children: kids, smooth } => {
+        ShapeKind::Csg { op: CsgOp::Intersect, children: kids, smooth } => {
             children(kids).into_iter().flatten().reduce(Aabb::intersect).map(|b| b.grow(*smooth))
         }
-        ShapeKind::Subtract { children: kids, smooth } => shape_bounds(kids.first()?).map(|b| b.grow(*smooth)),
+        ShapeKind::Csg { op: CsgOp::Subtract, children: kids, smooth } => {
+            shape_bounds(kids.first()?).map(|b| b.grow(*smooth))
+        }
         ShapeKind::Round { child, radius } => shape_bounds(child).map(|b| b.grow(*radius)),
         ShapeKind::Shell { child, thickness } => shape_bounds(child).map(|b| b.grow(thickness * 0.5)),
         ShapeKind::Repeat { child, period, count } => {
@@ -113,15 +108,8 @@ pub fn bounding_sphere(g: &Geometry) -> Option<(DVec3, f64)> {
 pub fn shape_sphere(shape: &Shape) -> Option<(DVec3, f64)> {
     let from_box = |b: Aabb| (b.centre(), (b.max - b.min).length() * 0.5);
     match &shape.kind {
-        ShapeKind::Sphere { radius } => Some((DVec3::ZERO, *radius)),
-        ShapeKind::Box { half } => Some((DVec3::ZERO, half.length())),
-        ShapeKind::Cylinder { radius: r, half_height: h } | ShapeKind::Cone { radius: r, half_height: h } => {
-            Some((DVec3::ZERO, (r * r + h * h).sqrt()))
-        }
-        ShapeKind::Capsule { radius, half_height } => Some((DVec3::ZERO, radius + half_height)),
-        ShapeKind::Torus { major, minor } => Some((DVec3::ZERO, major + minor)),
-        ShapeKind::Plane { .. } => None,
-        ShapeKind::Union { children, smooth } => {
+        ShapeKind::Primitive(p) => p.sphere_radius().map(|r| (DVec3::ZERO, r)),
+        ShapeKind::Csg { op: CsgOp::Union, children, smooth } => {
             let spheres: Option<Vec<(DVec3, f64)>> = children.iter().map(|c| shape_sphere(c)).collect();
             let spheres = spheres?;
             let boxes = spheres.iter().map(|(c, r)| Aabb { min: *c - *r, max: *c + *r });
@@ -129,12 +117,14 @@ pub fn shape_sphere(shape: &Shape) -> Option<(DVec3, f64)> {
             let radius = spheres.iter().map(|(c, r)| (*c - centre).length() + r).fold(0.0, f64::max);
             Some((centre, radius + smooth))
         }
-        ShapeKind::Intersect { children, smooth } => children
+        ShapeKind::Csg { op: CsgOp::Intersect, children, smooth } => children
             .iter()
             .filter_map(|c| shape_sphere(c))
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .map(|(c, r)| (c, r + smooth)),
-        ShapeKind::Subtract { children, smooth } => shape_sphere(children.first()?).map(|(c, r)| (c, r + smooth)),
+        ShapeKind::Csg { op: CsgOp::Subtract, children, smooth } => {
+            shape_sphere(children.first()?).map(|(c, r)| (c, r + smooth))
+        }
         ShapeKind::Round { child, radius } => shape_sphere(child).map(|(c, r)| (c, r + radius)),
         ShapeKind::Shell { child, thickness } => shape_sphere(child).map(|(c, r)| (c, r + thickness * 0.5)),
         ShapeKind::Repeat { .. } => shape_bounds(shape).map(from_box),

@@ -4,7 +4,7 @@ use std::fmt::Write as _;
 
 use glam::{DAffine3, DVec3};
 
-use super::{Geometry, LightKind, Material, Mesh, MeshSource, Scene, Shape, ShapeKind};
+use super::{Geometry, LightKind, Material, Mesh, MeshSource, Primitive, Scene, Shape, ShapeKind};
 use crate::source::SourceMap;
 use crate::span::Span;
 
@@ -71,31 +71,9 @@ impl Dumper<'_> {
         };
         let span = Some(shape.span);
         match &shape.kind {
-            ShapeKind::Sphere { radius } => self.line(indent, &format!("sphere radius {}", num(*radius)), span),
-            ShapeKind::Box { half } => self.line(indent, &format!("box half {}", vec(*half)), span),
-            ShapeKind::Cylinder { radius, half_height } => {
-                self.line(indent, &format!("cylinder radius {} half_height {}", num(*radius), num(*half_height)), span)
-            }
-            ShapeKind::Torus { major, minor } => {
-                self.line(indent, &format!("torus major {} minor {}", num(*major), num(*minor)), span)
-            }
-            ShapeKind::Plane { normal, offset } => {
-                self.line(indent, &format!("plane normal {} offset {}", vec(*normal), num(*offset)), span)
-            }
-            ShapeKind::Capsule { radius, half_height } => {
-                self.line(indent, &format!("capsule radius {} half_height {}", num(*radius), num(*half_height)), span)
-            }
-            ShapeKind::Cone { radius, half_height } => {
-                self.line(indent, &format!("cone radius {} half_height {}", num(*radius), num(*half_height)), span)
-            }
-            ShapeKind::Union { children: kids, smooth }
-            | ShapeKind::Intersect { children: kids, smooth }
-            | ShapeKind::Subtract { children: kids, smooth } => {
-                let op = match &shape.kind {
-                    ShapeKind::Union { .. } => "union",
-                    ShapeKind::Intersect { .. } => "intersect",
-                    _ => "subtract",
-                };
+            ShapeKind::Primitive(p) => self.line(indent, &primitive(p), span),
+            ShapeKind::Csg { op, children: kids, smooth } => {
+                let op = op.name();
                 let text = if *smooth > 0.0 { format!("{op} smooth {}", num(*smooth)) } else { op.to_string() };
                 self.line(indent, &text, span);
                 children(self, kids);
@@ -210,4 +188,20 @@ pub fn dump(scene: &Scene, map: &SourceMap) -> String {
         }
     }
     d.out
+}
+
+/// A primitive's dump line: its name and its parameters.
+fn primitive(p: &Primitive) -> String {
+    let name = p.name();
+    match p {
+        Primitive::Sphere { radius } => format!("{name} radius {}", num(*radius)),
+        Primitive::Box { half } => format!("{name} half {}", vec(*half)),
+        Primitive::Cylinder { radius, half_height }
+        | Primitive::Capsule { radius, half_height }
+        | Primitive::Cone { radius, half_height } => {
+            format!("{name} radius {} half_height {}", num(*radius), num(*half_height))
+        }
+        Primitive::Torus { major, minor } => format!("{name} major {} minor {}", num(*major), num(*minor)),
+        Primitive::Plane { normal, offset } => format!("{name} normal {} offset {}", vec(*normal), num(*offset)),
+    }
 }

@@ -10,6 +10,7 @@
 
 mod bounds;
 mod dump;
+mod primitive;
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -19,6 +20,7 @@ use glam::{DAffine3, DVec3};
 pub use bounds::{bounding_sphere, mesh_bounds, shape_bounds, shape_sphere, Aabb};
 pub use dump::dump;
 pub(crate) use dump::{num as dump_num, vec as dump_vec};
+pub use primitive::{Facets, Primitive};
 
 use crate::span::Span;
 
@@ -180,70 +182,37 @@ pub struct Shape {
     pub span: Span,
 }
 
-/// Shape nodes. Primitives are centred at the origin; sizes are radii and half-extents.
+/// How a CSG node combines its children.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CsgOp {
+    /// Everything inside any child.
+    Union,
+    /// Only what is inside every child.
+    Intersect,
+    /// The first child minus the rest.
+    Subtract,
+}
+
+impl CsgOp {
+    /// The builtin's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            CsgOp::Union => "union",
+            CsgOp::Intersect => "intersect",
+            CsgOp::Subtract => "subtract",
+        }
+    }
+}
+
+/// Shape nodes: a primitive leaf, a CSG operator, a modifier, a transform or a material.
 #[derive(Clone, Debug)]
 pub enum ShapeKind {
-    /// Sphere of radius `radius`.
-    Sphere {
-        /// Radius > 0.
-        radius: f64,
-    },
-    /// Box with half-extents `half`.
-    Box {
-        /// Half-extents, each > 0.
-        half: DVec3,
-    },
-    /// Capped cylinder along y.
-    Cylinder {
-        /// Radius > 0.
-        radius: f64,
-        /// Half-height > 0.
-        half_height: f64,
-    },
-    /// Torus in the xz plane.
-    Torus {
-        /// Distance from centre to tube centre, > 0.
-        major: f64,
-        /// Tube radius, > 0.
-        minor: f64,
-    },
-    /// Half-space below the plane `n·p = offset`.
-    Plane {
-        /// Unit normal.
-        normal: DVec3,
-        /// Offset along the normal.
-        offset: f64,
-    },
-    /// Capsule along y.
-    Capsule {
-        /// Radius > 0.
-        radius: f64,
-        /// Half-height of the axis segment, > 0.
-        half_height: f64,
-    },
-    /// Capped cone along y, apex up, base of radius `radius` at `-half_height`.
-    Cone {
-        /// Base radius > 0.
-        radius: f64,
-        /// Half-height > 0.
-        half_height: f64,
-    },
-    /// Union of the children (`smooth` = 0 for a sharp one).
-    Union {
-        /// At least one child.
-        children: Vec<Arc<Shape>>,
-        /// Smoothing radius ≥ 0.
-        smooth: f64,
-    },
-    /// Intersection of the children.
-    Intersect {
-        /// At least one child.
-        children: Vec<Arc<Shape>>,
-        /// Smoothing radius ≥ 0.
-        smooth: f64,
-    },
-    /// The first child minus the rest.
-    Subtract {
+    /// A primitive solid (every per-primitive fact is in [`primitive`]).
+    Primitive(Primitive),
+    /// A CSG operator over its children (`smooth` = 0 for a sharp one).
+    Csg {
+        /// Union, intersection or subtraction.
+        op: CsgOp,
         /// At least one child.
         children: Vec<Arc<Shape>>,
         /// Smoothing radius ≥ 0.
@@ -295,19 +264,31 @@ impl Shape {
     /// rounding, painting or transforming one).
     pub fn is_convex(&self) -> bool {
         match &self.kind {
-            ShapeKind::Sphere { .. }
-            | ShapeKind::Box { .. }
-            | ShapeKind::Cylinder { .. }
-            | ShapeKind::Capsule { .. }
-            | ShapeKind::Cone { .. }
-            | ShapeKind::Plane { .. } => true,
-            ShapeKind::Intersect { children, smooth } => *smooth == 0.0 && children.iter().all(|c| c.is_convex()),
+            ShapeKind::Primitive(p) => p.is_convex(),
+            ShapeKind::Csg { op: CsgOp::Intersect, children, smooth } => {
+                *smooth == 0.0 && children.iter().all(|c| c.is_convex())
+            }
+            ShapeKind::Csg { op: CsgOp::Union | CsgOp::Subtract, .. } => false,
             // Rounding grows the solid by a ball: still convex (its distance is exact or a
             // convex bound). An affine map keeps convexity; a material changes no shape.
             ShapeKind::Round { child, .. } | ShapeKind::Paint { child, .. } | ShapeKind::Transform { child, .. } => {
                 child.is_convex()
             }
-            _ => false,
+            // A shell is hollow and repeated copies leave gaps between them.
+            ShapeKind::Shell { .. } | ShapeKind::Repeat { .. } => false,
+        }
+    }
+
+    /// The node's children, in order (none for a primitive).
+    pub fn children(&self) -> &[Arc<Shape>] {
+        match &self.kind {
+            ShapeKind::Primitive(_) => &[],
+            ShapeKind::Csg { children, .. } => children,
+            ShapeKind::Round { child, .. }
+            | ShapeKind::Shell { child, .. }
+            | ShapeKind::Repeat { child, .. }
+            | ShapeKind::Transform { child, .. }
+            | ShapeKind::Paint { child, .. } => std::slice::from_ref(child),
         }
     }
 }
@@ -326,14 +307,15 @@ impl Mesh {
     /// Whether the generator makes a convex polytope (a square counts: it lies in one
     /// plane); tested for every generator in `convex_generators_make_convex_polytopes`.
     pub fn is_convex(&self) -> bool {
-        matches!(
-            self.source,
+        match self.source {
             MeshSource::UvSphere { .. }
-                | MeshSource::IcoSphere { .. }
-                | MeshSource::Box { .. }
-                | MeshSource::Cylinder { .. }
-                | MeshSource::Plane { .. }
-        )
+            | MeshSource::IcoSphere { .. }
+            | MeshSource::Box { .. }
+            | MeshSource::Cylinder { .. }
+            | MeshSource::Plane { .. } => true,
+            // An isosurface may dent even a convex shape; a file may hold anything.
+            MeshSource::Torus { .. } | MeshSource::Isosurface { .. } | MeshSource::File { .. } => false,
+        }
     }
 }
 

@@ -4,10 +4,11 @@
 
 use std::path::Path;
 
+use crate::check;
 use crate::check::builtins::{self, Builtin, Kind};
 use crate::check::index::{Def, DefKind, Index};
-use crate::check::{self, Loader};
 use crate::diag::Diagnostic;
+use crate::source::Loader;
 use crate::source::{FileId, SourceMap};
 use crate::span::Span;
 use crate::syntax::{self, ast, Token};
@@ -174,7 +175,7 @@ impl Analysis {
         };
         let mut out = Vec::new();
         if matches!(before.last(), Some((Token::Mesh, _))) {
-            out.extend(builtins::BUILTINS.iter().filter(|b| b.kind == Kind::MeshGenerator).map(builtin_candidate));
+            out.extend(builtins::BUILTINS.iter().filter(|b| b.kind() == Kind::MeshGenerator).map(builtin_candidate));
             return out;
         }
         let call = enclosing_call(before);
@@ -193,7 +194,7 @@ impl Analysis {
                 doc: None,
             });
         }
-        out.extend(builtins::BUILTINS.iter().filter(|b| b.kind == Kind::Function).map(builtin_candidate));
+        out.extend(builtins::BUILTINS.iter().filter(|b| b.kind() == Kind::Function).map(builtin_candidate));
         out.extend(builtins::CONSTANTS.iter().map(|(name, value)| Candidate {
             label: name.to_string(),
             kind: CandidateKind::Constant,

@@ -25,9 +25,9 @@ use lsp_types::{self as lt, Uri};
 
 use self::analysis::{Analysis, CandidateKind, Symbol, SymbolKind};
 use self::text::{path_to_uri, uri_to_path, LineIndex};
-use crate::check::{FsLoader, Loader};
 use crate::diag::{Diagnostic, Severity};
 use crate::source::SourceMap;
+use crate::source::{FsLoader, Loader};
 use crate::span::Span;
 
 /// Serves the protocol on stdin/stdout until the client asks to exit.

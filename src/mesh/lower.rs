@@ -5,24 +5,26 @@
 
 use glam::{DAffine3, DVec3};
 
-use super::{isosurface, obj, tessellate, MeshJob, TriMesh};
-use crate::check::Loader;
+use super::tessellate::count;
+use super::{isosurface, obj, tessellate, Detail, MeshJob, TriMesh};
 use crate::diag::{codes, Diagnostic};
-use crate::ir::{self, MeshSource, Shape, ShapeKind};
+use crate::ir::{self, MeshSource, Primitive, Shape, ShapeKind};
+use crate::render::MaterialTable;
 use crate::sdf::Builder;
+use crate::source::Loader;
 use crate::span::Span;
-use crate::world::Detail;
 
-/// Tessellates a shape object at `detail`.
+/// Tessellates a shape object at `detail`: a primitive with a generator by it, a plane
+/// as a square reaching the far limit, anything else as an isosurface.
 pub fn tessellate(
     shape: &Shape,
     xf: DAffine3,
     detail: Detail,
     max_distance: f64,
     budget: &mut u64,
-    builder: &mut Builder<'_>,
+    materials: &mut MaterialTable,
 ) -> Result<MeshJob, Diagnostic> {
-    // Walk down through transforms and materials to a primitive that has a generator.
+    // Walk down through transforms and materials to what decides how it is made.
     let (mut node, mut xf, mut material) = (shape, xf, 0u32);
     loop {
         match &node.kind {
@@ -31,29 +33,34 @@ pub fn tessellate(
                 node = child;
             }
             ShapeKind::Paint { child, material: m } => {
-                material = builder.materials.intern(m);
+                material = materials.intern(m);
                 node = child;
             }
-            _ => break,
+            ShapeKind::Primitive(_)
+            | ShapeKind::Csg { .. }
+            | ShapeKind::Round { .. }
+            | ShapeKind::Shell { .. }
+            | ShapeKind::Repeat { .. } => break,
         }
     }
-    let (rings, circle) = (detail.rings(), detail.circle());
-    let (r, c) = (rings as u64, circle as u64);
-    let expected = match node.kind {
-        ShapeKind::Sphere { .. } => 4 * r * (r - 1),
-        ShapeKind::Cylinder { .. } => 4 * c,
-        ShapeKind::Cone { .. } => 2 * c,
-        ShapeKind::Torus { .. } => 2 * c * r,
-        _ => 12,
+    let made = match &node.kind {
+        ShapeKind::Primitive(p) => generator(p, detail),
+        ShapeKind::Csg { .. }
+        | ShapeKind::Round { .. }
+        | ShapeKind::Shell { .. }
+        | ShapeKind::Repeat { .. }
+        | ShapeKind::Transform { .. }
+        | ShapeKind::Paint { .. } => Generator::None,
     };
-    spend(budget, expected, shape.span)?;
-    let generated = match node.kind {
-        ShapeKind::Sphere { radius } => Some(tessellate::uvsphere(radius, rings, 2 * rings)),
-        ShapeKind::Box { half } => Some(tessellate::cuboid(half)),
-        ShapeKind::Cylinder { radius, half_height } => Some(tessellate::cylinder(radius, half_height, circle)),
-        ShapeKind::Cone { radius, half_height } => Some(tessellate::cone(radius, half_height, circle)),
-        ShapeKind::Torus { major, minor } => Some(tessellate::torus(major, minor, circle, rings)),
-        ShapeKind::Plane { normal, offset } => {
+    match made {
+        Generator::Triangles(triangles, make) => {
+            spend(budget, triangles, shape.span)?;
+            // A generator's polytope is convex exactly when its shape is (tested for each);
+            // isosurfaces (below) may dent even a convex shape, so they are never marked.
+            Ok(MeshJob { mesh: make(), xf, material, per_triangle: None, smooth: false, convex: node.is_convex() })
+        }
+        Generator::Square { normal, offset } => {
+            spend(budget, tessellate::count::SQUARE, shape.span)?;
             // A square centred on the point of the plane nearest the camera, reaching the far limit.
             let inv = xf.inverse();
             let eye = inv.transform_point3(DVec3::ZERO);
@@ -66,28 +73,57 @@ pub fn tessellate(
             let reach = max_distance * inv.matrix3.to_cols_array().iter().fold(0.0f64, |a, x| a.max(x.abs())) * 2.0;
             let square = tessellate::square(reach.max(1.0));
             // Flat: a ray leaving its front never meets it again.
-            return Ok(MeshJob {
-                mesh: square,
-                xf: xf * frame,
-                material,
-                per_triangle: None,
-                smooth: false,
-                convex: node.is_convex(),
-            });
+            Ok(MeshJob { mesh: square, xf: xf * frame, material, per_triangle: None, smooth: false, convex: true })
         }
-        _ => None,
-    };
-    if let Some(mesh) = generated {
-        // A generator's polytope is convex exactly when its shape is (tested for each);
-        // isosurfaces (below) may dent even a convex shape, so they are never marked.
-        return Ok(MeshJob { mesh, xf, material, per_triangle: None, smooth: false, convex: node.is_convex() });
+        Generator::None => {
+            // An isosurface of the subtree in render space, at a cell size that follows the
+            // detail (a 1/(4·rings) fraction of the bounding diameter).
+            let bounds = ir::shape_bounds(node).ok_or_else(|| unbounded(node.span))?.transform(&xf);
+            let cell = (bounds.max - bounds.min).length() / (4.0 * detail.rings() as f64);
+            // Sampled in render space, so the vertices need no further placing.
+            let iso =
+                Iso { grid: xf, place: DAffine3::IDENTITY, material, cell, smooth: false, from: CellFrom::Detail };
+            let job = isosurface_object(node, iso, node.span, materials)?;
+            spend(budget, job.mesh.triangles.len() as u64, shape.span)?;
+            Ok(job)
+        }
     }
-    // Everything else: an isosurface of the subtree in render space, at a cell size that
-    // follows the detail (a 1/(4·rings) fraction of the bounding diameter).
-    let bounds = ir::shape_bounds(node).ok_or_else(|| unbounded(node.span))?.transform(&xf);
-    let cell = (bounds.max - bounds.min).length() / (4.0 * rings as f64);
-    // Sampled in render space, so the vertices need no further placing.
-    isosurface_object(node, xf, DAffine3::IDENTITY, material, cell, false, node.span, CellFrom::Detail, builder)
+}
+
+/// How the mesh back-end makes a primitive at a detail level.
+enum Generator {
+    /// Its generator: the exact triangle count (charged before anything is allocated)
+    /// and the call that makes them.
+    Triangles(u64, Box<dyn FnOnce() -> TriMesh>),
+    /// A half-space: a square reaching the far limit.
+    Square { normal: DVec3, offset: f64 },
+    /// No generator: an isosurface.
+    None,
+}
+
+/// The generator of every primitive, one exhaustive match: a new primitive must say how
+/// it is meshed (and `Primitive::facets` what that costs in accuracy; the two are tested
+/// to agree in `generators_agree_with_facets`).
+fn generator(p: &Primitive, detail: Detail) -> Generator {
+    let (rings, circle) = (detail.rings(), detail.circle());
+    let made = |n: u64, make: Box<dyn FnOnce() -> TriMesh>| Generator::Triangles(n, make);
+    match *p {
+        Primitive::Sphere { radius } => {
+            made(count::uvsphere(rings, 2 * rings), Box::new(move || tessellate::uvsphere(radius, rings, 2 * rings)))
+        }
+        Primitive::Box { half } => made(count::CUBOID, Box::new(move || tessellate::cuboid(half))),
+        Primitive::Cylinder { radius, half_height } => {
+            made(count::cylinder(circle), Box::new(move || tessellate::cylinder(radius, half_height, circle)))
+        }
+        Primitive::Cone { radius, half_height } => {
+            made(count::cone(circle), Box::new(move || tessellate::cone(radius, half_height, circle)))
+        }
+        Primitive::Torus { major, minor } => {
+            made(count::torus(circle, rings), Box::new(move || tessellate::torus(major, minor, circle, rings)))
+        }
+        Primitive::Plane { normal, offset } => Generator::Square { normal, offset },
+        Primitive::Capsule { .. } => Generator::None,
+    }
 }
 
 /// Most triangles all meshes of one scene may have together (about 2.4 GB with BVHs).
@@ -125,23 +161,34 @@ enum CellFrom {
     Detail,
 }
 
-/// An isosurface of `shape` on a grid laid out in the frame `grid` (render from the
-/// grid's frame), placed by `place` (render from the grid's frame, applied to the
-/// vertices), each triangle taking the material of the shape's nearest part.
-#[allow(clippy::too_many_arguments, reason = "shape, two frames, material, grid, shading and the span to blame")]
+/// How an isosurface is sampled and placed.
+struct Iso {
+    /// Render from the grid's frame: where the grid is laid out.
+    grid: DAffine3,
+    /// Render from the grid's frame, applied to the vertices.
+    place: DAffine3,
+    /// Material of parts that have none.
+    material: u32,
+    /// Cell size in the grid's units.
+    cell: f64,
+    /// Interpolated normals.
+    smooth: bool,
+    /// What set `cell`, for the hint of a failure.
+    from: CellFrom,
+}
+
+/// An isosurface of `shape` sampled and placed as `iso` says, each triangle taking the
+/// material of the shape's nearest part. The distance closures are temporary: they are
+/// not part of the world's memory.
 fn isosurface_object(
     shape: &Shape,
-    grid: DAffine3,
-    place: DAffine3,
-    material: u32,
-    cell: f64,
-    smooth: bool,
+    iso: Iso,
     span: Span,
-    from: CellFrom,
-    builder: &mut Builder<'_>,
+    materials: &mut MaterialTable,
 ) -> Result<MeshJob, Diagnostic> {
+    let Iso { grid, place, material, cell, smooth, from } = iso;
     let bounds = ir::shape_bounds(shape).ok_or_else(|| unbounded(shape.span))?.transform(&grid);
-    let (dist, mat) = builder.build(shape, grid, material);
+    let (dist, mat) = Builder { materials, bytes: 0 }.build(shape, grid, material);
     let mesh = isosurface::extract(&*dist, bounds.min, bounds.max, cell).map_err(|e| match e {
         isosurface::IsoError::TooManyCells { cells, min_cell } => {
             let d = Diagnostic::error(
@@ -188,22 +235,25 @@ pub fn explicit(
     m: &ir::Mesh,
     to_render: DAffine3,
     budget: &mut u64,
-    builder: &mut Builder<'_>,
+    materials: &mut MaterialTable,
     loader: &dyn Loader,
 ) -> Result<MeshJob, Diagnostic> {
     let xf = to_render * m.xf;
-    let material = m.material.as_ref().map_or(0, |mat| builder.materials.intern(mat));
+    let material = m.material.as_ref().map_or(0, |mat| materials.intern(mat));
+    // Generators are charged before anything is allocated; isosurfaces and files once
+    // made (their grid-cell and file-size limits bound them until then).
     let expected = match &m.source {
-        MeshSource::UvSphere { rings, segments, .. } => 2 * *segments as u64 * (*rings as u64 - 1),
-        MeshSource::IcoSphere { subdivisions, .. } => 20 * 4u64.pow(*subdivisions),
-        MeshSource::Box { .. } => 12,
-        MeshSource::Cylinder { segments, .. } => 4 * *segments as u64,
-        MeshSource::Torus { segments, sides, .. } => 2 * *segments as u64 * *sides as u64,
-        MeshSource::Plane { .. } => 2,
-        // Bounded by the grid-cell and OBJ-size limits; counted once made, below.
-        MeshSource::Isosurface { .. } | MeshSource::File { .. } => 0,
+        MeshSource::UvSphere { rings, segments, .. } => Some(count::uvsphere(*rings, *segments)),
+        MeshSource::IcoSphere { subdivisions, .. } => Some(count::icosphere(*subdivisions)),
+        MeshSource::Box { .. } => Some(count::CUBOID),
+        MeshSource::Cylinder { segments, .. } => Some(count::cylinder(*segments)),
+        MeshSource::Torus { segments, sides, .. } => Some(count::torus(*segments, *sides)),
+        MeshSource::Plane { .. } => Some(count::SQUARE),
+        MeshSource::Isosurface { .. } | MeshSource::File { .. } => None,
     };
-    spend(budget, expected, m.span)?;
+    if let Some(n) = expected {
+        spend(budget, n, m.span)?;
+    }
     let local: TriMesh = match &m.source {
         MeshSource::UvSphere { radius, rings, segments } => tessellate::uvsphere(*radius, *rings, *segments),
         MeshSource::IcoSphere { radius, subdivisions } => tessellate::icosphere(*radius, *subdivisions),
@@ -215,17 +265,17 @@ pub fn explicit(
         MeshSource::Plane { size } => tessellate::square(*size),
         MeshSource::Isosurface { shape, cell } => {
             // The grid is laid in the shape's own frame, so `cell` is in its units.
-            return isosurface_object(
-                shape,
-                DAffine3::IDENTITY,
-                xf,
+            let iso = Iso {
+                grid: DAffine3::IDENTITY,
+                place: xf,
                 material,
-                *cell,
-                m.smooth,
-                m.span,
-                CellFrom::Scene,
-                builder,
-            );
+                cell: *cell,
+                smooth: m.smooth,
+                from: CellFrom::Scene,
+            };
+            let job = isosurface_object(shape, iso, m.span, materials)?;
+            spend(budget, job.mesh.triangles.len() as u64, m.span)?;
+            return Ok(job);
         }
         MeshSource::File { path, written } => {
             let text = loader.read(path).map_err(|e| {
@@ -233,7 +283,7 @@ pub fn explicit(
                     codes::LOWERING,
                     m.span,
                     format!("cannot read mesh file `{written}`"),
-                    crate::check::io_reason(&e),
+                    crate::source::io_reason(&e),
                 )
                 .with_note(format!("looked for {}", path.display()))
             })?;
@@ -249,12 +299,63 @@ pub fn explicit(
             })?
         }
     };
+    if expected.is_none() {
+        spend(budget, local.triangles.len() as u64, m.span)?;
+    }
     Ok(MeshJob { mesh: local, xf, material, per_triangle: None, smooth: m.smooth, convex: m.is_convex() })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::ir::Facets;
+
+    /// Every primitive of `tests/data/primitives.scn`.
+    fn primitives() -> Vec<Primitive> {
+        fn walk(shape: &Shape, out: &mut Vec<Primitive>) {
+            if let ShapeKind::Primitive(p) = &shape.kind {
+                out.push(p.clone());
+            }
+            shape.children().iter().for_each(|c| walk(c, out));
+        }
+        let text = include_str!("../../tests/data/primitives.scn").to_string();
+        let path = std::path::Path::new("tests/data/primitives.scn");
+        let compiled = crate::compile_source("primitives.scn", path, text, &crate::source::FsLoader);
+        let scene = compiled.scene.expect("the primitives list compiles");
+        let mut out = Vec::new();
+        for o in &scene.objects {
+            match &o.geometry {
+                ir::Geometry::Shape(s) => walk(s, &mut out),
+                ir::Geometry::Mesh(m) => {
+                    if let MeshSource::Isosurface { shape, .. } = &m.source {
+                        walk(shape, &mut out);
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// What `Primitive::facets` tells the accuracy model is what the mesh back-end does,
+    /// and the triangles charged are the triangles made.
+    #[test]
+    fn generators_agree_with_facets() {
+        let all = primitives();
+        for name in ["sphere", "box", "cylinder", "torus", "plane", "capsule", "cone"] {
+            assert!(all.iter().any(|p| p.name() == name), "no {name} in tests/data/primitives.scn");
+        }
+        for p in &all {
+            for detail in [Detail::Low, Detail::High, Detail::N(3), Detail::N(40)] {
+                match (generator(p, detail), p.facets()) {
+                    (Generator::Triangles(n, make), Facets::Inscribed(_) | Facets::Exact) => {
+                        assert_eq!(make().triangles.len() as u64, n, "{} at {detail:?}", p.name());
+                    }
+                    (Generator::Square { .. }, Facets::Exact) | (Generator::None, Facets::Isosurface) => {}
+                    (_, facets) => panic!("{}: the generator does not match {facets:?}", p.name()),
+                }
+            }
+        }
+    }
 
     /// The budget is spent before anything is allocated, and exceeding it is an error at
     /// the object's span, never a partial spend.

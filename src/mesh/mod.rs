@@ -7,6 +7,7 @@
 //! everything else and primitives without a generator by `isosurface`) and every mesh.
 //! A plane shape becomes a finite square reaching `max_distance` around the camera.
 
+mod detail;
 pub mod isosurface;
 pub mod lower;
 pub mod obj;
@@ -14,6 +15,8 @@ pub mod tessellate;
 pub mod triangle;
 
 use glam::{DAffine3, DVec3, Vec3A, Vec4};
+
+pub use detail::Detail;
 
 use crate::bvh::{Aabb, Bvh, Rays4};
 use crate::render::{Counters, Hit, Ray, NO_OBJECT};

@@ -9,6 +9,41 @@ use glam::DVec3;
 
 use super::TriMesh;
 
+/// How many triangles each generator makes, so a budget can be charged before anything
+/// is allocated (each checked against its generator in `counts_are_what_generators_make`).
+pub mod count {
+    /// [`uvsphere`](super::uvsphere).
+    pub fn uvsphere(rings: u32, segments: u32) -> u64 {
+        2 * segments.max(3) as u64 * (rings.max(2) as u64 - 1)
+    }
+
+    /// [`icosphere`](super::icosphere).
+    pub fn icosphere(subdivisions: u32) -> u64 {
+        20 * 4u64.pow(subdivisions)
+    }
+
+    /// [`cuboid`](super::cuboid).
+    pub const CUBOID: u64 = 12;
+
+    /// [`square`](super::square).
+    pub const SQUARE: u64 = 2;
+
+    /// [`cylinder`](super::cylinder).
+    pub fn cylinder(segments: u32) -> u64 {
+        4 * segments.max(3) as u64
+    }
+
+    /// [`cone`](super::cone).
+    pub fn cone(segments: u32) -> u64 {
+        2 * segments.max(3) as u64
+    }
+
+    /// [`torus`](super::torus).
+    pub fn torus(segments: u32, sides: u32) -> u64 {
+        2 * segments.max(3) as u64 * sides.max(3) as u64
+    }
+}
+
 /// UV sphere: `rings` latitude bands (≥ 2) and `segments` longitudes (≥ 3), poles on ±y.
 pub fn uvsphere(r: f64, rings: u32, segments: u32) -> TriMesh {
     let (rings, segments) = (rings.max(2), segments.max(3));
@@ -212,6 +247,24 @@ mod tests {
         closed_and_outward("cylinder", &cylinder(1.0, 1.0, 64), 2.0 * PI, 0.01);
         closed_and_outward("cone", &cone(1.0, 1.0, 64), 2.0 * PI / 3.0, 0.01);
         closed_and_outward("torus", &torus(1.0, 0.25, 64, 32), 2.0 * PI * PI * 0.0625, 0.01);
+    }
+
+    #[test]
+    fn counts_are_what_generators_make() {
+        let n = |m: TriMesh| m.triangles.len() as u64;
+        for a in [0, 2, 3, 7, 14, 31] {
+            for b in [0, 3, 5, 50] {
+                assert_eq!(count::uvsphere(a, b), n(uvsphere(1.0, a, b)), "uvsphere({a}, {b})");
+                assert_eq!(count::torus(a, b), n(torus(1.0, 0.2, a, b)), "torus({a}, {b})");
+            }
+            assert_eq!(count::cylinder(a), n(cylinder(1.0, 1.0, a)), "cylinder({a})");
+            assert_eq!(count::cone(a), n(cone(1.0, 1.0, a)), "cone({a})");
+        }
+        for s in 0..4 {
+            assert_eq!(count::icosphere(s), n(icosphere(1.0, s)), "icosphere({s})");
+        }
+        assert_eq!(count::CUBOID, n(cuboid(DVec3::ONE)));
+        assert_eq!(count::SQUARE, n(square(1.0)));
     }
 
     #[test]

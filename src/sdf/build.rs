@@ -8,7 +8,7 @@ use std::sync::Arc;
 use glam::{Affine3A, DAffine3, DMat3, Vec3A};
 
 use super::prim;
-use crate::ir::{Shape, ShapeKind};
+use crate::ir::{CsgOp, Primitive, Shape, ShapeKind};
 use crate::render::MaterialTable;
 
 /// A distance bound: never more than the true distance to the surface.
@@ -47,20 +47,12 @@ impl Builder<'_> {
                 let id = self.materials.intern(material);
                 self.build(child, xf, id)
             }
-            ShapeKind::Union { children, smooth } if *smooth == 0.0 => {
+            ShapeKind::Csg { op, children, smooth } if *smooth == 0.0 => {
                 let kids: Vec<(Sdf, MatSdf)> = children.iter().map(|c| self.build(c, xf, mat)).collect();
-                self.combine(kids, Combine::Union)
+                self.combine(kids, *op)
             }
-            ShapeKind::Intersect { children, smooth } if *smooth == 0.0 => {
-                let kids: Vec<(Sdf, MatSdf)> = children.iter().map(|c| self.build(c, xf, mat)).collect();
-                self.combine(kids, Combine::Intersect)
-            }
-            ShapeKind::Subtract { children, smooth } if *smooth == 0.0 => {
-                let kids: Vec<(Sdf, MatSdf)> = children.iter().map(|c| self.build(c, xf, mat)).collect();
-                self.combine(kids, Combine::Subtract)
-            }
-            kind if is_primitive(kind) => self.primitive(kind, xf, mat),
-            _ => {
+            ShapeKind::Primitive(p) => self.primitive(p, xf, mat),
+            ShapeKind::Csg { .. } | ShapeKind::Round { .. } | ShapeKind::Shell { .. } | ShapeKind::Repeat { .. } => {
                 // Smooth operators and modifiers work in their own units: build locally, then wrap.
                 let (d, m) = self.local(shape, mat);
                 self.wrap(d, m, xf)
@@ -68,9 +60,9 @@ impl Builder<'_> {
         }
     }
 
-    fn primitive(&mut self, kind: &ShapeKind, xf: DAffine3, mat: u32) -> (Sdf, MatSdf) {
-        let local: Sdf = match *kind {
-            ShapeKind::Sphere { radius } => {
+    fn primitive(&mut self, p: &Primitive, xf: DAffine3, mat: u32) -> (Sdf, MatSdf) {
+        let local: Sdf = match *p {
+            Primitive::Sphere { radius } => {
                 let r = radius as f32;
                 // A sphere under a similarity is a sphere: no inverse map needed.
                 if let Some(scale) = similarity(xf.matrix3) {
@@ -82,19 +74,19 @@ impl Builder<'_> {
                 }
                 self.sdf(move |p| prim::sphere(p, r))
             }
-            ShapeKind::Box { half } => {
+            Primitive::Box { half } => {
                 let b = half.as_vec3a();
                 self.sdf(move |p| prim::cuboid(p, b))
             }
-            ShapeKind::Cylinder { radius, half_height } => {
+            Primitive::Cylinder { radius, half_height } => {
                 let (r, h) = (radius as f32, half_height as f32);
                 self.sdf(move |p| prim::cylinder(p, r, h))
             }
-            ShapeKind::Torus { major, minor } => {
+            Primitive::Torus { major, minor } => {
                 let (a, b) = (major as f32, minor as f32);
                 self.sdf(move |p| prim::torus(p, a, b))
             }
-            ShapeKind::Plane { normal, offset } => {
+            Primitive::Plane { normal, offset } => {
                 // Transform the plane itself (exact for any invertible map), in f64.
                 let n_world = (xf.matrix3.inverse().transpose() * normal).normalize();
                 let point = xf.transform_point3(normal * offset);
@@ -103,16 +95,14 @@ impl Builder<'_> {
                 let m = self.mat(move |p| (prim::plane(p, n, o), mat));
                 return (d, m);
             }
-            ShapeKind::Capsule { radius, half_height } => {
+            Primitive::Capsule { radius, half_height } => {
                 let (r, h) = (radius as f32, half_height as f32);
                 self.sdf(move |p| prim::capsule(p, r, h))
             }
-            ShapeKind::Cone { radius, half_height } => {
+            Primitive::Cone { radius, half_height } => {
                 let (r, h) = (radius as f32, half_height as f32);
                 self.sdf(move |p| prim::cone(p, r, h))
             }
-            // Only primitives reach here (see `is_primitive`); an empty shape is the safe answer.
-            _ => self.sdf(|_| f32::INFINITY),
         };
         let m = {
             let local = local.clone();
@@ -149,16 +139,9 @@ impl Builder<'_> {
     fn local(&mut self, shape: &Shape, mat: u32) -> (Sdf, MatSdf) {
         let id = DAffine3::IDENTITY;
         match &shape.kind {
-            ShapeKind::Union { children, smooth }
-            | ShapeKind::Intersect { children, smooth }
-            | ShapeKind::Subtract { children, smooth } => {
+            ShapeKind::Csg { op, children, smooth } => {
                 let kids: Vec<(Sdf, MatSdf)> = children.iter().map(|c| self.build(c, id, mat)).collect();
-                let op = match &shape.kind {
-                    ShapeKind::Union { .. } => Combine::Union,
-                    ShapeKind::Intersect { .. } => Combine::Intersect,
-                    _ => Combine::Subtract,
-                };
-                self.smooth(kids, op, *smooth as f32)
+                self.smooth(kids, *op, *smooth as f32)
             }
             ShapeKind::Round { child, radius } => {
                 let (d, m) = self.build(child, id, mat);
@@ -188,11 +171,13 @@ impl Builder<'_> {
                 let rep2 = rep.clone();
                 (self.sdf(move |p| rep.eval(p, |q| d(q))), self.mat(move |p| rep2.eval_mat(p, |q| m(q))))
             }
-            _ => self.build(shape, id, mat),
+            ShapeKind::Primitive(_) | ShapeKind::Transform { .. } | ShapeKind::Paint { .. } => {
+                self.build(shape, id, mat)
+            }
         }
     }
 
-    fn combine(&mut self, kids: Vec<(Sdf, MatSdf)>, op: Combine) -> (Sdf, MatSdf) {
+    fn combine(&mut self, kids: Vec<(Sdf, MatSdf)>, op: CsgOp) -> (Sdf, MatSdf) {
         let mut kids = kids;
         if kids.len() == 1 {
             if let Some(only) = kids.pop() {
@@ -202,19 +187,19 @@ impl Builder<'_> {
         let (ds, ms): (Vec<Sdf>, Vec<MatSdf>) = kids.into_iter().unzip();
         self.bytes += ds.len() * 2 * std::mem::size_of::<Sdf>();
         match op {
-            Combine::Union => (
+            CsgOp::Union => (
                 self.sdf(move |p| ds.iter().fold(f32::INFINITY, |a, f| a.min(f(p)))),
                 self.mat(move |p| {
                     ms.iter().map(|f| f(p)).fold((f32::INFINITY, 0), |a, b| if b.0 < a.0 { b } else { a })
                 }),
             ),
-            Combine::Intersect => (
+            CsgOp::Intersect => (
                 self.sdf(move |p| ds.iter().fold(f32::NEG_INFINITY, |a, f| a.max(f(p)))),
                 self.mat(move |p| {
                     ms.iter().map(|f| f(p)).fold((f32::NEG_INFINITY, 0), |a, b| if b.0 > a.0 { b } else { a })
                 }),
             ),
-            Combine::Subtract => (
+            CsgOp::Subtract => (
                 self.sdf(move |p| ds[1..].iter().fold(ds[0](p), |a, f| a.max(-f(p)))),
                 // The cut faces take the material of the part cut away.
                 self.mat(move |p| {
@@ -224,16 +209,16 @@ impl Builder<'_> {
         }
     }
 
-    fn smooth(&mut self, kids: Vec<(Sdf, MatSdf)>, op: Combine, k: f32) -> (Sdf, MatSdf) {
+    fn smooth(&mut self, kids: Vec<(Sdf, MatSdf)>, op: CsgOp, k: f32) -> (Sdf, MatSdf) {
         let (ds, ms): (Vec<Sdf>, Vec<MatSdf>) = kids.into_iter().unzip();
         self.bytes += ds.len() * 2 * std::mem::size_of::<Sdf>();
         // intersect = −smin(−a, −b); subtract(a, b) = −smin(−a, b).
         let fold = move |vals: &mut dyn Iterator<Item = f32>| -> f32 {
             let first = vals.next().unwrap_or(f32::INFINITY);
             match op {
-                Combine::Union => vals.fold(first, |a, b| prim::smin(a, b, k)),
-                Combine::Intersect => -vals.fold(-first, |a, b| prim::smin(a, -b, k)),
-                Combine::Subtract => -vals.fold(-first, |a, b| prim::smin(a, b, k)),
+                CsgOp::Union => vals.fold(first, |a, b| prim::smin(a, b, k)),
+                CsgOp::Intersect => -vals.fold(-first, |a, b| prim::smin(a, -b, k)),
+                CsgOp::Subtract => -vals.fold(-first, |a, b| prim::smin(a, b, k)),
             }
         };
         let fold2 = fold;
@@ -242,34 +227,14 @@ impl Builder<'_> {
             let vals: Vec<(f32, u32)> = ms.iter().map(|f| f(p)).collect();
             let dist = fold2(&mut vals.iter().map(|v| v.0));
             let id = match op {
-                Combine::Union => vals.iter().fold((f32::INFINITY, 0), |a, b| if b.0 < a.0 { *b } else { a }).1,
-                Combine::Intersect => vals.iter().fold((f32::NEG_INFINITY, 0), |a, b| if b.0 > a.0 { *b } else { a }).1,
-                Combine::Subtract => vals[1..].iter().fold(vals[0], |a, &(d, i)| if -d > a.0 { (-d, i) } else { a }).1,
+                CsgOp::Union => vals.iter().fold((f32::INFINITY, 0), |a, b| if b.0 < a.0 { *b } else { a }).1,
+                CsgOp::Intersect => vals.iter().fold((f32::NEG_INFINITY, 0), |a, b| if b.0 > a.0 { *b } else { a }).1,
+                CsgOp::Subtract => vals[1..].iter().fold(vals[0], |a, &(d, i)| if -d > a.0 { (-d, i) } else { a }).1,
             };
             (dist, id)
         });
         (d, m)
     }
-}
-
-#[derive(Clone, Copy)]
-enum Combine {
-    Union,
-    Intersect,
-    Subtract,
-}
-
-fn is_primitive(kind: &ShapeKind) -> bool {
-    matches!(
-        kind,
-        ShapeKind::Sphere { .. }
-            | ShapeKind::Box { .. }
-            | ShapeKind::Cylinder { .. }
-            | ShapeKind::Torus { .. }
-            | ShapeKind::Plane { .. }
-            | ShapeKind::Capsule { .. }
-            | ShapeKind::Cone { .. }
-    )
 }
 
 /// Finite repetition: `count` copies per axis, `period` apart, centred at the origin.

@@ -9,7 +9,7 @@ use scnc::render::{Counters, Geometry, Image, Ray};
 use scnc::world::Mode;
 
 fn scene(text: &str) -> scnc::ir::Scene {
-    let c = scnc::compile_source("t.scn", Path::new("t.scn"), text.to_string(), &scnc::check::FsLoader);
+    let c = scnc::compile_source("t.scn", Path::new("t.scn"), text.to_string(), &scnc::source::FsLoader);
     c.scene.unwrap_or_else(|| panic!("{}", scnc::diag::render_all(&c.diagnostics, &c.map)))
 }
 
@@ -24,7 +24,7 @@ fn render_in(mut s: scnc::ir::Scene, size: u32, effects: Option<Effects>, mode: 
     s.settings.width = size;
     s.settings.height = size;
     let effects = effects.unwrap_or_else(|| effects::derive(&s));
-    let (frame, world) = scnc::world::prepare(&s, effects, mode, &scnc::check::FsLoader).expect("lowering");
+    let (frame, world) = scnc::world::prepare(&s, effects, mode, &scnc::source::FsLoader).expect("lowering");
     let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().expect("pool");
     let (img, c) = pool.install(|| scnc::render::render(&world, &frame, &|| {}));
     let mut scratch = Counters::default();
@@ -170,7 +170,7 @@ object sphere(0.8) at [0, -0.2, 6] with material(color = rgb(255, 60, 60))
     assert!(h >= 40, "the hard shadow should have a sharp edge (largest step {h})");
     assert!(s_ * 2 <= h, "the soft shadow's largest step {s_} should be far below the hard one's {h}");
     assert!(sc.shadow_rays <= hits && hc.shadow_rays <= hits, "one shadow query per lit hit in an SDF scene");
-    let (_, mc, _) = render_in(scene(&base.replace("RADIUS", "0.8")), 48, None, Mode::Mesh(scnc::world::Detail::High));
+    let (_, mc, _) = render_in(scene(&base.replace("RADIUS", "0.8")), 48, None, Mode::Mesh(scnc::mesh::Detail::High));
     assert_eq!(mc.shadow_rays % 16, 0, "meshes sample the light with 16 rays");
     assert!(mc.shadow_rays > 0);
 }
@@ -191,7 +191,7 @@ object sphere(0.7) at [0, -0.3, 6.5] with material(color = rgb(200, 200, 200))
     let contact = (40..80).map(|y| (px(&without, 40, y) as i32 - px(&with, 40, y) as i32).max(0)).max().unwrap_or(0);
     assert!(contact >= 40, "occlusion should darken the contact (largest change {contact})");
     assert_eq!(px(&with, 2, 78), px(&without, 2, 78), "open floor is not occluded");
-    let (_, mc, _) = render_in(scene(text), 40, None, Mode::Mesh(scnc::world::Detail::High));
+    let (_, mc, _) = render_in(scene(text), 40, None, Mode::Mesh(scnc::mesh::Detail::High));
     assert!(hits > 0 && mc.occlusion_rays > 0 && mc.occlusion_rays % 16 == 0);
     // Without ambient light there is nothing to occlude, so the effect is not built.
     let e = effects::derive(&scene(&text.replace("light ambient(1)", "light point(1) at [0, 3, 0]")));

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use scnc::check::FsLoader;
+use scnc::source::FsLoader;
 use scnc::syntax::{self, Token};
 
 use crate::support::{cases, check_golden, finish};

@@ -68,7 +68,7 @@ fn syntax_recovery_reports_independent_errors() {
     let text =
         "object sphere(1 at [0, 0, 5]\nlight ambient(0.2)\nobject box(1) rotate\nobject sphere(1) at [0, 0, 5]\n"
             .to_string();
-    let c = scnc::compile_source("t.scn", std::path::Path::new("t.scn"), text, &scnc::check::FsLoader);
+    let c = scnc::compile_source("t.scn", std::path::Path::new("t.scn"), text, &scnc::source::FsLoader);
     let syntax: Vec<_> = c.diagnostics.iter().filter(|d| d.code == "E0100").collect();
     assert_eq!(syntax.len(), 2, "{:#?}", c.diagnostics);
 }
@@ -121,7 +121,7 @@ fn lowering_diagnostics() {
             continue;
         };
         let effects = scnc::effects::derive(scene);
-        match scnc::world::prepare(scene, effects, scnc::world::Mode::Sdf, &scnc::check::FsLoader) {
+        match scnc::world::prepare(scene, effects, scnc::world::Mode::Sdf, &scnc::source::FsLoader) {
             Ok(_) => failures.push(format!("{}: lowered without an error", path.display())),
             Err(d) => failures.extend(check_golden(&path.with_extension("txt"), &d.render(&c.map, false))),
         }

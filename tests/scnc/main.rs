@@ -8,6 +8,7 @@ mod grammar;
 mod lsp;
 mod mesh;
 mod nopanic;
+mod primitives;
 mod render;
 mod skip;
 mod stability;

@@ -2,11 +2,12 @@
 
 use glam::{DAffine3, DVec3, Vec3A, Vec4};
 use scnc::bvh::Rays4;
+use scnc::mesh::Detail;
 use scnc::mesh::{tessellate, triangle, MeshObject, TriMesh};
 use scnc::render::{Counters, Geometry, Hit, Packet, Ray};
-use scnc::world::{Detail, Mode};
+use scnc::world::Mode;
 
-use crate::support::{compile, lower, Rng};
+use crate::support::{compile, coverage, lower, Rng};
 
 fn brute_force(mesh: &TriMesh, ray: &Ray) -> Option<f32> {
     let shear = triangle::Shear::new(ray.dir);
@@ -125,17 +126,6 @@ fn rays_through_shared_edges_and_vertices_never_miss() {
     }
 }
 
-fn coverage(path: &std::path::Path, mode: Mode, size: u32) -> Vec<bool> {
-    let (frame, world) = lower(&compile(path).scene.expect("seed scene compiles"), size, mode);
-    let mut counters = Counters::default();
-    (0..size * size)
-        .map(|i| {
-            let dir = frame.direction((i % size) as f32 + 0.5, (i / size) as f32 + 0.5);
-            world.intersect(&Ray::new(Vec3A::ZERO, dir, frame.max_distance), &mut counters).is_some()
-        })
-        .collect()
-}
-
 /// At 256×256, which pixels hit geometry differs between `--geometry mesh --detail high`
 /// and the SDF back-end in at most 0.5 % of the pixels, and only on silhouettes (within
 /// one pixel of a pixel where the SDF render changes between hit and miss).
@@ -146,8 +136,9 @@ fn mesh_high_coverage_agrees_with_sdf() {
         if path.file_name().is_some_and(|n| n == "lights.scn") {
             continue;
         }
-        let sdf = coverage(&path, Mode::Sdf, SIZE);
-        let mesh = coverage(&path, Mode::Mesh(Detail::High), SIZE);
+        let scene = compile(&path).scene.expect("seed scene compiles");
+        let sdf = coverage(&scene, Mode::Sdf, SIZE);
+        let mesh = coverage(&scene, Mode::Mesh(Detail::High), SIZE);
         let s = SIZE as i32;
         let at = |x: i32, y: i32| sdf[(y.clamp(0, s - 1) * s + x.clamp(0, s - 1)) as usize];
         let mut differing = 0;

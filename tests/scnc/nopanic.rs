@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use scnc::check::Loader;
+use scnc::source::Loader;
 
 use crate::support::Rng;
 
@@ -12,7 +12,7 @@ struct Examples;
 
 impl Loader for Examples {
     fn read(&self, path: &Path) -> std::io::Result<String> {
-        scnc::check::FsLoader.read(path)
+        scnc::source::FsLoader.read(path)
     }
 }
 
@@ -124,7 +124,7 @@ fn editor_queries_never_panic() {
     }
     for (path, text) in files {
         let len = text.len() as u32;
-        let a = scnc::lsp::analysis::Analysis::new(Path::new(&path), text, &scnc::check::FsLoader);
+        let a = scnc::lsp::analysis::Analysis::new(Path::new(&path), text, &scnc::source::FsLoader);
         let total: u32 = a.map.files().map(|(_, f)| f.base + f.text.len() as u32).max().unwrap_or(0);
         for at in 0..=len {
             if let Some((span, _)) = a.hover(at) {

@@ -3,14 +3,15 @@
 use std::path::Path;
 
 use glam::Vec3A;
+use scnc::mesh::Detail;
 use scnc::render::{Counters, Image};
-use scnc::world::{Detail, Mode};
+use scnc::world::Mode;
 
 use crate::support::{cases, finish, updating, Rng};
 
 /// Compiles and renders scene text at `w × h` on a pool of `threads`.
 pub fn render_text(text: &str, w: u32, h: u32, threads: usize) -> (Image, Counters) {
-    let c = scnc::compile_source("t.scn", Path::new("t.scn"), text.to_string(), &scnc::check::FsLoader);
+    let c = scnc::compile_source("t.scn", Path::new("t.scn"), text.to_string(), &scnc::source::FsLoader);
     let scene =
         c.scene.unwrap_or_else(|| panic!("scene did not compile:\n{}", scnc::diag::render_all(&c.diagnostics, &c.map)));
     render_scene(scene, w, h, threads)
@@ -27,7 +28,7 @@ pub fn render_mode(mut scene: scnc::ir::Scene, w: u32, h: u32, threads: usize, m
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool");
     pool.install(|| {
         let effects = scnc::effects::derive(&scene);
-        let (frame, geometry) = scnc::world::prepare(&scene, effects, mode, &scnc::check::FsLoader).expect("lowering");
+        let (frame, geometry) = scnc::world::prepare(&scene, effects, mode, &scnc::source::FsLoader).expect("lowering");
         scnc::render::render(&geometry, &frame, &|| {})
     })
 }
@@ -178,9 +179,9 @@ fn every_evaluator_is_a_distance_bound() {
     let mut rng = Rng(0xb0u64 << 32 | 0x0d);
     for shape in shapes {
         let text = format!("light ambient(1)\nobject {shape} at [0, 0, 5]\n");
-        let c = scnc::compile_source("t.scn", Path::new("t.scn"), text, &scnc::check::FsLoader);
+        let c = scnc::compile_source("t.scn", Path::new("t.scn"), text, &scnc::source::FsLoader);
         let scene = c.scene.unwrap_or_else(|| panic!("{shape}: {}", scnc::diag::render_all(&c.diagnostics, &c.map)));
-        let (_, g) = scnc::world::prepare(&scene, scnc::effects::derive(&scene), Mode::Sdf, &scnc::check::FsLoader)
+        let (_, g) = scnc::world::prepare(&scene, scnc::effects::derive(&scene), Mode::Sdf, &scnc::source::FsLoader)
             .expect("lower");
         for _ in 0..4000 {
             let centre = Vec3A::new(0.0, 0.0, 5.0);

@@ -3,8 +3,9 @@
 //! and that the skip saves the work it is for.
 
 use glam::Vec3A;
+use scnc::mesh::Detail;
 use scnc::render::{spawn_offset, Counters, Geometry, Hit, Ray, NO_OBJECT};
-use scnc::world::{Detail, Mode};
+use scnc::world::Mode;
 
 use crate::support::{compile, lower, scene};
 

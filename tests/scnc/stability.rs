@@ -2,8 +2,9 @@
 
 use glam::{DVec3, Vec3A};
 use proptest::prelude::*;
+use scnc::mesh::Detail;
 use scnc::render::{Counters, Geometry, Image, Ray};
-use scnc::world::{Detail, Mode};
+use scnc::world::Mode;
 
 use crate::support::{lower, scene, Rng};
 
@@ -264,7 +265,7 @@ fn degenerate_input_is_an_error_or_defined() {
             "t.scn",
             std::path::Path::new("t.scn"),
             format!("light ambient(1)\n{text}\n"),
-            &scnc::check::FsLoader,
+            &scnc::source::FsLoader,
         );
         assert!(
             c.scene.is_none() && c.diagnostics.iter().any(|d| d.code == code),

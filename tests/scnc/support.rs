@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use scnc::check::FsLoader;
+use scnc::source::FsLoader;
 use scnc::Compiled;
 
 /// The `.scn` files directly inside `dir`, sorted.
@@ -36,6 +36,20 @@ pub fn lower(scene: &scnc::ir::Scene, size: u32, mode: scnc::world::Mode) -> (sc
     s.settings.width = size;
     s.settings.height = size;
     scnc::world::prepare(&s, scnc::effects::derive(&s), mode, &FsLoader).expect("lowering")
+}
+
+/// Which pixels of a `size × size` image hit geometry when `scene` is lowered by `mode`
+/// (primary rays only, no shading).
+pub fn coverage(scene: &scnc::ir::Scene, mode: scnc::world::Mode, size: u32) -> Vec<bool> {
+    use scnc::render::{Counters, Geometry, Ray};
+    let (frame, world) = lower(scene, size, mode);
+    let mut counters = Counters::default();
+    (0..size * size)
+        .map(|i| {
+            let dir = frame.direction((i % size) as f32 + 0.5, (i / size) as f32 + 0.5);
+            world.intersect(&Ray::new(glam::Vec3A::ZERO, dir, frame.max_distance), &mut counters).is_some()
+        })
+        .collect()
 }
 
 /// Whether golden files should be rewritten (`UPDATE_EXPECT=1`).
