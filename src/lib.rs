@@ -22,8 +22,8 @@
 //!
 //! Every stage reports problems as [`diag::Diagnostic`] values; only the binary prints.
 
+pub mod accel;
 pub mod accuracy;
-pub mod bvh;
 pub mod chart;
 pub mod check;
 pub mod diag;

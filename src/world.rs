@@ -8,7 +8,8 @@
 use glam::{DAffine3, Vec3A, Vec4};
 use rayon::prelude::*;
 
-use crate::bvh::{splat3, Aabb, Bvh, Rays4};
+use crate::accel::bvh::splat3;
+use crate::accel::{Aabb, Bvh, Rays4};
 use crate::diag::Diagnostic;
 use crate::ir;
 use crate::mesh::triangle::PacketShear;

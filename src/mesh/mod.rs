@@ -18,7 +18,7 @@ use glam::{DAffine3, DVec3, Vec3A, Vec4};
 
 pub use detail::Detail;
 
-use crate::bvh::{Aabb, Bvh, Rays4};
+use crate::accel::{Aabb, Bvh, Rays4};
 use crate::render::{Counters, Hit, Ray, NO_OBJECT};
 
 /// An indexed triangle mesh in some frame (local for generators, render space once lowered).
@@ -263,7 +263,7 @@ impl MeshObject {
             let (a, b, cc) = self.tri(i);
             let tri = shear.triangle(a, b, cc);
             for g in 0..N {
-                let lanes = crate::bvh::group(lanes, g);
+                let lanes = crate::accel::bvh::group_lanes(lanes, g);
                 if lanes == 0 {
                     continue;
                 }

@@ -161,7 +161,7 @@ pub struct Counters {
     pub budget_misses: u64,
     /// BVH nodes visited (a node a packet visits counts once for each ray the walk
     /// carries into it: every wanted ray from its first active one, see
-    /// [`Bvh::each_packet`](crate::bvh::Bvh::each_packet)).
+    /// [`Bvh::each_packet`](crate::accel::Bvh::each_packet)).
     pub node_visits: u64,
     /// Ray–triangle tests (mesh back-end; a packet's test counts once per ray it tests).
     pub triangle_tests: u64,

@@ -1,7 +1,7 @@
 //! The mesh back-end: BVH against brute force, watertightness, agreement with the SDF back-end.
 
 use glam::{DAffine3, DVec3, Vec3A, Vec4};
-use scnc::bvh::Rays4;
+use scnc::accel::Rays4;
 use scnc::mesh::Detail;
 use scnc::mesh::{tessellate, triangle, MeshObject, TriMesh};
 use scnc::render::{Counters, Geometry, Hit, Packet, Ray};

@@ -1,0 +1,116 @@
+//! Axis-aligned boxes in render space and the robust ray/box slab test, in one place:
+//! the scalar test here and the 4-wide one ([`enters4`]) every hierarchy walk uses.
+
+use glam::{Vec3A, Vec4};
+
+/// The far distance of every slab test is scaled by 1 + 2γ₃ (Ize 2013, "Robust BVH Ray
+/// Traversal"), so rounding never rejects a ray that touches a box, e.g. through a mesh
+/// vertex.
+pub const ROBUST: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON / (1.0 - 3.0 * f32::EPSILON));
+
+/// An axis-aligned box in render space (f32).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    /// Smallest corner.
+    pub min: Vec3A,
+    /// Largest corner.
+    pub max: Vec3A,
+}
+
+impl Aabb {
+    /// The empty box (contains nothing; the identity of `union`).
+    pub const EMPTY: Aabb = Aabb { min: Vec3A::splat(f32::INFINITY), max: Vec3A::splat(f32::NEG_INFINITY) };
+
+    /// The smallest box containing both.
+    pub fn union(self, o: Aabb) -> Aabb {
+        Aabb { min: self.min.min(o.min), max: self.max.max(o.max) }
+    }
+
+    /// Centre point.
+    pub fn centre(self) -> Vec3A {
+        (self.min + self.max) * 0.5
+    }
+
+    /// Half the surface area (the SAH cost of a box).
+    pub fn half_area(self) -> f32 {
+        let d = (self.max - self.min).max(Vec3A::ZERO);
+        d.x * d.y + d.y * d.z + d.z * d.x
+    }
+
+    /// Whether `o` lies inside (with a relative tolerance for rounding).
+    pub fn contains(self, o: Aabb) -> bool {
+        let tol = (self.max - self.min).abs().max_element() * 1e-5 + 1e-6;
+        (o.min + tol).cmpge(self.min).all() && (o.max - tol).cmple(self.max).all()
+    }
+
+    /// The parametric interval `[t0, t1]` where the ray is inside the box, clipped to
+    /// `[t_min, t_max]`; `None` on a miss. `inv_dir` is `1 / dir` (infinite for zero
+    /// components, which the min/max formulation handles).
+    #[inline]
+    pub fn slab(self, origin: Vec3A, inv_dir: Vec3A, t_min: f32, t_max: f32) -> Option<(f32, f32)> {
+        let t0 = (self.min - origin) * inv_dir;
+        let t1 = (self.max - origin) * inv_dir;
+        // `min`/`max` of glam ignore a NaN operand (0 × ∞ on a slab face), keeping the other;
+        // the far distance is scaled by [`ROBUST`].
+        let near = t0.min(t1).max_element();
+        let far = t0.max(t1).min_element() * ROBUST;
+        // Clamped by comparisons rather than `f32::max`/`min`, which spend instructions on
+        // a NaN in either operand: only `near` and `far` can be NaN, and then the bound wins
+        // just as `f32::max`/`min` would choose it.
+        let near = if near > t_min { near } else { t_min };
+        let far = if far < t_max { far } else { t_max };
+        (near <= far).then_some((near, far))
+    }
+}
+
+/// The slab test four lanes at a time (four boxes for one ray, or one box for four
+/// rays), from each axis's near and far plane distances per lane: the lanes that enter
+/// before `t_max` (a bit per lane) and their entry distances. Every 4-wide box test of
+/// the walks is this one function, so a ray tested in a packet enters exactly the boxes
+/// it enters tested alone (same operations, same operand order).
+#[inline(always)]
+pub(crate) fn enters4(axes: [(Vec4, Vec4); 3], t_min: Vec4, t_max: Vec4) -> (u32, Vec4) {
+    let mut near = t_min;
+    let mut far = Vec4::INFINITY;
+    for (lo, hi) in axes {
+        near = max_keep(lo, near);
+        far = min_keep(hi, far);
+    }
+    let far = min_keep(far * ROBUST, t_max);
+    (near.cmple(far).bitmask(), near)
+}
+
+/// `a.max(b)`, and `b` where `a` is NaN (a ray in a slab's face plane makes `0 × ∞`):
+/// then the bound so far stands, as in the scalar [`Aabb::slab`].
+#[inline(always)]
+fn max_keep(a: Vec4, b: Vec4) -> Vec4 {
+    // SSE's `maxps(a, b)`, which glam's `max` is on x86, returns `b` when either is NaN;
+    // elsewhere (NEON propagates NaN) the comparison says it explicitly.
+    #[cfg(any(target_arch = "x86", target_arch = "x86_64"))]
+    return a.max(b);
+    #[cfg(not(any(target_arch = "x86", target_arch = "x86_64")))]
+    return Vec4::select(a.cmpgt(b), a, b);
+}
+
+/// `a.min(b)`, and `b` where `a` is NaN (see [`max_keep`]).
+#[inline(always)]
+fn min_keep(a: Vec4, b: Vec4) -> Vec4 {
+    #[cfg(any(target_arch = "x86", target_arch = "x86_64"))]
+    return a.min(b);
+    #[cfg(not(any(target_arch = "x86", target_arch = "x86_64")))]
+    return Vec4::select(a.cmplt(b), a, b);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A NaN lane (a ray in a face plane) leaves the bound so far, on every target.
+    #[test]
+    fn a_nan_distance_keeps_the_bound() {
+        let nan = Vec4::new(f32::NAN, 1.0, f32::NAN, 5.0);
+        let bound = Vec4::new(2.0, 2.0, 2.0, 2.0);
+        assert_eq!(max_keep(nan, bound).to_array(), [2.0, 2.0, 2.0, 5.0]);
+        assert_eq!(min_keep(nan, bound).to_array(), [2.0, 1.0, 2.0, 2.0]);
+    }
+}

@@ -1,0 +1,164 @@
+//! The single-ray walks: closest hit and any hit, front to back.
+
+use glam::{Vec3A, Vec4, Vec4Swizzles};
+
+use super::{Bvh, Child, Deferred, Node};
+use crate::accel::aabb::enters4;
+
+/// Per-ray constants of the two-box slab test, splat across lanes.
+pub(super) struct RaySplat {
+    origin: [Vec4; 3],
+    inv_dir: [Vec4; 3],
+    t_min: Vec4,
+}
+
+impl RaySplat {
+    pub(super) fn new(origin: Vec3A, inv_dir: Vec3A, t_min: f32) -> RaySplat {
+        RaySplat {
+            origin: [Vec4::splat(origin.x), Vec4::splat(origin.y), Vec4::splat(origin.z)],
+            inv_dir: [Vec4::splat(inv_dir.x), Vec4::splat(inv_dir.y), Vec4::splat(inv_dir.z)],
+            t_min: Vec4::splat(t_min),
+        }
+    }
+
+    /// Which of the node's two children the ray enters before `t_max` (bit 0 left,
+    /// bit 1 right) and the entry distances (lanes 0 and 1). The same slab test as
+    /// [`Aabb::slab`], including its robust far bound. A ray lying exactly in a face
+    /// plane of a box makes `0 × ∞ = NaN` there and may miss that box, as it may in
+    /// [`Aabb::slab`]: it could only graze what the box holds, edge-on.
+    #[inline(always)]
+    pub(super) fn enters(&self, node: &Node, t_max: f32) -> (u32, Vec4) {
+        let axis = |planes: Vec4, k: usize| {
+            let t = (planes - self.origin[k]) * self.inv_dir[k];
+            // Lanes 2 and 3 moved to 0 and 1: each child's two planes side by side.
+            let swapped = t.zwxy();
+            (t.min(swapped), t.max(swapped))
+        };
+        let axes = [axis(node.x, 0), axis(node.y, 1), axis(node.z, 2)];
+        let (enters, near) = enters4(axes, self.t_min, Vec4::splat(t_max));
+        (enters & 0b11, near)
+    }
+}
+
+impl Bvh {
+    /// Visits leaves front to back along the ray. `visit(prim, t_max)` tests one primitive
+    /// and returns its hit distance if closer than `t_max`; the closest hit wins.
+    /// Returns the closest hit (primitive, t) and counts nodes visited into `visits`.
+    #[inline]
+    pub fn closest(
+        &self,
+        origin: Vec3A,
+        inv_dir: Vec3A,
+        t_min: f32,
+        mut t_max: f32,
+        visits: &mut u64,
+        mut visit: impl FnMut(u32, f32) -> Option<f32>,
+    ) -> Option<(u32, f32)> {
+        let mut best = None;
+        self.leaves(origin, inv_dir, t_min, &mut t_max, visits, |first, count, t_max| {
+            for k in first..first + count {
+                let p = self.prim(k);
+                if let Some(t) = visit(p, *t_max) {
+                    *t_max = t;
+                    best = Some((p, t));
+                }
+            }
+            false
+        });
+        best
+    }
+
+    /// Whether any primitive reports a hit (`visit` returns true); stops at the first.
+    #[inline]
+    pub fn any(
+        &self,
+        origin: Vec3A,
+        inv_dir: Vec3A,
+        t_min: f32,
+        mut t_max: f32,
+        visits: &mut u64,
+        mut visit: impl FnMut(u32, f32) -> bool,
+    ) -> bool {
+        let mut found = false;
+        self.leaves(origin, inv_dir, t_min, &mut t_max, visits, |first, count, t_max| {
+            found = (first..first + count).any(|k| visit(self.prim(k), *t_max));
+            found
+        });
+        found
+    }
+
+    /// The primitive in leaf slot `k`.
+    #[inline(always)]
+    pub(super) fn prim(&self, k: u32) -> u32 {
+        if self.prims.is_empty() {
+            k
+        } else {
+            self.prims[k as usize]
+        }
+    }
+
+    /// Visits leaves front to back along the ray: `leaf(first, count, t_max)` gets the
+    /// leaf's slots `first..first + count`, may lower `t_max` to the closest hit so far,
+    /// and returns true to stop the walk.
+    #[inline]
+    fn leaves(
+        &self,
+        origin: Vec3A,
+        inv_dir: Vec3A,
+        t_min: f32,
+        t_max: &mut f32,
+        visits: &mut u64,
+        mut leaf: impl FnMut(u32, u32, &mut f32) -> bool,
+    ) {
+        let Some((root_box, root)) = self.root() else { return };
+        *visits += 1;
+        if root_box.slab(origin, inv_dir, t_min, *t_max).is_none() {
+            return;
+        }
+        // A lone leaf needs no stack. The loop below would handle it, but the top-level
+        // tree of every one-object scene is one, and skipping the stack's set-up there
+        // measured ~10% more primary rays per second on seed scene 1.
+        if root.count > 0 {
+            leaf(root.index, root.count, t_max);
+            return;
+        }
+        let ray = RaySplat::new(origin, inv_dir, t_min);
+        // Deferred children with their entry distances: a popped child is skipped when it
+        // starts beyond the closest hit found since, without testing its box again.
+        let mut deferred_children = Deferred::new((Child { index: 0, count: 0 }, 0f32));
+        let mut cur = root;
+        loop {
+            if cur.count > 0 {
+                if leaf(cur.index, cur.count, t_max) {
+                    return;
+                }
+            } else {
+                *visits += 1;
+                let node = &self.nodes[cur.index as usize];
+                let (enters, near) = ray.enters(node, *t_max);
+                if enters != 0 {
+                    // Branching on the order, and storing only a real deferral, measured
+                    // faster than a branchless select that always writes the stack.
+                    let (next, deferred) = match enters {
+                        0b01 => (node.children[0], None),
+                        0b10 => (node.children[1], None),
+                        _ if near.x <= near.y => (node.children[0], Some((node.children[1], near.y))),
+                        _ => (node.children[1], Some((node.children[0], near.x))),
+                    };
+                    cur = next;
+                    if let Some(deferred) = deferred {
+                        deferred_children.push(deferred);
+                    }
+                    continue;
+                }
+            }
+            loop {
+                let Some((next, t_near)) = deferred_children.pop() else { return };
+                if t_near <= *t_max {
+                    cur = next;
+                    break;
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,8 @@
+//! Acceleration structures: boxes, the robust slab test and the bounding-volume
+//! hierarchy that both the top-level world and every mesh walk.
+
+mod aabb;
+pub mod bvh;
+
+pub use aabb::{Aabb, ROBUST};
+pub use bvh::{Bvh, Rays4};
