@@ -1,0 +1,107 @@
+//! Lowering: each object to its back-end, in scene order (materials and the triangle
+//! budget are spent deterministically), then meshes built in parallel.
+
+use glam::{DAffine3, Vec3A};
+use rayon::prelude::*;
+
+use super::{Mode, Object, ObjectKind, World};
+use crate::accel::{Aabb, Bvh};
+use crate::diag::Diagnostic;
+use crate::ir;
+use crate::mesh;
+use crate::render::Frame;
+use crate::sdf::{self, MarchParams, SdfObject};
+use crate::source::Loader;
+
+/// An object between lowering and building: an SDF object with its bounds, or a mesh to build.
+enum Lowered {
+    Sdf(SdfObject, Option<Aabb>, Option<(Vec3A, f32)>),
+    Mesh(mesh::MeshJob),
+}
+
+fn pad_box(b: ir::Aabb) -> Aabb {
+    // Widen by a few ulps so the f32 box never clips the surface.
+    let pad = b.max.abs().max(b.min.abs()).max_element() * 1e-6 + 1e-6;
+    Aabb { min: (b.min - pad).as_vec3a(), max: (b.max + pad).as_vec3a() }
+}
+
+/// Builds the frame for `effects` and lowers the scene into a world, with the scene's
+/// own sphere-tracing settings: the one call the CLI, tests and benchmarks use.
+pub fn prepare(
+    scene: &ir::Scene,
+    effects: crate::effects::Effects,
+    mode: Mode,
+    loader: &dyn Loader,
+) -> Result<(Frame, World), Diagnostic> {
+    let mut frame = Frame::with_effects(scene, effects);
+    let params = MarchParams { epsilon: scene.settings.epsilon as f32, max_steps: scene.settings.max_steps };
+    let world = lower(scene, &mut frame, mode, params, loader)?;
+    Ok((frame, world))
+}
+
+/// Lowers every object of the scene. Materials are interned into `frame`; mesh files
+/// are read through `loader`.
+pub fn lower(
+    scene: &ir::Scene,
+    frame: &mut Frame,
+    mode: Mode,
+    params: MarchParams,
+    loader: &dyn Loader,
+) -> Result<World, Diagnostic> {
+    // Render space: world translated so the camera is at the origin, composed in f64.
+    let to_render = DAffine3::from_translation(-frame.origin);
+    let max_distance = frame.max_distance as f64;
+    let mut builder = sdf::Builder { materials: &mut frame.materials, bytes: 0 };
+    let mut budget = mesh::lower::MAX_SCENE_TRIANGLES;
+    // In scene order: materials are interned and the triangle budget spent as objects
+    // come, so ids and errors do not depend on timing. Meshes are built afterwards.
+    let mut lowered = Vec::with_capacity(scene.objects.len());
+    for obj in &scene.objects {
+        let part = match (&obj.geometry, mode) {
+            (ir::Geometry::Shape(shape), Mode::Sdf) => {
+                let bounds = ir::shape_bounds(shape).map(|b| pad_box(b.transform(&to_render)));
+                let sphere = ir::shape_sphere(shape).map(|(c, r)| {
+                    let c = to_render.transform_point3(c);
+                    let pad = (c.abs().max_element() + r) * 1e-6 + 1e-6;
+                    (c.as_vec3a(), (r + pad) as f32)
+                });
+                Lowered::Sdf(SdfObject::new(shape, to_render, &mut builder), bounds, sphere)
+            }
+            (ir::Geometry::Shape(shape), Mode::Mesh(detail)) => Lowered::Mesh(mesh::lower::tessellate(
+                shape,
+                to_render,
+                detail,
+                max_distance,
+                &mut budget,
+                builder.materials,
+            )?),
+            (ir::Geometry::Mesh(m), _) => {
+                Lowered::Mesh(mesh::lower::explicit(m, to_render, &mut budget, builder.materials, loader)?)
+            }
+        };
+        lowered.push((part, obj.span));
+    }
+    // Building the meshes (vertices to render space, BVHs) is most of the lowering time
+    // of a scene of many meshes; they are independent, so they are built in parallel.
+    let objects: Vec<Object> = lowered
+        .into_par_iter()
+        .map(|(part, span)| match part {
+            Lowered::Sdf(s, bounds, sphere) => Object { kind: ObjectKind::Sdf(s), bounds, sphere, span },
+            Lowered::Mesh(job) => {
+                let m = job.build();
+                Object { bounds: Some(m.bounds()), sphere: m.sphere(), kind: ObjectKind::Mesh(m), span }
+            }
+        })
+        .collect();
+    let closure_bytes = builder.bytes;
+    let bounded: Vec<u32> = (0..objects.len() as u32)
+        .filter(|&i| objects[i as usize].bounds.is_some_and(|b| b.min.cmple(b.max).all()))
+        .collect();
+    let unbounded = (0..objects.len() as u32).filter(|&i| objects[i as usize].bounds.is_none()).collect();
+    let boxes: Vec<Aabb> = bounded.iter().map(|&i| objects[i as usize].bounds.unwrap_or(Aabb::EMPTY)).collect();
+    let bvh = Bvh::build(&boxes, 2);
+    debug_assert!(bvh.validate(&boxes).is_ok());
+    let has_meshes = objects.iter().any(|o| matches!(o.kind, ObjectKind::Mesh(_)));
+    let share_walks = has_meshes || bvh.node_count() > 1;
+    Ok(World { objects, bvh, bounded, unbounded, params, closure_bytes, has_meshes, share_walks })
+}

@@ -1,0 +1,257 @@
+//! Single-ray queries: the closest hit and any hit, through the top-level tree and
+//! then the unbounded objects.
+
+use glam::Vec3A;
+
+use super::{Object, ObjectKind, World};
+use crate::mesh::{self, MeshObject};
+use crate::render::{Counters, Geometry, Hit, Packet, Ray};
+use crate::sdf::SdfObject;
+
+impl World {
+    /// The interval of the ray inside object `i`'s bounds, clipped to `[ray.t_min, t_max]`.
+    #[inline]
+    pub(super) fn interval(&self, o: &Object, ray: &Ray, t_max: f32) -> Option<(f32, f32)> {
+        let (t0, t1) = match o.bounds {
+            Some(b) => b.slab(ray.origin, ray.inv_dir, ray.t_min, t_max)?,
+            None => (ray.t_min, t_max),
+        };
+        clip_to_sphere(o, ray, (t0, t1))
+    }
+
+    /// Whether the ray can reach mesh object `o` before `t_max`. Only its sphere is
+    /// tested: its box is the root of the mesh's own BVH, whose walk tests it anyway.
+    #[inline]
+    fn may_reach_mesh(&self, o: &Object, ray: &Ray, t_max: f32) -> bool {
+        clip_to_sphere(o, ray, (ray.t_min, t_max)).is_some()
+    }
+
+    /// The closest surface of object `i` before `t_max`, without its shading data.
+    pub(super) fn find(&self, i: u32, q: &mut Query<'_>, t_max: f32, c: &mut Counters) -> Option<Found<'_>> {
+        if i == q.ray.skip {
+            return None;
+        }
+        let o = &self.objects[i as usize];
+        match &o.kind {
+            ObjectKind::Sdf(s) => s
+                .closest(q.ray, self.interval(o, q.ray, t_max)?, self.params, c, &mut q.evals)
+                .map(|(t, error)| Found::Sdf { object: i, sdf: s, t, error }),
+            // Triangles are tested exactly; the sphere only decides whether to look.
+            ObjectKind::Mesh(m) if self.may_reach_mesh(o, q.ray, t_max) => {
+                m.closest(q.ray, q.shear(), t_max, c).map(|(tri, hit)| Found::Mesh { object: i, mesh: m, tri, hit })
+            }
+            ObjectKind::Mesh(_) => None,
+        }
+    }
+
+    /// Completes a ray's closest-hit query: the unbounded objects (outside the top-level
+    /// tree) are tried up to the tree's closest hit, then the counters are settled and the
+    /// winner's surface is computed.
+    #[inline(always)]
+    pub(super) fn finish<'w>(
+        &'w self,
+        q: &mut Query<'_>,
+        mut best: Option<Found<'w>>,
+        c: &mut Counters,
+    ) -> Option<Hit> {
+        for &i in &self.unbounded {
+            let limit = best.map_or(q.ray.t_max, |f| f.t());
+            if let Some(found) = self.find(i, q, limit, c) {
+                best = Some(found);
+            }
+        }
+        q.settle(c);
+        Some(best?.surface(q.ray, c))
+    }
+
+    fn blocks(&self, i: u32, q: &mut Query<'_>, t_max: f32, c: &mut Counters) -> bool {
+        if i == q.ray.skip {
+            return false;
+        }
+        let o = &self.objects[i as usize];
+        match &o.kind {
+            ObjectKind::Sdf(s) => self
+                .interval(o, q.ray, t_max)
+                .is_some_and(|interval| s.closest(q.ray, interval, self.params, c, &mut q.evals).is_some()),
+            ObjectKind::Mesh(m) => self.may_reach_mesh(o, q.ray, t_max) && m.occluded(q.ray, q.shear(), t_max, c),
+        }
+    }
+}
+
+/// A surface found along a ray, before its shading data is computed: the object it is
+/// on (numbered, and lowered by its back-end) and where.
+#[derive(Clone, Copy)]
+pub(super) enum Found<'w> {
+    /// An SDF hit: distance and the threshold there.
+    Sdf { object: u32, sdf: &'w SdfObject, t: f32, error: f32 },
+    /// A triangle hit.
+    Mesh { object: u32, mesh: &'w MeshObject, tri: u32, hit: mesh::triangle::TriHit },
+}
+
+impl Found<'_> {
+    /// Distance along the ray.
+    pub(super) fn t(&self) -> f32 {
+        match self {
+            Found::Sdf { t, .. } => *t,
+            Found::Mesh { hit, .. } => hit.t,
+        }
+    }
+
+    /// Normal, material and error of the winning surface, computed once per ray.
+    pub(super) fn surface(self, ray: &Ray, c: &mut Counters) -> Hit {
+        match self {
+            Found::Sdf { object, sdf, t, error } => sdf.surface(ray, t, error, object, c),
+            Found::Mesh { object, mesh, tri, hit } => mesh.surface(tri, hit, object),
+        }
+    }
+}
+
+/// Per-ray state shared by the objects one query visits.
+pub(super) struct Query<'a> {
+    pub(super) ray: &'a Ray,
+    /// The triangle test's shear, computed the first time a mesh is visited.
+    shear: Option<mesh::triangle::Shear>,
+    /// SDF evaluations so far.
+    pub(super) evals: u64,
+    /// Top-level BVH nodes visited.
+    visits: u64,
+}
+
+impl<'a> Query<'a> {
+    pub(super) fn new(ray: &'a Ray) -> Query<'a> {
+        Query::resumed(ray, 0)
+    }
+
+    /// A query for `ray` that has already spent `evals` SDF evaluations (a packet lane).
+    pub(super) fn resumed(ray: &'a Ray, evals: u64) -> Query<'a> {
+        Query { ray, shear: None, evals, visits: 0 }
+    }
+
+    /// Adds this query's work to the counters.
+    pub(super) fn settle(&self, c: &mut Counters) {
+        c.node_visits += self.visits;
+        c.sdf_evals += self.evals;
+        c.max_evals_per_ray = c.max_evals_per_ray.max(self.evals);
+    }
+
+    fn shear(&mut self) -> &mesh::triangle::Shear {
+        let dir = self.ray.dir;
+        self.shear.get_or_insert_with(|| mesh::triangle::Shear::new(dir))
+    }
+}
+
+/// `(t0, t1)` narrowed to where the ray is inside the object's bounding sphere, if it has one.
+#[inline]
+pub(super) fn clip_to_sphere(o: &Object, ray: &Ray, (t0, t1): (f32, f32)) -> Option<(f32, f32)> {
+    let (t0, t1) = match o.sphere {
+        Some((centre, radius)) => {
+            let (s0, s1) = sphere_interval(ray, centre, radius)?;
+            (t0.max(s0), t1.min(s1))
+        }
+        None => (t0, t1),
+    };
+    (t0 <= t1).then_some((t0, t1))
+}
+
+/// Where the ray is inside the sphere, or `None`. The discriminant is computed from the
+/// perpendicular distance to the centre (Haines et al., *Ray Tracing Gems* ch. 7), which
+/// stays accurate for distant spheres where `b² − c` would cancel catastrophically.
+#[inline]
+pub fn sphere_interval(ray: &Ray, centre: Vec3A, radius: f32) -> Option<(f32, f32)> {
+    let oc = ray.origin - centre;
+    let b = oc.dot(ray.dir);
+    let perp = oc - ray.dir * b;
+    let disc = radius * radius - perp.length_squared();
+    if disc < 0.0 {
+        return None;
+    }
+    let s = disc.sqrt();
+    Some((-b - s, -b + s))
+}
+
+impl Geometry for World {
+    fn intersect(&self, ray: &Ray, c: &mut Counters) -> Option<Hit> {
+        let mut q = Query::new(ray);
+        let mut visits = 0u64;
+        let mut best: Option<Found> = None;
+        self.bvh.closest(ray.origin, ray.inv_dir, ray.t_min, ray.t_max, &mut visits, |k, t_max| {
+            let found = self.find(self.bounded[k as usize], &mut q, t_max, c)?;
+            best = Some(found);
+            Some(found.t())
+        });
+        q.visits = visits;
+        self.finish(&mut q, best, c)
+    }
+
+    fn intersect4(&self, packet: &Packet, c: &mut Counters) -> [Option<Hit>; 4] {
+        let [hits] = self.intersect_packet(std::array::from_ref(packet), c);
+        hits
+    }
+
+    fn intersect16(&self, quads: &[Packet; 4], c: &mut Counters) -> [[Option<Hit>; 4]; 4] {
+        self.intersect_packet(quads, c)
+    }
+
+    fn occluded(&self, ray: &Ray, c: &mut Counters) -> bool {
+        let mut q = Query::new(ray);
+        let mut visits = 0u64;
+        let hit = self.bvh.any(ray.origin, ray.inv_dir, ray.t_min, ray.t_max, &mut visits, |k, t_max| {
+            self.blocks(self.bounded[k as usize], &mut q, t_max, c)
+        }) || self.unbounded.iter().any(|&i| self.blocks(i, &mut q, ray.t_max, c));
+        q.visits = visits;
+        q.settle(c);
+        hit
+    }
+
+    fn soft_visibility(&self, ray: &Ray, cone: f32, c: &mut Counters) -> Option<f32> {
+        World::soft_visibility(self, ray, cone, c)
+    }
+
+    fn occlusion(&self, point: Vec3A, normal: Vec3A, reach: f32, c: &mut Counters) -> Option<f32> {
+        World::occlusion(self, point, normal, reach, c)
+    }
+
+    fn bytes(&self) -> usize {
+        self.memory().total()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The perpendicular-distance form stays accurate where `b² − c` cancels: a unit
+    /// sphere 1e4 and 1e5 away, hit near its silhouette, against the same maths in f64.
+    #[test]
+    fn sphere_interval_is_stable_far_away() {
+        for dist in [10.0f64, 1e4, 1e5] {
+            for offset in [0.0f64, 0.5, 0.9, 0.999] {
+                let centre = glam::DVec3::new(offset, 0.0, dist);
+                let dir = glam::DVec3::Z;
+                let b = centre.dot(dir);
+                let perp = (centre - dir * b).length_squared();
+                let s = (1.0 - perp).sqrt();
+                let (t0, t1) = (b - s, b + s);
+                let ray = Ray::new(Vec3A::ZERO, Vec3A::Z, f32::MAX);
+                let (a0, a1) = sphere_interval(&ray, centre.as_vec3a(), 1.0).expect("the ray hits the sphere");
+                // Within a few f32 ulps of the distance, not the much larger cancellation error.
+                let tol = dist * 4.0 * f32::EPSILON as f64;
+                assert!(
+                    (a0 as f64 - t0).abs() <= tol && (a1 as f64 - t1).abs() <= tol,
+                    "at {dist}, offset {offset}: ({a0}, {a1}) vs ({t0}, {t1})"
+                );
+                // The naive form b² − c loses the chord entirely this far away.
+                if dist >= 1e4 && offset > 0.9 {
+                    let c32 = centre.as_vec3().length_squared() - 1.0;
+                    let b32 = b as f32;
+                    let naive = b32 * b32 - c32;
+                    let truth = 1.0 - perp;
+                    assert!(
+                        (naive as f64 - truth).abs() > 0.5 * truth,
+                        "this case should defeat the naive form ({naive} vs {truth})"
+                    );
+                }
+            }
+        }
+    }
+}
