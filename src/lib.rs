@@ -23,8 +23,6 @@
 //! Every stage reports problems as [`diag::Diagnostic`] values; only the binary prints.
 
 pub mod accel;
-pub mod accuracy;
-pub mod chart;
 pub mod check;
 pub mod diag;
 pub mod effects;
@@ -36,9 +34,8 @@ pub mod render;
 pub mod sdf;
 pub mod source;
 pub mod span;
-pub mod sweep;
+pub mod study;
 pub mod syntax;
-pub mod tolerance;
 pub mod world;
 
 use std::path::Path;

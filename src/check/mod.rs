@@ -13,7 +13,7 @@
 //! satisfies the invariants stated in [`ir`].
 
 pub mod builtins;
-pub mod construct;
+mod construct;
 mod expr;
 pub mod index;
 mod value;
@@ -29,6 +29,10 @@ use crate::ir::{self, Camera, Scene, Settings};
 use crate::source::{io_reason, FileId, Loader, SourceMap, MAX_FILE_BYTES};
 use crate::span::Span;
 use crate::syntax::{self, ast};
+pub use construct::{
+    MAX_DEPTH, MAX_GENERATED_TRIANGLES, MAX_IMAGE_SIDE, MAX_MESH_RESOLUTION, MAX_PIXELS, MAX_REPEAT, MAX_SAMPLES,
+    MAX_STEPS,
+};
 pub use value::Value;
 
 /// Most loop iterations in one compile, over all loops.

@@ -81,9 +81,12 @@ pub struct Memory {
 impl Memory {
     /// Every byte of geometry.
     pub fn total(&self) -> usize {
-        self.closure_bytes
-            + self.top_bvh_bytes
-            + self.meshes.iter().map(|(_, m)| m.vertex_bytes + m.index_bytes + m.bvh_bytes).sum::<usize>()
+        self.closure_bytes + self.top_bvh_bytes + self.mesh_bytes()
+    }
+
+    /// Bytes of every mesh: vertices, indices and BVHs.
+    pub fn mesh_bytes(&self) -> usize {
+        self.meshes.iter().map(|(_, m)| m.vertex_bytes + m.index_bytes + m.bvh_bytes).sum()
     }
 
     /// All triangles.

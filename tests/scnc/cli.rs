@@ -143,6 +143,9 @@ fn render_rejects_bad_flags_with_exit_2() {
     assert!(std::fs::read_dir(dir.path()).expect("dir").next().is_none(), "nothing may be written");
 }
 
+/// The columns of `sweep.csv`.
+const SWEEP_COLUMNS: &str = "backend,setting,wall_ms,rays_per_s,sdf_evals_per_ray,node_visits_per_ray,triangle_tests_per_ray,geometry_bytes,triangles,peak_rss_kib,geo_error_mean,geo_error_max,geo_error_max_pixels,coverage_error_px,rmse,psnr_db";
+
 /// The sweep runs on a seed scene at a tiny size with two settings per back-end, writes
 /// the expected columns, and errors fall where the maths says they must.
 #[test]
@@ -165,12 +168,17 @@ fn sweep_writes_csv_with_monotone_errors() {
     assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
     let csv = std::fs::read_to_string(dir.path().join("sweep.csv")).expect("sweep.csv");
     let mut lines = csv.lines();
-    assert_eq!(lines.next(), Some(scnc::sweep::CSV_HEADER));
+    // The documented columns (README, "scnc sweep"), in order.
+    assert_eq!(lines.next(), Some(SWEEP_COLUMNS));
     let rows: Vec<Vec<String>> = lines.map(|l| l.split(',').map(str::to_string).collect()).collect();
     assert_eq!(rows.len(), 4);
-    let col = |name: &str| scnc::sweep::CSV_HEADER.split(',').position(|c| c == name).expect("column");
+    let col = |name: &str| SWEEP_COLUMNS.split(',').position(|c| c == name).expect("column");
     let geo_max = |row: usize| rows[row][col("geo_error_max")].parse::<f64>().expect("number");
-    assert!(rows.iter().all(|r| r.len() == scnc::sweep::CSV_HEADER.split(',').count()));
+    assert!(rows.iter().all(|r| r.len() == SWEEP_COLUMNS.split(',').count()));
+    let md = std::fs::read_to_string(dir.path().join("sweep.md")).expect("sweep.md");
+    let table: Vec<&str> = md.lines().filter(|l| l.starts_with('|')).collect();
+    assert_eq!(table.len(), 2 + rows.len(), "heading, rule and one line per setting");
+    assert!(table.iter().all(|l| l.matches('|').count() == SWEEP_COLUMNS.split(',').count() + 1), "{md}");
     // A coarser hit threshold never gives a closer hit; more tessellation never a larger
     // chord error of the UV sphere.
     assert!(geo_max(0) >= geo_max(1), "sdf: epsilon 1e-2 should not beat 1e-4");
@@ -208,7 +216,7 @@ fn tolerance_picks_hold() {
     ]);
     assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
     let csv = std::fs::read_to_string(dir.path().join("sweep.csv")).expect("sweep.csv");
-    let col = scnc::sweep::CSV_HEADER.split(',').position(|c| c == "geo_error_max_pixels").expect("column");
+    let col = SWEEP_COLUMNS.split(',').position(|c| c == "geo_error_max_pixels").expect("column");
     let rows: Vec<f64> =
         csv.lines().skip(1).map(|l| l.split(',').nth(col).and_then(|v| v.parse().ok()).expect("number")).collect();
     assert_eq!(rows.len(), 2);
@@ -229,7 +237,7 @@ fn tolerance_picks_hold() {
         "mesh",
     ]);
     assert_eq!(o.status.code(), Some(0));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("picked detail"));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("tolerance 0.001: picked detail"));
     let o = scnc(&[
         "render",
         "examples/seed/01-sphere.scn",

@@ -6,8 +6,8 @@ use std::sync::Once;
 
 use plotters::prelude::*;
 
+use super::sweep::Row;
 use crate::render::Image;
-use crate::sweep::Row;
 
 static FONT: Once = Once::new();
 
@@ -15,8 +15,11 @@ fn register_font() {
     FONT.call_once(|| {
         // The bundled font is a valid TrueType file; if it were not, text would be missing
         // from the chart and drawing would report the error.
-        let _ =
-            plotters::style::register_font("sans-serif", FontStyle::Normal, include_bytes!("../assets/DejaVuSans.ttf"));
+        let _ = plotters::style::register_font(
+            "sans-serif",
+            FontStyle::Normal,
+            include_bytes!("../../assets/DejaVuSans.ttf"),
+        );
     });
 }
 

@@ -1,11 +1,10 @@
 //! `scnc sweep`: render one scene across a ladder of accuracy settings for both back-ends
 //! and measure, for each, time, work, memory and error against a reference (see
-//! [`crate::accuracy`] for the metrics and the reference).
+//! [`super::accuracy`] for the metrics and the reference); [`super::report`] writes them.
 
-use std::fmt::Write as _;
 use std::time::Instant;
 
-use crate::accuracy;
+use super::accuracy;
 use crate::diag::Diagnostic;
 use crate::effects;
 use crate::ir::Scene;
@@ -58,10 +57,10 @@ fn short_exp(x: f64) -> String {
 }
 
 /// The settings `--tolerance` picks for each back-end.
-pub fn picked(scene: &Scene, tol: crate::tolerance::Tolerance) -> Vec<Setting> {
+pub fn picked(scene: &Scene, tol: super::tolerance::Tolerance) -> Vec<Setting> {
     vec![
-        Setting::Sdf { epsilon: crate::tolerance::sdf_epsilon(scene, tol), max_steps: scene.settings.max_steps },
-        Setting::Mesh(crate::tolerance::mesh_detail(scene, tol)),
+        Setting::Sdf { epsilon: super::tolerance::sdf_epsilon(scene, tol), max_steps: scene.settings.max_steps },
+        Setting::Mesh(super::tolerance::mesh_detail(scene, tol)),
     ]
 }
 
@@ -168,14 +167,41 @@ fn measure(scene: &Scene, mode: Mode, runs: usize, loader: &dyn Loader) -> Resul
     Ok(Measured { image, counters, hits, bytes: mem.total(), triangles: mem.triangles(), wall_ms })
 }
 
-/// Runs the ladder on `scene` (already sized), calling `progress` after each setting.
-pub fn run(
-    scene: &Scene,
-    settings: &[Setting],
-    runs: usize,
-    loader: &dyn Loader,
-    progress: &dyn Fn(&Setting),
-) -> Result<Vec<Row>, Diagnostic> {
+/// Where the peak memory of each setting comes from: the process's own accounting,
+/// which only the binary may read (the library reads no system state).
+pub trait PeakMemory {
+    /// Starts a new measurement.
+    fn reset(&self);
+    /// The peak resident memory since the last reset, in KiB, if the system tells.
+    fn peak_kib(&self) -> Option<u64>;
+}
+
+/// Measures no memory (the `peak_rss_kib` column stays empty).
+pub struct NoPeakMemory;
+
+impl PeakMemory for NoPeakMemory {
+    fn reset(&self) {}
+
+    fn peak_kib(&self) -> Option<u64> {
+        None
+    }
+}
+
+/// How to run a sweep.
+pub struct Options<'a> {
+    /// Timed renders per setting after one warm-up.
+    pub runs: usize,
+    /// Reads mesh files.
+    pub loader: &'a dyn Loader,
+    /// Measures peak memory per setting.
+    pub memory: &'a dyn PeakMemory,
+    /// Called after each setting.
+    pub progress: &'a dyn Fn(&Setting),
+}
+
+/// Runs the ladder on `scene` (already sized).
+pub fn run(scene: &Scene, settings: &[Setting], opts: &Options<'_>) -> Result<Vec<Row>, Diagnostic> {
+    let Options { runs, loader, memory, progress } = *opts;
     let (reference_scene, _) = with_setting(scene, Setting::Sdf { epsilon: 1e-6, max_steps: 100_000 });
     let (ref_frame, ref_world) =
         world::prepare(&reference_scene, effects::derive(&reference_scene), Mode::Sdf, loader)?;
@@ -185,11 +211,11 @@ pub fn run(
     let mut rows = Vec::with_capacity(settings.len());
     for &setting in settings {
         let (s, mode) = with_setting(scene, setting);
-        reset_peak_rss();
+        memory.reset();
         let m = measure(&s, mode, runs, loader)?;
-        let peak_rss_kib = peak_rss_kib();
+        let peak_rss_kib = memory.peak_kib();
         let (geo_mean, geo_max) = accuracy::geometric_error(&m.hits, &distance);
-        let geo_max_px = accuracy::geometric_error_pixels(&m.hits, &distance, crate::tolerance::pixel_angle(scene));
+        let geo_max_px = accuracy::geometric_error_pixels(&m.hits, &distance, super::tolerance::pixel_angle(scene));
         let c = &m.counters;
         let rays = c.rays().max(1) as f64;
         let rmse = accuracy::rmse(&m.image, &ref_image);
@@ -213,78 +239,4 @@ pub fn run(
         progress(&setting);
     }
     Ok(rows)
-}
-
-/// Resets the process's peak resident set size (Linux ≥ 4.0); a no-op elsewhere.
-fn reset_peak_rss() {
-    // Writing 5 to clear_refs resets VmHWM to the current RSS. Failure only means the
-    // column is the peak since an earlier point, which `peak_rss_kib` cannot tell; on
-    // systems without procfs both calls do nothing.
-    let _ = std::fs::write("/proc/self/clear_refs", "5");
-}
-
-/// The process's peak resident set size in KiB, from /proc/self/status (Linux).
-fn peak_rss_kib() -> Option<u64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    line.split_whitespace().nth(1)?.parse().ok()
-}
-
-/// The columns of `sweep.csv`.
-pub const CSV_HEADER: &str = "backend,setting,wall_ms,rays_per_s,sdf_evals_per_ray,node_visits_per_ray,triangle_tests_per_ray,geometry_bytes,triangles,peak_rss_kib,geo_error_mean,geo_error_max,geo_error_max_pixels,coverage_error_px,rmse,psnr_db";
-
-/// Rows as CSV.
-pub fn csv(rows: &[Row]) -> String {
-    let mut out = format!("{CSV_HEADER}\n");
-    for r in rows {
-        let _ = writeln!(
-            out,
-            "{},{},{:.3},{:.0},{:.3},{:.3},{:.3},{},{},{},{:e},{:e},{:.4},{},{:.4},{:.2}",
-            r.setting.backend(),
-            r.setting.label(),
-            r.wall_ms,
-            r.rays_per_s,
-            r.evals_per_ray,
-            r.visits_per_ray,
-            r.tests_per_ray,
-            r.bytes,
-            r.triangles,
-            r.peak_rss_kib.map_or(String::new(), |k| k.to_string()),
-            r.geo_mean,
-            r.geo_max,
-            r.geo_max_px,
-            r.coverage,
-            r.rmse,
-            r.psnr
-        );
-    }
-    out
-}
-
-/// Rows as a Markdown table.
-pub fn markdown(rows: &[Row], title: &str) -> String {
-    let mut out = format!("# Sweep: {title}\n\nReference: the SDF render at epsilon 1e-6 with a 100 000-step budget. Geometric error is |d| at primary hits, in world units.\n\n| back-end | setting | wall | rays/s | evals/ray | visits/ray | tri tests/ray | bytes | triangles | peak RSS | geo error mean | geo error max | max in pixels | coverage px | RMSE | PSNR |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
-    for r in rows {
-        let _ = writeln!(
-            out,
-            "| {} | {} | {:.1} ms | {:.2} M | {:.2} | {:.2} | {:.2} | {} | {} | {} | {:.2e} | {:.2e} | {:.3} | {} | {:.2} | {:.1} dB |",
-            r.setting.backend(),
-            r.setting.label(),
-            r.wall_ms,
-            r.rays_per_s / 1e6,
-            r.evals_per_ray,
-            r.visits_per_ray,
-            r.tests_per_ray,
-            r.bytes,
-            r.triangles,
-            r.peak_rss_kib.map_or("n/a".to_string(), |k| format!("{:.1} MiB", k as f64 / 1024.0)),
-            r.geo_mean,
-            r.geo_max,
-            r.geo_max_px,
-            r.coverage,
-            r.rmse,
-            r.psnr
-        );
-    }
-    out
 }

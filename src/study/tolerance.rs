@@ -39,6 +39,16 @@ impl std::str::FromStr for Tolerance {
     }
 }
 
+impl std::fmt::Display for Tolerance {
+    /// As written on the command line: `pixel`, or the distance.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Tolerance::Absolute(t) => write!(f, "{t}"),
+            Tolerance::Pixel => f.write_str("pixel"),
+        }
+    }
+}
+
 /// The angular size of one pixel (radians per pixel at distance 1).
 pub fn pixel_angle(scene: &Scene) -> f64 {
     2.0 * (scene.camera.fov.to_radians() * 0.5).tan() / scene.settings.height as f64

@@ -1,0 +1,176 @@
+//! The `scnc` command line: the only code that reads arguments, prints, or exits.
+//!
+//! - `render` and `watch`: compile, lower and render to a PNG, once or on every change.
+//! - `sweep`: the accuracy ladder, with the process's own peak memory.
+//! - `stats`: what `render --stats` prints.
+//! - `files`: output written whole or not at all.
+//! - `fmt`: `scnc fmt`.
+
+mod files;
+mod fmt;
+mod render;
+mod stats;
+mod sweep;
+mod watch;
+
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand, ValueEnum};
+
+use scnc::diag::Diagnostic;
+use scnc::source::{FsLoader, Loader};
+use scnc::Compiled;
+
+use render::RenderArgs;
+use sweep::SweepArgs;
+
+#[derive(Parser)]
+#[command(name = "scnc", version, about = "Compile and render .scn scene files")]
+pub(crate) struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub(crate) enum MessageFormat {
+    /// Rendered for people, with source excerpts.
+    Human,
+    /// One JSON object per line, for editors and tests.
+    Json,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Check files for errors without rendering (exit 0 clean, 1 on errors).
+    Check {
+        /// The scene files.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// How to print diagnostics.
+        #[arg(long, value_enum, default_value = "human")]
+        message_format: MessageFormat,
+    },
+    /// Render a scene to an image (written whole or not at all).
+    Render(RenderArgs),
+    /// Render, then render again whenever the scene or a file it includes changes;
+    /// on errors, print them and keep the last good image. Ctrl-C ends it.
+    Watch(RenderArgs),
+    /// Render a scene across a ladder of accuracy settings for both back-ends and write
+    /// time, work, memory and error for each to DIR/sweep.csv and DIR/sweep.md.
+    Sweep(SweepArgs),
+    /// Run a Language Server Protocol server on stdin/stdout, for editors.
+    Lsp,
+    /// Format files in place in the canonical layout (comments and blank lines kept).
+    Fmt {
+        /// The scene files.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// Change nothing; list the files that would change and exit 1 if there are any.
+        #[arg(long)]
+        check: bool,
+    },
+    /// Print the evaluated scene IR.
+    Ir {
+        /// The scene file.
+        file: PathBuf,
+        /// How to print diagnostics.
+        #[arg(long, value_enum, default_value = "human")]
+        message_format: MessageFormat,
+    },
+}
+
+/// Reads and compiles a file. A file that cannot be read has no source to point into, so
+/// it is reported here, in the requested format, and `None` returned (exit 1).
+pub(crate) fn compile(path: &Path, format: MessageFormat) -> Option<Compiled> {
+    let name = path.display().to_string();
+    match FsLoader.read(path) {
+        Ok(text) => Some(scnc::with_big_stack(|| scnc::compile_source(&name, path, text, &FsLoader))),
+        Err(e) => {
+            let code = scnc::diag::codes::INCLUDE_READ;
+            let message = format!("cannot read `{name}`: {}", scnc::source::io_reason(&e));
+            let line = match format {
+                MessageFormat::Human => format!("error[{code}]: {message}"),
+                MessageFormat::Json => serde_json::json!({
+                    "severity": "error", "code": code, "message": message,
+                    "span": { "file": name }, "related": [], "notes": [], "hints": [],
+                })
+                .to_string(),
+            };
+            let _ = writeln!(std::io::stderr(), "{line}");
+            None
+        }
+    }
+}
+
+/// Prints diagnostics to stderr; returns whether any was an error.
+pub(crate) fn report(c: &Compiled, format: MessageFormat) -> bool {
+    let color = std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none();
+    let mut err = std::io::stderr().lock();
+    for d in &c.diagnostics {
+        let text = match format {
+            MessageFormat::Human => d.render(&c.map, color),
+            MessageFormat::Json => format!("{}\n", d.to_json(&c.map)),
+        };
+        let _ = err.write_all(text.as_bytes());
+    }
+    c.diagnostics.iter().any(Diagnostic::is_error)
+}
+
+/// A usage problem found after argument parsing: printed like clap's, exit 2.
+pub(crate) fn usage_error(msg: &str) -> ExitCode {
+    let _ = writeln!(std::io::stderr(), "error: {msg}");
+    ExitCode::from(2)
+}
+
+pub(crate) fn worker_pool(threads: Option<u16>) -> Result<rayon::ThreadPool, String> {
+    let mut pool = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = threads {
+        pool = pool.num_threads(n as usize);
+    }
+    pool.build().map_err(|e| format!("cannot start worker threads: {e}"))
+}
+
+fn run(cli: Cli) -> ExitCode {
+    match cli.command {
+        Command::Render(args) => render::render_cmd(args),
+        Command::Watch(args) => watch::watch_cmd(args),
+        Command::Sweep(args) => sweep::sweep_cmd(args),
+        Command::Fmt { files, check } => fmt::fmt_cmd(&files, check),
+        Command::Lsp => match scnc::lsp::run_stdio() {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => {
+                let _ = writeln!(std::io::stderr(), "error: the language server stopped: {e}");
+                ExitCode::from(1)
+            }
+        },
+        Command::Check { files, message_format } => {
+            let mut failed = false;
+            for file in &files {
+                failed |= compile(file, message_format).is_none_or(|c| report(&c, message_format));
+            }
+            if failed {
+                ExitCode::from(1)
+            } else {
+                ExitCode::SUCCESS
+            }
+        }
+        Command::Ir { file, message_format } => {
+            let Some(compiled) = compile(&file, message_format) else { return ExitCode::from(1) };
+            if report(&compiled, message_format) {
+                return ExitCode::from(1);
+            }
+            if let Some(scene) = &compiled.scene {
+                let text = format!("{}{}\n", scnc::ir::dump(scene, &compiled.map), scnc::effects::derive(scene));
+                let _ = std::io::stdout().lock().write_all(text.as_bytes());
+            }
+            ExitCode::SUCCESS
+        }
+    }
+}
+
+/// Parses the arguments and runs the command.
+pub fn main() -> ExitCode {
+    run(Cli::parse())
+}

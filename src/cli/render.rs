@@ -1,0 +1,260 @@
+//! `scnc render`: one scene compiled, lowered and rendered to a PNG.
+
+use std::io::{IsTerminal, Write};
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+use clap::ValueEnum;
+
+use scnc::check::{MAX_DEPTH, MAX_IMAGE_SIDE, MAX_PIXELS, MAX_SAMPLES, MAX_STEPS};
+use scnc::source::FsLoader;
+use scnc::study::tolerance::Tolerance;
+use scnc::Compiled;
+
+use super::files::{check_output, write_png};
+use super::{compile, report, usage_error, worker_pool, MessageFormat};
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum GeometryKind {
+    /// Sphere-trace signed distance functions.
+    Sdf,
+    /// Tessellate every shape into triangles, traced through BVHs.
+    Mesh,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum EffectsArg {
+    /// Build the tracer with the effects the scene calls for.
+    Derived,
+    /// Build the general tracer with every effect.
+    All,
+}
+
+#[derive(clap::Args)]
+pub(crate) struct RenderArgs {
+    /// The scene file.
+    file: PathBuf,
+    /// Output image (PNG).
+    #[arg(short, long)]
+    pub(crate) output: PathBuf,
+    /// Image width in pixels (overrides the scene's `render`).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
+    width: Option<u32>,
+    /// Image height in pixels (overrides the scene's `render`).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
+    height: Option<u32>,
+    /// Worker threads (default: one per core).
+    #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024))]
+    pub(crate) threads: Option<u16>,
+    /// Sphere-tracing hit threshold, relative to distance from the camera.
+    #[arg(long, value_parser = parse_epsilon)]
+    epsilon: Option<f64>,
+    /// Sphere-tracing step budget per ray.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_STEPS as i64))]
+    max_steps: Option<u32>,
+    /// Far limit of every ray.
+    #[arg(long, value_parser = parse_positive)]
+    max_distance: Option<f64>,
+    /// Reflection recursion depth.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=MAX_DEPTH as i64))]
+    depth: Option<u32>,
+    /// Samples per pixel (antialiasing).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_SAMPLES as i64))]
+    samples: Option<u32>,
+    /// Pick the cheapest setting expected to keep geometric error under this many world
+    /// units, or under a pixel's footprint with `pixel` (sets epsilon, or detail with meshes).
+    #[arg(long, conflicts_with_all = ["epsilon", "detail"])]
+    tolerance: Option<Tolerance>,
+    /// Geometry back-end for shapes (explicit meshes are always meshes).
+    #[arg(long, value_enum, default_value = "sdf")]
+    geometry: GeometryKind,
+    /// Tessellation detail with `--geometry mesh`: `low` (7 rings, 10-point circles),
+    /// `high` (14 rings, 50-point circles) or N (N rings, 2N-point circles).
+    #[arg(long, value_parser = parse_detail, default_value = "high")]
+    detail: scnc::mesh::Detail,
+    /// Print the effect set, ray counts, work per ray and memory.
+    #[arg(long)]
+    stats: bool,
+    /// Which tracer to build: `derived` (only the effects the scene calls for) or `all`
+    /// (every effect compiled in; a debugging and benchmarking aid, same image).
+    #[arg(long, value_enum, default_value = "derived")]
+    effects: EffectsArg,
+    /// How to print diagnostics.
+    #[arg(long, value_enum, default_value = "human")]
+    message_format: MessageFormat,
+}
+
+fn parse_detail(s: &str) -> Result<scnc::mesh::Detail, String> {
+    match s {
+        "low" => Ok(scnc::mesh::Detail::Low),
+        "high" => Ok(scnc::mesh::Detail::High),
+        n => match n.parse::<u32>() {
+            Ok(n) if (3..=2048).contains(&n) => Ok(scnc::mesh::Detail::N(n)),
+            _ => Err("expected `low`, `high` or a number of rings from 3 to 2048".into()),
+        },
+    }
+}
+
+fn parse_epsilon(s: &str) -> Result<f64, String> {
+    let x: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
+    if x > 0.0 && x < 1.0 {
+        Ok(x)
+    } else {
+        Err("must be between 0 and 1 (exclusive)".into())
+    }
+}
+
+fn parse_positive(s: &str) -> Result<f64, String> {
+    let x: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
+    if x > 0.0 && x.is_finite() {
+        Ok(x)
+    } else {
+        Err("must be a finite number greater than 0".into())
+    }
+}
+
+pub(crate) fn render_cmd(args: RenderArgs) -> ExitCode {
+    if let Err(e) = check_output(&args.output) {
+        return usage_error(&e);
+    }
+    let pool = match worker_pool(args.threads) {
+        Ok(p) => p,
+        Err(e) => return usage_error(&e),
+    };
+    match render_once(&args, &pool).result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(code) => code,
+    }
+}
+
+/// One render: the files it read (for `watch`), and whether the image was written
+/// (the exit code otherwise, after the reason was printed).
+pub(crate) struct Attempt {
+    pub(crate) files: Vec<PathBuf>,
+    pub(crate) result: Result<(), ExitCode>,
+}
+
+pub(crate) fn render_once(args: &RenderArgs, pool: &rayon::ThreadPool) -> Attempt {
+    let Some(compiled) = compile(&args.file, args.message_format) else {
+        return Attempt { files: vec![args.file.clone()], result: Err(ExitCode::from(1)) };
+    };
+    let files: Vec<PathBuf> = compiled.map.files().map(|(_, f)| f.path.clone()).collect();
+    let result = render_compiled(args, pool, compiled);
+    Attempt { files, result }
+}
+
+fn render_compiled(args: &RenderArgs, pool: &rayon::ThreadPool, compiled: Compiled) -> Result<(), ExitCode> {
+    if report(&compiled, args.message_format) {
+        return Err(ExitCode::from(1));
+    }
+    let Some(mut scene) = compiled.scene else {
+        return Err(ExitCode::from(1));
+    };
+    let s = &mut scene.settings;
+    s.width = args.width.unwrap_or(s.width);
+    s.height = args.height.unwrap_or(s.height);
+    s.epsilon = args.epsilon.unwrap_or(s.epsilon);
+    s.max_steps = args.max_steps.unwrap_or(s.max_steps);
+    s.max_distance = args.max_distance.unwrap_or(s.max_distance);
+    s.depth = args.depth.unwrap_or(s.depth);
+    s.samples = args.samples.unwrap_or(s.samples);
+    if s.width as u64 * s.height as u64 > MAX_PIXELS {
+        return Err(usage_error(&format!("{}×{} is too large: at most {} pixels", s.width, s.height, MAX_PIXELS)));
+    }
+    let mut detail = args.detail;
+    if let Some(tol) = args.tolerance {
+        match args.geometry {
+            GeometryKind::Sdf => scene.settings.epsilon = scnc::study::tolerance::sdf_epsilon(&scene, tol),
+            GeometryKind::Mesh => detail = scnc::study::tolerance::mesh_detail(&scene, tol),
+        }
+        let picked = match args.geometry {
+            GeometryKind::Sdf => format!("epsilon {:.3e}", scene.settings.epsilon),
+            GeometryKind::Mesh => format!("detail {}", detail.rings()),
+        };
+        let _ = writeln!(std::io::stderr(), "tolerance {tol}: picked {picked}");
+    }
+    let mode = match args.geometry {
+        GeometryKind::Sdf => scnc::world::Mode::Sdf,
+        GeometryKind::Mesh => scnc::world::Mode::Mesh(detail),
+    };
+    let started = Instant::now();
+    let effects = match args.effects {
+        EffectsArg::Derived => scnc::effects::derive(&scene),
+        EffectsArg::All => scnc::effects::Effects::all(&scene),
+    };
+    let lowered = pool.install(|| scnc::world::prepare(&scene, effects, mode, &FsLoader));
+    let (frame, geometry) = match lowered {
+        Ok(g) => g,
+        Err(d) => {
+            let c = Compiled { map: compiled.map, scene: None, diagnostics: vec![d] };
+            report(&c, args.message_format);
+            return Err(ExitCode::from(1));
+        }
+    };
+    let lowered = started.elapsed();
+    let progress = Progress::new(frame.height);
+    let (image, counters) = pool.install(|| scnc::render::render(&geometry, &frame, &|| progress.row()));
+    progress.finish();
+    let traced = started.elapsed() - lowered;
+    if let Err(e) = write_png(&args.output, &image) {
+        let _ = writeln!(std::io::stderr(), "error: cannot write `{}`: {e}", args.output.display());
+        return Err(ExitCode::from(1));
+    }
+    let secs = traced.as_secs_f64();
+    let mut err = std::io::stderr().lock();
+    let _ = writeln!(
+        err,
+        "rendered {}: {}×{} in {:.3} s ({:.2} M rays/s, {} threads)",
+        args.output.display(),
+        image.width,
+        image.height,
+        started.elapsed().as_secs_f64(),
+        counters.rays() as f64 / secs.max(1e-9) / 1e6,
+        pool.current_num_threads()
+    );
+    if args.stats {
+        let _ = writeln!(err, "{}", frame.effects);
+        let _ = write!(
+            err,
+            "{}",
+            super::stats::stats_text(&counters, &geometry, &compiled.map, lowered.as_secs_f64(), secs)
+        );
+    }
+    Ok(())
+}
+
+/// A progress bar on a terminal, shown only once a render has taken a second.
+struct Progress {
+    bar: Option<indicatif::ProgressBar>,
+    started: Instant,
+}
+
+impl Progress {
+    fn new(rows: u32) -> Progress {
+        let bar = std::io::stderr().is_terminal().then(|| {
+            let bar =
+                indicatif::ProgressBar::with_draw_target(Some(rows as u64), indicatif::ProgressDrawTarget::hidden());
+            if let Ok(style) = indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} rows, {eta} left") {
+                bar.set_style(style);
+            }
+            bar
+        });
+        Progress { bar, started: Instant::now() }
+    }
+
+    fn row(&self) {
+        if let Some(bar) = &self.bar {
+            if bar.is_hidden() && self.started.elapsed().as_secs_f64() > 1.0 {
+                bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+            }
+            bar.inc(1);
+        }
+    }
+
+    fn finish(&self) {
+        if let Some(bar) = &self.bar {
+            bar.finish_and_clear();
+        }
+    }
+}

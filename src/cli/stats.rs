@@ -1,0 +1,71 @@
+//! What `render --stats` prints: rays by kind, work per ray, and memory by structure.
+
+use scnc::render::Counters;
+use scnc::source::SourceMap;
+use scnc::world::World;
+
+/// The statistics of one render, for stderr.
+pub(crate) fn stats_text(c: &Counters, g: &World, map: &SourceMap, lower_s: f64, trace_s: f64) -> String {
+    let mem = g.memory();
+    let rays = c.rays().max(1) as f64;
+    let mut out = format!(
+        "stats:
+  time            lower {:.3} s (tessellation and BVH builds), trace {:.3} s
+  rays            {} primary, {} shadow, {} reflection, {} occlusion ({} total, {:.2} M/s)
+  sdf evaluations {} marching ({:.1} per ray, max {} on one ray), {} for normals and materials
+  step budget     {} marches ran out of steps (counted as misses)
+  bvh             {} node visits ({:.2} per ray), {} triangle tests ({:.2} per ray)
+  memory          {} bytes in total: {} SDF objects with {} bytes of closures, {} bytes of top-level BVH
+",
+        lower_s,
+        trace_s,
+        c.primary_rays,
+        c.shadow_rays,
+        c.reflection_rays,
+        c.occlusion_rays,
+        c.rays(),
+        c.rays() as f64 / trace_s.max(1e-9) / 1e6,
+        c.sdf_evals,
+        c.sdf_evals as f64 / rays,
+        c.max_evals_per_ray,
+        c.sdf_shading_evals,
+        c.budget_misses,
+        c.node_visits,
+        c.node_visits as f64 / rays,
+        c.triangle_tests,
+        c.triangle_tests as f64 / rays,
+        mem.total(),
+        mem.sdf_objects,
+        mem.closure_bytes,
+        mem.top_bvh_bytes,
+    );
+    if !mem.meshes.is_empty() {
+        let tri = mem.triangles();
+        let bytes = mem.mesh_bytes();
+        out.push_str(&format!(
+            "  meshes          {} objects, {} triangles, {} bytes ({:.1} bytes per triangle)\n",
+            mem.meshes.len(),
+            tri,
+            bytes,
+            bytes as f64 / tri.max(1) as f64
+        ));
+        for (span, m) in mem.meshes.iter().take(20) {
+            let (id, r) = map.local_range(*span);
+            let (line, _) = map.line_col(id, r.start);
+            out.push_str(&format!(
+                "    {}:{line}: {} triangles; vertices {} B, indices {} B, BVH {} B ({} nodes, depth {})\n",
+                map.file(id).name,
+                m.triangles,
+                m.vertex_bytes,
+                m.index_bytes,
+                m.bvh_bytes,
+                m.bvh_nodes,
+                m.bvh_depth
+            ));
+        }
+        if mem.meshes.len() > 20 {
+            out.push_str(&format!("    … and {} more mesh objects\n", mem.meshes.len() - 20));
+        }
+    }
+    out
+}
