@@ -19,8 +19,8 @@ fn lower_mode(path: &str, w: u32, h: u32, mode: scnc::world::Mode) -> (Frame, sc
     let mut scene = c.scene.expect("seed scenes compile");
     scene.settings.width = w;
     scene.settings.height = h;
-    let (frame, g) =
-        scnc::world::prepare(&scene, scnc::effects::derive(&scene), mode, &scnc::source::FsLoader).expect("lowering");
+    let (frame, g) = scnc::world::prepare(&scene, scnc::render::effects::derive(&scene), mode, &scnc::source::FsLoader)
+        .expect("lowering");
     (frame, g)
 }
 
@@ -48,7 +48,7 @@ fn primitives(c: &mut Criterion) {
         let scene = c2.scene.expect("compiles");
         let (_, g) = scnc::world::prepare(
             &scene,
-            scnc::effects::derive(&scene),
+            scnc::render::effects::derive(&scene),
             scnc::world::Mode::Sdf,
             &scnc::source::FsLoader,
         )

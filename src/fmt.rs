@@ -30,11 +30,6 @@ pub fn format(text: &str) -> Result<String, Vec<Diagnostic>> {
     Ok(out.finish())
 }
 
-/// Whether `text` is already formatted (`None` when it has syntax errors).
-pub fn is_formatted(text: &str) -> Option<bool> {
-    format(text).ok().map(|f| f == text)
-}
-
 #[derive(Default)]
 struct Formatter<'t> {
     out: String,

@@ -3,29 +3,33 @@
 //! The pipeline, one module per stage, each with one entry point:
 //!
 //! ```text
-//! text ─syntax::parse─▶ ast::File ─check::check─▶ ir::Scene ─effects::derive─▶ Effects
+//! text ─syntax::parse─▶ ast::File ─check::check─▶ ir::Scene ─render::effects::derive─▶ Effects
 //!                                                    │
 //!                    world::prepare(scene, effects, Mode::Sdf | Mode::Mesh(detail))
 //!                                                    ▼
-//!      Frame (camera, lights, materials) + World (SdfObject | MeshObject under one BVH)
+//!      Frame (camera, lights, materials) + World (SdfObject | MeshObject under one Bvh)
 //!                                                    │
 //!                          render::render(&dyn Geometry, &Frame) ─▶ Image, Counters
 //! ```
 //!
 //! - [`syntax`]: logos tokens and a chumsky parser that recovers, so one run reports many errors.
-//! - [`check`]: names, types, arity and ranges, by evaluating the pure language to the IR.
-//! - [`ir`]: the evaluated scene in f64 with source spans; bounds; a stable text dump.
+//! - [`check`]: names, types, arity and ranges, by evaluating the pure language to the IR;
+//!   every builtin names its constructor.
+//! - [`ir`]: the evaluated scene in f64 with source spans; every per-primitive fact in
+//!   [`ir::Primitive`]; bounds; a stable text dump.
 //! - [`sdf`] and [`mesh`]: the two geometry back-ends; [`world`] puts their objects, in
-//!   camera-relative f32, under one top-level [`bvh`].
-//! - [`render`]: the one Whitted tracer, built for the scene's [`effects`].
-//! - [`accuracy`], [`sweep`], [`tolerance`] and [`chart`]: what accuracy costs.
+//!   camera-relative f32, under one top-level [`accel::Bvh`].
+//! - [`accel`]: boxes, the robust slab test and the BVH (build, single-ray and packet walks).
+//! - [`render`]: the one Whitted tracer, built for the scene's [`render::effects`].
+//! - [`study`]: what accuracy costs (`--tolerance`, `scnc sweep`, its report and charts).
+//! - [`source`], [`span`] and [`diag`]: input text, positions and diagnostics; [`fmt`] and
+//!   [`lsp`]: the formatter and the language server.
 //!
 //! Every stage reports problems as [`diag::Diagnostic`] values; only the binary prints.
 
 pub mod accel;
 pub mod check;
 pub mod diag;
-pub mod effects;
 pub mod fmt;
 pub mod ir;
 pub mod lsp;

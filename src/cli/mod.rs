@@ -162,7 +162,8 @@ fn run(cli: Cli) -> ExitCode {
                 return ExitCode::from(1);
             }
             if let Some(scene) = &compiled.scene {
-                let text = format!("{}{}\n", scnc::ir::dump(scene, &compiled.map), scnc::effects::derive(scene));
+                let text =
+                    format!("{}{}\n", scnc::ir::dump(scene, &compiled.map), scnc::render::effects::derive(scene));
                 let _ = std::io::stdout().lock().write_all(text.as_bytes());
             }
             ExitCode::SUCCESS

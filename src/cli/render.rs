@@ -180,8 +180,8 @@ fn render_compiled(args: &RenderArgs, pool: &rayon::ThreadPool, compiled: Compil
     };
     let started = Instant::now();
     let effects = match args.effects {
-        EffectsArg::Derived => scnc::effects::derive(&scene),
-        EffectsArg::All => scnc::effects::Effects::all(&scene),
+        EffectsArg::Derived => scnc::render::effects::derive(&scene),
+        EffectsArg::All => scnc::render::effects::Effects::all(&scene),
     };
     let lowered = pool.install(|| scnc::world::prepare(&scene, effects, mode, &FsLoader));
     let (frame, geometry) = match lowered {

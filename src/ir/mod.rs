@@ -207,7 +207,7 @@ impl CsgOp {
 /// Shape nodes: a primitive leaf, a CSG operator, a modifier, a transform or a material.
 #[derive(Clone, Debug)]
 pub enum ShapeKind {
-    /// A primitive solid (every per-primitive fact is in [`primitive`]).
+    /// A primitive solid (every per-primitive fact is stated there).
     Primitive(Primitive),
     /// A CSG operator over its children (`smooth` = 0 for a sharp one).
     Csg {

@@ -31,13 +31,6 @@ pub struct TriMesh {
 }
 
 impl TriMesh {
-    /// Appends another mesh.
-    pub fn append(&mut self, other: &TriMesh) {
-        let base = self.positions.len() as u32;
-        self.positions.extend_from_slice(&other.positions);
-        self.triangles.extend(other.triangles.iter().map(|t| [t[0] + base, t[1] + base, t[2] + base]));
-    }
-
     /// Signed volume (positive for a closed mesh wound outward).
     pub fn signed_volume(&self) -> f64 {
         self.triangles

@@ -2,8 +2,8 @@
 
 use glam::{DVec3, Vec3A};
 
-use crate::effects::Effects;
 use crate::ir;
+use crate::render::effects::Effects;
 
 /// A material ready for shading.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -108,13 +108,8 @@ pub struct Frame {
 }
 
 impl Frame {
-    /// Builds the frame for a scene with its derived effect set; materials are filled in
-    /// by the back-end's lowering.
-    pub fn new(scene: &ir::Scene) -> Frame {
-        Frame::with_effects(scene, crate::effects::derive(scene))
-    }
-
-    /// Builds the frame with a given effect set (`Effects::all` for the general tracer).
+    /// Builds the frame with a given effect set (`Effects::all` for the general tracer);
+    /// materials are filled in by the back-ends' lowering.
     pub fn with_effects(scene: &ir::Scene, effects: Effects) -> Frame {
         let cam = &scene.camera;
         let s = &scene.settings;

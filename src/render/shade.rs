@@ -2,11 +2,12 @@
 //! Phong `(R·V/|R||V|)^s`), hard shadows, reflections blended `(1 − r)·local + r·reflected`,
 //! colour clamped once at the end.
 //!
-//! The tracer is built for the scene's effect set: `trace` is generic over three const
-//! flags (shadow rays, reflection rays, specular highlights), and [`render`](super::render)
-//! picks the one of eight monomorphised variants that the effect set calls for before
-//! the first ray. Lights arrive pre-split into an ambient sum, casting and non-casting
-//! lists, so no per-ray code tests for an effect or a light kind the scene does not have.
+//! The tracer is built for the scene's effect set: `block`, `trace` and `shade` are
+//! generic over four const flags (shadow rays, reflection rays, specular highlights,
+//! ambient occlusion), and [`render`](super::render) picks the one of sixteen
+//! monomorphised variants that the effect set calls for before the first ray. Lights
+//! arrive pre-split into an ambient sum, casting and non-casting lists, so no per-ray
+//! code tests for an effect or a light kind the scene does not have.
 
 use glam::Vec3A;
 

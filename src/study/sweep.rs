@@ -6,9 +6,9 @@ use std::time::Instant;
 
 use super::accuracy;
 use crate::diag::Diagnostic;
-use crate::effects;
 use crate::ir::Scene;
 use crate::mesh::Detail;
+use crate::render::effects;
 use crate::render::{self, Counters, Image};
 use crate::source::Loader;
 use crate::world::{self, Mode};

@@ -29,7 +29,7 @@ fn pad_box(b: ir::Aabb) -> Aabb {
 /// own sphere-tracing settings: the one call the CLI, tests and benchmarks use.
 pub fn prepare(
     scene: &ir::Scene,
-    effects: crate::effects::Effects,
+    effects: crate::render::effects::Effects,
     mode: Mode,
     loader: &dyn Loader,
 ) -> Result<(Frame, World), Diagnostic> {

@@ -11,7 +11,7 @@ use crate::mesh::triangle::PacketShear;
 use crate::render::{intersect_each, lanes, Counters, Hit, Packet, NO_OBJECT};
 
 impl World {
-    /// [`Geometry::intersect4`] for `N` packets of four traced together: one walk of the
+    /// [`Geometry::intersect4`](crate::render::Geometry::intersect4) for `N` packets of four traced together: one walk of the
     /// top-level tree and of each mesh's tree for all of their rays.
     #[inline]
     pub(super) fn intersect_packet<const N: usize>(
@@ -121,7 +121,7 @@ impl World {
 
 /// The lanes of a packet that may reach object `o` before their `t_max`: its bounding
 /// sphere tested for four rays at once, lane by lane the arithmetic of
-/// [`sphere_interval`] and [`clip_to_sphere`] (a mesh object's box is its BVH's root,
+/// [`sphere_interval`](super::query::sphere_interval) and [`clip_to_sphere`](super::query::clip_to_sphere) (a mesh object's box is its BVH's root,
 /// which the walk tests anyway).
 #[inline]
 fn sphere_lanes(o: &Object, rays: &Rays4, dir: &[Vec4; 3], t_max: Vec4) -> u32 {

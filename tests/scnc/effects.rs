@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use glam::Vec3A;
-use scnc::effects::{self, Effects};
+use scnc::render::effects::{self, Effects};
 use scnc::render::{Counters, Geometry, Image, Ray};
 use scnc::world::Mode;
 

@@ -40,7 +40,7 @@ fn meaning(path: &Path, text: String) -> String {
             out.push_str(line);
             out.push('\n');
         }
-        out.push_str(&scnc::effects::derive(scene).to_string());
+        out.push_str(&scnc::render::effects::derive(scene).to_string());
     }
     out
 }

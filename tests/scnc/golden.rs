@@ -20,7 +20,7 @@ fn ir_dumps() {
         };
         let mut actual = scnc::diag::render_all(&c.diagnostics, &c.map);
         actual.push_str(&scnc::ir::dump(scene, &c.map));
-        actual.push_str(&format!("{}\n", scnc::effects::derive(scene)));
+        actual.push_str(&format!("{}\n", scnc::render::effects::derive(scene)));
         failures.extend(check_golden(&path.with_extension("ir"), &actual));
     }
     finish(failures);
@@ -120,7 +120,7 @@ fn lowering_diagnostics() {
             failures.push(format!("{}: did not compile", path.display()));
             continue;
         };
-        let effects = scnc::effects::derive(scene);
+        let effects = scnc::render::effects::derive(scene);
         match scnc::world::prepare(scene, effects, scnc::world::Mode::Sdf, &scnc::source::FsLoader) {
             Ok(_) => failures.push(format!("{}: lowered without an error", path.display())),
             Err(d) => failures.extend(check_golden(&path.with_extension("txt"), &d.render(&c.map, false))),

@@ -27,7 +27,7 @@ pub fn render_mode(mut scene: scnc::ir::Scene, w: u32, h: u32, threads: usize, m
     scene.settings.height = h;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool");
     pool.install(|| {
-        let effects = scnc::effects::derive(&scene);
+        let effects = scnc::render::effects::derive(&scene);
         let (frame, geometry) = scnc::world::prepare(&scene, effects, mode, &scnc::source::FsLoader).expect("lowering");
         scnc::render::render(&geometry, &frame, &|| {})
     })
@@ -181,8 +181,9 @@ fn every_evaluator_is_a_distance_bound() {
         let text = format!("light ambient(1)\nobject {shape} at [0, 0, 5]\n");
         let c = scnc::compile_source("t.scn", Path::new("t.scn"), text, &scnc::source::FsLoader);
         let scene = c.scene.unwrap_or_else(|| panic!("{shape}: {}", scnc::diag::render_all(&c.diagnostics, &c.map)));
-        let (_, g) = scnc::world::prepare(&scene, scnc::effects::derive(&scene), Mode::Sdf, &scnc::source::FsLoader)
-            .expect("lower");
+        let (_, g) =
+            scnc::world::prepare(&scene, scnc::render::effects::derive(&scene), Mode::Sdf, &scnc::source::FsLoader)
+                .expect("lower");
         for _ in 0..4000 {
             let centre = Vec3A::new(0.0, 0.0, 5.0);
             let p = centre + rng.vec(3.0);

@@ -35,7 +35,7 @@ pub fn lower(scene: &scnc::ir::Scene, size: u32, mode: scnc::world::Mode) -> (sc
     let mut s = scene.clone();
     s.settings.width = size;
     s.settings.height = size;
-    scnc::world::prepare(&s, scnc::effects::derive(&s), mode, &FsLoader).expect("lowering")
+    scnc::world::prepare(&s, scnc::render::effects::derive(&s), mode, &FsLoader).expect("lowering")
 }
 
 /// Which pixels of a `size × size` image hit geometry when `scene` is lowered by `mode`

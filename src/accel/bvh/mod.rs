@@ -5,9 +5,9 @@
 //! traversal step is one load and one 4-wide slab test; leaves are ranges of primitives
 //! named in their parent. The builder makes the usual one-box-per-node tree first.
 //!
-//! - [`build`]: binned SAH.
-//! - [`walk`]: closest and any hit for one ray.
-//! - [`packet`]: the walk shared by packets of coherent rays.
+//! - `build`: binned SAH.
+//! - `walk`: closest and any hit for one ray.
+//! - `packet`: the walk shared by packets of coherent rays.
 //!
 //! **Invariant:** every node's box contains the boxes of all primitives below it, and
 //! every primitive index appears in exactly one leaf ([`Bvh::validate`] checks both).

@@ -23,9 +23,9 @@ impl RaySplat {
 
     /// Which of the node's two children the ray enters before `t_max` (bit 0 left,
     /// bit 1 right) and the entry distances (lanes 0 and 1). The same slab test as
-    /// [`Aabb::slab`], including its robust far bound. A ray lying exactly in a face
+    /// [`Aabb::slab`](crate::accel::Aabb::slab), including its robust far bound. A ray lying exactly in a face
     /// plane of a box makes `0 × ∞ = NaN` there and may miss that box, as it may in
-    /// [`Aabb::slab`]: it could only graze what the box holds, edge-on.
+    /// [`Aabb::slab`](crate::accel::Aabb::slab): it could only graze what the box holds, edge-on.
     #[inline(always)]
     pub(super) fn enters(&self, node: &Node, t_max: f32) -> (u32, Vec4) {
         let axis = |planes: Vec4, k: usize| {

@@ -1,0 +1,53 @@
+//! Work counters: rays by kind, SDF evaluations, BVH visits, triangle tests.
+
+/// Work counters, summed over the whole render.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Counters {
+    /// Camera rays.
+    pub primary_rays: u64,
+    /// Shadow (occlusion) rays.
+    pub shadow_rays: u64,
+    /// Reflection rays.
+    pub reflection_rays: u64,
+    /// Ambient-occlusion rays (mesh scenes; SDF scenes estimate without rays).
+    pub occlusion_rays: u64,
+    /// SDF evaluations during marching (SDF back-end).
+    pub sdf_evals: u64,
+    /// SDF evaluations for normals and materials at hits.
+    pub sdf_shading_evals: u64,
+    /// Most SDF evaluations spent on one ray.
+    pub max_evals_per_ray: u64,
+    /// Marches that ran out of steps before deciding (counted as misses).
+    pub budget_misses: u64,
+    /// BVH nodes visited (a node a packet visits counts once for each ray the walk
+    /// carries into it: every wanted ray from its first active one, see
+    /// [`Bvh::each_packet`](crate::accel::Bvh::each_packet)).
+    pub node_visits: u64,
+    /// Ray–triangle tests (mesh back-end; a packet's test counts once per ray it tests).
+    pub triangle_tests: u64,
+    /// Samples whose colour was not finite (always 0 unless there is a bug; such a
+    /// sample is written as black).
+    pub nonfinite_samples: u64,
+}
+
+impl Counters {
+    /// Adds another set of counters.
+    pub fn add(&mut self, o: &Counters) {
+        self.primary_rays += o.primary_rays;
+        self.shadow_rays += o.shadow_rays;
+        self.reflection_rays += o.reflection_rays;
+        self.occlusion_rays += o.occlusion_rays;
+        self.sdf_evals += o.sdf_evals;
+        self.sdf_shading_evals += o.sdf_shading_evals;
+        self.max_evals_per_ray = self.max_evals_per_ray.max(o.max_evals_per_ray);
+        self.budget_misses += o.budget_misses;
+        self.node_visits += o.node_visits;
+        self.triangle_tests += o.triangle_tests;
+        self.nonfinite_samples += o.nonfinite_samples;
+    }
+
+    /// All rays cast.
+    pub fn rays(&self) -> u64 {
+        self.primary_rays + self.shadow_rays + self.reflection_rays + self.occlusion_rays
+    }
+}
