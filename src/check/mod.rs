@@ -13,9 +13,11 @@
 //! satisfies the invariants stated in [`ir`].
 
 pub mod builtins;
+mod call;
 mod construct;
 mod expr;
 pub mod index;
+mod transform;
 mod value;
 
 use std::collections::{HashMap, HashSet};

@@ -1,0 +1,397 @@
+//! Calls: arguments bound to parameters (positional, named, defaults, coercions), then
+//! a builtin's constructor or a user function's body.
+
+use std::collections::HashMap;
+use std::rc::Rc;
+
+use glam::DVec3;
+
+use super::builtins::{self, Builtin, Kind, Ty};
+use super::expr::{ArgVal, BoundArgs, SYNONYMS};
+use super::{Bound, Ctx, Func, Value, MAX_CALL_DEPTH};
+use crate::diag::{codes, suggest, Diagnostic};
+use crate::ir::dump_num;
+use crate::span::Span;
+use crate::syntax::ast;
+
+impl Ctx<'_> {
+    fn eval_args(&mut self, args: &[ast::Arg]) -> Vec<ArgVal> {
+        args.iter()
+            .map(|a| ArgVal {
+                name: a.name.clone(),
+                value: self.expr(&a.value),
+                span: a.name.as_ref().map_or(a.value.span, |n| n.span.to(a.value.span)),
+            })
+            .collect()
+    }
+
+    pub(super) fn call(&mut self, callee: &ast::Ident, args: &[ast::Arg], span: Span) -> Value {
+        let binding = self.lookup(callee);
+        if let Some(b) = &binding {
+            match &b.bound {
+                Bound::Func(f) => {
+                    let f = f.clone();
+                    let args = self.eval_args(args);
+                    let Some(values) = self.bind_user(&f, args, span, callee.span) else {
+                        return Value::Error;
+                    };
+                    return self.call_user(&f, values, span);
+                }
+                Bound::Value(v) => {
+                    let ty = v.ty_name();
+                    self.report(
+                        Diagnostic::error(
+                            codes::NOT_A_VALUE,
+                            callee.span,
+                            format!("`{}` is a `{ty}`, not a function", callee.name),
+                            "called here",
+                        )
+                        .with_label(b.span, "defined here as a value"),
+                    );
+                    return Value::Error;
+                }
+            }
+        }
+        let Some(builtin) = builtins::lookup(&callee.name, Kind::Function) else {
+            let mut candidates: Vec<String> = self.names_in_scope(true);
+            candidates.extend(builtins::names(Kind::Function).map(str::to_string));
+            let mut d = Diagnostic::error(
+                codes::UNKNOWN_FUNCTION,
+                callee.span,
+                format!("unknown function `{}`", callee.name),
+                "not a builtin or a function in scope",
+            );
+            if builtins::lookup(&callee.name, Kind::MeshGenerator).is_some() {
+                d = d.with_hint(format!("`{}` is a mesh generator: try `mesh {}(…)`", callee.name, callee.name));
+            } else if let Some(s) = suggest(&callee.name, candidates.iter().map(String::as_str)) {
+                d = d.with_replacement(callee.span, s);
+            } else if matches!(callee.name.as_str(), "camera" | "render") {
+                d = d.with_note(format!("`{}(…)` is a statement, not an expression", callee.name));
+            }
+            self.report(d);
+            // Still evaluate the arguments, to report their own mistakes.
+            let _ = self.eval_args(args);
+            return Value::Error;
+        };
+        self.note_builtin(callee.span, builtin);
+        self.apply_builtin(builtin, args, span)
+    }
+
+    /// Records in the index that `span` names `builtin`.
+    fn note_builtin(&mut self, span: Span, builtin: &'static Builtin) {
+        if let Some(ix) = &mut self.index {
+            ix.builtins.insert(span, super::index::BuiltinUse { span, builtin, param: None });
+        }
+    }
+
+    /// Evaluates the arguments, binds them and builds the builtin's value.
+    fn apply_builtin(&mut self, builtin: &'static Builtin, args: &[ast::Arg], span: Span) -> Value {
+        let args = self.eval_args(args);
+        match self.bind_builtin(builtin, args, span) {
+            Some(bound) => self.construct(builtin, bound),
+            None => Value::Error,
+        }
+    }
+
+    pub(super) fn mesh_call(&mut self, generator: &ast::Ident, args: &[ast::Arg], span: Span) -> Value {
+        let Some(builtin) = builtins::lookup(&generator.name, Kind::MeshGenerator) else {
+            let mut d = Diagnostic::error(
+                codes::NOT_A_MESH_GENERATOR,
+                generator.span,
+                format!("unknown mesh generator `{}`", generator.name),
+                "not a mesh generator",
+            );
+            if generator.name == "sphere" {
+                d = d
+                    .with_hint("did you mean `uvsphere` or `icosphere`?")
+                    .with_fix(generator.span, "uvsphere")
+                    .with_fix(generator.span, "icosphere");
+            } else if let Some(s) = suggest(&generator.name, builtins::names(Kind::MeshGenerator)) {
+                d = d.with_replacement(generator.span, s);
+            } else {
+                d = d.with_note(format!(
+                    "mesh generators: {}",
+                    builtins::names(Kind::MeshGenerator).collect::<Vec<_>>().join(", ")
+                ));
+                if builtins::lookup(&generator.name, Kind::Function).is_some() {
+                    d = d.with_hint(format!("try `mesh isosurface({}(…))` to triangulate any shape", generator.name));
+                }
+            }
+            self.report(d);
+            let _ = self.eval_args(args);
+            return Value::Error;
+        };
+        self.note_builtin(generator.span, builtin);
+        self.apply_builtin(builtin, args, span)
+    }
+
+    /// Matches arguments to parameter slots: positional ones in order (or all into `rest`
+    /// for a variadic callee), named ones by name. Reports too many arguments, unknown
+    /// names (with a suggestion) and arguments given twice; returns the slots, the extra
+    /// positional values, and whether all went well. `note` is the callee's signature.
+    #[allow(clippy::type_complexity, reason = "slots and variadic values, both with the span to blame")]
+    fn bind_slots(
+        &mut self,
+        callee: &str,
+        params: &[&str],
+        variadic: bool,
+        args: Vec<ArgVal>,
+        call: Span,
+        note: Option<String>,
+    ) -> (Vec<Option<(Value, Span)>>, Vec<(Value, Span)>, bool) {
+        let recovered = args.iter().any(|a| a.value.is_error() && a.name.is_none());
+        let with_note = |d: Diagnostic| match &note {
+            Some(n) => d.with_note(n.clone()),
+            None => d,
+        };
+        let mut ok = true;
+        let mut vals: Vec<Option<(Value, Span)>> = vec![None; params.len()];
+        let mut rest = Vec::new();
+        let mut next = 0;
+        for arg in args {
+            let idx = match &arg.name {
+                None if variadic => {
+                    rest.push((arg.value, arg.span));
+                    continue;
+                }
+                None if next >= params.len() => {
+                    if !recovered {
+                        let plural = if params.len() == 1 { "" } else { "s" };
+                        let d = Diagnostic::error(
+                            codes::ARITY,
+                            arg.span,
+                            format!("`{callee}` takes {} argument{plural}, but more were given", params.len()),
+                            "unexpected argument",
+                        )
+                        .with_label(call, "in this call");
+                        self.report(with_note(d));
+                    }
+                    ok = false;
+                    continue;
+                }
+                None => {
+                    next += 1;
+                    next - 1
+                }
+                Some(name) => match params.iter().position(|p| *p == name.name) {
+                    Some(i) => i,
+                    None => {
+                        let mut d = Diagnostic::error(
+                            codes::UNKNOWN_ARG,
+                            name.span,
+                            format!("`{callee}` has no parameter named `{}`", name.name),
+                            "unknown parameter",
+                        );
+                        // `radius` means `r`, and so does a misspelt `radus`.
+                        let known = SYNONYMS.iter().filter(|(_, p)| params.contains(p));
+                        let word = suggest(&name.name, known.clone().map(|(w, _)| *w));
+                        let synonym = known.clone().find(|(w, _)| *w == name.name || Some(*w) == word).map(|(_, p)| *p);
+                        if let Some(s) = synonym.or_else(|| suggest(&name.name, params.iter().copied())) {
+                            d = d.with_replacement(name.span, s);
+                        }
+                        self.report(with_note(d));
+                        ok = false;
+                        continue;
+                    }
+                },
+            };
+            if let Some((_, prev)) = &vals[idx] {
+                self.report(
+                    Diagnostic::error(
+                        codes::DUPLICATE_ARG,
+                        arg.span,
+                        format!("argument `{}` is given twice", params[idx]),
+                        "given again here",
+                    )
+                    .with_label(*prev, "first given here"),
+                );
+                ok = false;
+                continue;
+            }
+            vals[idx] = Some((arg.value, arg.span));
+        }
+        (vals, rest, ok && !recovered)
+    }
+
+    /// Binds arguments to a builtin's parameters; `None` after reporting (or on poison).
+    pub(super) fn bind_builtin(&mut self, b: &'static Builtin, mut args: Vec<ArgVal>, call: Span) -> Option<BoundArgs> {
+        if let Some(ix) = &mut self.index {
+            for name in args.iter().filter_map(|a| a.name.as_ref()) {
+                if let Some(param) = b.params.iter().find(|p| p.name == name.name) {
+                    let span = name.span;
+                    ix.builtins.insert(span, super::index::BuiltinUse { span, builtin: b, param: Some(param) });
+                }
+            }
+        }
+        let recovered = args.iter().any(|a| a.value.is_error() && a.name.is_none());
+        // `box(x, y, z)`: three numbers are one size vector.
+        if b.name == "box"
+            && args.len() == 3
+            && args.iter().all(|a| a.name.is_none() && matches!(a.value, Value::Num(_)))
+        {
+            let n = |a: &ArgVal| if let Value::Num(x) = a.value { x } else { 0.0 };
+            let span = args[0].span.to(args[2].span);
+            let v = DVec3::new(n(&args[0]), n(&args[1]), n(&args[2]));
+            args = vec![ArgVal { name: None, value: Value::Vec3(v), span }];
+        }
+        let names: Vec<&str> = b.params.iter().map(|p| p.name).collect();
+        // A misspelt name is one mistake: the parameter it meant is not also "missing".
+        let misspelt = args.iter().any(|a| a.name.as_ref().is_some_and(|n| !names.contains(&n.name.as_str())));
+        let note = Some(format!("signature: {}", b.signature()));
+        let (mut vals, mut rest, mut ok) = self.bind_slots(b.name, &names, b.variadic.is_some(), args, call, note);
+        if !recovered && !misspelt {
+            for (p, v) in b.params.iter().zip(&vals) {
+                if v.is_none() && p.default == builtins::Default::Required {
+                    self.report(
+                        Diagnostic::error(
+                            codes::MISSING_ARG,
+                            call,
+                            format!("missing argument `{}` of `{}`", p.name, b.name),
+                            format!("`{}` is required", p.name),
+                        )
+                        .with_note(format!("signature: {}", b.signature())),
+                    );
+                    ok = false;
+                }
+            }
+        }
+        // Type checks.
+        for (p, slot) in b.params.iter().zip(vals.iter_mut()) {
+            if let Some((v, span)) = slot {
+                match self.coerce(v, p.ty, *span, &format!("parameter `{}` of `{}`", p.name, b.name)) {
+                    Some(c) => *v = c,
+                    None => ok = false,
+                }
+            }
+        }
+        if let Some(ty) = b.variadic {
+            for (v, span) in rest.iter_mut() {
+                match self.coerce(v, ty, *span, &format!("every positional argument of `{}`", b.name)) {
+                    Some(c) => *v = c,
+                    None => ok = false,
+                }
+            }
+        }
+        let poisoned = vals.iter().flatten().any(|(v, _)| v.is_error()) || rest.iter().any(|(v, _)| v.is_error());
+        (ok && !poisoned && !recovered).then_some(BoundArgs { vals, rest, call })
+    }
+
+    /// Converts `v` to `ty` or reports a mismatch; poison passes through.
+    fn coerce(&mut self, v: &Value, ty: Ty, span: Span, what: &str) -> Option<Value> {
+        let ok = match (ty, v) {
+            (_, Value::Error) => return Some(Value::Error),
+            (Ty::Num, Value::Num(_)) => true,
+            (Ty::Int, Value::Num(x)) => {
+                if x.fract() != 0.0 {
+                    self.report(
+                        Diagnostic::error(
+                            codes::NOT_INTEGER,
+                            span,
+                            format!("expected a whole number, found {}", dump_num(*x)),
+                            "not a whole number",
+                        )
+                        .with_note(format!("{what} is an `int`"))
+                        .with_hint("try `floor(…)`"),
+                    );
+                    return None;
+                }
+                true
+            }
+            (Ty::Size, Value::Num(x)) => return Some(Value::Vec3(DVec3::splat(*x))),
+            (Ty::Size | Ty::Vec3, Value::Vec3(_)) => true,
+            (Ty::Bool, Value::Bool(_)) | (Ty::Str, Value::Str(_)) | (Ty::Color, Value::Color(_)) => true,
+            (Ty::Material, Value::Material(_)) | (Ty::Shape, Value::Shape(_)) | (Ty::Mesh, Value::Mesh(_)) => true,
+            (Ty::Light, Value::Light(_)) | (Ty::List, Value::List(_)) => true,
+            _ => false,
+        };
+        if ok {
+            return Some(v.clone());
+        }
+        let mut d = Diagnostic::error(
+            codes::TYPE_MISMATCH,
+            span,
+            format!("expected `{ty}`, found `{}`", v.ty_name()),
+            format!("this is a `{}`", v.ty_name()),
+        )
+        .with_note(format!("{what} is a `{ty}`"));
+        match (ty, v) {
+            (Ty::Color, Value::Vec3(c)) => {
+                d = d.with_hint(format!("try `rgb({}, {}, {})`", dump_num(c.x), dump_num(c.y), dump_num(c.z)))
+            }
+            (Ty::Shape, Value::Mesh(_)) => {
+                d = d.with_note("meshes cannot take part in CSG; shapes can be meshed with `mesh isosurface(…)`")
+            }
+            (Ty::Vec3, Value::Num(x)) => d = d.with_hint(format!("try `[{0}, {0}, {0}]`", dump_num(*x))),
+            (Ty::Vec3, Value::List(items)) => {
+                d = d.with_note(format!("a vector has exactly 3 numbers; this list has {}", items.len()))
+            }
+            _ => {}
+        }
+        self.report(d);
+        None
+    }
+
+    fn bind_user(&mut self, f: &Func, args: Vec<ArgVal>, call: Span, callee_span: Span) -> Option<Vec<Value>> {
+        let recovered = args.iter().any(|a| a.value.is_error() && a.name.is_none());
+        let names: Vec<&str> = f.params.iter().map(|p| p.name.as_str()).collect();
+        if let Some(ix) = &mut self.index {
+            for name in args.iter().filter_map(|a| a.name.as_ref()) {
+                if let Some(p) = f.params.iter().find(|p| p.name == name.name) {
+                    ix.refer(name.span, p.span);
+                }
+            }
+        }
+        let misspelt = args.iter().any(|a| a.name.as_ref().is_some_and(|n| !names.contains(&n.name.as_str())));
+        let (vals, _, mut ok) = self.bind_slots(&f.name, &names, false, args, callee_span, None);
+        if recovered || misspelt {
+            return None;
+        }
+        for (p, v) in f.params.iter().zip(&vals) {
+            if v.is_none() {
+                self.report(
+                    Diagnostic::error(
+                        codes::MISSING_ARG,
+                        call,
+                        format!("missing argument `{}` of `{}`", p.name, f.name),
+                        format!("`{}` is required", p.name),
+                    )
+                    .with_label(p.span, "parameter declared here"),
+                );
+                ok = false;
+            }
+        }
+        ok.then(|| vals.into_iter().map(|v| v.map_or(Value::Error, |(v, _)| v)).collect())
+    }
+
+    pub(super) fn call_user(&mut self, f: &Func, args: Vec<Value>, call: Span) -> Value {
+        if self.call_depth >= MAX_CALL_DEPTH {
+            self.report(
+                Diagnostic::error(
+                    codes::CALL_DEPTH,
+                    call,
+                    "function calls nest too deeply",
+                    format!("call depth {MAX_CALL_DEPTH} is exceeded here"),
+                )
+                .with_note(format!("functions may call each other at most {MAX_CALL_DEPTH} levels deep")),
+            );
+            return Value::Error;
+        }
+        let mut frame = Vec::with_capacity(f.params.len());
+        let mut seen = HashMap::new();
+        for (p, v) in f.params.iter().zip(args) {
+            let ty = (!v.is_error()).then(|| v.ty_name());
+            self.note_def(p, super::index::DefKind::Param, ty, f.body.span.start, f.body.span.end);
+            if seen.insert(p.name.clone(), ()).is_none() {
+                frame.push(Rc::new(super::Binding { name: p.name.clone(), span: p.span, bound: Bound::Value(v) }));
+            }
+        }
+        let saved = std::mem::replace(&mut self.scopes, vec![f.env.clone(), frame]);
+        let saved_dir = std::mem::replace(&mut self.dir, f.file_dir.clone());
+        self.call_depth += 1;
+        let v = self.expr(&f.body);
+        self.call_depth -= 1;
+        self.dir = saved_dir;
+        self.scopes = saved;
+        v
+    }
+}
