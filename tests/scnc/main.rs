@@ -1,6 +1,7 @@
 //! The single integration-test binary: every test module links into it.
 
 mod cli;
+mod conformance;
 mod effects;
 mod fmt;
 mod golden;

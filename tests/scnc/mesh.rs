@@ -159,76 +159,72 @@ fn mesh_high_coverage_agrees_with_sdf() {
 }
 
 /// Each lane of a camera-ray packet finds what its ray finds traced alone, for every seed
-/// scene in all three modes, for 2×2 packets and 4×4 blocks of four, full and partial:
-/// hit or miss exactly, the distance up to rounding, and the same surface except where a
-/// ray meets an edge and two faces tie within rounding (then either face is correct; the
-/// walks visit leaves in different orders). Packets spread too wide to share a shear
-/// still share the BVH walk and test meshes lane by lane.
-#[test]
-fn packets_agree_with_single_rays() {
+/// scene (in every mode, by `conformance.rs`), for 2×2 packets and 4×4 blocks of four,
+/// full and partial: hit or miss exactly, the distance up to rounding, and the same
+/// surface except where a ray meets an edge and two faces tie within rounding (then
+/// either face is correct; the walks visit leaves in different orders). Packets spread
+/// too wide to share a shear still share the BVH walk and test meshes lane by lane.
+pub fn packets_agree_with_single_rays(mode: Mode) {
     const SIZE: u32 = 128;
     let mut rng = Rng(0x9ac4_e7a1);
     for path in crate::support::cases("examples/seed") {
         if path.file_name().is_some_and(|n| n == "lights.scn") {
             continue;
         }
-        for mode in [Mode::Sdf, Mode::Mesh(Detail::Low), Mode::Mesh(Detail::High)] {
-            let (frame, world) = lower(&compile(&path).scene.expect("seed scene compiles"), SIZE, mode);
-            let ray = |x: u32, y: u32| {
-                Ray::new(Vec3A::ZERO, frame.direction(x as f32 + 0.5, y as f32 + 0.5), frame.max_distance)
-            };
-            let (mut lanes, mut ties) = (0usize, 0usize);
-            let mut c = Counters::default();
-            let mut check = |packet: &Packet, hits: &[Option<Hit>; 4], at: &str, c: &mut Counters| {
-                for (l, r) in packet.rays.iter().enumerate() {
-                    if packet.mask & (1 << l) == 0 {
-                        assert!(hits[l].is_none(), "{at} lane {l}: an unwanted lane returns nothing");
-                        continue;
-                    }
-                    let alone = world.intersect(r, c);
-                    lanes += 1;
-                    match (alone, hits[l]) {
-                        (None, None) => {}
-                        (Some(a), Some(p)) => {
-                            assert!(
-                                (a.t - p.t).abs() <= a.t * 1e-6,
-                                "{at} lane {l}: distance {} alone, {} in a packet",
-                                a.t,
-                                p.t
-                            );
-                            if a.normal != p.normal || a.material != p.material {
-                                ties += 1;
-                            }
-                        }
-                        (a, p) => panic!("{at} lane {l}: {} alone, {} in a packet", a.is_some(), p.is_some()),
-                    }
+        let (frame, world) = lower(&compile(&path).scene.expect("seed scene compiles"), SIZE, mode);
+        let ray =
+            |x: u32, y: u32| Ray::new(Vec3A::ZERO, frame.direction(x as f32 + 0.5, y as f32 + 0.5), frame.max_distance);
+        let (mut lanes, mut ties) = (0usize, 0usize);
+        let mut c = Counters::default();
+        let mut check = |packet: &Packet, hits: &[Option<Hit>; 4], at: &str, c: &mut Counters| {
+            for (l, r) in packet.rays.iter().enumerate() {
+                if packet.mask & (1 << l) == 0 {
+                    assert!(hits[l].is_none(), "{at} lane {l}: an unwanted lane returns nothing");
+                    continue;
                 }
-            };
-            for by in (0..SIZE).step_by(4) {
-                for bx in (0..SIZE).step_by(4) {
-                    let quads: [Packet; 4] = std::array::from_fn(|q| {
-                        let (qx, qy) = (bx + 2 * (q as u32 % 2), by + 2 * (q as u32 / 2));
-                        let mut rays = vec![ray(qx, qy), ray(qx + 1, qy), ray(qx, qy + 1), ray(qx + 1, qy + 1)];
-                        // Some packets partial or wanting nothing (a block at the frame's
-                        // edge), some spread over the whole frame (the fallback).
-                        match rng.below(10) {
-                            0 => rays.truncate(1 + rng.below(3)),
-                            1 => rays[3] = ray(rng.below(SIZE as usize) as u32, rng.below(SIZE as usize) as u32),
-                            2 => return Packet { mask: 0, ..Packet::new(&rays) },
-                            _ => {}
+                let alone = world.intersect(r, c);
+                lanes += 1;
+                match (alone, hits[l]) {
+                    (None, None) => {}
+                    (Some(a), Some(p)) => {
+                        assert!(
+                            (a.t - p.t).abs() <= a.t * 1e-6,
+                            "{at} lane {l}: distance {} alone, {} in a packet",
+                            a.t,
+                            p.t
+                        );
+                        if a.normal != p.normal || a.material != p.material {
+                            ties += 1;
                         }
-                        Packet::new(&rays)
-                    });
-                    let at = format!("{} {mode:?} block ({bx}, {by})", path.display());
-                    let block = world.intersect16(&quads, &mut c);
-                    for (q, quad) in quads.iter().enumerate() {
-                        check(quad, &block[q], &format!("{at} 4×4 packet {q}"), &mut c);
-                        check(quad, &world.intersect4(quad, &mut c), &format!("{at} 2×2 packet {q}"), &mut c);
                     }
+                    (a, p) => panic!("{at} lane {l}: {} alone, {} in a packet", a.is_some(), p.is_some()),
                 }
             }
-            assert!(ties <= lanes / 1000, "{} {mode:?}: {ties} of {lanes} lanes found another surface", path.display());
+        };
+        for by in (0..SIZE).step_by(4) {
+            for bx in (0..SIZE).step_by(4) {
+                let quads: [Packet; 4] = std::array::from_fn(|q| {
+                    let (qx, qy) = (bx + 2 * (q as u32 % 2), by + 2 * (q as u32 / 2));
+                    let mut rays = vec![ray(qx, qy), ray(qx + 1, qy), ray(qx, qy + 1), ray(qx + 1, qy + 1)];
+                    // Some packets partial or wanting nothing (a block at the frame's
+                    // edge), some spread over the whole frame (the fallback).
+                    match rng.below(10) {
+                        0 => rays.truncate(1 + rng.below(3)),
+                        1 => rays[3] = ray(rng.below(SIZE as usize) as u32, rng.below(SIZE as usize) as u32),
+                        2 => return Packet { mask: 0, ..Packet::new(&rays) },
+                        _ => {}
+                    }
+                    Packet::new(&rays)
+                });
+                let at = format!("{} {mode:?} block ({bx}, {by})", path.display());
+                let block = world.intersect16(&quads, &mut c);
+                for (q, quad) in quads.iter().enumerate() {
+                    check(quad, &block[q], &format!("{at} 4×4 packet {q}"), &mut c);
+                    check(quad, &world.intersect4(quad, &mut c), &format!("{at} 2×2 packet {q}"), &mut c);
+                }
+            }
         }
+        assert!(ties <= lanes / 1000, "{} {mode:?}: {ties} of {lanes} lanes found another surface", path.display());
     }
 }
 

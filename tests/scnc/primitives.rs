@@ -3,12 +3,10 @@
 //! handle fails here (the matches over kinds are exhaustive, so most fail to compile).
 
 use scnc::check::builtins::{Builtin, Kind, Ty, BUILTINS};
-use scnc::mesh::Detail;
-use scnc::world::Mode;
 
 use crate::support::{coverage, scene};
 
-const MODES: [Mode; 3] = [Mode::Sdf, Mode::Mesh(Detail::Low), Mode::Mesh(Detail::High)];
+use crate::conformance::MODES;
 
 /// An argument of type `ty` that every builtin accepts where it asks for one.
 fn argument(ty: Ty) -> &'static str {

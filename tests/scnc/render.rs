@@ -122,20 +122,22 @@ fn golden_images_mesh_high() {
     golden_images(Mode::Mesh(Detail::High), "mesh-high", &is_seed);
 }
 
-#[test]
-fn image_is_identical_for_any_thread_count() {
+/// The image and every counter are the same on 1, 2 and 3 threads and between runs.
+/// Every mode (`conformance.rs`).
+pub fn image_is_identical_for_any_thread_count(mode: Mode) {
     let text = std::fs::read_to_string("examples/seed/05-mirrors.scn").expect("scene").replace(
         "include \"lights.scn\"",
         "light ambient(0.2)\nlight point(0.6) at [2, 1, 0]\nlight directional(0.2, towards = [1, 4, 4])",
     );
-    let (one, c1) = render_text(&text, 96, 80, 1);
+    let scene = crate::support::scene(&text);
+    let (one, c1) = render_mode(scene.clone(), 96, 80, 1, mode);
     for threads in [2, 3] {
-        let (many, cn) = render_text(&text, 96, 80, threads);
-        assert!(one == many, "image differs with {threads} threads");
-        assert_eq!(c1, cn, "counters differ with {threads} threads");
+        let (many, cn) = render_mode(scene.clone(), 96, 80, threads, mode);
+        assert!(one == many, "{mode:?}: image differs with {threads} threads");
+        assert_eq!(c1, cn, "{mode:?}: counters differ with {threads} threads");
     }
-    let (again, _) = render_text(&text, 96, 80, 2);
-    assert!(one == again, "image differs between runs");
+    let (again, _) = render_mode(scene, 96, 80, 2, mode);
+    assert!(one == again, "{mode:?}: image differs between runs");
 }
 
 /// A ray through the centre of a sphere hits; one beside it misses; colours are as shaded.

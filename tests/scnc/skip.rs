@@ -9,8 +9,6 @@ use scnc::world::Mode;
 
 use crate::support::{compile, lower, scene};
 
-const MODES: [Mode; 3] = [Mode::Sdf, Mode::Mesh(Detail::Low), Mode::Mesh(Detail::High)];
-
 /// A hit is marked convex exactly when the object is a convex solid *as lowered*: an SDF
 /// shape by its form, a tessellated shape only when a generator made it (an isosurface
 /// may dent), an explicit mesh by its generator and only with flat normals. Every normal
@@ -82,9 +80,8 @@ fn secondary(hit: &Hit, ray: &Ray, t_max: f32) -> Vec<Ray> {
 /// edge; a ray leaving almost tangentially there may graze back in, so at most 1 in
 /// 10⁴ skipped SDF rays may, and only one within 6° of the tangent plane. Rays leaving
 /// non-convex objects, or a convex one from inside, are never skipped, and some of them
-/// do meet their object again.
-#[test]
-fn a_skipped_object_is_never_met_again() {
+/// do meet their object again. Every mode (`conformance.rs`).
+pub fn a_skipped_object_is_never_met_again(mode: Mode) {
     const SIZE: u32 = 40;
     let non_convex = "light ambient(0.2)\nlight point(0.8) at [3, 4, 0]\n\
         object torus(1, 0.3) rotate [60, 0, 0] at [-1.2, 0, 6]\n\
@@ -100,63 +97,57 @@ fn a_skipped_object_is_never_met_again() {
     // Seen from inside, a convex solid is met again by every ray leaving its wall.
     scenes.push(("inside a box".into(), scene("light ambient(1)\nobject box(4, 3, 5) rotate [0, 20, 0]\n")));
     for (name, s) in &scenes {
-        for mode in MODES {
-            let (frame, world) = lower(s, SIZE, mode);
-            let mut c = Counters::default();
-            let (mut skipped, mut grazed_back, mut met_again_unskipped) = (0usize, 0usize, 0usize);
-            for i in 0..SIZE * SIZE {
-                let dir = frame.direction((i % SIZE) as f32 + 0.5, (i / SIZE) as f32 + 0.5);
-                let camera = Ray::new(Vec3A::ZERO, dir, frame.max_distance);
-                let Some(hit) = world.intersect(&camera, &mut c) else { continue };
-                for ray in secondary(&hit, &camera, frame.max_distance) {
-                    let plain = Ray { skip: NO_OBJECT, ..ray };
-                    let unskipped = world.intersect(&plain, &mut c);
-                    if ray.skip == NO_OBJECT {
-                        if unskipped.is_some_and(|h| h.object == hit.object) {
-                            met_again_unskipped += 1;
-                        }
-                        continue;
+        let (frame, world) = lower(s, SIZE, mode);
+        let mut c = Counters::default();
+        let (mut skipped, mut grazed_back, mut met_again_unskipped) = (0usize, 0usize, 0usize);
+        for i in 0..SIZE * SIZE {
+            let dir = frame.direction((i % SIZE) as f32 + 0.5, (i / SIZE) as f32 + 0.5);
+            let camera = Ray::new(Vec3A::ZERO, dir, frame.max_distance);
+            let Some(hit) = world.intersect(&camera, &mut c) else { continue };
+            for ray in secondary(&hit, &camera, frame.max_distance) {
+                let plain = Ray { skip: NO_OBJECT, ..ray };
+                let unskipped = world.intersect(&plain, &mut c);
+                if ray.skip == NO_OBJECT {
+                    if unskipped.is_some_and(|h| h.object == hit.object) {
+                        met_again_unskipped += 1;
                     }
-                    assert!(hit.convex && ray.skip == hit.object, "{name}: a ray skips an object it does not leave");
-                    skipped += 1;
-                    let with_skip = world.intersect(&ray, &mut c);
-                    assert_eq!(
-                        world.occluded(&ray, &mut c),
-                        with_skip.is_some(),
-                        "{name} {mode:?}: any-hit and closest-hit disagree on a skipping ray"
-                    );
-                    match unskipped {
-                        Some(h) if h.object == hit.object => {
-                            let leaving = ray.dir.dot(hit.normal);
-                            assert!(
-                                mode == Mode::Sdf && leaving < 0.1,
-                                "{name} {mode:?}: a ray leaving object {} at {} along {} (cos {leaving}) meets it again at t = {}",
-                                hit.object,
-                                hit.point,
-                                ray.dir,
-                                h.t
-                            );
-                            grazed_back += 1;
-                        }
-                        Some(h) => {
-                            let s = with_skip.expect("skipping one object loses no other hit");
-                            assert_eq!(
-                                (s.object, s.t),
-                                (h.object, h.t),
-                                "{name} {mode:?}: the skip changed another hit"
-                            );
-                        }
-                        None => assert!(with_skip.is_none(), "{name} {mode:?}: the skip made a hit"),
+                    continue;
+                }
+                assert!(hit.convex && ray.skip == hit.object, "{name}: a ray skips an object it does not leave");
+                skipped += 1;
+                let with_skip = world.intersect(&ray, &mut c);
+                assert_eq!(
+                    world.occluded(&ray, &mut c),
+                    with_skip.is_some(),
+                    "{name} {mode:?}: any-hit and closest-hit disagree on a skipping ray"
+                );
+                match unskipped {
+                    Some(h) if h.object == hit.object => {
+                        let leaving = ray.dir.dot(hit.normal);
+                        assert!(
+                            mode == Mode::Sdf && leaving < 0.1,
+                            "{name} {mode:?}: a ray leaving object {} at {} along {} (cos {leaving}) meets it again at t = {}",
+                            hit.object,
+                            hit.point,
+                            ray.dir,
+                            h.t
+                        );
+                        grazed_back += 1;
                     }
+                    Some(h) => {
+                        let s = with_skip.expect("skipping one object loses no other hit");
+                        assert_eq!((s.object, s.t), (h.object, h.t), "{name} {mode:?}: the skip changed another hit");
+                    }
+                    None => assert!(with_skip.is_none(), "{name} {mode:?}: the skip made a hit"),
                 }
             }
-            assert!(grazed_back * 10_000 <= skipped.max(1), "{name} {mode:?}: {grazed_back} of {skipped} grazed back");
-            if !name.starts_with("examples") {
-                assert_eq!(skipped, 0, "{name} {mode:?}: no ray leaves the outside of a convex object");
-                assert!(met_again_unskipped > 0, "{name} {mode:?}: some rays should meet their object again");
-            } else {
-                assert!(skipped > 0, "{name} {mode:?}: every seed object is convex, so rays skip");
-            }
+        }
+        assert!(grazed_back * 10_000 <= skipped.max(1), "{name} {mode:?}: {grazed_back} of {skipped} grazed back");
+        if !name.starts_with("examples") {
+            assert_eq!(skipped, 0, "{name} {mode:?}: no ray leaves the outside of a convex object");
+            assert!(met_again_unskipped > 0, "{name} {mode:?}: some rays should meet their object again");
+        } else {
+            assert!(skipped > 0, "{name} {mode:?}: every seed object is convex, so rays skip");
         }
     }
 }

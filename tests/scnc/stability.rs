@@ -2,7 +2,6 @@
 
 use glam::{DVec3, Vec3A};
 use proptest::prelude::*;
-use scnc::mesh::Detail;
 use scnc::render::{Counters, Geometry, Image, Ray};
 use scnc::world::Mode;
 
@@ -79,27 +78,25 @@ object torus(0.5, 0.15) rotate [60, 0, 0] at [O + 1.6, O - 0.5, O + 4.5] with ma
 ";
 
 /// Hard case 2 (Far from the origin): the same scene moved by 1e3, 1e4 and 1e5 (camera too) renders
-/// the same image (no acne, no leaks), with both back-ends, and identically on 1 and 2 threads.
-#[test]
-fn far_from_the_origin_renders_the_same() {
-    for mode in [Mode::Sdf, Mode::Mesh(Detail::High)] {
-        let base = render(&scene(&FAR_SCENE.replace('O', "0")), 96, mode, 2).0;
-        for offset in ["1000", "10000", "100000"] {
-            let s = scene(&FAR_SCENE.replace('O', offset));
-            let (img, c) = render(&s, 96, mode, 2);
-            assert_eq!(c.nonfinite_samples, 0);
-            let n = differing(&base, &img, 2);
-            assert!(n <= 96 * 96 / 100, "{mode:?} at offset {offset}: {n} pixels differ from the scene at the origin");
-            let (one, _) = render(&s, 96, mode, 1);
-            assert!(one == img, "{mode:?} at offset {offset}: 1 and 2 threads differ");
-        }
+/// the same image (no acne, no leaks), and identically on 1 and 2 threads. Run for every
+/// back-end mode by the conformance table (`conformance.rs`).
+pub fn far_from_the_origin_renders_the_same(mode: Mode) {
+    let base = render(&scene(&FAR_SCENE.replace('O', "0")), 96, mode, 2).0;
+    for offset in ["1000", "10000", "100000"] {
+        let s = scene(&FAR_SCENE.replace('O', offset));
+        let (img, c) = render(&s, 96, mode, 2);
+        assert_eq!(c.nonfinite_samples, 0);
+        let n = differing(&base, &img, 2);
+        assert!(n <= 96 * 96 / 100, "{mode:?} at offset {offset}: {n} pixels differ from the scene at the origin");
+        let (one, _) = render(&s, 96, mode, 1);
+        assert!(one == img, "{mode:?} at offset {offset}: 1 and 2 threads differ");
     }
 }
 
 /// Hard case 3 (Tiny and huge): the scene scaled by 1e-4 and 1e4 about the camera renders the same
-/// image as at scale 1 (the hit threshold and spawn offsets are relative).
-#[test]
-fn tiny_and_huge_scenes_render_the_same() {
+/// image as at scale 1 (the hit threshold and spawn offsets are relative). Every mode
+/// (`conformance.rs`).
+pub fn tiny_and_huge_scenes_render_the_same(mode: Mode) {
     let text = |k: &str| {
         format!(
             "render(max_distance = 1000 * {k})
@@ -110,14 +107,12 @@ object box(3 * {k}, 0.2 * {k}, 3 * {k}) at [0, -1.2 * {k}, 6 * {k}]
 "
         )
     };
-    for mode in [Mode::Sdf, Mode::Mesh(Detail::High)] {
-        let base = render(&scene(&text("1")), 96, mode, 2).0;
-        for k in ["0.0001", "10000"] {
-            let (img, c) = render(&scene(&text(k)), 96, mode, 2);
-            assert_eq!(c.nonfinite_samples, 0);
-            let n = differing(&base, &img, 2);
-            assert!(n <= 96 * 96 / 100, "{mode:?} at scale {k}: {n} pixels differ from scale 1");
-        }
+    let base = render(&scene(&text("1")), 96, mode, 2).0;
+    for k in ["0.0001", "10000"] {
+        let (img, c) = render(&scene(&text(k)), 96, mode, 2);
+        assert_eq!(c.nonfinite_samples, 0);
+        let n = differing(&base, &img, 2);
+        assert!(n <= 96 * 96 / 100, "{mode:?} at scale {k}: {n} pixels differ from scale 1");
     }
 }
 
@@ -197,12 +192,12 @@ fn sphere_tracing_never_oversteps() {
 }
 
 /// Hard case 8 (Extreme materials): exponents 0, 1 and 1e4 and two facing perfect mirrors at depth 50
-/// give finite colours, bounded energy (clamped) and a predictable ray count.
-#[test]
-fn extreme_materials_stay_finite_and_bounded() {
+/// give finite colours, bounded energy (clamped) and a predictable ray count. Every mode
+/// (`conformance.rs`).
+pub fn extreme_materials_stay_finite_and_bounded(mode: Mode) {
     for spec in ["0", "1", "10000"] {
-        let (_, c) = render(&scene(&format!("light ambient(0.2)\nlight point(5) at [0, 3, 0]\nobject sphere(1) at [0, 0, 5] with material(specular = {spec})\n")), 48, Mode::Sdf, 2);
-        assert_eq!(c.nonfinite_samples, 0, "specular {spec}");
+        let (_, c) = render(&scene(&format!("light ambient(0.2)\nlight point(5) at [0, 3, 0]\nobject sphere(1) at [0, 0, 5] with material(specular = {spec})\n")), 48, mode, 2);
+        assert_eq!(c.nonfinite_samples, 0, "specular {spec} in {mode:?}");
     }
     let mirrors = "render(depth = 50)\nlight ambient(0.3)\nlight point(2) at [0, 1.5, 3]
 let mirror = material(color = rgb(255, 255, 255), specular = 100, reflective = 1)
@@ -210,12 +205,10 @@ object box(0.1, 3, 30) at [-1, 0, 10] with mirror
 object box(0.1, 3, 30) at [1, 0, 10] with mirror
 object sphere(0.3) at [0, 0, 6] with material(color = rgb(255, 0, 0))
 ";
-    for mode in [Mode::Sdf, Mode::Mesh(Detail::Low)] {
-        let (img, c) = render(&scene(mirrors), 48, mode, 2);
-        assert_eq!(c.nonfinite_samples, 0);
-        assert!(c.reflection_rays <= c.primary_rays * 50, "at most depth reflection rays per pixel");
-        assert!(img.pixels.chunks(3).any(|p| p[0] as i32 > p[1] as i32 + 50), "the red sphere is seen in the mirrors");
-    }
+    let (img, c) = render(&scene(mirrors), 48, mode, 2);
+    assert_eq!(c.nonfinite_samples, 0);
+    assert!(c.reflection_rays <= c.primary_rays * 50, "at most depth reflection rays per pixel");
+    assert!(img.pixels.chunks(3).any(|p| p[0] as i32 > p[1] as i32 + 50), "the red sphere is seen in the mirrors");
 }
 
 /// Hard case 9 (normals): at sharp box edges and corners, at cusps and in the torus hole are unit
