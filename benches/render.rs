@@ -24,36 +24,38 @@ fn lower_mode(path: &str, w: u32, h: u32, mode: scnc::world::Mode) -> (Frame, sc
     (frame, g)
 }
 
+/// The SDF of every shape in `tests/data/primitives.scn` (the one list tests and
+/// benches share), lowered alone, at points around it.
 fn primitives(c: &mut Criterion) {
     let mut group = c.benchmark_group("sdf eval");
-    let shapes = [
-        "sphere(1)",
-        "box(1, 0.5, 0.25)",
-        "cylinder(0.5, 1)",
-        "torus(1, 0.3)",
-        "capsule(0.4, 0.6)",
-        "cone(0.7, 0.8)",
-        "box(1) rotate [10, 20, 30]",
-        "union(sphere(1), box(0.8) at [1, 0, 0], smooth = 0.3)",
-    ];
-    let points: Vec<Vec3A> = (0..256)
-        .map(|i| {
-            Vec3A::new((i as f32 * 0.37).sin() * 2.0, (i as f32 * 0.71).cos() * 2.0, 5.0 + (i as f32 * 0.13).sin())
-        })
-        .collect();
-    group.throughput(Throughput::Elements(points.len() as u64));
-    for shape in shapes {
-        let text = format!("light ambient(1)\nobject {shape} at [0, 0, 5]\n");
-        let c2 = scnc::compile_source("b.scn", Path::new("b.scn"), text, &scnc::source::FsLoader);
-        let scene = c2.scene.expect("compiles");
+    let path = "tests/data/primitives.scn";
+    let text = std::fs::read_to_string(path).expect("the primitives list");
+    let c2 = scnc::compile_source(path, Path::new(path), text.clone(), &scnc::source::FsLoader);
+    let list = c2.scene.expect("the primitives list compiles");
+    for object in &list.objects {
+        let scnc::ir::Geometry::Shape(_) = &object.geometry else { continue };
+        let (_, range) = c2.map.local_range(object.span);
+        let source = text[range].trim_start_matches("object ").to_string();
+        let mut alone = list.clone();
+        alone.objects = vec![object.clone()];
         let (_, g) = scnc::world::prepare(
-            &scene,
-            scnc::render::effects::derive(&scene),
+            &alone,
+            scnc::render::effects::derive(&alone),
             scnc::world::Mode::Sdf,
             &scnc::source::FsLoader,
         )
         .expect("lowers");
-        group.bench_function(shape, |b| {
+        // The list has no camera, so render space is world space.
+        let (centre, r) = scnc::ir::bounding_sphere(&object.geometry).expect("bounded");
+        let points: Vec<Vec3A> = (0..256)
+            .map(|i| {
+                let i = i as f64;
+                let offset = glam::DVec3::new((i * 0.37).sin(), (i * 0.71).cos(), (i * 0.13).sin()) * 1.5 * r;
+                (centre + offset).as_vec3a()
+            })
+            .collect();
+        group.throughput(Throughput::Elements(points.len() as u64));
+        group.bench_function(source, |b| {
             b.iter(|| points.iter().map(|p| g.sdf_eval(0, black_box(*p)).unwrap_or(0.0)).sum::<f32>())
         });
     }

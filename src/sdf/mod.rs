@@ -51,7 +51,8 @@ impl SdfObject {
     /// The surface at a hit found by [`closest`](Self::closest): normal from the gradient
     /// and material from the material closure, numbered `object`. Done once per ray, for the winner.
     // Kept out of line: inlined into `World::intersect` it bloated the march loop's caller
-    // and cost a one-object SDF scene ~10% of its primary-ray throughput (criterion A/B).
+    // and cost a one-object SDF scene ~10% of its primary-ray throughput (bench
+    // `primary rays/intersect sdf/01-sphere`).
     #[inline(never)]
     pub fn surface(&self, ray: &Ray, t: f32, error: f32, object: u32, c: &mut Counters) -> Hit {
         let point = ray.at(t);
