@@ -115,16 +115,22 @@ fn parse_positive(s: &str) -> Result<f64, String> {
 }
 
 pub(crate) fn render_cmd(args: RenderArgs) -> ExitCode {
-    if let Err(e) = check_output(&args.output) {
-        return usage_error(&e);
-    }
-    let pool = match worker_pool(args.threads) {
+    let pool = match args.checked_pool() {
         Ok(p) => p,
-        Err(e) => return usage_error(&e),
+        Err(code) => return code,
     };
     match render_once(&args, &pool).result {
         Ok(()) => ExitCode::SUCCESS,
         Err(code) => code,
+    }
+}
+
+impl RenderArgs {
+    /// The worker pool, once the output path is known to be writable: the usage errors
+    /// `render` and `watch` both report before any work.
+    pub(crate) fn checked_pool(&self) -> Result<rayon::ThreadPool, ExitCode> {
+        check_output(&self.output).map_err(|e| usage_error(&e))?;
+        worker_pool(self.threads).map_err(|e| usage_error(&e))
     }
 }
 

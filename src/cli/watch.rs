@@ -5,9 +5,8 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use super::files::check_output;
 use super::render::{render_once, RenderArgs};
-use super::{usage_error, worker_pool};
+use super::usage_error;
 
 /// What wakes `watch` up.
 enum Wake {
@@ -23,12 +22,9 @@ const DEBOUNCE: std::time::Duration = std::time::Duration::from_millis(150);
 
 pub(crate) fn watch_cmd(args: RenderArgs) -> ExitCode {
     use notify::Watcher as _;
-    if let Err(e) = check_output(&args.output) {
-        return usage_error(&e);
-    }
-    let pool = match worker_pool(args.threads) {
+    let pool = match args.checked_pool() {
         Ok(p) => p,
-        Err(e) => return usage_error(&e),
+        Err(code) => return code,
     };
     let (tx, rx) = std::sync::mpsc::channel();
     let stop = tx.clone();

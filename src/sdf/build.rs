@@ -78,14 +78,8 @@ impl Builder<'_> {
                 let b = half.as_vec3a();
                 self.sdf(move |p| prim::cuboid(p, b))
             }
-            Primitive::Cylinder { radius, half_height } => {
-                let (r, h) = (radius as f32, half_height as f32);
-                self.sdf(move |p| prim::cylinder(p, r, h))
-            }
-            Primitive::Torus { major, minor } => {
-                let (a, b) = (major as f32, minor as f32);
-                self.sdf(move |p| prim::torus(p, a, b))
-            }
+            Primitive::Cylinder { radius, half_height } => self.leaf2(prim::cylinder, radius, half_height),
+            Primitive::Torus { major, minor } => self.leaf2(prim::torus, major, minor),
             Primitive::Plane { normal, offset } => {
                 // Transform the plane itself (exact for any invertible map), in f64.
                 let n_world = (xf.matrix3.inverse().transpose() * normal).normalize();
@@ -95,20 +89,21 @@ impl Builder<'_> {
                 let m = self.mat(move |p| (prim::plane(p, n, o), mat));
                 return (d, m);
             }
-            Primitive::Capsule { radius, half_height } => {
-                let (r, h) = (radius as f32, half_height as f32);
-                self.sdf(move |p| prim::capsule(p, r, h))
-            }
-            Primitive::Cone { radius, half_height } => {
-                let (r, h) = (radius as f32, half_height as f32);
-                self.sdf(move |p| prim::cone(p, r, h))
-            }
+            Primitive::Capsule { radius, half_height } => self.leaf2(prim::capsule, radius, half_height),
+            Primitive::Cone { radius, half_height } => self.leaf2(prim::cone, radius, half_height),
         };
         let m = {
             let local = local.clone();
             self.mat(move |p| (local(p), mat))
         };
         self.wrap(local, m, xf)
+    }
+
+    /// A primitive of two sizes in its own frame. `f` is a function item, so each
+    /// primitive's closure is its own type with the distance inlined (no indirect call).
+    fn leaf2<F: Fn(Vec3A, f32, f32) -> f32 + Send + Sync + 'static>(&mut self, f: F, a: f64, b: f64) -> Sdf {
+        let (a, b) = (a as f32, b as f32);
+        self.sdf(move |p| f(p, a, b))
     }
 
     /// Applies `xf` (render from local) to a local-frame evaluator: the inverse maps the

@@ -4,119 +4,78 @@ use std::fmt::Write as _;
 
 use super::sweep::Row;
 
-/// One column: its CSV name, its Markdown heading, and its cell in each format.
-struct Column {
-    csv: &'static str,
-    heading: &'static str,
-    csv_cell: fn(&Row) -> String,
-    md_cell: fn(&Row) -> String,
+/// How a column's value is shown: in full in the CSV, rounded for people in Markdown.
+enum Cell {
+    /// Text, the same in both.
+    Text(fn(&Row) -> String),
+    /// A count, the same in both.
+    Count(fn(&Row) -> usize),
+    /// A decimal: `csv` digits in the CSV; in Markdown, times `scale`, to `md` digits,
+    /// followed by `unit`.
+    Fixed { get: fn(&Row) -> f64, csv: usize, md: usize, scale: f64, unit: &'static str },
+    /// A small error: full precision in the CSV, three significant digits in Markdown.
+    Sci(fn(&Row) -> f64),
+    /// KiB if measured: empty in the CSV and `n/a` in Markdown when not.
+    Kib(fn(&Row) -> Option<u64>),
 }
 
-/// Every column, in order.
-const COLUMNS: &[Column] = &[
-    Column {
-        csv: "backend",
-        heading: "back-end",
-        csv_cell: |r| r.setting.backend().into(),
-        md_cell: |r| r.setting.backend().into(),
-    },
-    Column { csv: "setting", heading: "setting", csv_cell: |r| r.setting.label(), md_cell: |r| r.setting.label() },
-    Column {
-        csv: "wall_ms",
-        heading: "wall",
-        csv_cell: |r| format!("{:.3}", r.wall_ms),
-        md_cell: |r| format!("{:.1} ms", r.wall_ms),
-    },
-    Column {
-        csv: "rays_per_s",
-        heading: "rays/s",
-        csv_cell: |r| format!("{:.0}", r.rays_per_s),
-        md_cell: |r| format!("{:.2} M", r.rays_per_s / 1e6),
-    },
-    Column {
-        csv: "sdf_evals_per_ray",
-        heading: "evals/ray",
-        csv_cell: |r| format!("{:.3}", r.evals_per_ray),
-        md_cell: |r| format!("{:.2}", r.evals_per_ray),
-    },
-    Column {
-        csv: "node_visits_per_ray",
-        heading: "visits/ray",
-        csv_cell: |r| format!("{:.3}", r.visits_per_ray),
-        md_cell: |r| format!("{:.2}", r.visits_per_ray),
-    },
-    Column {
-        csv: "triangle_tests_per_ray",
-        heading: "tri tests/ray",
-        csv_cell: |r| format!("{:.3}", r.tests_per_ray),
-        md_cell: |r| format!("{:.2}", r.tests_per_ray),
-    },
-    Column {
-        csv: "geometry_bytes",
-        heading: "bytes",
-        csv_cell: |r| r.bytes.to_string(),
-        md_cell: |r| r.bytes.to_string(),
-    },
-    Column {
-        csv: "triangles",
-        heading: "triangles",
-        csv_cell: |r| r.triangles.to_string(),
-        md_cell: |r| r.triangles.to_string(),
-    },
-    Column {
-        csv: "peak_rss_kib",
-        heading: "peak RSS",
-        csv_cell: |r| r.peak_rss_kib.map_or(String::new(), |k| k.to_string()),
-        md_cell: |r| r.peak_rss_kib.map_or("n/a".to_string(), |k| format!("{:.1} MiB", k as f64 / 1024.0)),
-    },
-    Column {
-        csv: "geo_error_mean",
-        heading: "geo error mean",
-        csv_cell: |r| format!("{:e}", r.geo_mean),
-        md_cell: |r| format!("{:.2e}", r.geo_mean),
-    },
-    Column {
-        csv: "geo_error_max",
-        heading: "geo error max",
-        csv_cell: |r| format!("{:e}", r.geo_max),
-        md_cell: |r| format!("{:.2e}", r.geo_max),
-    },
-    Column {
-        csv: "geo_error_max_pixels",
-        heading: "max in pixels",
-        csv_cell: |r| format!("{:.4}", r.geo_max_px),
-        md_cell: |r| format!("{:.3}", r.geo_max_px),
-    },
-    Column {
-        csv: "coverage_error_px",
-        heading: "coverage px",
-        csv_cell: |r| r.coverage.to_string(),
-        md_cell: |r| r.coverage.to_string(),
-    },
-    Column {
-        csv: "rmse",
-        heading: "RMSE",
-        csv_cell: |r| format!("{:.4}", r.rmse),
-        md_cell: |r| format!("{:.2}", r.rmse),
-    },
-    Column {
-        csv: "psnr_db",
-        heading: "PSNR",
-        csv_cell: |r| format!("{:.2}", r.psnr),
-        md_cell: |r| format!("{:.1} dB", r.psnr),
-    },
+impl Cell {
+    fn csv(&self, r: &Row) -> String {
+        match self {
+            Cell::Text(get) => get(r),
+            Cell::Count(get) => get(r).to_string(),
+            Cell::Fixed { get, csv, .. } => format!("{:.*}", csv, get(r)),
+            Cell::Sci(get) => format!("{:e}", get(r)),
+            Cell::Kib(get) => get(r).map_or(String::new(), |k| k.to_string()),
+        }
+    }
+
+    fn markdown(&self, r: &Row) -> String {
+        match self {
+            Cell::Text(get) => get(r),
+            Cell::Count(get) => get(r).to_string(),
+            Cell::Fixed { get, md, scale, unit, .. } => format!("{:.*}{unit}", md, get(r) * scale),
+            Cell::Sci(get) => format!("{:.2e}", get(r)),
+            Cell::Kib(get) => get(r).map_or("n/a".to_string(), |k| format!("{:.1} MiB", k as f64 / 1024.0)),
+        }
+    }
+}
+
+/// A decimal shown to `csv` digits in the CSV and `md` in Markdown, unscaled.
+const fn fixed(get: fn(&Row) -> f64, csv: usize, md: usize) -> Cell {
+    Cell::Fixed { get, csv, md, scale: 1.0, unit: "" }
+}
+
+/// Every column in order: its CSV name, its Markdown heading, and its cell.
+const COLUMNS: &[(&str, &str, Cell)] = &[
+    ("backend", "back-end", Cell::Text(|r| r.setting.backend().into())),
+    ("setting", "setting", Cell::Text(|r| r.setting.label())),
+    ("wall_ms", "wall", Cell::Fixed { get: |r| r.wall_ms, csv: 3, md: 1, scale: 1.0, unit: " ms" }),
+    ("rays_per_s", "rays/s", Cell::Fixed { get: |r| r.rays_per_s, csv: 0, md: 2, scale: 1e-6, unit: " M" }),
+    ("sdf_evals_per_ray", "evals/ray", fixed(|r| r.evals_per_ray, 3, 2)),
+    ("node_visits_per_ray", "visits/ray", fixed(|r| r.visits_per_ray, 3, 2)),
+    ("triangle_tests_per_ray", "tri tests/ray", fixed(|r| r.tests_per_ray, 3, 2)),
+    ("geometry_bytes", "bytes", Cell::Count(|r| r.bytes)),
+    ("triangles", "triangles", Cell::Count(|r| r.triangles)),
+    ("peak_rss_kib", "peak RSS", Cell::Kib(|r| r.peak_rss_kib)),
+    ("geo_error_mean", "geo error mean", Cell::Sci(|r| r.geo_mean)),
+    ("geo_error_max", "geo error max", Cell::Sci(|r| r.geo_max)),
+    ("geo_error_max_pixels", "max in pixels", fixed(|r| r.geo_max_px, 4, 3)),
+    ("coverage_error_px", "coverage px", Cell::Count(|r| r.coverage)),
+    ("rmse", "RMSE", fixed(|r| r.rmse, 4, 2)),
+    ("psnr_db", "PSNR", Cell::Fixed { get: |r| r.psnr, csv: 2, md: 1, scale: 1.0, unit: " dB" }),
 ];
 
 /// The header line of `sweep.csv`.
 pub fn csv_header() -> String {
-    COLUMNS.iter().map(|c| c.csv).collect::<Vec<_>>().join(",")
+    COLUMNS.iter().map(|(name, _, _)| *name).collect::<Vec<_>>().join(",")
 }
 
 /// Rows as CSV.
 pub fn csv(rows: &[Row]) -> String {
     let mut out = csv_header() + "\n";
     for r in rows {
-        let cells: Vec<String> = COLUMNS.iter().map(|c| (c.csv_cell)(r)).collect();
+        let cells: Vec<String> = COLUMNS.iter().map(|(_, _, cell)| cell.csv(r)).collect();
         let _ = writeln!(out, "{}", cells.join(","));
     }
     out
@@ -127,12 +86,58 @@ pub fn markdown(rows: &[Row], title: &str) -> String {
     let mut out = format!(
         "# Sweep: {title}\n\nReference: the SDF render at epsilon 1e-6 with a 100 000-step budget. Geometric error is |d| at primary hits, in world units.\n\n"
     );
-    let headings: Vec<&str> = COLUMNS.iter().map(|c| c.heading).collect();
+    let headings: Vec<&str> = COLUMNS.iter().map(|(_, heading, _)| *heading).collect();
     let _ = writeln!(out, "| {} |", headings.join(" | "));
     let _ = writeln!(out, "|{}", "---|".repeat(COLUMNS.len()));
     for r in rows {
-        let cells: Vec<String> = COLUMNS.iter().map(|c| (c.md_cell)(r)).collect();
+        let cells: Vec<String> = COLUMNS.iter().map(|(_, _, cell)| cell.markdown(r)).collect();
         let _ = writeln!(out, "| {} |", cells.join(" | "));
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::Detail;
+    use crate::study::sweep::Setting;
+
+    fn row(peak_rss_kib: Option<u64>) -> Row {
+        Row {
+            setting: Setting::Mesh(Detail::N(28)),
+            wall_ms: 12.34567,
+            rays_per_s: 4_567_890.4,
+            evals_per_ray: 1.23456,
+            visits_per_ray: 7.5,
+            tests_per_ray: 0.0,
+            bytes: 123_456,
+            triangles: 789,
+            peak_rss_kib,
+            geo_mean: 1.5e-4,
+            geo_max: 2.25e-3,
+            geo_max_px: 0.12345,
+            coverage: 3,
+            rmse: 1.23456,
+            psnr: 45.678,
+        }
+    }
+
+    /// The formats the README documents and scripts parse.
+    #[test]
+    fn rows_are_written_as_documented() {
+        let csv = csv(&[row(Some(2048)), row(None)]);
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines[0], csv_header());
+        assert_eq!(
+            lines[1],
+            "mesh,detail 28,12.346,4567890,1.235,7.500,0.000,123456,789,2048,1.5e-4,2.25e-3,0.1235,3,1.2346,45.68"
+        );
+        assert_eq!(
+            lines[2],
+            "mesh,detail 28,12.346,4567890,1.235,7.500,0.000,123456,789,,1.5e-4,2.25e-3,0.1235,3,1.2346,45.68"
+        );
+        let md = markdown(&[row(Some(2048))], "t");
+        assert!(md.contains("| mesh | detail 28 | 12.3 ms | 4.57 M | 1.23 | 7.50 | 0.00 | 123456 | 789 | 2.0 MiB | 1.50e-4 | 2.25e-3 | 0.123 | 3 | 1.23 | 45.7 dB |"), "{md}");
+        assert!(markdown(&[row(None)], "t").contains("| 789 | n/a |"));
+    }
 }

@@ -222,43 +222,17 @@ fn tolerance_picks_hold() {
     assert_eq!(rows.len(), 2);
     assert!(rows.iter().all(|&px| px <= 1.0 + 1e-3), "an error over a pixel: {rows:?}");
     let png = dir.path().join("t.png");
-    let o = scnc(&[
-        "render",
-        "examples/seed/01-sphere.scn",
-        "-o",
-        png.to_str().unwrap_or_default(),
-        "--width",
-        "32",
-        "--height",
-        "32",
-        "--tolerance",
-        "0.001",
-        "--geometry",
-        "mesh",
-    ]);
+    let sphere = |extra: &[&str]| {
+        let mut args = vec!["render", "examples/seed/01-sphere.scn", "-o", png.to_str().unwrap_or_default()];
+        args.extend_from_slice(extra);
+        scnc(&args)
+    };
+    let o = sphere(&["--width", "32", "--height", "32", "--tolerance", "0.001", "--geometry", "mesh"]);
     assert_eq!(o.status.code(), Some(0));
     assert!(String::from_utf8_lossy(&o.stderr).contains("tolerance 0.001: picked detail"));
-    let o = scnc(&[
-        "render",
-        "examples/seed/01-sphere.scn",
-        "-o",
-        png.to_str().unwrap_or_default(),
-        "--tolerance",
-        "0",
-        "--width",
-        "8",
-    ]);
+    let o = sphere(&["--tolerance", "0", "--width", "8"]);
     assert_eq!(o.status.code(), Some(2), "a tolerance of 0 is a usage error");
-    let o = scnc(&[
-        "render",
-        "examples/seed/01-sphere.scn",
-        "-o",
-        png.to_str().unwrap_or_default(),
-        "--tolerance",
-        "pixel",
-        "--epsilon",
-        "0.01",
-    ]);
+    let o = sphere(&["--tolerance", "pixel", "--epsilon", "0.01"]);
     assert_eq!(o.status.code(), Some(2), "--tolerance and --epsilon conflict");
 }
 

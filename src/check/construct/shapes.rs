@@ -25,22 +25,10 @@ impl Ctx<'_> {
                 self.check_vec(a, b, 0, pos, POS).then_some(())?;
                 Primitive::Box { half: a.vec(b, 0) }
             }
-            Prim::Cylinder => {
-                let (radius, half_height) = two()?;
-                Primitive::Cylinder { radius, half_height }
-            }
-            Prim::Capsule => {
-                let (radius, half_height) = two()?;
-                Primitive::Capsule { radius, half_height }
-            }
-            Prim::Cone => {
-                let (radius, half_height) = two()?;
-                Primitive::Cone { radius, half_height }
-            }
-            Prim::Torus => {
-                let (major, minor) = two()?;
-                Primitive::Torus { major, minor }
-            }
+            Prim::Cylinder => two().map(|(radius, half_height)| Primitive::Cylinder { radius, half_height })?,
+            Prim::Capsule => two().map(|(radius, half_height)| Primitive::Capsule { radius, half_height })?,
+            Prim::Cone => two().map(|(radius, half_height)| Primitive::Cone { radius, half_height })?,
+            Prim::Torus => two().map(|(major, minor)| Primitive::Torus { major, minor })?,
             Prim::Plane => {
                 let Some(normal) = direction(a.vec(b, 0)) else {
                     self.range_error(
