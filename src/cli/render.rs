@@ -126,6 +126,40 @@ pub(crate) fn render_cmd(args: RenderArgs) -> ExitCode {
 }
 
 impl RenderArgs {
+    /// Applies the command line's overrides and `--tolerance` to the scene, and says which
+    /// back-end renders its shapes; an image too large is a usage error.
+    fn apply(&self, scene: &mut scnc::ir::Scene) -> Result<scnc::world::Mode, ExitCode> {
+        let s = &mut scene.settings;
+        s.width = self.width.unwrap_or(s.width);
+        s.height = self.height.unwrap_or(s.height);
+        s.epsilon = self.epsilon.unwrap_or(s.epsilon);
+        s.max_steps = self.max_steps.unwrap_or(s.max_steps);
+        s.max_distance = self.max_distance.unwrap_or(s.max_distance);
+        s.depth = self.depth.unwrap_or(s.depth);
+        s.samples = self.samples.unwrap_or(s.samples);
+        if s.width as u64 * s.height as u64 > MAX_PIXELS {
+            return Err(usage_error(&format!("{}×{} is too large: at most {} pixels", s.width, s.height, MAX_PIXELS)));
+        }
+        let mut detail = self.detail;
+        if let Some(tol) = self.tolerance {
+            let picked = match self.geometry {
+                GeometryKind::Sdf => {
+                    scene.settings.epsilon = scnc::study::tolerance::sdf_epsilon(scene, tol);
+                    format!("epsilon {:.3e}", scene.settings.epsilon)
+                }
+                GeometryKind::Mesh => {
+                    detail = scnc::study::tolerance::mesh_detail(scene, tol);
+                    format!("detail {}", detail.rings())
+                }
+            };
+            let _ = writeln!(std::io::stderr(), "tolerance {tol}: picked {picked}");
+        }
+        Ok(match self.geometry {
+            GeometryKind::Sdf => scnc::world::Mode::Sdf,
+            GeometryKind::Mesh => scnc::world::Mode::Mesh(detail),
+        })
+    }
+
     /// The worker pool, once the output path is known to be writable: the usage errors
     /// `render` and `watch` both report before any work.
     pub(crate) fn checked_pool(&self) -> Result<rayon::ThreadPool, ExitCode> {
@@ -157,33 +191,7 @@ fn render_compiled(args: &RenderArgs, pool: &rayon::ThreadPool, compiled: Compil
     let Some(mut scene) = compiled.scene else {
         return Err(ExitCode::from(1));
     };
-    let s = &mut scene.settings;
-    s.width = args.width.unwrap_or(s.width);
-    s.height = args.height.unwrap_or(s.height);
-    s.epsilon = args.epsilon.unwrap_or(s.epsilon);
-    s.max_steps = args.max_steps.unwrap_or(s.max_steps);
-    s.max_distance = args.max_distance.unwrap_or(s.max_distance);
-    s.depth = args.depth.unwrap_or(s.depth);
-    s.samples = args.samples.unwrap_or(s.samples);
-    if s.width as u64 * s.height as u64 > MAX_PIXELS {
-        return Err(usage_error(&format!("{}×{} is too large: at most {} pixels", s.width, s.height, MAX_PIXELS)));
-    }
-    let mut detail = args.detail;
-    if let Some(tol) = args.tolerance {
-        match args.geometry {
-            GeometryKind::Sdf => scene.settings.epsilon = scnc::study::tolerance::sdf_epsilon(&scene, tol),
-            GeometryKind::Mesh => detail = scnc::study::tolerance::mesh_detail(&scene, tol),
-        }
-        let picked = match args.geometry {
-            GeometryKind::Sdf => format!("epsilon {:.3e}", scene.settings.epsilon),
-            GeometryKind::Mesh => format!("detail {}", detail.rings()),
-        };
-        let _ = writeln!(std::io::stderr(), "tolerance {tol}: picked {picked}");
-    }
-    let mode = match args.geometry {
-        GeometryKind::Sdf => scnc::world::Mode::Sdf,
-        GeometryKind::Mesh => scnc::world::Mode::Mesh(detail),
-    };
+    let mode = args.apply(&mut scene)?;
     let started = Instant::now();
     let effects = match args.effects {
         EffectsArg::Derived => scnc::render::effects::derive(&scene),
