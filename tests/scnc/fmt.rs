@@ -84,3 +84,18 @@ fn fmt_is_idempotent_and_changes_only_whitespace() {
     assert!(formatted >= 100 && refused >= 5, "formatted {formatted}, refused {refused}");
     finish(failures);
 }
+
+/// Shipped examples are in the canonical layout (`scnc fmt --check` is clean on them).
+#[test]
+fn shipped_examples_are_formatted() {
+    let mut failures = Vec::new();
+    for dir in ["examples/seed", "examples/features", "benches/scenes", "tests/data"] {
+        for path in cases(dir) {
+            let text = std::fs::read_to_string(&path).expect("reading the example");
+            if scnc::fmt::format(&text).is_ok_and(|f| f != text) {
+                failures.push(format!("{}: not formatted (run `scnc fmt` on it)", path.display()));
+            }
+        }
+    }
+    finish(failures);
+}
