@@ -297,6 +297,12 @@ pub mod codes {
     pub const TOO_MANY_OBJECTS: &str = "E0704";
     /// A list or file too large.
     pub const TOO_LARGE: &str = "E0705";
+    /// Evaluation ran out of fuel.
+    pub const OUT_OF_FUEL: &str = "E0706";
+    /// A shape that expands to too many nodes.
+    pub const SHAPE_TOO_LARGE: &str = "E0707";
+    /// Too many errors: evaluation stopped.
+    pub const TOO_MANY_ERRORS: &str = "E0708";
     /// A render-time failure traced back to the source (e.g. a mesh file that cannot be read).
     pub const LOWERING: &str = "E0800";
     /// Unused `let` binding.

@@ -18,15 +18,28 @@ pub trait Loader {
 pub struct FsLoader;
 
 impl Loader for FsLoader {
+    /// Reads a regular file of at most [`MAX_FILE_BYTES`], checking the limit while
+    /// reading (a file may grow after it was measured). A directory, device, pipe or
+    /// socket is refused before it is opened: `/dev/zero` would never end and opening a
+    /// pipe blocks until a writer comes.
     fn read(&self, path: &Path) -> std::io::Result<String> {
+        use std::io::Read as _;
         let meta = std::fs::metadata(path)?;
         if meta.is_dir() {
             return Err(std::io::Error::other("it is a directory"));
         }
-        if meta.len() > MAX_FILE_BYTES as u64 {
-            return Err(std::io::Error::other(format!("it is larger than the {} MiB limit", MAX_FILE_BYTES >> 20)));
+        if !meta.is_file() {
+            return Err(std::io::Error::other("it is not a regular file (a device, pipe or socket)"));
         }
-        let bytes = std::fs::read(path)?;
+        let too_large = || std::io::Error::other(format!("it is larger than the {} MiB limit", MAX_FILE_BYTES >> 20));
+        if meta.len() > MAX_FILE_BYTES as u64 {
+            return Err(too_large());
+        }
+        let mut bytes = Vec::with_capacity(meta.len() as usize);
+        std::fs::File::open(path)?.take(MAX_FILE_BYTES as u64 + 1).read_to_end(&mut bytes)?;
+        if bytes.len() > MAX_FILE_BYTES {
+            return Err(too_large());
+        }
         String::from_utf8(bytes).map_err(|_| std::io::Error::other("it is not valid UTF-8"))
     }
 }

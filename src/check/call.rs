@@ -376,6 +376,7 @@ impl Ctx<'_> {
             );
             return Value::Error;
         }
+        *self.calls.entry(f.name.clone()).or_default() += 1;
         let mut frame = Vec::with_capacity(f.params.len());
         let mut seen = HashMap::new();
         for (p, v) in f.params.iter().zip(args) {

@@ -49,6 +49,9 @@ fn vec3_of(v: &Value) -> Option<DVec3> {
 
 impl Ctx<'_> {
     pub(super) fn expr(&mut self, e: &ast::Expr) -> Value {
+        if !self.burn(1, e.span) {
+            return Value::Error;
+        }
         if self.expr_depth >= MAX_EXPR_DEPTH {
             if std::mem::replace(&mut self.too_deep, true) {
                 return Value::Error;
@@ -350,6 +353,11 @@ impl Ctx<'_> {
                         "list is too long",
                         format!("the result would have {} elements", x.len() + y.len()),
                     ));
+                    return Value::Error;
+                }
+                // Lists are values: joining copies both, so a list grown in a loop costs
+                // its length every step, and that is what it burns.
+                if !self.burn((x.len() + y.len()) as u64, span) {
                     return Value::Error;
                 }
                 Value::List(Rc::new(x.iter().chain(y.iter()).cloned().collect()))

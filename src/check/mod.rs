@@ -20,7 +20,7 @@ pub mod index;
 mod transform;
 mod value;
 
-use std::collections::{HashMap, HashSet};
+use std::collections::HashMap;
 use std::path::{Component, Path, PathBuf};
 use std::rc::Rc;
 
@@ -32,8 +32,8 @@ use crate::source::{io_reason, FileId, Loader, SourceMap, MAX_FILE_BYTES};
 use crate::span::Span;
 use crate::syntax::{self, ast};
 pub use construct::{
-    MAX_DEPTH, MAX_GENERATED_TRIANGLES, MAX_IMAGE_SIDE, MAX_MESH_RESOLUTION, MAX_PIXELS, MAX_REPEAT, MAX_SAMPLES,
-    MAX_STEPS,
+    EPSILON_RULE, MAX_DEPTH, MAX_GENERATED_TRIANGLES, MAX_IMAGE_SIDE, MAX_MESH_RESOLUTION, MAX_PIXELS, MAX_REPEAT,
+    MAX_SAMPLES, MAX_STEPS, MIN_EPSILON,
 };
 pub use value::Value;
 
@@ -43,6 +43,9 @@ pub const MAX_ITERATIONS: u64 = 1_000_000;
 pub const MAX_CALL_DEPTH: usize = 64;
 /// Deepest chain of includes.
 pub const MAX_INCLUDE_DEPTH: usize = 16;
+/// Most `include` statements one compile may carry out (a file including the next twice,
+/// sixteen deep, would read 65,536 files).
+pub const MAX_INCLUDES: usize = 1_000;
 /// Most objects in a scene.
 pub const MAX_OBJECTS: usize = 100_000;
 /// Most lights in a scene.
@@ -51,6 +54,13 @@ pub const MAX_LIGHTS: usize = 1_000;
 pub const MAX_LIST: usize = 100_000;
 /// Deepest expression nesting (operators, calls and transforms count).
 pub const MAX_EXPR_DEPTH: usize = 256;
+/// Evaluation steps one compile may take: every expression evaluated, and every list
+/// element copied, is one. Depth limits bound recursion, not total work; this does.
+pub const MAX_FUEL: u64 = 10_000_000;
+/// Shape nodes one scene may hold, shared parts counted each time they are used.
+pub const MAX_SCENE_NODES: u64 = 4_000_000;
+/// Error reports (repeats included) after which evaluation stops.
+pub const MAX_ERROR_REPORTS: u64 = 10_000;
 
 /// What a name is bound to.
 #[derive(Clone, Debug)]
@@ -80,7 +90,23 @@ struct Ctx<'a> {
     map: &'a mut SourceMap,
     loader: &'a dyn Loader,
     diags: Vec<Diagnostic>,
-    reported: HashSet<(&'static str, Span, String)>,
+    /// Each diagnostic reported so far, by code, span and message: its index in `diags`.
+    reported: HashMap<(&'static str, Span, String), usize>,
+    /// How many more times each diagnostic of `diags` was reported.
+    repeats: Vec<u64>,
+    /// Error reports so far, repeats included.
+    error_reports: u64,
+    /// Evaluation steps left (see [`MAX_FUEL`]).
+    fuel: u64,
+    /// Calls of each user function, to name what used the fuel.
+    calls: HashMap<String, u64>,
+    /// Shape nodes of the scene's objects so far (see [`MAX_SCENE_NODES`]).
+    scene_nodes: u64,
+    /// `include` statements carried out so far.
+    includes: usize,
+    /// Set when fuel ran out or errors passed their cap: everything left evaluates to
+    /// an error at once, and loops stop.
+    halted: bool,
     scopes: Vec<Vec<Rc<Binding>>>,
     /// `let` definitions by span, and whether each was ever used.
     lets: HashMap<Span, (String, bool)>,
@@ -109,10 +135,54 @@ struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
+    /// Records a diagnostic; the same one again (code, span and message) only counts.
     fn report(&mut self, d: Diagnostic) {
-        if self.reported.insert((d.code, d.span(), d.message.clone())) {
-            self.diags.push(d);
+        let is_error = d.is_error();
+        let key = (d.code, d.span(), d.message.clone());
+        match self.reported.get(&key) {
+            Some(&i) => self.repeats[i] += 1,
+            None => {
+                self.reported.insert(key, self.diags.len());
+                self.diags.push(d);
+                self.repeats.push(0);
+            }
         }
+        if is_error {
+            self.error_reports += 1;
+            if self.error_reports == MAX_ERROR_REPORTS && !self.halted {
+                self.halted = true;
+                let span = self.diags.last().map_or(Span::default(), Diagnostic::span);
+                self.report(
+                    Diagnostic::error(codes::TOO_MANY_ERRORS, span, "too many errors", "evaluation stopped here")
+                        .with_note(format!("evaluation stops after {MAX_ERROR_REPORTS} errors; fix these first")),
+                );
+            }
+        }
+    }
+
+    /// Spends `steps` of fuel on the work at `span`; `false` once it has run out (or
+    /// evaluation stopped), after reporting where, and what used it, once.
+    fn burn(&mut self, steps: u64, span: Span) -> bool {
+        if self.halted {
+            return false;
+        }
+        if let Some(left) = self.fuel.checked_sub(steps) {
+            self.fuel = left;
+            return true;
+        }
+        self.halted = true;
+        let mut d = Diagnostic::error(
+            codes::OUT_OF_FUEL,
+            span,
+            "the scene takes too long to evaluate",
+            "evaluation ran out of fuel here",
+        )
+        .with_note(format!("a scene may take at most {MAX_FUEL} evaluation steps"));
+        if let Some((name, n)) = self.calls.iter().max_by_key(|(name, n)| (**n, std::cmp::Reverse((*name).clone()))) {
+            d = d.with_note(format!("`{name}` was called {n} times"));
+        }
+        self.report(d);
+        false
     }
 
     fn lookup(&mut self, id: &ast::Ident) -> Option<Rc<Binding>> {
@@ -163,6 +233,9 @@ impl Ctx<'_> {
 
     fn stmts(&mut self, stmts: &[ast::Stmt]) {
         for stmt in stmts {
+            if self.halted {
+                break;
+            }
             self.stmt(stmt);
         }
     }
@@ -344,7 +417,7 @@ impl Ctx<'_> {
         self.iterations += count;
         for i in lo..hi {
             run(self, Value::Num(i as f64));
-            if self.too_many_objects {
+            if self.too_many_objects || self.halted {
                 break;
             }
         }
@@ -418,6 +491,35 @@ impl Ctx<'_> {
             }
             return;
         }
+        let nodes = match &geometry {
+            ir::Geometry::Shape(s) => s.nodes,
+            ir::Geometry::Mesh(m) => match &m.source {
+                ir::MeshSource::Isosurface { shape, .. } => shape.nodes,
+                ir::MeshSource::UvSphere { .. }
+                | ir::MeshSource::IcoSphere { .. }
+                | ir::MeshSource::Box { .. }
+                | ir::MeshSource::Cylinder { .. }
+                | ir::MeshSource::Torus { .. }
+                | ir::MeshSource::Plane { .. }
+                | ir::MeshSource::File { .. } => 0,
+            },
+        };
+        self.scene_nodes = self.scene_nodes.saturating_add(nodes);
+        if self.scene_nodes > MAX_SCENE_NODES {
+            self.too_many_objects = true;
+            self.report(
+                Diagnostic::error(
+                    codes::SHAPE_TOO_LARGE,
+                    stmt_span,
+                    "the scene's shapes are too large in total",
+                    format!("with this object they have {} nodes", self.scene_nodes),
+                )
+                .with_note(format!(
+                    "a scene's shapes may have at most {MAX_SCENE_NODES} nodes in all, counting a shared part each time it is used"
+                )),
+            );
+            return;
+        }
         self.objects.push(ir::Object { geometry, span: stmt_span });
     }
 
@@ -437,6 +539,15 @@ impl Ctx<'_> {
                     "this include closes a cycle",
                 )
                 .with_note(format!("include chain: {}", chain.join(" → "))),
+            );
+            return;
+        }
+        self.includes += 1;
+        if self.includes > MAX_INCLUDES {
+            self.halted = true;
+            self.report(
+                Diagnostic::error(codes::INCLUDE_DEPTH, span, "too many includes", "include number 1,001 is here")
+                    .with_note(format!("a compile may carry out at most {MAX_INCLUDES} includes in all")),
             );
             return;
         }
@@ -560,7 +671,15 @@ impl Ctx<'_> {
                 );
             }
         }
-        let mut diags = self.diags;
+        let mut diags: Vec<Diagnostic> = self
+            .diags
+            .into_iter()
+            .zip(self.repeats)
+            .map(|(d, more)| match more {
+                0 => d,
+                n => d.with_note(format!("and {n} more {} here", if n == 1 { "time" } else { "times" })),
+            })
+            .collect();
         diags.sort_by_key(|d| (d.span().start, d.severity));
         if diags.iter().any(Diagnostic::is_error) {
             return (None, diags);
@@ -593,6 +712,10 @@ fn normalize(path: &Path) -> PathBuf {
             c => out.push(c),
         }
     }
+    // `include "."` from a file in the working directory names that directory, not "".
+    if out.as_os_str().is_empty() {
+        out.push(".");
+    }
     out
 }
 
@@ -608,7 +731,14 @@ fn run(
         map,
         loader,
         diags: Vec::new(),
-        reported: HashSet::new(),
+        reported: HashMap::new(),
+        repeats: Vec::new(),
+        error_reports: 0,
+        fuel: MAX_FUEL,
+        calls: HashMap::new(),
+        scene_nodes: 0,
+        halted: false,
+        includes: 0,
         scopes: vec![Vec::new()],
         lets: HashMap::new(),
         camera: None,

@@ -82,9 +82,7 @@ impl Ctx<'_> {
                 return Value::Error;
             };
             return match target {
-                Value::Shape(s) => {
-                    Value::Shape(Arc::new(ir::Shape { kind: ir::ShapeKind::Paint { child: s, material: m }, span }))
-                }
+                Value::Shape(s) => self.shape_value(ir::ShapeKind::Paint { child: s, material: m }, span),
                 Value::Mesh(mesh) => {
                     let mut mesh = (*mesh).clone();
                     // The innermost material wins, as for shapes.
@@ -148,7 +146,7 @@ impl Ctx<'_> {
             }
         };
         match target {
-            Value::Shape(s) => Value::Shape(apply_xf(s, xf, span)),
+            Value::Shape(s) => self.sized(apply_xf(s, xf, span)),
             Value::Mesh(m) => {
                 let mut m = (*m).clone();
                 m.xf = xf * m.xf;
@@ -169,18 +167,16 @@ pub(crate) fn rotation(deg: DVec3) -> DMat3 {
 fn apply_xf(shape: Arc<ir::Shape>, xf: DAffine3, span: Span) -> Arc<ir::Shape> {
     match &shape.kind {
         ir::ShapeKind::Transform { child, xf: inner } => {
-            Arc::new(ir::Shape { kind: ir::ShapeKind::Transform { child: child.clone(), xf: xf * *inner }, span })
+            Arc::new(ir::Shape::new(ir::ShapeKind::Transform { child: child.clone(), xf: xf * *inner }, span))
         }
-        ir::ShapeKind::Paint { child, material } => Arc::new(ir::Shape {
-            kind: ir::ShapeKind::Paint { child: apply_xf(child.clone(), xf, span), material: material.clone() },
-            span: shape.span,
-        }),
+        ir::ShapeKind::Paint { child, material } => Arc::new(ir::Shape::new(
+            ir::ShapeKind::Paint { child: apply_xf(child.clone(), xf, span), material: material.clone() },
+            shape.span,
+        )),
         ir::ShapeKind::Primitive(_)
         | ir::ShapeKind::Csg { .. }
         | ir::ShapeKind::Round { .. }
         | ir::ShapeKind::Shell { .. }
-        | ir::ShapeKind::Repeat { .. } => {
-            Arc::new(ir::Shape { kind: ir::ShapeKind::Transform { child: shape, xf }, span })
-        }
+        | ir::ShapeKind::Repeat { .. } => Arc::new(ir::Shape::new(ir::ShapeKind::Transform { child: shape, xf }, span)),
     }
 }

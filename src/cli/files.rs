@@ -1,23 +1,88 @@
 //! Output files written whole or not at all: to a temporary file beside the target,
-//! then renamed over it, keeping the mode of a file being replaced.
+//! then renamed over it, keeping the mode of a file being replaced. A symbolic link at
+//! the output path is written through (its target is replaced, the link kept), as
+//! editors and `cp` do.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
-/// The usage error for an output path scnc cannot write a PNG to.
+/// Temporary files being written, removed if the process is interrupted.
+static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// On Ctrl-C (SIGINT): remove any temporary file being written and end the process at
+/// once with `code`, leaving every output as it was. Without this a render runs on and
+/// an interrupt during encoding leaves a `.scnc-*.tmp` file behind.
+pub(crate) fn stop_on_interrupt(code: i32) -> Result<(), String> {
+    ctrlc::set_handler(move || {
+        for path in PENDING.lock().map(|p| p.clone()).unwrap_or_default() {
+            let _ = std::fs::remove_file(path);
+        }
+        #[allow(clippy::exit, reason = "the interrupt handler ends the process; the main thread may be mid-render")]
+        std::process::exit(code);
+    })
+    .map_err(|e| format!("cannot handle Ctrl-C: {e}"))
+}
+
+/// Registers a temporary file for removal on interrupt while it lives.
+struct Pending(PathBuf);
+
+impl Pending {
+    fn new(path: &Path) -> Pending {
+        if let Ok(mut p) = PENDING.lock() {
+            p.push(path.to_path_buf());
+        }
+        Pending(path.to_path_buf())
+    }
+}
+
+impl Drop for Pending {
+    fn drop(&mut self) {
+        if let Ok(mut p) = PENDING.lock() {
+            p.retain(|q| *q != self.0);
+        }
+    }
+}
+
+/// The usage error for an output path scnc cannot write a PNG to, found before any work.
 pub(crate) fn check_output(path: &Path) -> Result<(), String> {
+    let shown = path.display();
+    if path.as_os_str().to_string_lossy().ends_with(std::path::MAIN_SEPARATOR) {
+        return Err(format!("cannot write `{shown}`: it names a directory; give a file name ending in `.png`"));
+    }
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     if ext.as_deref() != Some("png") {
-        return Err(format!("cannot write `{}`: scnc writes PNG images; try a `.png` file name", path.display()));
+        return Err(format!("cannot write `{shown}`: scnc writes PNG images; try a `.png` file name"));
     }
-    let out_dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
+    let target = link_target(path);
+    if target.is_dir() {
+        return Err(format!("cannot write `{shown}`: it is a directory"));
+    }
+    let out_dir = parent_dir(&target);
     if !out_dir.is_dir() {
-        return Err(format!("cannot write `{}`: the directory `{}` does not exist", path.display(), out_dir.display()));
+        return Err(format!("cannot write `{shown}`: the directory `{}` does not exist", out_dir.display()));
     }
     Ok(())
+}
+
+/// The directory a file is in (`.` for a bare file name).
+fn parent_dir(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
+/// The file a path finally names, following symbolic links (a dangling one names
+/// where its target would be); `path` itself when it is not a link. A loop of links
+/// stops after 40, like the kernel's limit.
+fn link_target(path: &Path) -> PathBuf {
+    let mut p = path.to_path_buf();
+    for _ in 0..40 {
+        let Ok(next) = std::fs::read_link(&p) else { break };
+        p = if next.is_absolute() { next } else { parent_dir(&p).join(next) };
+    }
+    p
 }
 
 /// Writes `path` through `write` into a temporary file beside it (named with `suffix`),
@@ -27,11 +92,10 @@ pub(crate) fn write_atomic(
     suffix: &str,
     write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
+    let path = &link_target(path);
+    let dir = parent_dir(path);
     let mut tmp = tempfile::Builder::new().prefix(".scnc-").suffix(suffix).tempfile_in(dir)?;
+    let _pending = Pending::new(tmp.path());
     // Replacing a file keeps its permissions (a temporary file is private by default).
     if let Ok(meta) = std::fs::metadata(path) {
         tmp.as_file().set_permissions(meta.permissions())?;

@@ -92,9 +92,15 @@ pub(crate) fn compile(path: &Path, format: MessageFormat) -> Option<Compiled> {
             let message = format!("cannot read `{name}`: {}", scnc::source::io_reason(&e));
             let line = match format {
                 MessageFormat::Human => format!("error[{code}]: {message}"),
+                // The documented fields of every diagnostic: a file that cannot be read
+                // is blamed on a zero-length span at its start.
                 MessageFormat::Json => serde_json::json!({
                     "severity": "error", "code": code, "message": message,
-                    "span": { "file": name }, "related": [], "notes": [], "hints": [],
+                    "span": {
+                        "file": name, "byte_start": 0, "byte_end": 0, "line_start": 1, "column_start": 1,
+                        "line_end": 1, "column_end": 1, "label": "cannot be read",
+                    },
+                    "related": [], "notes": [], "hints": [], "fixes": [],
                 })
                 .to_string(),
             };

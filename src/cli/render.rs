@@ -7,12 +7,12 @@ use std::time::Instant;
 
 use clap::ValueEnum;
 
-use scnc::check::{MAX_DEPTH, MAX_IMAGE_SIDE, MAX_PIXELS, MAX_SAMPLES, MAX_STEPS};
+use scnc::check::{EPSILON_RULE, MAX_DEPTH, MAX_IMAGE_SIDE, MAX_PIXELS, MAX_SAMPLES, MAX_STEPS, MIN_EPSILON};
 use scnc::source::FsLoader;
 use scnc::study::tolerance::Tolerance;
 use scnc::Compiled;
 
-use super::files::{check_output, write_png};
+use super::files::{check_output, stop_on_interrupt, write_png};
 use super::{compile, report, usage_error, worker_pool, MessageFormat};
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -98,10 +98,10 @@ fn parse_detail(s: &str) -> Result<scnc::mesh::Detail, String> {
 
 fn parse_epsilon(s: &str) -> Result<f64, String> {
     let x: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
-    if x > 0.0 && x < 1.0 {
+    if (MIN_EPSILON..1.0).contains(&x) {
         Ok(x)
     } else {
-        Err("must be between 0 and 1 (exclusive)".into())
+        Err(format!("must be {EPSILON_RULE}"))
     }
 }
 
@@ -115,7 +115,8 @@ fn parse_positive(s: &str) -> Result<f64, String> {
 }
 
 pub(crate) fn render_cmd(args: RenderArgs) -> ExitCode {
-    let pool = match args.checked_pool() {
+    // Interrupted, nothing is written: the shell's 128 + SIGINT.
+    let pool = match args.checked_pool(130) {
         Ok(p) => p,
         Err(code) => return code,
     };
@@ -160,10 +161,14 @@ impl RenderArgs {
         })
     }
 
-    /// The worker pool, once the output path is known to be writable: the usage errors
-    /// `render` and `watch` both report before any work.
-    pub(crate) fn checked_pool(&self) -> Result<rayon::ThreadPool, ExitCode> {
+    /// The worker pool, once the output path is known to be writable and Ctrl-C ends the
+    /// process with `interrupted` (leaving no partial output): what `render` and `watch`
+    /// both need before any work.
+    pub(crate) fn checked_pool(&self, interrupted: i32) -> Result<rayon::ThreadPool, ExitCode> {
         check_output(&self.output).map_err(|e| usage_error(&e))?;
+        if let Err(e) = stop_on_interrupt(interrupted) {
+            let _ = writeln!(std::io::stderr(), "warning: {e}");
+        }
         worker_pool(self.threads).map_err(|e| usage_error(&e))
     }
 }

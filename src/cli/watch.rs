@@ -8,37 +8,24 @@ use std::process::ExitCode;
 use super::render::{render_once, RenderArgs};
 use super::usage_error;
 
-/// What wakes `watch` up.
-enum Wake {
-    /// These paths changed.
-    Changed(Vec<PathBuf>),
-    /// Ctrl-C.
-    Stop,
-}
-
 /// How long `watch` waits for more changes before rendering, so one save (often
 /// several file-system events) renders once.
 const DEBOUNCE: std::time::Duration = std::time::Duration::from_millis(150);
 
 pub(crate) fn watch_cmd(args: RenderArgs) -> ExitCode {
     use notify::Watcher as _;
-    let pool = match args.checked_pool() {
+    // Ctrl-C is how a watch ends: at once, even mid-render, with the last image whole
+    // and no temporary file left.
+    let pool = match args.checked_pool(0) {
         Ok(p) => p,
         Err(code) => return code,
     };
-    let (tx, rx) = std::sync::mpsc::channel();
-    let stop = tx.clone();
-    // The handler only wakes the loop, so a render in progress finishes and its output
-    // is written whole (or not at all) before the process ends.
-    if let Err(e) = ctrlc::set_handler(move || {
-        let _ = stop.send(Wake::Stop);
-    }) {
-        let _ = writeln!(std::io::stderr(), "warning: Ctrl-C will stop watch abruptly: {e}");
-    }
+    // The paths each file-system event names.
+    let (tx, rx) = std::sync::mpsc::channel::<Vec<PathBuf>>();
     let watcher = notify::recommended_watcher(move |event: notify::Result<notify::Event>| {
         if let Ok(event) = event {
             if !event.kind.is_access() {
-                let _ = tx.send(Wake::Changed(event.paths));
+                let _ = tx.send(event.paths);
             }
         }
     });
@@ -74,15 +61,15 @@ pub(crate) fn watch_cmd(args: RenderArgs) -> ExitCode {
         // Wait for a change to one of the files, then for the burst of events to end.
         loop {
             match rx.recv() {
-                Ok(Wake::Changed(paths)) if paths.iter().any(|p| files.contains(p)) => break,
-                Ok(Wake::Changed(_)) => {}
-                Ok(Wake::Stop) | Err(_) => return ExitCode::SUCCESS,
+                Ok(paths) if paths.iter().any(|p| files.contains(p)) => break,
+                Ok(_) => {}
+                Err(_) => return ExitCode::SUCCESS,
             }
         }
         loop {
             match rx.recv_timeout(DEBOUNCE) {
-                Ok(Wake::Changed(_)) => {}
-                Ok(Wake::Stop) | Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => return ExitCode::SUCCESS,
+                Ok(_) => {}
+                Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => return ExitCode::SUCCESS,
                 Err(std::sync::mpsc::RecvTimeoutError::Timeout) => break,
             }
         }

@@ -180,6 +180,19 @@ pub struct Shape {
     pub kind: ShapeKind,
     /// The expression it came from.
     pub span: Span,
+    /// Nodes of the tree with shared parts counted each time they are used: what every
+    /// walk of the tree (bounds, lowering, the dump) visits. A repeated shape counts once,
+    /// as its evaluation visits one cell's neighbourhood. Saturates.
+    pub nodes: u64,
+}
+
+impl Shape {
+    /// A node over `kind`, counting its expanded size from its children's.
+    pub fn new(kind: ShapeKind, span: Span) -> Shape {
+        let mut shape = Shape { kind, span, nodes: 1 };
+        shape.nodes = shape.children().iter().fold(1u64, |n, c| n.saturating_add(c.nodes));
+        shape
+    }
 }
 
 /// How a CSG node combines its children.

@@ -146,6 +146,15 @@ pub fn spend(budget: &mut u64, triangles: u64, span: Span) -> Result<(), Diagnos
     Ok(())
 }
 
+/// A size as people write it: exponent form when it is huge.
+fn short(x: f64) -> String {
+    if x.abs() >= 1e6 {
+        format!("{x:e}")
+    } else {
+        ir::dump_num(x)
+    }
+}
+
 fn unbounded(span: Span) -> Diagnostic {
     Diagnostic::error(codes::LOWERING, span, "cannot tessellate an unbounded shape", "this shape has no finite extent")
         .with_note("an isosurface needs finite bounds; only a bare `plane` is meshed as a large square")
@@ -188,6 +197,22 @@ fn isosurface_object(
 ) -> Result<MeshJob, Diagnostic> {
     let Iso { grid, place, material, cell, smooth, from } = iso;
     let bounds = ir::shape_bounds(shape).ok_or_else(|| unbounded(shape.span))?.transform(&grid);
+    // A cell as large as the shape samples a few points around it: the mesh would be a
+    // sliver or nothing, so it is refused like a grid that finds no surface.
+    let across = (bounds.max - bounds.min).length();
+    if cell >= across || cell.is_nan() {
+        let d = Diagnostic::error(
+            codes::LOWERING,
+            span,
+            "isosurface cell is as large as the shape",
+            format!("cell {} for a shape {} across", short(cell), short(across)),
+        )
+        .with_note("a cell must be smaller than the shape for the grid to see it");
+        return Err(match from {
+            CellFrom::Scene => d.with_hint(format!("try `cell = {}` or less", ir::dump_num(across / 20.0))),
+            CellFrom::Detail => d.with_hint("try a higher `--detail`"),
+        });
+    }
     let (dist, mat) = Builder { materials, bytes: 0 }.build(shape, grid, material);
     let mesh = isosurface::extract(&*dist, bounds.min, bounds.max, cell).map_err(|e| match e {
         isosurface::IsoError::TooManyCells { cells, min_cell } => {

@@ -24,6 +24,8 @@ pub const MAX_ELEMENTS: usize = 50_000_000;
 
 /// Parses OBJ text.
 pub fn parse(text: &str) -> Result<TriMesh, ObjError> {
+    // Some exporters start the file with a byte-order mark; it would hide the first `v`.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut mesh = TriMesh::default();
     let mut faces: Vec<(usize, Vec<i64>)> = Vec::new();
     for (n, raw) in text.lines().enumerate() {
@@ -96,6 +98,13 @@ mod tests {
             .expect("valid");
         assert_eq!(m.positions.len(), 4);
         assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3], [0, 1, 2]]);
+    }
+
+    /// A byte-order mark before the first record is skipped, not read into it.
+    #[test]
+    fn a_byte_order_mark_is_skipped() {
+        let m = parse("\u{feff}v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").expect("valid");
+        assert_eq!((m.positions.len(), m.triangles.len()), (3, 1));
     }
 
     #[test]

@@ -223,7 +223,11 @@ where
             .map(|((name, params), value)| StmtKind::Let { name, params, value })
             .labelled("let statement")
             .as_context();
-        let body = stmt.repeated().collect::<Vec<_>>().delimited_by(just(Token::LBrace), just(Token::RBrace));
+        // A body left open at the end of the file ends there (its missing `}` is still
+        // reported): failing the whole loop instead made every enclosing open loop parse
+        // what follows twice, once inside and once after recovery, 2ⁿ times for n levels.
+        let close = just(Token::RBrace).ignored().recover_with(via_parser(end()));
+        let body = stmt.repeated().collect::<Vec<_>>().delimited_by(just(Token::LBrace), close);
         let for_ = just(Token::For)
             .ignore_then(ident())
             .then_ignore(just(Token::In))
@@ -245,7 +249,11 @@ where
             .as_context();
 
         choice((camera, render, light, object, let_, for_, include))
-            .map_with(|kind, e| Stmt { kind, span: Span::from(e.span()) })
+            .map_with(|kind, e| {
+                #[cfg(test)]
+                tests::STATEMENTS_BUILT.with(|c| c.set(c.get() + 1));
+                Stmt { kind, span: Span::from(e.span()) }
+            })
             .labelled("statement")
             // Skip the bad statement up to the next one, so later mistakes are reported too.
             .recover_with(via_parser(
@@ -262,4 +270,29 @@ where
         Stmt { kind: StmtKind::Error, span: Span::from(e.span()) }
     });
     stmt.or(stray_brace).repeated().collect::<Vec<_>>().then_ignore(end()).map(|stmts| File { stmts })
+}
+
+#[cfg(test)]
+mod tests {
+    use std::cell::Cell;
+
+    thread_local! {
+        /// Statements the parser has built, failed attempts included: the parser's work.
+        pub(super) static STATEMENTS_BUILT: Cell<u64> = const { Cell::new(0) };
+    }
+
+    /// Loops left open down to the end of the file are parsed once each: the work grows
+    /// with the input, not 2ⁿ with the depth (judged by statements built, not by time).
+    #[test]
+    fn unclosed_loops_are_parsed_in_linear_work() {
+        for depth in [4u64, 16, 100] {
+            let text = "for i in 0..1 {\nobject sphere(1)\n".repeat(depth as usize);
+            STATEMENTS_BUILT.with(|c| c.set(0));
+            let (file, diags) = crate::syntax::parse(&text, 0);
+            let built = STATEMENTS_BUILT.with(Cell::get);
+            assert!(built <= 2 * depth, "depth {depth}: {built} statements built");
+            assert_eq!(file.stmts.len(), 1, "one outer loop holding the rest");
+            assert!(!diags.is_empty(), "the missing braces are reported");
+        }
+    }
 }

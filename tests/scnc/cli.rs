@@ -253,6 +253,72 @@ fn empty_and_unreadable_files_are_reported_for_what_they_are() {
         serde_json::from_str(String::from_utf8_lossy(&o.stderr).trim()).expect("one JSON line");
     assert_eq!((line["code"].as_str(), line["severity"].as_str()), (Some("E0600"), Some("error")));
     assert_eq!(line["span"]["file"], "no/such/file.scn");
+    // It has the documented fields of every diagnostic, a zero-length span at the start.
+    let o = scnc(&["check", "--message-format", "json", "tests/data/diag/two-syntax-errors.scn"]);
+    let text = String::from_utf8_lossy(&o.stderr);
+    let normal: serde_json::Value = serde_json::from_str(text.lines().next().unwrap_or_default()).expect("JSON");
+    let keys = |v: &serde_json::Value| v.as_object().map(|o| o.keys().cloned().collect::<Vec<_>>()).unwrap_or_default();
+    assert_eq!(keys(&line), keys(&normal));
+    assert_eq!(keys(&line["span"]), keys(&normal["span"]));
+    assert_eq!((line["span"]["byte_start"].as_u64(), line["span"]["line_start"].as_u64()), (Some(0), Some(1)));
+}
+
+/// Output paths that cannot be a PNG file are usage errors (exit 2) before any work; a
+/// symbolic link at the output path is written through, keeping the link and the mode.
+#[cfg(unix)]
+#[test]
+fn output_paths_directories_and_links() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().expect("temp dir");
+    let as_dir = dir.path().join("out.png");
+    std::fs::create_dir(&as_dir).expect("mkdir");
+    let o = scnc(&["render", "examples/seed/01-sphere.scn", "-o", as_dir.to_str().unwrap_or_default()]);
+    assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("it is a directory"));
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("rendered"), "refused before rendering");
+    let slash = format!("{}/", dir.path().join("x.png").display());
+    let o = scnc(&["render", "examples/seed/01-sphere.scn", "-o", &slash]);
+    assert_eq!(o.status.code(), Some(2));
+    // A link to a readable 0644 image: the image is replaced, the link stays a link.
+    let target = dir.path().join("target.png");
+    std::fs::write(&target, b"old").expect("write");
+    std::fs::set_permissions(&target, std::fs::Permissions::from_mode(0o644)).expect("chmod");
+    let link = dir.path().join("link.png");
+    std::os::unix::fs::symlink(&target, &link).expect("symlink");
+    let o = scnc(&["render", "examples/seed/01-sphere.scn", "-o", link.to_str().unwrap_or_default(), "--width", "8"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(std::fs::symlink_metadata(&link).expect("link").file_type().is_symlink(), "the link was replaced");
+    assert!(image::open(&target).is_ok(), "the link's target holds the image");
+    let mode = std::fs::metadata(&target).expect("target").permissions().mode() & 0o777;
+    assert_eq!(mode, 0o644, "the replaced file keeps its mode");
+    let stray: Vec<_> = std::fs::read_dir(dir.path())
+        .expect("dir")
+        .filter_map(Result::ok)
+        .filter(|e| e.file_name().to_string_lossy().starts_with(".scnc-"))
+        .collect();
+    assert!(stray.is_empty(), "temporary files left: {stray:?}");
+}
+
+/// Only regular files are read: a device or a pipe named by `include` (or on the command
+/// line) is a clear error at once, never an endless read or a blocked open.
+#[cfg(unix)]
+#[test]
+fn devices_and_pipes_are_refused() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = dir.path().join("s.scn");
+    std::fs::write(&scene, "include \"/dev/zero\"\ninclude \".\"\n").expect("write");
+    let o = scnc(&["check", scene.to_str().unwrap_or_default()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("it is not a regular file"), "{err}");
+    assert!(err.contains("it is a directory"), "`include \".\"` names the directory: {err}");
+    let fifo = dir.path().join("pipe.scn");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status().is_ok_and(|s| s.success());
+    if made {
+        let o = scnc(&["check", fifo.to_str().unwrap_or_default()]);
+        assert_eq!(o.status.code(), Some(1));
+        assert!(String::from_utf8_lossy(&o.stderr).contains("it is not a regular file"));
+    }
 }
 
 #[test]

@@ -32,8 +32,15 @@ pub const MAX_DEPTH: u32 = 64;
 pub const MAX_SAMPLES: u32 = 256;
 /// Largest sphere-tracing step budget.
 pub const MAX_STEPS: u32 = 1_000_000;
+/// The smallest relative hit threshold: a few f32 ulps (2⁻²³ ≈ 1.2e-7) of the distance
+/// travelled, below which a march cannot get that close to a surface and ends as a miss.
+pub const MIN_EPSILON: f64 = 1e-6;
+/// How a bad `epsilon` is explained, in the scene and on the command line.
+pub const EPSILON_RULE: &str = "at least 1e-6 (f32 cannot resolve less) and less than 1";
 /// Most copies per axis of `repeat`.
 pub const MAX_REPEAT: u32 = 1_000;
+/// Most nodes of one shape, shared parts counted each time they are used.
+pub const MAX_SHAPE_NODES: u64 = 1_000_000;
 
 /// The rule of sizes, radii and intensities that must be positive.
 const POS: &str = "greater than 0";
@@ -122,16 +129,52 @@ impl Ctx<'_> {
     }
 
     /// The shape value of a node made by a constructor, or `Value::Error` if it reported.
-    fn shape(kind: Option<ShapeKind>, span: Span) -> Value {
-        kind.map_or(Value::Error, |kind| Value::Shape(Arc::new(ir::Shape { kind, span })))
+    fn shape(&mut self, kind: Option<ShapeKind>, span: Span) -> Value {
+        kind.map_or(Value::Error, |kind| self.shape_value(kind, span))
+    }
+
+    /// The shape value of a new node, if its tree is not too large.
+    pub(in crate::check) fn shape_value(&mut self, kind: ShapeKind, span: Span) -> Value {
+        self.sized(Arc::new(ir::Shape::new(kind, span)))
+    }
+
+    /// `shape` as a value, or an error at its span when its tree, with shared parts
+    /// counted each time they are used, has more than [`MAX_SHAPE_NODES`] nodes: every
+    /// later stage walks the expanded tree, so a doubling `let` chain would otherwise
+    /// build a small value that takes hours to lower.
+    pub(in crate::check) fn sized(&mut self, shape: Arc<ir::Shape>) -> Value {
+        if shape.nodes <= MAX_SHAPE_NODES {
+            return Value::Shape(shape);
+        }
+        self.report(
+            Diagnostic::error(
+                codes::SHAPE_TOO_LARGE,
+                shape.span,
+                "this shape is too large",
+                format!("it expands to {} nodes", shape.nodes),
+            )
+            .with_note(format!(
+                "a shape may have at most {MAX_SHAPE_NODES} nodes, counting a shared part each time it is used"
+            )),
+        );
+        Value::Error
     }
 
     /// Builds the value of a builtin call whose arguments are bound and well typed.
     pub(super) fn construct(&mut self, b: &Builtin, a: BoundArgs) -> Value {
         match b.ctor {
-            Ctor::Primitive(p) => Self::shape(self.primitive(b, p, &a).map(ShapeKind::Primitive), a.call),
-            Ctor::Csg(op) => Self::shape(self.csg(b, op, &a), a.call),
-            Ctor::Modifier(m) => Self::shape(self.modifier(b, m, &a), a.call),
+            Ctor::Primitive(p) => {
+                let kind = self.primitive(b, p, &a).map(ShapeKind::Primitive);
+                self.shape(kind, a.call)
+            }
+            Ctor::Csg(op) => {
+                let kind = self.csg(b, op, &a);
+                self.shape(kind, a.call)
+            }
+            Ctor::Modifier(m) => {
+                let kind = self.modifier(b, m, &a);
+                self.shape(kind, a.call)
+            }
             Ctor::Material => self.material(b, &a),
             Ctor::Rgb => self.rgb(b, &a),
             Ctor::Light(l) => self.light(b, l, &a),
@@ -233,7 +276,7 @@ impl Ctx<'_> {
         let width = self.check_int(&a, b, 0, 1, MAX_IMAGE_SIDE);
         let height = self.check_int(&a, b, 1, 1, MAX_IMAGE_SIDE);
         let depth = self.check_int(&a, b, 2, 0, MAX_DEPTH);
-        let ok_eps = self.check_num(&a, b, 4, |e| e > 0.0 && e < 1.0, "between 0 and 1 (exclusive)");
+        let ok_eps = self.check_num(&a, b, 4, |e| (MIN_EPSILON..1.0).contains(&e), EPSILON_RULE);
         let steps = self.check_int(&a, b, 5, 1, MAX_STEPS);
         let ok_dist = self.check_num(&a, b, 6, |d| d > 0.0, "greater than 0");
         let samples = self.check_int(&a, b, 7, 1, MAX_SAMPLES);

@@ -1,0 +1,60 @@
+//! Work amplification: inputs whose work grows exponentially or quadratically while
+//! every depth limit holds end with a clear error, judged by diagnostics and counts,
+//! never by wall time. (The goldens `tests/data/diag/fuel-*`, `shape-doubling` and
+//! `error-in-long-loop` pin the messages.)
+
+use std::path::Path;
+
+use scnc::source::FsLoader;
+
+/// The codes of a compile's errors, in order.
+fn error_codes(path: &Path) -> Vec<&'static str> {
+    let text = std::fs::read_to_string(path).expect("reading the case");
+    let c = scnc::with_big_stack(|| scnc::compile_source("t.scn", path, text, &FsLoader));
+    c.diagnostics.iter().filter(|d| d.is_error()).map(|d| d.code).collect()
+}
+
+/// Sixteen files each including the next twice would read 65,536 files: the include
+/// count stops it after 1,000 with one error.
+#[test]
+fn doubling_includes_stop_at_the_include_count() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    for i in 0..16 {
+        let text = if i == 15 {
+            "light ambient(1)\n".to_string()
+        } else {
+            format!("include \"f{}.scn\"\ninclude \"f{}.scn\"\n", i + 1, i + 1)
+        };
+        std::fs::write(dir.path().join(format!("f{i}.scn")), text).expect("write");
+    }
+    let codes = error_codes(&dir.path().join("f0.scn"));
+    assert_eq!(codes, vec![scnc::diag::codes::INCLUDE_DEPTH], "one error: too many includes");
+}
+
+/// The same error in every iteration of a long loop is one diagnostic with a count,
+/// and evaluation stops at the error cap: the loop of a million stops after 10,000.
+#[test]
+fn an_error_in_a_long_loop_is_reported_once() {
+    let text = std::fs::read_to_string("tests/data/diag/error-in-long-loop.scn").expect("case");
+    let c = scnc::compile_source("t.scn", Path::new("t.scn"), text, &FsLoader);
+    let errors: Vec<_> = c.diagnostics.iter().filter(|d| d.is_error()).collect();
+    assert_eq!(errors.len(), 2, "the unknown function once, then the cap: {errors:#?}");
+    assert!(errors.iter().any(|d| d.notes.iter().any(|n| n == "and 9999 more times here")), "{errors:#?}");
+    assert!(errors.iter().any(|d| d.code == scnc::diag::codes::TOO_MANY_ERRORS));
+}
+
+/// Doubling function calls, doubling shape DAGs and copied lists end with their own
+/// error, whatever the depth limits say.
+#[test]
+fn doubling_work_ends_with_its_limit() {
+    use scnc::diag::codes;
+    for (case, code) in [
+        ("fuel-doubling-calls", codes::OUT_OF_FUEL),
+        ("shape-doubling", codes::SHAPE_TOO_LARGE),
+        ("fuel-list-copies", codes::OUT_OF_FUEL),
+    ] {
+        let codes = error_codes(Path::new(&format!("tests/data/diag/{case}.scn")));
+        assert_eq!(codes.first(), Some(&code), "{case}: {codes:?}");
+        assert!(codes.len() <= 3, "{case}: a few errors, not one per step: {codes:?}");
+    }
+}
