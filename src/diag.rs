@@ -275,6 +275,8 @@ pub mod codes {
     pub const NOT_FINITE: &str = "E0401";
     /// Degenerate camera.
     pub const BAD_CAMERA: &str = "E0402";
+    /// Beyond the renderable range.
+    pub const OUT_OF_REACH: &str = "E0403";
     /// `camera` or `render` given twice.
     pub const DUPLICATE_STATEMENT: &str = "E0500";
     /// `object` of something that is not a shape or mesh.

@@ -17,6 +17,7 @@ mod call;
 mod construct;
 mod expr;
 pub mod index;
+mod range;
 mod transform;
 mod value;
 
@@ -35,6 +36,7 @@ pub use construct::{
     EPSILON_RULE, MAX_DEPTH, MAX_GENERATED_TRIANGLES, MAX_IMAGE_SIDE, MAX_MESH_RESOLUTION, MAX_PIXELS, MAX_REPEAT,
     MAX_SAMPLES, MAX_STEPS, MIN_EPSILON,
 };
+pub use range::{MAX_INTENSITY, MAX_REACH, MIN_SIZE};
 pub use value::Value;
 
 /// Most loop iterations in one compile, over all loops.
@@ -658,6 +660,7 @@ impl Ctx<'_> {
             }
         }
         let camera = self.camera.clone().unwrap_or_default();
+        self.check_range(&camera);
         for obj in &self.objects.clone() {
             if let Some(dist) = behind_camera(obj, &camera) {
                 self.report(

@@ -107,10 +107,10 @@ fn parse_epsilon(s: &str) -> Result<f64, String> {
 
 fn parse_positive(s: &str) -> Result<f64, String> {
     let x: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
-    if x > 0.0 && x.is_finite() {
+    if x > 0.0 && x <= scnc::check::MAX_REACH {
         Ok(x)
     } else {
-        Err("must be a finite number greater than 0".into())
+        Err("must be greater than 0 and at most 1e15 (the renderable range)".into())
     }
 }
 

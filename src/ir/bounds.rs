@@ -138,7 +138,7 @@ pub fn shape_sphere(shape: &Shape) -> Option<(DVec3, f64)> {
 
 /// An upper bound of the largest singular value (how far the map can stretch a
 /// vector): the largest column-norm sum bound, exact for rotations and scales.
-fn max_stretch(m: glam::DMat3) -> f64 {
+pub fn max_stretch(m: glam::DMat3) -> f64 {
     let mtm = m.transpose() * m;
     // The largest eigenvalue of the symmetric mᵀm is at most its largest absolute row sum.
     let rows = [mtm.row(0), mtm.row(1), mtm.row(2)];

@@ -93,6 +93,12 @@ pub fn lower(
             }
         })
         .collect();
+    // The checker's renderable range (check::range) keeps camera-relative f32 finite.
+    debug_assert!(
+        objects.iter().all(|o| o.bounds.is_none_or(|b| b.min.is_finite() && b.max.is_finite())
+            && o.sphere.is_none_or(|(c, r)| c.is_finite() && r.is_finite())),
+        "lowering made a non-finite bound"
+    );
     let closure_bytes = builder.bytes;
     let bounded: Vec<u32> = (0..objects.len() as u32)
         .filter(|&i| objects[i as usize].bounds.is_some_and(|b| b.min.cmple(b.max).all()))

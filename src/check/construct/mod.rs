@@ -278,7 +278,7 @@ impl Ctx<'_> {
         let depth = self.check_int(&a, b, 2, 0, MAX_DEPTH);
         let ok_eps = self.check_num(&a, b, 4, |e| (MIN_EPSILON..1.0).contains(&e), EPSILON_RULE);
         let steps = self.check_int(&a, b, 5, 1, MAX_STEPS);
-        let ok_dist = self.check_num(&a, b, 6, |d| d > 0.0, "greater than 0");
+        let ok_dist = self.check_num(&a, b, 6, |d| d > 0.0 && d <= super::MAX_REACH, "greater than 0 and at most 1e15");
         let samples = self.check_int(&a, b, 7, 1, MAX_SAMPLES);
         let ok_ao = self.check_num(&a, b, 8, |d| d >= 0.0, "at least 0 (0 turns it off)");
         let (Some(width), Some(height), Some(depth), true, Some(max_steps), true, Some(samples)) =
