@@ -60,18 +60,23 @@ pub struct Compiled {
     pub diagnostics: Vec<Diagnostic>,
 }
 
-/// Compiles scene text named `name` (whose includes resolve relative to `path`).
+/// Compiles scene text named `name` (whose includes resolve relative to `path`). Text
+/// over [`source::MAX_FILE_BYTES`] is refused whatever it came from (a file, or an
+/// editor's open document).
 pub fn compile_source(name: &str, path: &Path, text: String, loader: &dyn Loader) -> Compiled {
     let mut map = SourceMap::new();
-    let Some(root) = map.add(name, path, text) else {
+    let bytes = text.len();
+    let root = if bytes > source::MAX_FILE_BYTES { None } else { map.add(name, path, text) };
+    let Some(root) = root else {
         let mut map = SourceMap::new();
         let _ = map.add(name, path, String::new());
         let d = Diagnostic::error(
             diag::codes::TOO_LARGE,
             span::Span::default(),
             format!("`{name}` is too large"),
-            "the file is too large",
-        );
+            format!("the file has {bytes} bytes"),
+        )
+        .with_note(format!("a source file may have at most {} MiB", source::MAX_FILE_BYTES >> 20));
         return Compiled { map, scene: None, diagnostics: vec![d] };
     };
     let (scene, diagnostics) = check::check(&mut map, root, loader);

@@ -144,7 +144,9 @@ fn run(cli: Cli) -> ExitCode {
         Command::Watch(args) => watch::watch_cmd(args),
         Command::Sweep(args) => sweep::sweep_cmd(args),
         Command::Fmt { files, check } => fmt::fmt_cmd(&files, check),
-        Command::Lsp => match scnc::lsp::run_stdio() {
+        Command::Lsp => match scnc::lsp::run_stdio(|why| {
+            let _ = writeln!(std::io::stderr(), "scnc lsp: {why}");
+        }) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {
                 let _ = writeln!(std::io::stderr(), "error: the language server stopped: {e}");

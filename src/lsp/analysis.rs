@@ -94,6 +94,12 @@ impl Analysis {
         crate::with_big_stack(|| {
             let mut map = SourceMap::new();
             let name = path.display().to_string();
+            // Too large a document gets `compile_source`'s error, as the same file on disk
+            // would (it used to be analysed as if empty).
+            if text.len() > crate::source::MAX_FILE_BYTES {
+                let compiled = crate::compile_source(&name, path, text, loader);
+                return Analysis { map: compiled.map, diagnostics: compiled.diagnostics, index: Index::default() };
+            }
             let Some(root) = map.add(&name, path, text) else {
                 let compiled = crate::compile_source(&name, path, String::new(), loader);
                 return Analysis { map: compiled.map, diagnostics: compiled.diagnostics, index: Index::default() };

@@ -8,6 +8,7 @@
 
 pub mod analysis;
 pub mod text;
+pub mod wire;
 
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
@@ -30,12 +31,41 @@ use crate::source::SourceMap;
 use crate::source::{FsLoader, Loader};
 use crate::span::Span;
 
-/// Serves the protocol on stdin/stdout until the client asks to exit.
-pub fn run_stdio() -> Result<(), String> {
-    let (connection, io) = Connection::stdio();
-    serve(&connection)?;
-    drop(connection);
-    io.join().map_err(|e| e.to_string())
+/// Serves the protocol on stdin/stdout until the client asks to exit (or the input
+/// ends). Frames that cannot be messages are skipped and described to `log`, so no input
+/// ends the server.
+pub fn run_stdio(log: impl Fn(String) + Send + 'static) -> Result<(), String> {
+    let (to_server, receiver) = crossbeam_channel::bounded::<Message>(0);
+    let (sender, to_client) = crossbeam_channel::bounded::<Message>(0);
+    let reader = std::thread::spawn(move || -> std::io::Result<()> {
+        let mut input = std::io::stdin().lock();
+        loop {
+            match wire::read_frame(&mut input)? {
+                wire::Frame::Message(m) => {
+                    let exit = matches!(&m, Message::Notification(n) if n.method == "exit");
+                    if to_server.send(m).is_err() || exit {
+                        return Ok(());
+                    }
+                }
+                wire::Frame::Skipped(why) => log(format!("skipped {why}")),
+                wire::Frame::End => return Ok(()),
+            }
+        }
+    });
+    let writer = std::thread::spawn(move || -> std::io::Result<()> {
+        let mut out = std::io::stdout().lock();
+        for m in to_client {
+            m.write(&mut out)?;
+        }
+        Ok(())
+    });
+    let served = serve(&Connection { sender, receiver });
+    // Dropping the connection ends the writer; the reader ends with its input.
+    let wrote = writer.join().map_err(|_| "the writer thread panicked".to_string())?;
+    wrote.map_err(|e| e.to_string())?;
+    served?;
+    drop(reader);
+    Ok(())
 }
 
 /// What the server offers.
@@ -62,17 +92,26 @@ fn capabilities() -> lt::ServerCapabilities {
 /// Runs the protocol on `connection`: the handshake, then requests until shutdown.
 pub fn serve(connection: &Connection) -> Result<(), String> {
     let caps = serde_json::to_value(capabilities()).map_err(|e| e.to_string())?;
-    connection.initialize(caps).map_err(|e| e.to_string())?;
+    connection.initialize(caps).map_err(|e| format!("the client sent no `initialize` request ({e})"))?;
     let mut server = Server { docs: HashMap::new(), published: HashMap::new(), cache: Cache::default() };
+    let mut shut_down = false;
     for msg in &connection.receiver {
         match msg {
+            Message::Request(req) if req.method == "shutdown" => {
+                shut_down = true;
+                connection.sender.send(Response::new_ok(req.id, ()).into()).map_err(|e| e.to_string())?;
+            }
+            Message::Request(req) if shut_down => {
+                // After `shutdown` only `exit` is expected; anything else is refused, not fatal.
+                let code = lsp_server::ErrorCode::InvalidRequest as i32;
+                let resp = Response::new_err(req.id, code, "the server is shutting down".into());
+                connection.sender.send(resp.into()).map_err(|e| e.to_string())?;
+            }
             Message::Request(req) => {
-                if connection.handle_shutdown(&req).map_err(|e| e.to_string())? {
-                    return Ok(());
-                }
                 let resp = server.request(req);
                 connection.sender.send(resp.into()).map_err(|e| e.to_string())?;
             }
+            Message::Notification(note) if note.method == "exit" => return Ok(()),
             Message::Notification(note) => {
                 for out in server.notification(note) {
                     connection.sender.send(out.into()).map_err(|e| e.to_string())?;

@@ -301,3 +301,56 @@ fn diagnostics_in_an_included_file_go_to_that_file() {
     assert!(c.diagnostics(&doc).is_empty());
     c.stop();
 }
+
+/// The server never dies of its input: malformed frames are skipped, an oversized
+/// document is a diagnostic, a document including a device is an error, a request after
+/// `shutdown` is refused with an error reply, and `exit` still ends it cleanly.
+#[test]
+fn malformed_input_never_ends_the_server() {
+    let mut client = Client::start();
+    let raw = |client: &mut Client, bytes: &[u8]| {
+        client.stdin.write_all(bytes).expect("writing");
+        client.stdin.flush().expect("flushing");
+    };
+    raw(&mut client, b"Content-Length: 99999999999999999999999\r\n\r\n");
+    raw(&mut client, b"Content-Length: 9\r\n\r\n{not json");
+    raw(&mut client, b"Content-Length: 3\r\n\r\n\xff\xfe\xfd");
+    raw(&mut client, b"Content-Type: nothing\r\n\r\n");
+    // Still answering.
+    let dir = tempfile::tempdir().expect("temp dir");
+    let file = dir.path().join("dev.scn");
+    let u = uri(&file);
+    client.open(&u, "include \"/dev/stdin\"\nlight ambient(1)\nobject sphere(1) at [0, 0, 5]\n");
+    let diags = client.diagnostics(&u);
+    assert!(
+        diags.iter().any(|d| d["message"].as_str().is_some_and(|m| m.contains("cannot read `/dev/stdin`"))),
+        "{diags:?}"
+    );
+    let big = format!("// {}\nlight ambient(1)\n", "x".repeat(5 << 20));
+    let large = dir.path().join("large.scn");
+    client.open(&uri(&large), &big);
+    let diags = client.diagnostics(&uri(&large));
+    assert!(diags.iter().any(|d| d["code"] == "E0705"), "{diags:?}");
+    client.request("shutdown", Value::Null);
+    let id = client.next_id;
+    client.next_id += 1;
+    client.send(json!({ "jsonrpc": "2.0", "id": id, "method": "textDocument/hover", "params": {} }));
+    let deadline = Instant::now() + TIMEOUT;
+    let reply = loop {
+        let msg = client.next(deadline);
+        if msg["id"] == json!(id) {
+            break msg;
+        }
+    };
+    assert!(reply.get("error").is_some(), "a request after shutdown is refused: {reply}");
+    client.notify("exit", Value::Null);
+    let deadline = Instant::now() + TIMEOUT;
+    loop {
+        if let Some(status) = client.child.try_wait().expect("waiting for the server") {
+            assert!(status.success(), "scnc lsp exited with {status}");
+            break;
+        }
+        assert!(Instant::now() < deadline, "scnc lsp did not exit after `exit`");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
