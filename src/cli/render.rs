@@ -73,6 +73,10 @@ pub(crate) struct RenderArgs {
     /// `high` (14 rings, 50-point circles) or N (N rings, 2N-point circles).
     #[arg(long, value_parser = parse_detail, default_value = "high")]
     detail: scnc::mesh::Detail,
+    /// Most memory the scene's meshes may take while they are built, in bytes or with a
+    /// K, M or G suffix (binary); a mesh that would need more is refused before it is made.
+    #[arg(long, value_parser = parse_bytes, default_value = "4G")]
+    memory_limit: u64,
     /// Print the effect set, ray counts, work per ray and memory.
     #[arg(long)]
     stats: bool,
@@ -102,6 +106,22 @@ fn parse_epsilon(s: &str) -> Result<f64, String> {
         Ok(x)
     } else {
         Err(format!("must be {EPSILON_RULE}"))
+    }
+}
+
+/// A byte count: a whole number, optionally with a K, M or G suffix (powers of 1024).
+fn parse_bytes(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let (digits, shift) = match t.char_indices().last() {
+        Some((i, 'K' | 'k')) => (&t[..i], 10),
+        Some((i, 'M' | 'm')) => (&t[..i], 20),
+        Some((i, 'G' | 'g')) => (&t[..i], 30),
+        _ => (t, 0),
+    };
+    let n: u64 = digits.parse().map_err(|_| format!("`{s}` is not a size: try `4G`, `512M` or a number of bytes"))?;
+    match n.checked_mul(1 << shift) {
+        Some(bytes) if bytes > 0 => Ok(bytes),
+        _ => Err(format!("`{s}` must be greater than 0 and at most {} bytes", u64::MAX)),
     }
 }
 
@@ -202,7 +222,7 @@ fn render_compiled(args: &RenderArgs, pool: &rayon::ThreadPool, compiled: Compil
         EffectsArg::Derived => scnc::render::effects::derive(&scene),
         EffectsArg::All => scnc::render::effects::Effects::all(&scene),
     };
-    let lowered = pool.install(|| scnc::world::prepare(&scene, effects, mode, &FsLoader));
+    let lowered = pool.install(|| scnc::world::prepare_within(&scene, effects, mode, &FsLoader, args.memory_limit));
     let (frame, geometry) = match lowered {
         Ok(g) => g,
         Err(d) => {

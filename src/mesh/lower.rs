@@ -21,7 +21,7 @@ pub fn tessellate(
     xf: DAffine3,
     detail: Detail,
     max_distance: f64,
-    budget: &mut u64,
+    budget: &mut Budget,
     materials: &mut MaterialTable,
 ) -> Result<MeshJob, Diagnostic> {
     // Walk down through transforms and materials to what decides how it is made.
@@ -54,13 +54,13 @@ pub fn tessellate(
     };
     match made {
         Generator::Triangles(triangles, make) => {
-            spend(budget, triangles, shape.span)?;
+            budget.spend(triangles, shape.span)?;
             // A generator's polytope is convex exactly when its shape is (tested for each);
             // isosurfaces (below) may dent even a convex shape, so they are never marked.
             Ok(MeshJob { mesh: make(), xf, material, per_triangle: None, smooth: false, convex: node.is_convex() })
         }
         Generator::Square { normal, offset } => {
-            spend(budget, tessellate::count::SQUARE, shape.span)?;
+            budget.spend(tessellate::count::SQUARE, shape.span)?;
             // A square centred on the point of the plane nearest the camera, reaching the far limit.
             let inv = xf.inverse();
             let eye = inv.transform_point3(DVec3::ZERO);
@@ -84,7 +84,7 @@ pub fn tessellate(
             let iso =
                 Iso { grid: xf, place: DAffine3::IDENTITY, material, cell, smooth: false, from: CellFrom::Detail };
             let job = isosurface_object(node, iso, node.span, materials)?;
-            spend(budget, job.mesh.triangles.len() as u64, shape.span)?;
+            budget.spend(job.mesh.triangles.len() as u64, shape.span)?;
             Ok(job)
         }
     }
@@ -129,21 +129,69 @@ fn generator(p: &Primitive, detail: Detail) -> Generator {
 /// Most triangles all meshes of one scene may have together (about 2.4 GB with BVHs).
 pub const MAX_SCENE_TRIANGLES: u64 = 50_000_000;
 
-/// Takes `triangles` from the scene's remaining budget, or reports the object that would
-/// exceed it, before anything is allocated.
-pub fn spend(budget: &mut u64, triangles: u64, span: Span) -> Result<(), Diagnostic> {
-    if triangles > *budget {
-        return Err(Diagnostic::error(
-            codes::LOWERING,
-            span,
-            "the scene's meshes would have too many triangles",
-            format!("this object needs {triangles} more triangles"),
-        )
-        .with_note(format!("a scene may have at most {MAX_SCENE_TRIANGLES} triangles in all its meshes"))
-        .with_hint("try a lower `--detail`, or fewer or coarser meshes"));
+/// Bytes one triangle may take at the peak of lowering, an upper estimate: the mesh in
+/// f64 as generated, its camera-relative f32 copy with smooth normals and indices, the
+/// BVH build's boxes, centres and order, and the BVH. Measured: a 10 M-triangle smooth
+/// UV sphere peaks at 121 bytes per triangle of the whole process (`/usr/bin/time -f %M
+/// scnc render` of `uvsphere(rings = 2237, segments = 2237, smooth = true)`), 113 flat;
+/// what meshes keep afterwards is checked in `tests/scnc/mesh.rs`
+/// (`memory_estimate_bounds_what_meshes_keep`).
+pub const BYTES_PER_TRIANGLE: u64 = 144;
+
+/// The default memory limit for meshes: 4 GiB, room on a laptop and on the test machine.
+pub const DEFAULT_MEMORY_LIMIT: u64 = 4 << 30;
+
+/// What the scene's meshes may still use: triangles, and bytes at the estimate above.
+#[derive(Clone, Copy, Debug)]
+pub struct Budget {
+    triangles: u64,
+    bytes: u64,
+    limit: u64,
+}
+
+impl Budget {
+    /// The whole budget, for a memory limit in bytes.
+    pub fn new(memory_limit: u64) -> Budget {
+        Budget { triangles: MAX_SCENE_TRIANGLES, bytes: memory_limit, limit: memory_limit }
     }
-    *budget -= triangles;
-    Ok(())
+
+    /// Takes `triangles` from what is left, or reports the object that would exceed the
+    /// triangle count or the memory limit, before anything is allocated.
+    pub fn spend(&mut self, triangles: u64, span: Span) -> Result<(), Diagnostic> {
+        if triangles > self.triangles {
+            return Err(Diagnostic::error(
+                codes::LOWERING,
+                span,
+                "the scene's meshes would have too many triangles",
+                format!("this object needs {triangles} more triangles"),
+            )
+            .with_note(format!("a scene may have at most {MAX_SCENE_TRIANGLES} triangles in all its meshes"))
+            .with_hint("try a lower `--detail`, or fewer or coarser meshes"));
+        }
+        let bytes = triangles.saturating_mul(BYTES_PER_TRIANGLE);
+        if bytes > self.bytes {
+            return Err(Diagnostic::error(
+                codes::LOWERING,
+                span,
+                "the scene's meshes would need more memory than the limit",
+                format!("this object needs about {} ({triangles} triangles)", mib(bytes)),
+            )
+            .with_note(format!(
+                "the memory limit is {}, of which {} is left; a triangle takes up to {BYTES_PER_TRIANGLE} bytes while it is built",
+                mib(self.limit),
+                mib(self.bytes)
+            ))
+            .with_hint("try a lower `--detail`, coarser meshes, or a higher `--memory-limit`"));
+        }
+        self.triangles -= triangles;
+        self.bytes -= bytes;
+        Ok(())
+    }
+}
+
+/// Bytes in MiB, for people.
+fn mib(bytes: u64) -> String {
+    format!("{:.0} MiB", bytes as f64 / (1u64 << 20) as f64)
 }
 
 /// A size as people write it: exponent form when it is huge.
@@ -259,7 +307,7 @@ fn isosurface_object(
 pub fn explicit(
     m: &ir::Mesh,
     to_render: DAffine3,
-    budget: &mut u64,
+    budget: &mut Budget,
     materials: &mut MaterialTable,
     loader: &dyn Loader,
 ) -> Result<MeshJob, Diagnostic> {
@@ -277,7 +325,7 @@ pub fn explicit(
         MeshSource::Isosurface { .. } | MeshSource::File { .. } => None,
     };
     if let Some(n) = expected {
-        spend(budget, n, m.span)?;
+        budget.spend(n, m.span)?;
     }
     let local: TriMesh = match &m.source {
         MeshSource::UvSphere { radius, rings, segments } => tessellate::uvsphere(*radius, *rings, *segments),
@@ -299,7 +347,7 @@ pub fn explicit(
                 from: CellFrom::Scene,
             };
             let job = isosurface_object(shape, iso, m.span, materials)?;
-            spend(budget, job.mesh.triangles.len() as u64, m.span)?;
+            budget.spend(job.mesh.triangles.len() as u64, m.span)?;
             return Ok(job);
         }
         MeshSource::File { path, written } => {
@@ -325,7 +373,7 @@ pub fn explicit(
         }
     };
     if expected.is_none() {
-        spend(budget, local.triangles.len() as u64, m.span)?;
+        budget.spend(local.triangles.len() as u64, m.span)?;
     }
     Ok(MeshJob { mesh: local, xf, material, per_triangle: None, smooth: m.smooth, convex: m.is_convex() })
 }
@@ -382,18 +430,20 @@ mod tests {
         }
     }
 
-    /// The budget is spent before anything is allocated, and exceeding it is an error at
-    /// the object's span, never a partial spend.
+    /// The budget is spent before anything is allocated, and exceeding it (in triangles
+    /// or in bytes) is an error at the object's span, never a partial spend.
     #[test]
-    fn triangle_budget_is_checked_before_spending() {
+    fn budget_is_checked_before_spending() {
         let span = Span::new(3, 9);
-        let mut budget = 10;
-        assert!(spend(&mut budget, 4, span).is_ok());
-        assert_eq!(budget, 6);
-        let err = spend(&mut budget, 7, span).expect_err("over budget");
+        let mut budget = Budget::new(10 * BYTES_PER_TRIANGLE);
+        assert!(budget.spend(4, span).is_ok());
+        let err = budget.spend(7, span).expect_err("over the memory limit");
         assert_eq!((err.code, err.span()), (codes::LOWERING, span));
-        assert_eq!(budget, 6, "a refused spend takes nothing");
-        assert!(spend(&mut budget, 6, span).is_ok());
-        assert_eq!(budget, 0);
+        assert!(err.message.contains("memory"), "{}", err.message);
+        assert!(budget.spend(6, span).is_ok(), "a refused spend takes nothing");
+        assert!(budget.spend(1, span).is_err());
+        let mut roomy = Budget::new(u64::MAX);
+        assert!(roomy.spend(MAX_SCENE_TRIANGLES, span).is_ok());
+        assert!(roomy.spend(1, span).expect_err("over the triangle count").message.contains("triangles"));
     }
 }

@@ -26,33 +26,47 @@ fn pad_box(b: ir::Aabb) -> Aabb {
 }
 
 /// Builds the frame for `effects` and lowers the scene into a world, with the scene's
-/// own sphere-tracing settings: the one call the CLI, tests and benchmarks use.
+/// own sphere-tracing settings and the default memory limit: the one call the CLI,
+/// tests and benchmarks use.
 pub fn prepare(
     scene: &ir::Scene,
     effects: crate::render::effects::Effects,
     mode: Mode,
     loader: &dyn Loader,
 ) -> Result<(Frame, World), Diagnostic> {
+    prepare_within(scene, effects, mode, loader, mesh::lower::DEFAULT_MEMORY_LIMIT)
+}
+
+/// [`prepare`] with meshes limited to `memory_limit` bytes (at
+/// [`mesh::lower::BYTES_PER_TRIANGLE`] each), refused before anything is allocated.
+pub fn prepare_within(
+    scene: &ir::Scene,
+    effects: crate::render::effects::Effects,
+    mode: Mode,
+    loader: &dyn Loader,
+    memory_limit: u64,
+) -> Result<(Frame, World), Diagnostic> {
     let mut frame = Frame::with_effects(scene, effects);
     let params = MarchParams { epsilon: scene.settings.epsilon as f32, max_steps: scene.settings.max_steps };
-    let world = lower(scene, &mut frame, mode, params, loader)?;
+    let budget = mesh::lower::Budget::new(memory_limit);
+    let world = lower(scene, &mut frame, mode, params, loader, budget)?;
     Ok((frame, world))
 }
 
-/// Lowers every object of the scene. Materials are interned into `frame`; mesh files
-/// are read through `loader`.
+/// Lowers every object of the scene within `budget`. Materials are interned into
+/// `frame`; mesh files are read through `loader`.
 pub fn lower(
     scene: &ir::Scene,
     frame: &mut Frame,
     mode: Mode,
     params: MarchParams,
     loader: &dyn Loader,
+    mut budget: mesh::lower::Budget,
 ) -> Result<World, Diagnostic> {
     // Render space: world translated so the camera is at the origin, composed in f64.
     let to_render = DAffine3::from_translation(-frame.origin);
     let max_distance = frame.max_distance as f64;
     let mut builder = sdf::Builder { materials: &mut frame.materials, bytes: 0 };
-    let mut budget = mesh::lower::MAX_SCENE_TRIANGLES;
     // In scene order: materials are interned and the triangle budget spent as objects
     // come, so ids and errors do not depend on timing. Meshes are built afterwards.
     let mut lowered = Vec::with_capacity(scene.objects.len());

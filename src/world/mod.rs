@@ -17,7 +17,7 @@ mod query;
 
 use glam::Vec3A;
 
-pub use lower::{lower, prepare};
+pub use lower::{lower, prepare, prepare_within};
 pub use query::sphere_interval;
 
 use crate::accel::{Aabb, Bvh};

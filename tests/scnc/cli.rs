@@ -349,3 +349,23 @@ fn fmt_rewrites_in_place_and_check_lists_what_would_change() {
     assert!(err.contains("E0100") && err.contains("was not formatted"), "{err}");
     assert_eq!(std::fs::read_to_string(&broken).expect("reading"), "object sphere(1 at [0, 0, 5]\n");
 }
+
+/// `--memory-limit` takes sizes with K, M or G; a mesh over it is an error before it is
+/// built, and a bad size is a usage error.
+#[test]
+fn memory_limit_refuses_meshes_before_building_them() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let png = dir.path().join("m.png");
+    let png = png.to_str().unwrap_or_default();
+    let scene = "examples/features/meshes.scn";
+    let o = scnc(&["render", scene, "-o", png, "--width", "16", "--height", "16", "--memory-limit", "64K"]);
+    assert_eq!(o.status.code(), Some(1), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("more memory than the limit"));
+    assert!(std::fs::metadata(png).is_err(), "nothing is written");
+    let o = scnc(&["render", scene, "-o", png, "--width", "16", "--height", "16", "--memory-limit", "512M"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    for bad in ["0", "lots", "4T", "99999999999G"] {
+        let o = scnc(&["render", scene, "-o", png, "--memory-limit", bad]);
+        assert_eq!(o.status.code(), Some(2), "--memory-limit {bad}");
+    }
+}

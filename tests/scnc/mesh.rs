@@ -321,3 +321,31 @@ fn convex_generators_make_convex_polytopes() {
     let torus = worst_bulge(&tessellate::torus(1.0, 0.3, 16, 8));
     assert!(torus > 0.1, "the torus is not convex, but its worst bulge is {torus}");
 }
+
+/// The memory budget's per-triangle estimate is above what every generator's mesh keeps
+/// once built (vertices, normals, indices, BVH), flat and smooth, small and large.
+#[test]
+fn memory_estimate_bounds_what_meshes_keep() {
+    let generators = [
+        "uvsphere(rings = 3",
+        "uvsphere(rings = 200",
+        "icosphere(subdivisions = 5",
+        "torus(segments = 300, sides = 100",
+        "box(1",
+        "cylinder(segments = 500",
+    ];
+    for smooth in [false, true] {
+        for generator in generators {
+            let s = crate::support::scene(&format!(
+                "light ambient(1)\nobject mesh {generator}, smooth = {smooth}) at [0, 0, 5]\n"
+            ));
+            let (_, world) = lower(&s, 8, Mode::Mesh(Detail::High));
+            let mem = world.memory();
+            let per = mem.mesh_bytes() as f64 / mem.triangles().max(1) as f64;
+            assert!(
+                per <= scnc::mesh::lower::BYTES_PER_TRIANGLE as f64,
+                "{generator}) smooth {smooth}: {per:.1} bytes per triangle kept"
+            );
+        }
+    }
+}
