@@ -345,3 +345,40 @@ pub fn suggest<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) ->
         .min()
         .map(|(_, c)| c)
 }
+
+#[cfg(test)]
+mod position_tests {
+    use std::path::Path;
+
+    use crate::lsp::text::LineIndex;
+    use crate::source::FsLoader;
+
+    /// The line and column a diagnostic is shown at agree between the human rendering
+    /// (ariadne), the JSON fields and the language server's positions, for `\n`, `\r\n`
+    /// and lone `\r` line endings, and at the end of input.
+    #[test]
+    fn human_json_and_lsp_positions_agree_for_every_line_ending() {
+        for nl in ["\n", "\r\n", "\r"] {
+            let texts = [
+                format!("light ambient(1){nl}{nl}object spher(1) at [0, 0, 5]{nl}"),
+                format!("light ambient(1){nl}object sphere(1{nl}{nl}"),
+                format!("light ambient(1){nl}for i in 0..2 {{{nl}  object sphere(1){nl}"),
+            ];
+            for text in texts {
+                let c = crate::compile_source("t.scn", Path::new("t.scn"), text.clone(), &FsLoader);
+                assert!(!c.diagnostics.is_empty(), "{text:?} has an error");
+                for d in &c.diagnostics {
+                    let human = d.render(&c.map, false);
+                    let header = human.split("t.scn:").nth(1).and_then(|h| h.split(' ').next()).unwrap_or_default();
+                    let json: serde_json::Value = serde_json::from_str(&d.to_json(&c.map)).expect("JSON");
+                    let from_json = format!("{}:{}", json["span"]["line_start"], json["span"]["column_start"]);
+                    let (_, r) = c.map.local_range(d.span());
+                    let p = LineIndex::new(&text).position(r.start);
+                    let from_lsp = format!("{}:{}", p.line + 1, p.character + 1);
+                    assert_eq!(header, from_json, "{text:?}: human vs JSON\n{human}");
+                    assert_eq!(from_json, from_lsp, "{text:?}: JSON vs LSP");
+                }
+            }
+        }
+    }
+}

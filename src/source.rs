@@ -136,16 +136,31 @@ impl SourceMap {
         &self.file(id).text[r]
     }
 
-    /// One-based line and column (in characters) of a file-local byte offset.
+    /// One-based line and column (in characters) of a file-local byte offset. Lines end
+    /// at `\n`, `\r\n` or a lone `\r`, as for ariadne and the Language Server Protocol.
     pub fn line_col(&self, id: FileId, offset: usize) -> (usize, usize) {
         let text = &self.file(id).text;
         let offset = offset.min(text.len());
         let before = &text[..floor_char_boundary(text, offset)];
-        let line = before.matches('\n').count() + 1;
-        let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+        let starts = line_starts(before);
+        let line_start = starts.last().copied().unwrap_or(0);
         let col = before[line_start..].chars().count() + 1;
-        (line, col)
+        (starts.len(), col)
     }
+}
+
+/// The byte offsets where the lines of `text` start: 0, and after each `\n`, `\r\n` or
+/// lone `\r` (a `\r` directly before a `\n` belongs to that line break).
+pub fn line_starts(text: &str) -> Vec<usize> {
+    let bytes = text.as_bytes();
+    let mut starts = vec![0];
+    for (i, &b) in bytes.iter().enumerate() {
+        let lone_cr = b == b'\r' && bytes.get(i + 1) != Some(&b'\n');
+        if b == b'\n' || lone_cr {
+            starts.push(i + 1);
+        }
+    }
+    starts
 }
 
 fn floor_char_boundary(s: &str, mut i: usize) -> usize {

@@ -15,8 +15,7 @@ pub struct LineIndex<'t> {
 impl<'t> LineIndex<'t> {
     /// Indexes the line starts of `text`.
     pub fn new(text: &'t str) -> LineIndex<'t> {
-        let starts = std::iter::once(0).chain(text.match_indices('\n').map(|(i, _)| i + 1)).collect();
-        LineIndex { text, starts }
+        LineIndex { text, starts: crate::source::line_starts(text) }
     }
 
     /// The position of a byte offset (clamped to the text).
@@ -37,7 +36,11 @@ impl<'t> LineIndex<'t> {
         let Some(&start) = self.starts.get(pos.line as usize) else {
             return self.text.len();
         };
-        let line_end = self.starts.get(pos.line as usize + 1).map_or(self.text.len(), |&s| s - 1);
+        // The line ends before its break: `\n`, `\r\n` or a lone `\r`.
+        let line_end = self.starts.get(pos.line as usize + 1).map_or(self.text.len(), |&next| {
+            let body = &self.text[start..next];
+            next - (body.len() - body.trim_end_matches(['\n', '\r']).len()).min(2)
+        });
         let mut units = 0u32;
         for (i, c) in self.text[start..line_end].char_indices() {
             if units >= pos.character {

@@ -209,7 +209,10 @@ pub fn parse(text: &str, base: u32) -> (ast::File, Vec<Diagnostic>) {
         diags.push(d);
         return (ast::File::default(), diags);
     }
-    let eoi = SimpleSpan::from(base as usize + text.len()..base as usize + text.len());
+    // "End of input" points just after the last token, not past trailing blank lines:
+    // that is where an editor shows it, and a line every renderer agrees exists.
+    let end = base as usize + text.trim_end().len();
+    let eoi = SimpleSpan::from(end..end);
     // The parser works on chumsky's span type; ours convert back from it.
     let tokens_ss: Vec<(Token<'_>, SimpleSpan)> =
         tokens.iter().map(|(t, s)| (t.clone(), SimpleSpan::from(s.range()))).collect();
