@@ -3,6 +3,7 @@
 //! Every stage reports problems as [`Diagnostic`] values: a stable code from [`codes`], a
 //! message, labelled spans, notes and hints. Only this module knows about ariadne.
 
+use std::collections::HashMap;
 use std::fmt::Write as _;
 
 use ariadne::{Config, IndexType, Label as ALabel, Report, ReportKind};
@@ -130,6 +131,12 @@ impl Diagnostic {
 
     /// Renders with ariadne, as `rustc` would print it; `color` for a terminal.
     pub fn render(&self, map: &SourceMap, color: bool) -> String {
+        self.render_with(&mut Sources::new(map), color)
+    }
+
+    /// Renders like [`Diagnostic::render`], with files prepared once for many diagnostics.
+    pub fn render_with(&self, sources: &mut Sources<'_>, color: bool) -> String {
+        let map = sources.map;
         let name = |span: Span| map.file(map.file_of(span)).name.clone();
         let (_, primary) = map.local_range(self.span());
         let kind = match self.severity {
@@ -165,10 +172,9 @@ impl Diagnostic {
         for hint in &self.hints {
             report = report.with_help(hint);
         }
-        let cache = ariadne::sources(map.files().map(|(_, f)| (f.name.clone(), f.text.clone())));
         let mut out = Vec::new();
         // Writing to a Vec cannot fail, and every span was clamped into its file above.
-        let _ = report.finish().write(cache, &mut out);
+        let _ = report.finish().write(sources, &mut out);
         String::from_utf8_lossy(&out).into_owned()
     }
 
@@ -220,11 +226,44 @@ impl Diagnostic {
 
 /// Renders many diagnostics, one after another, without colour (for golden tests).
 pub fn render_all(diags: &[Diagnostic], map: &SourceMap) -> String {
+    let mut sources = Sources::new(map);
     let mut out = String::new();
     for d in diags {
-        let _ = write!(out, "{}", d.render(map, false));
+        let _ = write!(out, "{}", d.render_with(&mut sources, false));
     }
     out
+}
+
+/// The files of a source map as ariadne reads them, each indexed on first use and then
+/// kept: indexing every file again for each diagnostic made many warnings quadratic.
+pub struct Sources<'m> {
+    map: &'m SourceMap,
+    indexed: HashMap<String, ariadne::Source<&'m str>>,
+}
+
+impl<'m> Sources<'m> {
+    /// Nothing indexed yet.
+    pub fn new(map: &'m SourceMap) -> Sources<'m> {
+        Sources { map, indexed: HashMap::new() }
+    }
+}
+
+impl<'m> ariadne::Cache<String> for Sources<'m> {
+    type Storage = &'m str;
+
+    fn fetch(&mut self, id: &String) -> Result<&ariadne::Source<&'m str>, impl std::fmt::Debug> {
+        if !self.indexed.contains_key(id) {
+            // The last file of a name wins, as it did when all were indexed up front.
+            if let Some((_, f)) = self.map.files().filter(|(_, f)| f.name == *id).last() {
+                self.indexed.insert(id.clone(), ariadne::Source::from(f.text.as_str()));
+            }
+        }
+        self.indexed.get(id).ok_or_else(|| format!("no file named `{id}`"))
+    }
+
+    fn display<'a>(&self, id: &'a String) -> Option<impl std::fmt::Display + 'a> {
+        Some(id)
+    }
 }
 
 /// Every diagnostic code with a one-line summary; `docs/errors.md` explains each.
@@ -340,6 +379,9 @@ pub fn suggest<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) ->
     candidates
         .into_iter()
         .filter(|c| *c != word)
+        // The distance is at least the difference in length: most candidates of a big
+        // scope are dismissed without the quadratic comparison.
+        .filter(|c| c.chars().count().abs_diff(word.chars().count()) <= limit)
         .map(|c| (levenshtein(word, c), c))
         .filter(|(d, _)| *d <= limit)
         .min()

@@ -68,6 +68,8 @@ pub struct SourceFile {
     pub text: String,
     /// Global offset of the first byte.
     pub base: u32,
+    /// Where each line starts (see [`line_starts`]), so a position costs a binary search.
+    line_starts: Vec<usize>,
 }
 
 /// All files of one compile, laid end to end in one offset space (with a gap byte
@@ -97,6 +99,7 @@ impl SourceMap {
         self.files.push(SourceFile {
             name: name.into(),
             path: path.as_ref().to_path_buf(),
+            line_starts: line_starts(&text),
             text,
             base: self.next_base,
         });
@@ -139,13 +142,12 @@ impl SourceMap {
     /// One-based line and column (in characters) of a file-local byte offset. Lines end
     /// at `\n`, `\r\n` or a lone `\r`, as for ariadne and the Language Server Protocol.
     pub fn line_col(&self, id: FileId, offset: usize) -> (usize, usize) {
-        let text = &self.file(id).text;
-        let offset = offset.min(text.len());
-        let before = &text[..floor_char_boundary(text, offset)];
-        let starts = line_starts(before);
-        let line_start = starts.last().copied().unwrap_or(0);
-        let col = before[line_start..].chars().count() + 1;
-        (starts.len(), col)
+        let f = self.file(id);
+        let offset = floor_char_boundary(&f.text, offset.min(f.text.len()));
+        let line = f.line_starts.partition_point(|&s| s <= offset);
+        let line_start = f.line_starts[line - 1];
+        let col = f.text[line_start..offset].chars().count() + 1;
+        (line, col)
     }
 }
 

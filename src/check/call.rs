@@ -1,14 +1,11 @@
 //! Calls: arguments bound to parameters (positional, named, defaults, coercions), then
 //! a builtin's constructor or a user function's body.
 
-use std::collections::HashMap;
-use std::rc::Rc;
-
 use glam::DVec3;
 
 use super::builtins::{self, Builtin, Kind, Ty};
 use super::expr::{ArgVal, BoundArgs, SYNONYMS};
-use super::{Bound, Ctx, Func, Value, MAX_CALL_DEPTH};
+use super::{Bound, Ctx, Env, Func, Value, MAX_CALL_DEPTH};
 use crate::diag::{codes, suggest, Diagnostic};
 use crate::ir::dump_num;
 use crate::span::Span;
@@ -31,11 +28,24 @@ impl Ctx<'_> {
             match &b.bound {
                 Bound::Func(f) => {
                     let f = f.clone();
+                    // The common call, positional arguments one per parameter, skips the
+                    // general binding (and its allocations): this is the evaluator's
+                    // inner loop for generated scenes.
+                    if args.len() == f.params.len() && args.iter().all(|a| a.name.is_none()) {
+                        let mut values = Vec::with_capacity(args.len());
+                        for a in args {
+                            values.push(self.expr(&a.value));
+                        }
+                        if values.iter().any(Value::is_error) {
+                            return Value::Error;
+                        }
+                        return self.call_user(&f, values, span, false);
+                    }
                     let args = self.eval_args(args);
                     let Some(values) = self.bind_user(&f, args, span, callee.span) else {
                         return Value::Error;
                     };
-                    return self.call_user(&f, values, span);
+                    return self.call_user(&f, values, span, false);
                 }
                 Bound::Value(v) => {
                     let ty = v.ty_name();
@@ -363,7 +373,8 @@ impl Ctx<'_> {
         ok.then(|| vals.into_iter().map(|v| v.map_or(Value::Error, |(v, _)| v)).collect())
     }
 
-    pub(super) fn call_user(&mut self, f: &Func, args: Vec<Value>, call: Span) -> Value {
+    /// Evaluates `f`'s body with `args`; `defining` for the evaluation at its definition.
+    pub(super) fn call_user(&mut self, f: &Func, args: Vec<Value>, call: Span, defining: bool) -> Value {
         if self.call_depth >= MAX_CALL_DEPTH {
             self.report(
                 Diagnostic::error(
@@ -376,23 +387,24 @@ impl Ctx<'_> {
             );
             return Value::Error;
         }
-        *self.calls.entry(f.name.clone()).or_default() += 1;
-        let mut frame = Vec::with_capacity(f.params.len());
-        let mut seen = HashMap::new();
-        for (p, v) in f.params.iter().zip(args) {
-            let ty = (!v.is_error()).then(|| v.ty_name());
-            self.note_def(p, super::index::DefKind::Param, ty, f.body.span.start, f.body.span.end);
-            if seen.insert(p.name.clone(), ()).is_none() {
-                frame.push(Rc::new(super::Binding { name: p.name.clone(), span: p.span, bound: Bound::Value(v) }));
+        f.calls.set(f.calls.get() + 1);
+        if self.index.is_some() {
+            for (p, v) in f.params.iter().zip(&args) {
+                let ty = (!v.is_error()).then(|| v.ty_name());
+                self.note_def(p, super::index::DefKind::Param, ty, f.body.span.start, f.body.span.end);
             }
         }
-        let saved = std::mem::replace(&mut self.scopes, vec![f.env.clone(), frame]);
+        let env = Env::call(f.captured.clone(), args, defining);
+        let caller = std::mem::replace(&mut self.env, env);
+        self.outer.push(caller);
         let saved_dir = std::mem::replace(&mut self.dir, f.file_dir.clone());
         self.call_depth += 1;
         let v = self.expr(&f.body);
         self.call_depth -= 1;
         self.dir = saved_dir;
-        self.scopes = saved;
+        if let Some(caller) = self.outer.pop() {
+            self.env = caller;
+        }
         v
     }
 }

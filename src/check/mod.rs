@@ -15,12 +15,14 @@
 pub mod builtins;
 mod call;
 mod construct;
+mod env;
 mod expr;
 pub mod index;
 mod range;
 mod transform;
 mod value;
 
+use std::cell::Cell;
 use std::collections::HashMap;
 use std::path::{Component, Path, PathBuf};
 use std::rc::Rc;
@@ -36,6 +38,7 @@ pub use construct::{
     EPSILON_RULE, MAX_DEPTH, MAX_GENERATED_TRIANGLES, MAX_IMAGE_SIDE, MAX_MESH_RESOLUTION, MAX_PIXELS, MAX_REPEAT,
     MAX_SAMPLES, MAX_STEPS, MIN_EPSILON,
 };
+use env::{Binding, Captured, Env, Found};
 pub use range::{MAX_INTENSITY, MAX_REACH, MIN_SIZE};
 pub use value::Value;
 
@@ -76,15 +79,11 @@ struct Func {
     name: String,
     params: Vec<ast::Ident>,
     body: Rc<ast::Expr>,
-    env: Vec<Rc<Binding>>,
-    file_dir: PathBuf,
-}
-
-#[derive(Debug)]
-struct Binding {
-    name: String,
-    span: Span,
-    bound: Bound,
+    /// The parameters and the outer bindings the body refers to.
+    captured: Rc<Captured>,
+    file_dir: Rc<Path>,
+    /// Calls so far, to name what used the fuel.
+    calls: Cell<u64>,
 }
 
 /// The evaluator's state for one compile.
@@ -100,8 +99,8 @@ struct Ctx<'a> {
     error_reports: u64,
     /// Evaluation steps left (see [`MAX_FUEL`]).
     fuel: u64,
-    /// Calls of each user function, to name what used the fuel.
-    calls: HashMap<String, u64>,
+    /// Every user function defined so far, to name what used the fuel.
+    funcs: Vec<Rc<Func>>,
     /// Shape nodes of the scene's objects so far (see [`MAX_SCENE_NODES`]).
     scene_nodes: u64,
     /// `include` statements carried out so far.
@@ -109,7 +108,10 @@ struct Ctx<'a> {
     /// Set when fuel ran out or errors passed their cap: everything left evaluates to
     /// an error at once, and loops stop.
     halted: bool,
-    scopes: Vec<Vec<Rc<Binding>>>,
+    /// The names in scope where evaluation is.
+    env: Env,
+    /// The environments of the callers of the calls in progress, innermost last.
+    outer: Vec<Env>,
     /// `let` definitions by span, and whether each was ever used.
     lets: HashMap<Span, (String, bool)>,
     camera: Option<Camera>,
@@ -121,7 +123,7 @@ struct Ctx<'a> {
     expr_depth: usize,
     include_stack: Vec<PathBuf>,
     /// Directory of the file being evaluated (for `include` and `mesh file`).
-    dir: PathBuf,
+    dir: Rc<Path>,
     /// > 0 while evaluating code only to find mistakes (nothing is emitted).
     dry: u32,
     too_many_objects: bool,
@@ -180,17 +182,25 @@ impl Ctx<'_> {
             "evaluation ran out of fuel here",
         )
         .with_note(format!("a scene may take at most {MAX_FUEL} evaluation steps"));
-        if let Some((name, n)) = self.calls.iter().max_by_key(|(name, n)| (**n, std::cmp::Reverse((*name).clone()))) {
+        let mut calls: HashMap<&str, u64> = HashMap::new();
+        for f in &self.funcs {
+            *calls.entry(&f.name).or_default() += f.calls.get();
+        }
+        if let Some((name, n)) =
+            calls.into_iter().filter(|&(_, n)| n > 0).max_by_key(|&(name, n)| (n, std::cmp::Reverse(name)))
+        {
             d = d.with_note(format!("`{name}` was called {n} times"));
         }
         self.report(d);
         false
     }
 
-    fn lookup(&mut self, id: &ast::Ident) -> Option<Rc<Binding>> {
-        let found = self.scopes.iter().rev().flat_map(|s| s.iter().rev()).find(|b| b.name == id.name).cloned()?;
-        if let Some(entry) = self.lets.get_mut(&found.span) {
-            entry.1 = true;
+    fn lookup(&mut self, id: &ast::Ident) -> Option<Found> {
+        let found = self.env.find(&id.name)?;
+        if let Some(b) = found.binding.as_ref().filter(|b| !b.used.replace(true)) {
+            if let Some(entry) = self.lets.get_mut(&b.span) {
+                entry.1 = true;
+            }
         }
         if let Some(ix) = &mut self.index {
             ix.refer(id.span, found.span);
@@ -208,7 +218,7 @@ impl Ctx<'_> {
             Some((from, to))
         } else {
             let exported = matches!(kind, index::DefKind::Value | index::DefKind::Function);
-            self.export.filter(|e| exported && e.2 == self.scopes.len()).map(|(f, t, _)| (f, t))
+            self.export.filter(|e| exported && Some(e.2) == self.env.depth()).map(|(f, t, _)| (f, t))
         };
         let params = Vec::new();
         let def = index::Def { name: name.name.clone(), span: name.span, kind, ty, params, visible };
@@ -218,19 +228,23 @@ impl Ctx<'_> {
     }
 
     fn bind(&mut self, name: &ast::Ident, bound: Bound) {
-        let binding = Rc::new(Binding { name: name.name.clone(), span: name.span, bound });
-        if let Some(scope) = self.scopes.last_mut() {
-            scope.push(binding);
-        }
+        self.env.bind(Binding { name: Rc::from(name.name.as_str()), span: name.span, bound, used: Cell::new(false) });
     }
 
+    /// The names visible here that are (or are not) functions, for suggestions. While
+    /// a function is evaluated at its definition, those around the definition count too.
     fn names_in_scope(&self, funcs: bool) -> Vec<String> {
-        self.scopes
-            .iter()
-            .flatten()
-            .filter(|b| matches!(b.bound, Bound::Func(_)) == funcs)
-            .map(|b| b.name.clone())
-            .collect()
+        let around = self.outer.last().filter(|_| self.env.defining());
+        let mut names: Vec<String> = around
+            .into_iter()
+            .flat_map(Env::names)
+            .chain(self.env.names())
+            .filter(|&(_, is_func)| is_func == funcs)
+            .map(|(name, _)| name.to_string())
+            .collect();
+        names.sort_unstable();
+        names.dedup();
+        names
     }
 
     fn stmts(&mut self, stmts: &[ast::Stmt]) {
@@ -332,7 +346,7 @@ impl Ctx<'_> {
                 let root = self.include_stack.len() == 1;
                 let outer = self.export;
                 if root {
-                    self.export = Some((stmt.span.end, self.block_end, self.scopes.len()));
+                    self.export = Some((stmt.span.end, self.block_end, self.env.depth().unwrap_or(0)));
                 }
                 self.include(path, *path_span);
                 self.export = outer;
@@ -355,20 +369,21 @@ impl Ctx<'_> {
                 );
             }
         }
-        let env: Vec<Rc<Binding>> = self.scopes.iter().flatten().cloned().collect();
         let func = Rc::new(Func {
             name: name.name.clone(),
             params: params.to_vec(),
             body: Rc::new(body.clone()),
-            env,
+            captured: Rc::new(Captured::new(&self.env, params, body)),
             file_dir: self.dir.clone(),
+            calls: Cell::new(0),
         });
+        self.funcs.push(func.clone());
         self.lets.entry(name.span).or_insert_with(|| (name.name.clone(), false));
         // Evaluate the body once with poisoned parameters: reports unknown names and type
         // errors that do not depend on the arguments, even if the function is never called.
         let poisoned = params.iter().map(|_| Value::Error).collect();
         self.dry += 1;
-        let _ = self.call_user(&func, poisoned, name.span);
+        let _ = self.call_user(&func, poisoned, name.span, true);
         self.dry -= 1;
         self.bind(name, Bound::Func(func));
     }
@@ -379,14 +394,14 @@ impl Ctx<'_> {
         let lo = self.int_operand(&lo, start.span, "the loop start");
         let hi = self.int_operand(&hi, end.span, "the loop end");
         let run = |this: &mut Self, value: Value| {
-            this.scopes.push(Vec::new());
+            this.env.push_scope();
             let ty = (!value.is_error()).then(|| value.ty_name());
             this.note_def(var, index::DefKind::LoopVar, ty, end.span.end, span.end);
             this.bind(var, Bound::Value(value));
             let outer = std::mem::replace(&mut this.block_end, span.end);
             this.stmts(body);
             this.block_end = outer;
-            this.scopes.pop();
+            this.env.pop_scope();
         };
         let (Some(lo), Some(hi)) = (lo, hi) else {
             self.dry += 1;
@@ -605,7 +620,7 @@ impl Ctx<'_> {
             self.report(d);
         }
         let path = self.map.file(id).path.clone();
-        let old_dir = std::mem::replace(&mut self.dir, path.parent().map(Path::to_path_buf).unwrap_or_default());
+        let old_dir = std::mem::replace(&mut self.dir, Rc::from(path.parent().unwrap_or(Path::new(""))));
         self.include_stack.push(normalize(&path));
         self.stmts(&file.stmts);
         self.include_stack.pop();
@@ -729,7 +744,7 @@ fn run(
     loader: &dyn Loader,
     indexed: bool,
 ) -> (Option<Scene>, Vec<Diagnostic>, Option<index::Index>) {
-    let dir = map.file(root).path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let dir: Rc<Path> = Rc::from(map.file(root).path.parent().unwrap_or(Path::new("")));
     let mut ctx = Ctx {
         map,
         loader,
@@ -738,11 +753,12 @@ fn run(
         repeats: Vec::new(),
         error_reports: 0,
         fuel: MAX_FUEL,
-        calls: HashMap::new(),
+        funcs: Vec::new(),
         scene_nodes: 0,
         halted: false,
         includes: 0,
-        scopes: vec![Vec::new()],
+        env: Env::default(),
+        outer: Vec::new(),
         lets: HashMap::new(),
         camera: None,
         settings: None,

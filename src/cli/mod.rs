@@ -114,9 +114,10 @@ pub(crate) fn compile(path: &Path, format: MessageFormat) -> Option<Compiled> {
 pub(crate) fn report(c: &Compiled, format: MessageFormat) -> bool {
     let color = std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none();
     let mut err = std::io::stderr().lock();
+    let mut sources = scnc::diag::Sources::new(&c.map);
     for d in &c.diagnostics {
         let text = match format {
-            MessageFormat::Human => d.render(&c.map, color),
+            MessageFormat::Human => d.render_with(&mut sources, color),
             MessageFormat::Json => format!("{}\n", d.to_json(&c.map)),
         };
         let _ = err.write_all(text.as_bytes());
