@@ -138,7 +138,8 @@ impl Ctx<'_> {
     /// Matches arguments to parameter slots: positional ones in order (or all into `rest`
     /// for a variadic callee), named ones by name. Reports too many arguments, unknown
     /// names (with a suggestion) and arguments given twice; returns the slots, the extra
-    /// positional values, and whether all went well. `note` is the callee's signature.
+    /// positional values, and whether all went well. `note` is the builtin whose signature
+    /// a report shows.
     #[allow(clippy::type_complexity, reason = "slots and variadic values, both with the span to blame")]
     fn bind_slots(
         &mut self,
@@ -147,11 +148,12 @@ impl Ctx<'_> {
         variadic: bool,
         args: Vec<ArgVal>,
         call: Span,
-        note: Option<String>,
+        note: Option<&'static Builtin>,
     ) -> (Vec<Option<(Value, Span)>>, Vec<(Value, Span)>, bool) {
         let recovered = args.iter().any(|a| a.value.is_error() && a.name.is_none());
-        let with_note = |d: Diagnostic| match &note {
-            Some(n) => d.with_note(n.clone()),
+        // The signature is formatted only when a mistake is reported.
+        let with_note = |d: Diagnostic| match note {
+            Some(b) => d.with_note(format!("signature: {}", b.signature())),
             None => d,
         };
         let mut ok = true;
@@ -247,8 +249,7 @@ impl Ctx<'_> {
         let names: Vec<&str> = b.params.iter().map(|p| p.name).collect();
         // A misspelt name is one mistake: the parameter it meant is not also "missing".
         let misspelt = args.iter().any(|a| a.name.as_ref().is_some_and(|n| !names.contains(&n.name.as_str())));
-        let note = Some(format!("signature: {}", b.signature()));
-        let (mut vals, mut rest, mut ok) = self.bind_slots(b.name, &names, b.variadic.is_some(), args, call, note);
+        let (mut vals, mut rest, mut ok) = self.bind_slots(b.name, &names, b.variadic.is_some(), args, call, Some(b));
         if !recovered && !misspelt {
             for (p, v) in b.params.iter().zip(&vals) {
                 if v.is_none() && p.default == builtins::Default::Required {
@@ -268,7 +269,7 @@ impl Ctx<'_> {
         // Type checks.
         for (p, slot) in b.params.iter().zip(vals.iter_mut()) {
             if let Some((v, span)) = slot {
-                match self.coerce(v, p.ty, *span, &format!("parameter `{}` of `{}`", p.name, b.name)) {
+                match self.coerce(v, p.ty, *span, &|| format!("parameter `{}` of `{}`", p.name, b.name)) {
                     Some(c) => *v = c,
                     None => ok = false,
                 }
@@ -276,7 +277,7 @@ impl Ctx<'_> {
         }
         if let Some(ty) = b.variadic {
             for (v, span) in rest.iter_mut() {
-                match self.coerce(v, ty, *span, &format!("every positional argument of `{}`", b.name)) {
+                match self.coerce(v, ty, *span, &|| format!("every positional argument of `{}`", b.name)) {
                     Some(c) => *v = c,
                     None => ok = false,
                 }
@@ -286,8 +287,9 @@ impl Ctx<'_> {
         (ok && !poisoned && !recovered).then_some(BoundArgs { vals, rest, call })
     }
 
-    /// Converts `v` to `ty` or reports a mismatch; poison passes through.
-    fn coerce(&mut self, v: &Value, ty: Ty, span: Span, what: &str) -> Option<Value> {
+    /// Converts `v` to `ty` or reports a mismatch; poison passes through. `what` names
+    /// the slot, formatted only for a report.
+    fn coerce(&mut self, v: &Value, ty: Ty, span: Span, what: &dyn Fn() -> String) -> Option<Value> {
         let ok = match (ty, v) {
             (_, Value::Error) => return Some(Value::Error),
             (Ty::Num, Value::Num(_)) => true,
@@ -300,7 +302,7 @@ impl Ctx<'_> {
                             format!("expected a whole number, found {}", dump_num(*x)),
                             "not a whole number",
                         )
-                        .with_note(format!("{what} is an `int`"))
+                        .with_note(format!("{} is an `int`", what()))
                         .with_hint("try `floor(…)`"),
                     );
                     return None;
@@ -323,7 +325,7 @@ impl Ctx<'_> {
             format!("expected `{ty}`, found `{}`", v.ty_name()),
             format!("this is a `{}`", v.ty_name()),
         )
-        .with_note(format!("{what} is a `{ty}`"));
+        .with_note(format!("{} is a `{ty}`", what()));
         match (ty, v) {
             (Ty::Color, Value::Vec3(c)) => {
                 d = d.with_hint(format!("try `rgb({}, {}, {})`", dump_num(c.x), dump_num(c.y), dump_num(c.z)))
