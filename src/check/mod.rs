@@ -66,6 +66,9 @@ pub const MAX_FUEL: u64 = 10_000_000;
 pub const MAX_SCENE_NODES: u64 = 4_000_000;
 /// Error reports (repeats included) after which evaluation stops.
 pub const MAX_ERROR_REPORTS: u64 = 10_000;
+/// Evaluation steps between two questions whether a result is still wanted: about a
+/// tenth of a millisecond of work.
+const POLL_STEPS: u64 = 4096;
 
 /// What a name is bound to.
 #[derive(Clone, Debug)]
@@ -108,6 +111,13 @@ struct Ctx<'a> {
     /// Set when fuel ran out or errors passed their cap: everything left evaluates to
     /// an error at once, and loops stop.
     halted: bool,
+    /// Asked every [`POLL_STEPS`] steps whether the result is still wanted (the language
+    /// server's document changed meanwhile); a yes halts evaluation.
+    cancel: &'a dyn Fn() -> bool,
+    /// Steps until `cancel` is asked again.
+    until_poll: u64,
+    /// Set when `cancel` said yes: the result is incomplete and must not be shown.
+    cancelled: bool,
     /// The names in scope where evaluation is.
     env: Env,
     /// The environments of the callers of the calls in progress, innermost last.
@@ -169,6 +179,16 @@ impl Ctx<'_> {
     fn burn(&mut self, steps: u64, span: Span) -> bool {
         if self.halted {
             return false;
+        }
+        if let Some(left) = self.until_poll.checked_sub(steps) {
+            self.until_poll = left;
+        } else {
+            self.until_poll = POLL_STEPS;
+            if (self.cancel)() {
+                self.halted = true;
+                self.cancelled = true;
+                return false;
+            }
         }
         if let Some(left) = self.fuel.checked_sub(steps) {
             self.fuel = left;
@@ -743,7 +763,8 @@ fn run(
     root: FileId,
     loader: &dyn Loader,
     indexed: bool,
-) -> (Option<Scene>, Vec<Diagnostic>, Option<index::Index>) {
+    cancel: &dyn Fn() -> bool,
+) -> Option<(Option<Scene>, Vec<Diagnostic>, Option<index::Index>)> {
     let dir: Rc<Path> = Rc::from(map.file(root).path.parent().unwrap_or(Path::new("")));
     let mut ctx = Ctx {
         map,
@@ -756,6 +777,9 @@ fn run(
         funcs: Vec::new(),
         scene_nodes: 0,
         halted: false,
+        cancel,
+        until_poll: POLL_STEPS,
+        cancelled: false,
         includes: 0,
         env: Env::default(),
         outer: Vec::new(),
@@ -777,26 +801,32 @@ fn run(
         export: None,
     };
     ctx.run_file(root);
+    if ctx.cancelled {
+        return None;
+    }
     let index = ctx.index.take();
     let (scene, diags) = ctx.finish();
-    (scene, diags, index)
+    Some((scene, diags, index))
 }
 
 /// Checks and evaluates the file `root` of `map` (already added), loading includes
 /// through `loader`. Returns the scene when there are no errors, and every diagnostic.
 pub fn check(map: &mut SourceMap, root: FileId, loader: &dyn Loader) -> (Option<Scene>, Vec<Diagnostic>) {
-    let (scene, diags, _) = run(map, root, loader, false);
-    (scene, diags)
+    // Nothing cancels this compile, so there is always a result.
+    run(map, root, loader, false, &|| false).map(|(scene, diags, _)| (scene, diags)).unwrap_or_default()
 }
 
 /// [`check`], also returning the [`index::Index`] of names and types for editor tooling.
+/// `cancel` is asked now and then whether the result is still wanted; once it says yes,
+/// evaluation stops and the result is `None`.
 pub fn check_indexed(
     map: &mut SourceMap,
     root: FileId,
     loader: &dyn Loader,
-) -> (Option<Scene>, Vec<Diagnostic>, index::Index) {
-    let (scene, diags, index) = run(map, root, loader, true);
-    (scene, diags, index.unwrap_or_default())
+    cancel: &dyn Fn() -> bool,
+) -> Option<(Option<Scene>, Vec<Diagnostic>, index::Index)> {
+    let (scene, diags, index) = run(map, root, loader, true, cancel)?;
+    Some((scene, diags, index.unwrap_or_default()))
 }
 
 /// The unit vector along `v`, or `None` for a zero or non-finite vector.

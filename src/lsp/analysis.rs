@@ -89,8 +89,14 @@ pub enum SymbolKind {
 const STATEMENT_KEYWORDS: [&str; 7] = ["let", "object", "light", "camera", "render", "for", "include"];
 
 impl Analysis {
-    /// Compiles `text` as the file at `path` (includes resolve relative to it).
-    pub fn new(path: &Path, text: String, loader: &(dyn Loader + Sync)) -> Analysis {
+    /// Compiles `text` as the file at `path` (includes resolve relative to it); `None`
+    /// when `cancel` said the result is no longer wanted before it was complete.
+    pub fn new(
+        path: &Path,
+        text: String,
+        loader: &(dyn Loader + Sync),
+        cancel: &(dyn Fn() -> bool + Sync),
+    ) -> Option<Analysis> {
         crate::with_big_stack(|| {
             let mut map = SourceMap::new();
             let name = path.display().to_string();
@@ -98,14 +104,22 @@ impl Analysis {
             // would (it used to be analysed as if empty).
             if text.len() > crate::source::MAX_FILE_BYTES {
                 let compiled = crate::compile_source(&name, path, text, loader);
-                return Analysis { map: compiled.map, diagnostics: compiled.diagnostics, index: Index::default() };
+                return Some(Analysis {
+                    map: compiled.map,
+                    diagnostics: compiled.diagnostics,
+                    index: Index::default(),
+                });
             }
             let Some(root) = map.add(&name, path, text) else {
                 let compiled = crate::compile_source(&name, path, String::new(), loader);
-                return Analysis { map: compiled.map, diagnostics: compiled.diagnostics, index: Index::default() };
+                return Some(Analysis {
+                    map: compiled.map,
+                    diagnostics: compiled.diagnostics,
+                    index: Index::default(),
+                });
             };
-            let (_, diagnostics, index) = check::check_indexed(&mut map, root, loader);
-            Analysis { map, diagnostics, index }
+            let (_, diagnostics, index) = check::check_indexed(&mut map, root, loader, cancel)?;
+            Some(Analysis { map, diagnostics, index })
         })
     }
 

@@ -2,9 +2,11 @@
 //!
 //! Built on `lsp-server` and `lsp-types`, the synchronous crates under rust-analyzer:
 //! the compiler is synchronous and fast (a scene checks in milliseconds), so an async
-//! runtime would add weight and nothing else. Every request recompiles the document
-//! with the compiler's own front-end ([`check::check_indexed`](crate::check::check_indexed)),
-//! so the editor shows exactly what `scnc check` prints.
+//! runtime would add weight and nothing else. Every edit recompiles the document with
+//! the compiler's own front-end ([`check::check_indexed`](crate::check::check_indexed)),
+//! so the editor shows exactly what `scnc check` prints. A reader thread counts edits as
+//! it reads them, and an analysis stops as soon as a newer edit is waiting, so a document
+//! that takes the whole evaluation budget never delays the answer to the next.
 
 pub mod analysis;
 pub mod text;
@@ -13,6 +15,8 @@ pub mod wire;
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
 
 use lsp_server::{Connection, Message, Notification, Request, Response};
 use lsp_types::notification::{
@@ -37,11 +41,18 @@ use crate::span::Span;
 pub fn run_stdio(log: impl Fn(String) + Send + 'static) -> Result<(), String> {
     let (to_server, receiver) = crossbeam_channel::bounded::<Message>(0);
     let (sender, to_client) = crossbeam_channel::bounded::<Message>(0);
+    let edits = Arc::new(AtomicU64::new(0));
+    let edits_read = edits.clone();
     let reader = std::thread::spawn(move || -> std::io::Result<()> {
         let mut input = std::io::stdin().lock();
         loop {
             match wire::read_frame(&mut input)? {
                 wire::Frame::Message(m) => {
+                    // Counted before it waits for the server, so an analysis under way
+                    // learns that its document has changed.
+                    if matches!(&m, Message::Notification(n) if is_edit(&n.method)) {
+                        edits_read.fetch_add(1, Ordering::SeqCst);
+                    }
                     let exit = matches!(&m, Message::Notification(n) if n.method == "exit");
                     if to_server.send(m).is_err() || exit {
                         return Ok(());
@@ -59,7 +70,7 @@ pub fn run_stdio(log: impl Fn(String) + Send + 'static) -> Result<(), String> {
         }
         Ok(())
     });
-    let served = serve(&Connection { sender, receiver });
+    let served = serve(&Connection { sender, receiver }, edits);
     // Dropping the connection ends the writer; the reader ends with its input.
     let wrote = writer.join().map_err(|_| "the writer thread panicked".to_string())?;
     wrote.map_err(|e| e.to_string())?;
@@ -89,11 +100,19 @@ fn capabilities() -> lt::ServerCapabilities {
     }
 }
 
+/// Whether a notification changes the open documents (and so makes analyses stale).
+fn is_edit(method: &str) -> bool {
+    matches!(method, DidOpenTextDocument::METHOD | DidChangeTextDocument::METHOD | DidCloseTextDocument::METHOD)
+}
+
 /// Runs the protocol on `connection`: the handshake, then requests until shutdown.
-pub fn serve(connection: &Connection) -> Result<(), String> {
+/// `edits_read` counts the document edits read from the client so far, including those
+/// still queued; an analysis stops as soon as it is behind it.
+pub fn serve(connection: &Connection, edits_read: Arc<AtomicU64>) -> Result<(), String> {
     let caps = serde_json::to_value(capabilities()).map_err(|e| e.to_string())?;
     connection.initialize(caps).map_err(|e| format!("the client sent no `initialize` request ({e})"))?;
-    let mut server = Server { docs: HashMap::new(), published: HashMap::new(), cache: Cache::default() };
+    let mut server =
+        Server { docs: HashMap::new(), published: HashMap::new(), cache: Cache::default(), edits_read, edits_seen: 0 };
     let mut shut_down = false;
     for msg in &connection.receiver {
         match msg {
@@ -139,6 +158,49 @@ struct Server {
     /// For each open document, the other files its last compile published diagnostics to.
     published: HashMap<String, HashSet<String>>,
     cache: Cache,
+    /// Document edits the client has sent (some perhaps not yet handled).
+    edits_read: Arc<AtomicU64>,
+    /// Document edits handled.
+    edits_seen: u64,
+}
+
+/// Why a document has no analysis to answer from.
+enum Unavailable {
+    /// The client has not opened it.
+    NotOpen,
+    /// It changed while it was being analysed; the newer text will be analysed next.
+    Superseded,
+}
+
+/// A request that could not be answered: a JSON-RPC error code and message.
+struct Failure {
+    code: i32,
+    message: String,
+}
+
+impl From<String> for Failure {
+    fn from(message: String) -> Failure {
+        Failure { code: lsp_server::ErrorCode::InvalidParams as i32, message }
+    }
+}
+
+impl From<&str> for Failure {
+    fn from(message: &str) -> Failure {
+        Failure::from(message.to_string())
+    }
+}
+
+impl From<Unavailable> for Failure {
+    fn from(why: Unavailable) -> Failure {
+        match why {
+            Unavailable::NotOpen => Failure::from("the document is not open"),
+            // The code the protocol has for this: the client asks again if it still cares.
+            Unavailable::Superseded => Failure {
+                code: lsp_server::ErrorCode::ContentModified as i32,
+                message: "the document changed while it was being analysed".into(),
+            },
+        }
+    }
 }
 
 /// Reads open documents from the editor's buffers and other files from disk, so an
@@ -165,15 +227,18 @@ fn parse_uri(s: &str) -> Option<Uri> {
 }
 
 impl Server {
-    fn analyse(&self, uri: &str) -> Option<Rc<Analysis>> {
+    fn analyse(&self, uri: &str) -> Result<Rc<Analysis>, Unavailable> {
         if let Some(a) = self.cache.borrow().get(uri) {
-            return Some(a.clone());
+            return Ok(a.clone());
         }
-        let doc = self.docs.get(uri)?;
+        let doc = self.docs.get(uri).ok_or(Unavailable::NotOpen)?;
         let open = self.docs.iter().map(|(u, d)| (doc_path(u), d.text.clone())).collect();
-        let a = Rc::new(Analysis::new(&doc_path(uri), doc.text.clone(), &Overlay { open }));
+        let (edits_read, seen) = (&*self.edits_read, self.edits_seen);
+        let stale = move || edits_read.load(Ordering::SeqCst) > seen;
+        let a = Analysis::new(&doc_path(uri), doc.text.clone(), &Overlay { open }, &stale);
+        let a = Rc::new(a.ok_or(Unavailable::Superseded)?);
         self.cache.borrow_mut().insert(uri.to_string(), a.clone());
-        Some(a)
+        Ok(a)
     }
 
     /// The URI and range of `span` in the compile of the document `root`: the document's
@@ -196,6 +261,9 @@ impl Server {
     }
 
     fn notification(&mut self, note: Notification) -> Vec<Notification> {
+        if is_edit(&note.method) {
+            self.edits_seen += 1;
+        }
         self.cache.borrow_mut().clear();
         let uri = match note.method.as_str() {
             DidOpenTextDocument::METHOD => {
@@ -238,7 +306,8 @@ impl Server {
     /// Compiles the document and publishes its diagnostics, and those in files it
     /// includes; clears files that had diagnostics from its previous compile.
     fn publish_all(&mut self, uri: &str) -> Vec<Notification> {
-        let Some(analysis) = self.analyse(uri) else {
+        // A superseded analysis publishes nothing: the edit that superseded it publishes.
+        let Ok(analysis) = self.analyse(uri) else {
             return Vec::new();
         };
         let version = self.docs.get(uri).map(|d| d.version);
@@ -269,13 +338,13 @@ impl Server {
         let id = req.id.clone();
         match self.answer(req) {
             Ok(value) => Response::new_ok(id, value),
-            Err(message) => Response::new_err(id, lsp_server::ErrorCode::InvalidParams as i32, message),
+            Err(Failure { code, message }) => Response::new_err(id, code, message),
         }
     }
 
-    fn answer(&mut self, req: Request) -> Result<serde_json::Value, String> {
-        fn params<P: serde::de::DeserializeOwned>(req: Request) -> Result<P, String> {
-            serde_json::from_value(req.params).map_err(|e| e.to_string())
+    fn answer(&mut self, req: Request) -> Result<serde_json::Value, Failure> {
+        fn params<P: serde::de::DeserializeOwned>(req: Request) -> Result<P, Failure> {
+            serde_json::from_value(req.params).map_err(|e| Failure::from(e.to_string()))
         }
         match req.method.as_str() {
             HoverRequest::METHOD => {
@@ -335,7 +404,7 @@ impl Server {
             DocumentSymbolRequest::METHOD => {
                 let p: lt::DocumentSymbolParams = params(req)?;
                 let uri = p.text_document.uri.as_str().to_string();
-                let a = self.analyse(&uri).ok_or("the document is not open")?;
+                let a = self.analyse(&uri)?;
                 let index = LineIndex::new(a.text());
                 let symbols: Vec<lt::DocumentSymbol> = a.symbols().iter().map(|s| document_symbol(s, &index)).collect();
                 Ok(json(&lt::DocumentSymbolResponse::Nested(symbols)))
@@ -343,7 +412,7 @@ impl Server {
             CodeActionRequest::METHOD => {
                 let p: lt::CodeActionParams = params(req)?;
                 let uri = p.text_document.uri.as_str().to_string();
-                let a = self.analyse(&uri).ok_or("the document is not open")?;
+                let a = self.analyse(&uri)?;
                 let index = LineIndex::new(a.text());
                 let range = index.offset(p.range.start) as u32..index.offset(p.range.end) as u32;
                 let actions: Vec<lt::CodeActionOrCommand> = a
@@ -382,14 +451,14 @@ impl Server {
                 };
                 Ok(json(&edits))
             }
-            other => Err(format!("scnc lsp does not handle `{other}`")),
+            other => Err(Failure::from(format!("scnc lsp does not handle `{other}`"))),
         }
     }
 
     /// The document, its analysis and the global offset of a position in it.
-    fn at(&self, p: &lt::TextDocumentPositionParams) -> Result<(String, Rc<Analysis>, u32), String> {
+    fn at(&self, p: &lt::TextDocumentPositionParams) -> Result<(String, Rc<Analysis>, u32), Failure> {
         let uri = p.text_document.uri.as_str().to_string();
-        let a = self.analyse(&uri).ok_or("the document is not open")?;
+        let a = self.analyse(&uri)?;
         let at = LineIndex::new(a.text()).offset(p.position) as u32;
         Ok((uri, a, at))
     }

@@ -58,3 +58,32 @@ fn doubling_work_ends_with_its_limit() {
         assert!(codes.len() <= 3, "{case}: a few errors, not one per step: {codes:?}");
     }
 }
+
+/// A compile can be cancelled part-way (the language server does so when the document
+/// changes): it is asked every few thousand steps, and a yes ends it without a result.
+#[test]
+fn a_long_compile_asks_whether_to_go_on() {
+    let path = Path::new("tests/data/diag/fuel-doubling-calls.scn");
+    let text = std::fs::read_to_string(path).expect("case");
+    let run = |cancel: &dyn Fn() -> bool| {
+        let mut map = scnc::source::SourceMap::new();
+        let root = map.add("t.scn", path, text.clone()).expect("fits");
+        scnc::check::check_indexed(&mut map, root, &FsLoader, cancel).map(|(_, diags, _)| diags)
+    };
+    let asked = std::cell::Cell::new(0u64);
+    let diags = run(&|| {
+        asked.set(asked.get() + 1);
+        false
+    })
+    .expect("not cancelled");
+    assert!(diags.iter().any(|d| d.code == scnc::diag::codes::OUT_OF_FUEL));
+    // Ten million steps, a question every 4,096.
+    assert!((2000..=2500).contains(&asked.get()), "asked {} times", asked.get());
+    let asked = std::cell::Cell::new(0u64);
+    let cancelled = run(&|| {
+        asked.set(asked.get() + 1);
+        asked.get() == 3
+    });
+    assert!(cancelled.is_none(), "a yes ends the compile without a result");
+    assert_eq!(asked.get(), 3, "and nothing is asked after it");
+}

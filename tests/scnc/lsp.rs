@@ -354,3 +354,49 @@ fn malformed_input_never_ends_the_server() {
         std::thread::sleep(Duration::from_millis(10));
     }
 }
+
+/// An edit stops the analysis of the text it replaces: a document that takes the whole
+/// evaluation budget (about half a second) is superseded by the next edit, so its
+/// diagnostics are never published and the edit's are, and a request that follows is
+/// answered from the new text. (The server's reader counts the edit as soon as it has
+/// read it, within the first of the old analysis's thousands of polls.)
+#[test]
+fn an_edit_cancels_the_analysis_it_makes_stale() {
+    let mut client = Client::start();
+    let dir = tempfile::tempdir().expect("temp dir");
+    let u = uri(&dir.path().join("slow.scn"));
+    let mut slow = String::from("let f0(x) = x + 1\n");
+    for i in 1..=24 {
+        slow += &format!("let f{i}(x) = f{}(x) + f{}(x)\n", i - 1, i - 1);
+    }
+    slow += "light ambient(1)\nobject sphere(f24(1)) at [0, 0, 5]\n";
+    let fixed = "light ambient(1)\nobject spher(1) at [0, 0, 5]\n";
+    let open = json!({ "jsonrpc": "2.0", "method": "textDocument/didOpen", "params": {
+        "textDocument": { "uri": u, "languageId": "scn", "version": 1, "text": slow } } });
+    let change = json!({ "jsonrpc": "2.0", "method": "textDocument/didChange", "params": {
+        "textDocument": { "uri": u, "version": 2 }, "contentChanges": [{ "text": fixed }] } });
+    // Both in one write, so the server has the edit in hand while it analyses the first.
+    let (open, change) = (open.to_string(), change.to_string());
+    let both = format!("Content-Length: {}\r\n\r\n{open}Content-Length: {}\r\n\r\n{change}", open.len(), change.len());
+    client.stdin.write_all(both.as_bytes()).expect("writing");
+    client.stdin.flush().expect("flushing");
+    let hover = client.at("textDocument/hover", &u, 0, 8);
+    assert!(hover.to_string().contains("ambient"), "the hover reads the new text: {hover}");
+    let deadline = Instant::now() + TIMEOUT;
+    let first = loop {
+        let found = client
+            .pending
+            .iter()
+            .position(|m| m["method"] == "textDocument/publishDiagnostics" && m["params"]["uri"] == json!(u));
+        if let Some(i) = found {
+            break client.pending.remove(i);
+        }
+        let msg = client.next(deadline);
+        client.pending.push(msg);
+    };
+    assert_eq!(first["params"]["version"], json!(2), "the stale analysis published nothing: {first}");
+    let codes: Vec<&Value> =
+        first["params"]["diagnostics"].as_array().into_iter().flatten().map(|d| &d["code"]).collect();
+    assert!(codes.contains(&&json!("E0201")), "{first}");
+    client.stop();
+}

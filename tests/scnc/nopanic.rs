@@ -124,7 +124,8 @@ fn editor_queries_never_panic() {
     }
     for (path, text) in files {
         let len = text.len() as u32;
-        let a = scnc::lsp::analysis::Analysis::new(Path::new(&path), text, &scnc::source::FsLoader);
+        let a = scnc::lsp::analysis::Analysis::new(Path::new(&path), text, &scnc::source::FsLoader, &|| false)
+            .expect("nothing cancels this analysis");
         let total: u32 = a.map.files().map(|(_, f)| f.base + f.text.len() as u32).max().unwrap_or(0);
         for at in 0..=len {
             if let Some((span, _)) = a.hover(at) {
