@@ -138,6 +138,9 @@ pub const MAX_SCENE_TRIANGLES: u64 = 50_000_000;
 /// (`memory_estimate_bounds_what_meshes_keep`).
 pub const BYTES_PER_TRIANGLE: u64 = 144;
 
+/// Bytes spent between two confirmations with the system ([`Budget::confirm`]).
+const CONFIRM_FROM: u64 = 64 << 20;
+
 /// The default memory limit for meshes: 4 GiB, room on a laptop and on the test machine.
 pub const DEFAULT_MEMORY_LIMIT: u64 = 4 << 30;
 
@@ -147,12 +150,44 @@ pub struct Budget {
     triangles: u64,
     bytes: u64,
     limit: u64,
+    /// Bytes spent since the system was last asked for them ([`Budget::confirm`]), and
+    /// the object that took the most of them, to name if it will not give them.
+    unconfirmed: u64,
+    largest: Option<(u64, Span)>,
 }
 
 impl Budget {
     /// The whole budget, for a memory limit in bytes.
     pub fn new(memory_limit: u64) -> Budget {
-        Budget { triangles: MAX_SCENE_TRIANGLES, bytes: memory_limit, limit: memory_limit }
+        Budget {
+            triangles: MAX_SCENE_TRIANGLES,
+            bytes: memory_limit,
+            limit: memory_limit,
+            unconfirmed: 0,
+            largest: None,
+        }
+    }
+
+    /// Asks the system for the bytes spent since the last question, and gives them back:
+    /// an address-space cap or a strict overcommit policy then refuses here, with an
+    /// error, rather than aborting the process halfway through building. Only address
+    /// space is taken (no page is touched), so a question costs a map and an unmap; it is
+    /// asked when 64 MiB have been spent, before they are allocated, and at the end.
+    pub fn confirm(&mut self) -> Result<(), Diagnostic> {
+        let planned = std::mem::take(&mut self.unconfirmed);
+        let Some((_, span)) = self.largest.take() else { return Ok(()) };
+        let mut probe: Vec<u8> = Vec::new();
+        if probe.try_reserve_exact(planned as usize).is_ok() {
+            return Ok(());
+        }
+        Err(Diagnostic::error(
+            codes::LOWERING,
+            span,
+            "the system would not give the memory the scene's meshes need",
+            format!("the meshes need about {} more here, most of it for this object", mib(planned)),
+        )
+        .with_note("the memory limit allowed it, but the process may not have that much (see `ulimit -v`)")
+        .with_hint("try a lower `--detail`, coarser meshes, or a lower `--memory-limit`"))
     }
 
     /// Takes `triangles` from what is left, or reports the object that would exceed the
@@ -185,6 +220,13 @@ impl Budget {
         }
         self.triangles -= triangles;
         self.bytes -= bytes;
+        self.unconfirmed += bytes;
+        if self.largest.is_none_or(|(most, _)| bytes > most) {
+            self.largest = Some((bytes, span));
+        }
+        if self.unconfirmed >= CONFIRM_FROM {
+            self.confirm()?;
+        }
         Ok(())
     }
 }

@@ -95,6 +95,7 @@ pub fn lower(
         };
         lowered.push((part, obj.span));
     }
+    budget.confirm()?;
     // Building the meshes (vertices to render space, BVHs) is most of the lowering time
     // of a scene of many meshes; they are independent, so they are built in parallel.
     let objects: Vec<Object> = lowered

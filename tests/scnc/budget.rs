@@ -87,3 +87,29 @@ fn a_long_compile_asks_whether_to_go_on() {
     assert!(cancelled.is_none(), "a yes ends the compile without a result");
     assert_eq!(asked.get(), 3, "and nothing is asked after it");
 }
+
+/// Under an address-space cap the memory limit allows more than the process can have:
+/// the meshes' bytes are asked of the system before they are built, so the render ends
+/// with an error naming the object (exit 1), not an allocation abort (SIGABRT).
+#[cfg(target_os = "linux")]
+#[test]
+fn an_address_space_cap_is_an_error_not_an_abort() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = dir.path().join("big.scn");
+    let text = "light ambient(1)\nobject mesh uvsphere(rings = 2000, segments = 2000) at [0, 0, 5]\n";
+    std::fs::write(&scene, text).expect("write");
+    let out = dir.path().join("big.png");
+    let script =
+        "ulimit -v 1000000 && exec \"$0\" render \"$1\" -o \"$2\" --geometry mesh --width 16 --height 16 --memory-limit 16G";
+    let run = std::process::Command::new("sh")
+        .args(["-c", script, env!("CARGO_BIN_EXE_scnc")])
+        .arg(&scene)
+        .arg(&out)
+        .output()
+        .expect("running sh");
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("the system would not give the memory"), "{stderr}");
+    assert!(stderr.contains("big.scn:2:8"), "{stderr}");
+    assert!(!out.exists(), "nothing written");
+}
