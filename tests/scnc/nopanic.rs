@@ -113,6 +113,61 @@ fn random_mutations_compile_or_report() {
     });
 }
 
+/// Work amplification (nested unclosed blocks, doubling calls, doubling shapes, long
+/// loops of errors, many names) spliced into the examples at a line start: every case
+/// ends, by one of the budgets or with a scene, with a handful of diagnostics rather
+/// than one per step. The budgets bound the work (fuel, shape nodes, errors), so the
+/// test is judged by what it reports, not by how long it takes.
+#[test]
+fn amplified_examples_end_by_a_budget() {
+    fn unclosed(rng: &mut Rng) -> String {
+        "for i in 0..1 {\n".repeat(1 + rng.below(200))
+    }
+    fn doubling_calls(rng: &mut Rng) -> String {
+        let depth = 4 + rng.below(22);
+        let mut s = String::from("let g0(x) = x + 1\n");
+        for i in 1..=depth {
+            s += &format!("let g{i}(x) = g{}(x) + g{}(x)\n", i - 1, i - 1);
+        }
+        s + &format!("object sphere(g{depth}(0) * 0 + 1) at [0, 0, 9]\n")
+    }
+    fn doubling_shapes(rng: &mut Rng) -> String {
+        let depth = 4 + rng.below(24);
+        let mut s = String::from("let d0 = sphere(0.1)\n");
+        for i in 1..=depth {
+            s += &format!("let d{i} = union(d{}, d{} at [0.001, 0, 0])\n", i - 1, i - 1);
+        }
+        s + &format!("object d{depth} at [0, 0, 9]\n")
+    }
+    fn error_loop(rng: &mut Rng) -> String {
+        format!("for i in 0..{} {{ object nowhere(i) }}\n", 1 + rng.below(1_000_000))
+    }
+    fn many_names(rng: &mut Rng) -> String {
+        let n = 1 + rng.below(20_000);
+        let mut s = String::from("let _n0 = 1\n");
+        for i in 1..n {
+            s += &format!("let _n{i} = _n0 + {i}\n");
+        }
+        s
+    }
+    let shapes: [fn(&mut Rng) -> String; 5] = [unclosed, doubling_calls, doubling_shapes, error_loop, many_names];
+    scnc::with_big_stack(|| {
+        let sources = sources();
+        let mut rng = Rng(0xa3f1_77d0_0b1e);
+        for n in 0..40 {
+            let (path, text) = &sources[rng.below(sources.len())];
+            let starts: Vec<usize> = std::iter::once(0).chain(text.match_indices('\n').map(|(i, _)| i + 1)).collect();
+            let at = starts[rng.below(starts.len())];
+            let amplified = shapes[n % shapes.len()](&mut rng);
+            let text = format!("{}{amplified}{}", &text[..at], &text[at..]);
+            let c = scnc::compile_source(path, Path::new(path), text, &Examples);
+            assert!(c.scene.is_some() || c.diagnostics.iter().any(|d| d.is_error()), "case {n}: {path}");
+            assert!(c.diagnostics.len() <= 40, "case {n} ({path}): {} diagnostics", c.diagnostics.len());
+            let _ = scnc::diag::render_all(&c.diagnostics, &c.map);
+        }
+    });
+}
+
 /// The language server's questions at every position of every example and diagnostic
 /// case (many of them broken files) answer without panicking, and every answer points
 /// inside the compile's files.
