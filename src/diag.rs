@@ -278,6 +278,8 @@ pub mod codes {
     pub const BAD_NUMBER: &str = "E0004";
     /// Malformed colour literal.
     pub const BAD_COLOR: &str = "E0005";
+    /// `&&`, `||` or `!` where scnc writes `and`, `or`, `not`.
+    pub const FOREIGN_OPERATOR: &str = "E0006";
     /// Syntax error.
     pub const SYNTAX: &str = "E0100";
     /// Unknown name.
@@ -308,6 +310,12 @@ pub mod codes {
     pub const NOT_A_MESH_GENERATOR: &str = "E0308";
     /// Transform not allowed on this value.
     pub const BAD_TRANSFORM: &str = "E0309";
+    /// A condition that is not a boolean.
+    pub const NOT_A_BOOL: &str = "E0310";
+    /// The branches of an `if` expression have different types.
+    pub const BRANCH_MISMATCH: &str = "E0311";
+    /// A `for` over something that is neither a range nor a list.
+    pub const NOT_ITERABLE: &str = "E0312";
     /// Value out of its allowed range.
     pub const OUT_OF_RANGE: &str = "E0400";
     /// Arithmetic produced a non-finite number (division by zero, overflow).

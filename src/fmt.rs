@@ -49,8 +49,15 @@ struct Formatter<'t> {
     in_statement: bool,
 }
 
-fn starts_statement(t: &Token<'_>) -> bool {
-    matches!(t, Token::Let | Token::Object | Token::Light | Token::Camera | Token::Render | Token::For | Token::Include)
+/// Whether `t`, after `prev`, begins a statement. `if` begins one unless an operand is
+/// expected (`let x = if …`, `else if …`); `for` inside brackets is a comprehension,
+/// which the callers tell by the bracket depth.
+fn starts_statement(t: &Token<'_>, prev: Option<&Token<'_>>) -> bool {
+    match t {
+        Token::Let | Token::Object | Token::Light | Token::Camera | Token::Render | Token::For | Token::Include => true,
+        Token::If => prev.is_none_or(|p| matches!(p, Token::LBrace | Token::RBrace)) || !operand_expected(prev),
+        _ => false,
+    }
 }
 
 /// A `-` after these is a negation, not a subtraction.
@@ -98,7 +105,7 @@ impl<'t> Formatter<'t> {
         }
         lines.dedup();
         let mut level = self.braces + lines.len();
-        let continues = self.in_statement && lines.is_empty() && !starts_statement(tok);
+        let continues = self.in_statement && lines.is_empty() && !starts_statement(tok, self.prev.as_ref());
         if continues && !matches!(tok, Token::RBrace | Token::LineComment | Token::BlockComment(_)) {
             level += 1;
         }
@@ -115,7 +122,7 @@ impl<'t> Formatter<'t> {
         let comment = matches!(tok, Token::LineComment | Token::BlockComment(_));
         let depth0 = self.brackets.is_empty();
         let forced = !self.out.is_empty()
-            && ((starts_statement(tok) && depth0)
+            && ((starts_statement(tok, self.prev.as_ref()) && depth0)
                 || matches!(tok, Token::RBrace) && !matches!(self.prev, Some(Token::LBrace))
                 || matches!(self.prev, Some(Token::LBrace)) && !self.after_comment && !matches!(tok, Token::RBrace));
         if newlines > 0 || forced {
@@ -155,11 +162,13 @@ impl<'t> Formatter<'t> {
             }
             _ => {}
         }
-        if starts_statement(tok) {
+        if starts_statement(tok, self.prev.as_ref()) {
             self.in_statement = true;
         }
         // A `for` header ends at its `{`; other statements end where the next begins.
-        if matches!(tok, Token::LBrace) || next.is_some_and(|n| starts_statement(n) && self.brackets.is_empty()) {
+        if matches!(tok, Token::LBrace)
+            || next.is_some_and(|n| starts_statement(n, Some(tok)) && self.brackets.is_empty())
+        {
             self.in_statement = false;
         }
         if matches!(tok, Token::Minus) {

@@ -276,6 +276,29 @@ impl Ctx<'_> {
             }
         }
         if let Some(ty) = b.variadic {
+            // `union(a, xs, b)`: a list among the shapes (or numbers) stands for its
+            // elements, in order, so generated parts combine like written ones.
+            if rest.iter().any(|(v, _)| matches!(v, Value::List(_))) {
+                rest = rest
+                    .into_iter()
+                    .flat_map(|(v, span)| match v {
+                        Value::List(items) => items.iter().map(|x| (x.clone(), span)).collect::<Vec<_>>(),
+                        v => vec![(v, span)],
+                    })
+                    .collect();
+                if rest.is_empty() {
+                    self.report(
+                        Diagnostic::error(
+                            codes::ARITY,
+                            call,
+                            format!("`{}` of nothing: every list given is empty", b.name),
+                            "no elements",
+                        )
+                        .with_note(format!("`{}` needs at least one element", b.name)),
+                    );
+                    return None;
+                }
+            }
             for (v, span) in rest.iter_mut() {
                 match self.coerce(v, ty, *span, &|| format!("every positional argument of `{}`", b.name)) {
                     Some(c) => *v = c,

@@ -78,7 +78,20 @@ impl Captured {
                 }
                 ExprKind::Mesh { generator: _, args } => stack.extend(args.iter().map(|a| &a.value)),
                 ExprKind::Index { base, index } => stack.extend([&**base, &**index]),
-                ExprKind::Neg(inner) => stack.push(inner),
+                ExprKind::Neg(inner) | ExprKind::Not(inner) => stack.push(inner),
+                ExprKind::If { cond, then, otherwise } => stack.extend([&**cond, &**then, &**otherwise]),
+                // A comprehension's variables are local, so capturing an outer binding of
+                // the same name is harmless: the local one is found first.
+                ExprKind::Comprehension { generators, filter, body } => {
+                    for g in generators {
+                        match &g.over {
+                            ast::Iterable::Range { start, end } => stack.extend([start, end]),
+                            ast::Iterable::List(e) => stack.push(e),
+                        }
+                    }
+                    stack.extend(filter.as_deref());
+                    stack.push(body);
+                }
                 ExprKind::Binary { op: _, lhs, rhs } => stack.extend([&**lhs, &**rhs]),
                 ExprKind::Transform { op: _, op_span: _, target, arg } => stack.extend([&**target, &**arg]),
             }

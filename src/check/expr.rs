@@ -125,10 +125,22 @@ impl Ctx<'_> {
                     Value::Error
                 }
             },
+            ExprKind::Binary { op: op @ (BinOp::And | BinOp::Or), lhs, rhs } => self.logic(*op, lhs, rhs),
             ExprKind::Binary { op, lhs, rhs } => {
                 let a = self.expr(lhs);
                 let b = self.expr(rhs);
                 self.binary(*op, a, lhs.span, b, rhs.span, e.span)
+            }
+            ExprKind::Not(inner) => {
+                let v = self.expr(inner);
+                match self.condition(&v, inner.span, "the operand of `not`") {
+                    Some(b) => Value::Bool(!b),
+                    None => Value::Error,
+                }
+            }
+            ExprKind::If { cond, then, otherwise } => self.if_expr(cond, then, otherwise),
+            ExprKind::Comprehension { generators, filter, body } => {
+                self.comprehension(generators, filter.as_deref(), body, e.span)
             }
             ExprKind::Call { callee, args } => self.call(callee, args, e.span),
             ExprKind::Mesh { generator, args } => self.mesh_call(generator, args, e.span),
@@ -222,10 +234,16 @@ impl Ctx<'_> {
             let n = |i: usize| if let Value::Num(x) = values[i].0 { x } else { 0.0 };
             return Value::Vec3(DVec3::new(n(0), n(1), n(2)));
         }
+        self.uniform_list(values).unwrap_or(Value::Error)
+    }
+
+    /// A list of `values` if they share one type, else `None` after reporting the first
+    /// element that differs.
+    pub(super) fn uniform_list(&mut self, values: Vec<(Value, Span)>) -> Option<Value> {
         if let Some((first, first_span)) = values.first() {
             let name = |v: &Value| v.ty_name();
             for (v, s) in &values[1..] {
-                if name(v) != name(first) {
+                if !v.same_type(first) {
                     self.report(
                         Diagnostic::error(
                             codes::TYPE_MISMATCH,
@@ -239,11 +257,11 @@ impl Ctx<'_> {
                         )
                         .with_label(*first_span, format!("the first element is a `{}`", name(first))),
                     );
-                    return Value::Error;
+                    return None;
                 }
             }
         }
-        Value::List(Rc::new(values.into_iter().map(|(v, _)| v).collect()))
+        Some(Value::List(Rc::new(values.into_iter().map(|(v, _)| v).collect())))
     }
 
     fn index(&mut self, base: Value, base_span: Span, index: Value, index_span: Span) -> Value {
@@ -313,6 +331,19 @@ impl Ctx<'_> {
         if a.is_error() || b.is_error() {
             return Value::Error;
         }
+        match op {
+            BinOp::Eq | BinOp::Ne => return self.equality(op, &a, a_span, &b, b_span, span),
+            BinOp::Lt | BinOp::Le | BinOp::Gt | BinOp::Ge => return self.ordering(op, &a, a_span, &b, b_span, span),
+            BinOp::And | BinOp::Or => {
+                let what = format!("an operand of `{}`", op.symbol());
+                let (x, y) = (self.condition(&a, a_span, &what), self.condition(&b, b_span, &what));
+                return match (x, y) {
+                    (Some(x), Some(y)) => Value::Bool(if op == BinOp::And { x && y } else { x || y }),
+                    _ => Value::Error,
+                };
+            }
+            BinOp::Add | BinOp::Sub | BinOp::Mul | BinOp::Div | BinOp::Rem => {}
+        }
         if matches!(op, BinOp::Div | BinOp::Rem) {
             let zero = match &b {
                 Num(x) => *x == 0.0,
@@ -334,6 +365,8 @@ impl Ctx<'_> {
             BinOp::Mul => x * y,
             BinOp::Div => x / y,
             BinOp::Rem => x % y,
+            // Not arithmetic: answered above. NaN would be reported as an overflow.
+            BinOp::Eq | BinOp::Ne | BinOp::Lt | BinOp::Le | BinOp::Gt | BinOp::Ge | BinOp::And | BinOp::Or => f64::NAN,
         };
         let v3 = |x: DVec3, y: DVec3| DVec3::new(f(x.x, y.x), f(x.y, y.y), f(x.z, y.z));
         let result = match (&a, &b) {
@@ -398,6 +431,100 @@ impl Ctx<'_> {
             return Value::Error;
         }
         result
+    }
+}
+
+/// Equality of values that `==` compares; `None` for values it does not.
+fn equal(a: &Value, b: &Value) -> Option<bool> {
+    Some(match (a, b) {
+        (Value::Num(x), Value::Num(y)) => x == y,
+        (Value::Bool(x), Value::Bool(y)) => x == y,
+        (Value::Str(x), Value::Str(y)) => x == y,
+        (Value::Vec3(x), Value::Vec3(y)) | (Value::Color(x), Value::Color(y)) => x == y,
+        (Value::List(x), Value::List(y)) => {
+            if x.len() != y.len() {
+                return Some(false);
+            }
+            for (p, q) in x.iter().zip(y.iter()) {
+                if !equal(p, q)? {
+                    return Some(false);
+                }
+            }
+            true
+        }
+        _ => return None,
+    })
+}
+
+impl Ctx<'_> {
+    /// `and` / `or`: the right operand is evaluated only when the left does not decide.
+    fn logic(&mut self, op: BinOp, lhs: &ast::Expr, rhs: &ast::Expr) -> Value {
+        let what = format!("an operand of `{}`", op.symbol());
+        let a = self.expr(lhs);
+        match (op, self.condition(&a, lhs.span, &what)) {
+            (BinOp::And, Some(false)) => Value::Bool(false),
+            (BinOp::Or, Some(true)) => Value::Bool(true),
+            (_, Some(_)) => {
+                let b = self.expr(rhs);
+                self.condition(&b, rhs.span, &what).map_or(Value::Error, Value::Bool)
+            }
+            (_, None) => {
+                // The left is unknown: the right is checked, as an untaken branch is.
+                self.dry += 1;
+                let b = self.expr(rhs);
+                let _ = self.condition(&b, rhs.span, &what);
+                self.dry -= 1;
+                Value::Error
+            }
+        }
+    }
+
+    fn equality(&mut self, op: BinOp, a: &Value, a_span: Span, b: &Value, b_span: Span, span: Span) -> Value {
+        let same =
+            if a.same_type(b) || matches!((a, b), (Value::List(_), Value::List(_))) { equal(a, b) } else { None };
+        match same {
+            Some(eq) => Value::Bool(eq == (op == BinOp::Eq)),
+            None => {
+                self.report(
+                    Diagnostic::error(
+                        codes::BAD_OPERANDS,
+                        span,
+                        format!("cannot compare `{}` with `{}`", a.ty_name(), b.ty_name()),
+                        format!("`{}` {} `{}` is not defined", a.ty_name(), op.symbol(), b.ty_name()),
+                    )
+                    .with_label(a_span, format!("this is a `{}`", a.ty_name()))
+                    .with_label(b_span, format!("this is a `{}`", b.ty_name()))
+                    .with_note(
+                        "`==` and `!=` compare two numbers, booleans, strings, vectors, colours or lists of them",
+                    ),
+                );
+                Value::Error
+            }
+        }
+    }
+
+    fn ordering(&mut self, op: BinOp, a: &Value, a_span: Span, b: &Value, b_span: Span, span: Span) -> Value {
+        if let (Value::Num(x), Value::Num(y)) = (a, b) {
+            return Value::Bool(match op {
+                BinOp::Lt => x < y,
+                BinOp::Le => x <= y,
+                BinOp::Gt => x > y,
+                BinOp::Ge => x >= y,
+                BinOp::Add | BinOp::Sub | BinOp::Mul | BinOp::Div | BinOp::Rem => false,
+                BinOp::Eq | BinOp::Ne | BinOp::And | BinOp::Or => false,
+            });
+        }
+        let (bad, bad_span) = if matches!(a, Value::Num(_)) { (b, b_span) } else { (a, a_span) };
+        self.report(
+            Diagnostic::error(
+                codes::BAD_OPERANDS,
+                bad_span,
+                format!("`{}` orders numbers, not `{}`", op.symbol(), bad.ty_name()),
+                format!("this is a `{}`", bad.ty_name()),
+            )
+            .with_label(span, "in this comparison"),
+        );
+        Value::Error
     }
 }
 

@@ -15,6 +15,7 @@
 pub mod builtins;
 mod call;
 mod construct;
+mod control;
 mod env;
 mod expr;
 pub mod index;
@@ -361,7 +362,8 @@ impl Ctx<'_> {
                     self.settings = Some(settings.unwrap_or(Settings { span: Some(stmt.span), ..Settings::default() }));
                 }
             }
-            ast::StmtKind::For { var, start, end, body } => self.for_loop(var, start, end, body, stmt.span),
+            ast::StmtKind::For { each, body } => self.for_loop(each, body, stmt.span),
+            ast::StmtKind::If { branches, otherwise } => self.if_stmt(branches, otherwise.as_deref()),
             ast::StmtKind::Include { path, path_span } => {
                 let root = self.include_stack.len() == 1;
                 let outer = self.export;
@@ -406,58 +408,6 @@ impl Ctx<'_> {
         let _ = self.call_user(&func, poisoned, name.span, true);
         self.dry -= 1;
         self.bind(name, Bound::Func(func));
-    }
-
-    fn for_loop(&mut self, var: &ast::Ident, start: &ast::Expr, end: &ast::Expr, body: &[ast::Stmt], span: Span) {
-        let lo = self.expr(start);
-        let hi = self.expr(end);
-        let lo = self.int_operand(&lo, start.span, "the loop start");
-        let hi = self.int_operand(&hi, end.span, "the loop end");
-        let run = |this: &mut Self, value: Value| {
-            this.env.push_scope();
-            let ty = (!value.is_error()).then(|| value.ty_name());
-            this.note_def(var, index::DefKind::LoopVar, ty, end.span.end, span.end);
-            this.bind(var, Bound::Value(value));
-            let outer = std::mem::replace(&mut this.block_end, span.end);
-            this.stmts(body);
-            this.block_end = outer;
-            this.env.pop_scope();
-        };
-        let (Some(lo), Some(hi)) = (lo, hi) else {
-            self.dry += 1;
-            run(self, Value::Error);
-            self.dry -= 1;
-            return;
-        };
-        if hi <= lo {
-            self.dry += 1;
-            run(self, Value::Error);
-            self.dry -= 1;
-            return;
-        }
-        let count = (hi - lo) as u64;
-        if self.iterations + count > MAX_ITERATIONS {
-            self.report(
-                Diagnostic::error(
-                    codes::TOO_MANY_ITERATIONS,
-                    span,
-                    "too many loop iterations",
-                    format!("this loop would run {count} times"),
-                )
-                .with_note(format!("a scene may run at most {MAX_ITERATIONS} loop iterations in total")),
-            );
-            self.dry += 1;
-            run(self, Value::Error);
-            self.dry -= 1;
-            return;
-        }
-        self.iterations += count;
-        for i in lo..hi {
-            run(self, Value::Num(i as f64));
-            if self.too_many_objects || self.halted {
-                break;
-            }
-        }
     }
 
     /// A number that must be a whole number in i64 range, for loop bounds.

@@ -68,6 +68,19 @@ impl Value {
         }
     }
 
+    /// Whether two values have the same type as users read it ([`Value::ty_name`]),
+    /// without formatting either.
+    pub fn same_type(&self, other: &Value) -> bool {
+        fn key(v: &Value) -> (Option<Ty>, Option<Ty>) {
+            let num = |t: Option<Ty>| if t == Some(Ty::Int) { Some(Ty::Num) } else { t };
+            match v {
+                Value::List(items) => (Some(Ty::List), num(items.first().and_then(Value::ty))),
+                v => (num(v.ty()), None),
+            }
+        }
+        key(self) == key(other)
+    }
+
     /// True for poison.
     pub fn is_error(&self) -> bool {
         matches!(self, Value::Error)

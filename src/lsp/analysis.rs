@@ -84,6 +84,8 @@ pub enum SymbolKind {
     Setting,
     /// `for …`.
     Loop,
+    /// `if …`.
+    Conditional,
 }
 
 const STATEMENT_KEYWORDS: [&str; 7] = ["let", "object", "light", "camera", "render", "for", "include"];
@@ -396,13 +398,33 @@ fn symbols_of(stmts: &[ast::Stmt], map: &SourceMap) -> Vec<Symbol> {
                 ast::StmtKind::Light(e) => symbol(format!("light {}", head(e, map)), SymbolKind::Light, s.span, e.span),
                 ast::StmtKind::Camera(_) => symbol("camera".into(), SymbolKind::Setting, s.span, s.span),
                 ast::StmtKind::Render(_) => symbol("render".into(), SymbolKind::Setting, s.span, s.span),
-                ast::StmtKind::For { var, start, end, body } => Symbol {
-                    name: format!("for {} in {}..{}", var.name, map.snippet(start.span), map.snippet(end.span)),
-                    kind: SymbolKind::Loop,
-                    span: s.span,
-                    name_span: var.span,
-                    children: symbols_of(body, map),
-                },
+                ast::StmtKind::For { each, body } => {
+                    let over = match &each.over {
+                        ast::Iterable::Range { start, end } => {
+                            format!("{}..{}", map.snippet(start.span), map.snippet(end.span))
+                        }
+                        ast::Iterable::List(e) => map.snippet(e.span).to_string(),
+                    };
+                    Symbol {
+                        name: format!("for {} in {over}", each.var.name),
+                        kind: SymbolKind::Loop,
+                        span: s.span,
+                        name_span: each.var.span,
+                        children: symbols_of(body, map),
+                    }
+                }
+                ast::StmtKind::If { branches, otherwise } => {
+                    let (cond, _) = branches.first()?;
+                    let mut children: Vec<Symbol> = branches.iter().flat_map(|(_, b)| symbols_of(b, map)).collect();
+                    children.extend(otherwise.iter().flat_map(|b| symbols_of(b, map)));
+                    Symbol {
+                        name: format!("if {}", map.snippet(cond.span)),
+                        kind: SymbolKind::Conditional,
+                        span: s.span,
+                        name_span: cond.span,
+                        children,
+                    }
+                }
                 ast::StmtKind::Include { .. } | ast::StmtKind::Error => return None,
             })
         })

@@ -522,6 +522,7 @@ fn document_symbol(s: &Symbol, index: &LineIndex<'_>) -> lt::DocumentSymbol {
             SymbolKind::Light => lt::SymbolKind::EVENT,
             SymbolKind::Setting => lt::SymbolKind::PROPERTY,
             SymbolKind::Loop => lt::SymbolKind::NAMESPACE,
+            SymbolKind::Conditional => lt::SymbolKind::NAMESPACE,
         },
         tags: None,
         deprecated: None,

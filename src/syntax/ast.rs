@@ -47,16 +47,19 @@ pub enum StmtKind {
         /// The value or function body.
         value: Expr,
     },
-    /// `for var in start..end { body }` (end exclusive).
+    /// `for var in start..end { body }` (end exclusive) or `for var in list { body }`.
     For {
-        /// Loop variable.
-        var: Ident,
-        /// First value.
-        start: Expr,
-        /// One past the last value.
-        end: Expr,
+        /// Loop variable and what it runs over.
+        each: Generator,
         /// The statements repeated.
         body: Vec<Stmt>,
+    },
+    /// `if c { … } else if d { … } else { … }`.
+    If {
+        /// Each condition with the statements it guards, in order.
+        branches: Vec<(Expr, Vec<Stmt>)>,
+        /// The statements of the final `else`, if any.
+        otherwise: Option<Vec<Stmt>>,
     },
     /// `include "path"`.
     Include {
@@ -67,6 +70,29 @@ pub enum StmtKind {
     },
     /// A statement that failed to parse (already reported).
     Error,
+}
+
+/// `var in start..end` or `var in list`: one loop variable and what it runs over.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Generator {
+    /// The variable.
+    pub var: Ident,
+    /// What it takes in turn.
+    pub over: Iterable,
+}
+
+/// What a `for` runs over.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Iterable {
+    /// The whole numbers from `start` up to, not including, `end`.
+    Range {
+        /// First value.
+        start: Expr,
+        /// One past the last value.
+        end: Expr,
+    },
+    /// The elements of a list.
+    List(Expr),
 }
 
 /// A call argument, positional or named.
@@ -100,6 +126,22 @@ pub enum BinOp {
     Div,
     /// `%`
     Rem,
+    /// `==`
+    Eq,
+    /// `!=`
+    Ne,
+    /// `<`
+    Lt,
+    /// `<=`
+    Le,
+    /// `>`
+    Gt,
+    /// `>=`
+    Ge,
+    /// `and` (the right operand is evaluated only when the left is `true`)
+    And,
+    /// `or` (the right operand is evaluated only when the left is `false`)
+    Or,
 }
 
 impl BinOp {
@@ -111,6 +153,14 @@ impl BinOp {
             BinOp::Mul => "*",
             BinOp::Div => "/",
             BinOp::Rem => "%",
+            BinOp::Eq => "==",
+            BinOp::Ne => "!=",
+            BinOp::Lt => "<",
+            BinOp::Le => "<=",
+            BinOp::Gt => ">",
+            BinOp::Ge => ">=",
+            BinOp::And => "and",
+            BinOp::Or => "or",
         }
     }
 }
@@ -171,6 +221,26 @@ pub enum ExprKind {
     },
     /// `-expr`.
     Neg(Box<Expr>),
+    /// `not expr`.
+    Not(Box<Expr>),
+    /// `if cond then a else b`.
+    If {
+        /// The condition.
+        cond: Box<Expr>,
+        /// The value when it holds.
+        then: Box<Expr>,
+        /// The value when it does not.
+        otherwise: Box<Expr>,
+    },
+    /// `[for i in 0..n, p in ps if cond => body]`.
+    Comprehension {
+        /// The loop variables, outermost first.
+        generators: Vec<Generator>,
+        /// Elements are made only where this holds.
+        filter: Option<Box<Expr>>,
+        /// Each element.
+        body: Box<Expr>,
+    },
     /// `lhs op rhs`.
     Binary {
         /// Operator.

@@ -111,6 +111,24 @@ fn clean_tokens<'s>(tokens: Vec<(Token<'s>, Span)>, diags: &mut Vec<Diagnostic>)
                     diags.push(d);
                 }
             }
+            Token::ForeignLogic(s) => {
+                let (word, tok) = match s {
+                    "&&" => ("and", Token::And),
+                    "||" => ("or", Token::Or),
+                    _ => ("not", Token::Not),
+                };
+                diags.push(
+                    Diagnostic::error(
+                        codes::FOREIGN_OPERATOR,
+                        span,
+                        format!("`{s}` is not an operator in scnc"),
+                        format!("scnc writes this `{word}`"),
+                    )
+                    .with_replacement(span, word),
+                );
+                // Parsed as the word meant, so the rest of the expression is still checked.
+                out.push((tok, span));
+            }
             tok => out.push((tok, span)),
         }
     }
@@ -176,7 +194,19 @@ fn to_diagnostic(err: &parser::ParseError<'_, '_>) -> Diagnostic {
             let mut items: Vec<String> =
                 err.expected().filter(|p| !matches!(p, RichPattern::SomethingElse)).map(describe).collect();
             // The pieces an expression may start with read better as one word.
-            const STARTS: [&str; 7] = ["`(`", "`-`", "identifier", "literal", "mesh", "vector or list", "expression"];
+            const STARTS: [&str; 11] = [
+                "`(`",
+                "`-`",
+                "`not`",
+                "`if`",
+                "identifier",
+                "literal",
+                "mesh",
+                "vector or list",
+                "list comprehension",
+                "if expression",
+                "expression",
+            ];
             if items.iter().filter(|i| STARTS.contains(&i.as_str())).count() > 1 {
                 items.retain(|i| !STARTS.contains(&i.as_str()));
                 items.push("expression".into());
@@ -190,6 +220,9 @@ fn to_diagnostic(err: &parser::ParseError<'_, '_>) -> Diagnostic {
             );
             for (label, ctx_span) in err.contexts() {
                 d = d.with_label(Span::from(*ctx_span), format!("while parsing this {}", describe(label)));
+            }
+            if let Some(Token::Ident(word @ ("elif" | "elsif" | "elseif"))) = err.found() {
+                d = d.with_hint(format!("scnc writes `else if`, not `{word}`"));
             }
             let keyword = err.found().map(|t| t.to_string()).filter(|t| Token::KEYWORDS.contains(&t.as_str()));
             if let (Some(kw), true) = (keyword, expected.contains("identifier")) {

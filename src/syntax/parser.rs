@@ -7,7 +7,7 @@
 use chumsky::input::ValueInput;
 use chumsky::prelude::*;
 
-use super::ast::{Arg, BinOp, Expr, ExprKind, File, Ident, Stmt, StmtKind, TransformOp};
+use super::ast::{Arg, BinOp, Expr, ExprKind, File, Generator, Ident, Iterable, Stmt, StmtKind, TransformOp};
 use super::token::Token;
 use crate::span::Span;
 
@@ -76,6 +76,23 @@ where
         )))
 }
 
+/// `var in start..end` or `var in list`, for loops and comprehensions.
+fn generator<'t, 's: 't, I, P>(expr: P) -> impl Parser<'t, I, Generator, Extra<'t, 's>> + Clone
+where
+    I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
+    P: Parser<'t, I, Expr, Extra<'t, 's>> + Clone,
+{
+    ident().then_ignore(just(Token::In)).then(expr.clone()).then(just(Token::DotDot).ignore_then(expr).or_not()).map(
+        |((var, first), end)| {
+            let over = match end {
+                Some(end) => Iterable::Range { start: first, end },
+                None => Iterable::List(first),
+            };
+            Generator { var, over }
+        },
+    )
+}
+
 /// The expression parser.
 pub fn expr<'t, 's: 't, I>() -> impl Parser<'t, I, Expr, Extra<'t, 's>> + Clone
 where
@@ -101,6 +118,19 @@ where
             .map(ExprKind::List)
             .labelled("vector or list");
 
+        let comprehension = just(Token::For)
+            .ignore_then(generator(expr.clone()).separated_by(just(Token::Comma)).at_least(1).collect::<Vec<_>>())
+            .then(just(Token::If).ignore_then(expr.clone()).or_not())
+            .then_ignore(just(Token::Arrow))
+            .then(expr.clone())
+            .delimited_by(just(Token::LBracket), just(Token::RBracket))
+            .map(|((generators, filter), body)| ExprKind::Comprehension {
+                generators,
+                filter: filter.map(Box::new),
+                body: Box::new(body),
+            })
+            .labelled("list comprehension");
+
         let mesh = just(Token::Mesh)
             .ignore_then(ident().labelled("mesh generator"))
             .then(args(expr.clone()))
@@ -112,6 +142,7 @@ where
             call,
             // A name followed by `(` is a call or nothing: never fall back to a bare name.
             ident().then_ignore(just(Token::LParen).not()).map(ExprKind::Ident),
+            comprehension,
             list,
             mesh,
         ))
@@ -160,6 +191,45 @@ where
             binary(&[(Token::Star, BinOp::Mul), (Token::Slash, BinOp::Div), (Token::Percent, BinOp::Rem)])(unary);
         let sum = binary(&[(Token::Plus, BinOp::Add), (Token::Minus, BinOp::Sub)])(product);
 
+        // One comparison at most: `a < b < c` is a syntax error, not `(a < b) < c`.
+        let compare_op = select! {
+            Token::EqEq => BinOp::Eq,
+            Token::NotEq => BinOp::Ne,
+            Token::Lt => BinOp::Lt,
+            Token::Le => BinOp::Le,
+            Token::Gt => BinOp::Gt,
+            Token::Ge => BinOp::Ge,
+        };
+        let comparison = sum
+            .clone()
+            .then(compare_op.map_with(|op, e| (op, e.span())).then(sum).repeated().at_most(8).collect::<Vec<_>>())
+            .validate(|(lhs, rest), e, emitter| {
+                if let Some(((_, second), _)) = rest.get(1) {
+                    emitter.emit(Rich::custom(
+                        *second,
+                        "comparisons do not chain: `a < b < c` is written `a < b and b < c`",
+                    ));
+                }
+                match rest.into_iter().next() {
+                    None => lhs,
+                    Some(((op, _), rhs)) => Expr {
+                        kind: ExprKind::Binary { op, lhs: Box::new(lhs), rhs: Box::new(rhs) },
+                        span: Span::from(e.span()),
+                    },
+                }
+            })
+            .boxed();
+        let negation = just(Token::Not)
+            .to_span()
+            .repeated()
+            .foldr_with(comparison, |_, operand, e| Expr {
+                kind: ExprKind::Not(Box::new(operand)),
+                span: Span::from(e.span()),
+            })
+            .boxed();
+        let conjunction = binary(&[(Token::And, BinOp::And)])(negation);
+        let disjunction = binary(&[(Token::Or, BinOp::Or)])(conjunction);
+
         let transform_op = select! {
             Token::At => TransformOp::At,
             Token::Rotate => TransformOp::Rotate,
@@ -168,12 +238,39 @@ where
         }
         .map_with(|op, e| (op, Span::from(e.span())));
 
-        sum.clone()
-            .foldl_with(transform_op.then(sum).repeated(), |target, ((op, op_span), arg), e| Expr {
+        let transformed = disjunction.clone().foldl_with(
+            transform_op.then(disjunction).repeated(),
+            |target, ((op, op_span), arg), e| Expr {
                 kind: ExprKind::Transform { op, op_span, target: Box::new(target), arg: Box::new(arg) },
                 span: Span::from(e.span()),
+            },
+        );
+
+        // `if` reaches as far right as it can: `if c then a else b at p` places `b` only.
+        // A missing `else` is reported here, where it is missing, rather than failing
+        // the statement (whose recovery would take the `if` for an `if` statement).
+        let conditional = just(Token::If)
+            .ignore_then(expr.clone())
+            .then_ignore(just(Token::Then))
+            .then(expr.clone())
+            .then(just(Token::Else).ignore_then(expr.clone()).or_not())
+            .validate(|((cond, then), otherwise), e, emitter| {
+                let span = Span::from(e.span());
+                let otherwise = otherwise.unwrap_or_else(|| {
+                    emitter.emit(Rich::custom(
+                        e.span(),
+                        "an `if` used as a value needs an `else`: which value is it otherwise?",
+                    ));
+                    Expr { kind: ExprKind::Error, span }
+                });
+                Expr {
+                    kind: ExprKind::If { cond: Box::new(cond), then: Box::new(then), otherwise: Box::new(otherwise) },
+                    span,
+                }
             })
-            .labelled("expression")
+            .labelled("if expression");
+
+        conditional.or(transformed).labelled("expression")
     })
 }
 
@@ -186,6 +283,7 @@ where
         Token::Object,
         Token::Light,
         Token::For,
+        Token::If,
         Token::Include,
         Token::Camera,
         Token::Render,
@@ -229,14 +327,23 @@ where
         let close = just(Token::RBrace).ignored().recover_with(via_parser(end()));
         let body = stmt.repeated().collect::<Vec<_>>().delimited_by(just(Token::LBrace), close);
         let for_ = just(Token::For)
-            .ignore_then(ident())
-            .then_ignore(just(Token::In))
-            .then(e.clone())
-            .then_ignore(just(Token::DotDot))
-            .then(e.clone())
-            .then(body)
-            .map(|(((var, start), end), body)| StmtKind::For { var, start, end, body })
+            .ignore_then(generator(e.clone()))
+            .then(body.clone())
+            .map(|(each, body)| StmtKind::For { each, body })
             .labelled("for loop")
+            .as_context();
+        let else_if = just(Token::Else).ignore_then(just(Token::If)).ignore_then(e.clone()).then(body.clone());
+        let if_ = just(Token::If)
+            .ignore_then(e.clone())
+            .then(body.clone())
+            .then(else_if.repeated().collect::<Vec<_>>())
+            .then(just(Token::Else).ignore_then(body).or_not())
+            .map(|(((cond, then), more), otherwise)| {
+                let mut branches = vec![(cond, then)];
+                branches.extend(more);
+                StmtKind::If { branches, otherwise }
+            })
+            .labelled("if statement")
             .as_context();
         let include = just(Token::Include)
             .ignore_then(
@@ -248,7 +355,7 @@ where
             .labelled("include statement")
             .as_context();
 
-        choice((camera, render, light, object, let_, for_, include))
+        choice((camera, render, light, object, let_, for_, if_, include))
             .map_with(|kind, e| {
                 #[cfg(test)]
                 tests::STATEMENTS_BUILT.with(|c| c.set(c.get() + 1));

@@ -47,6 +47,24 @@ pub enum Token<'src> {
     /// `mesh`
     #[token("mesh")]
     Mesh,
+    /// `if`
+    #[token("if")]
+    If,
+    /// `then`
+    #[token("then")]
+    Then,
+    /// `else`
+    #[token("else")]
+    Else,
+    /// `and`
+    #[token("and")]
+    And,
+    /// `or`
+    #[token("or")]
+    Or,
+    /// `not`
+    #[token("not")]
+    Not,
     /// `true` or `false`
     #[token("true", |_| true)]
     #[token("false", |_| false)]
@@ -105,6 +123,33 @@ pub enum Token<'src> {
     /// `..`
     #[token("..")]
     DotDot,
+    /// `==`
+    #[token("==")]
+    EqEq,
+    /// `!=`
+    #[token("!=")]
+    NotEq,
+    /// `<`
+    #[token("<")]
+    Lt,
+    /// `<=`
+    #[token("<=")]
+    Le,
+    /// `>`
+    #[token(">")]
+    Gt,
+    /// `>=`
+    #[token(">=")]
+    Ge,
+    /// `=>`
+    #[token("=>")]
+    Arrow,
+    /// `&&`, `||` or `!`: other languages' logic operators, lexed so the error can name
+    /// the word scnc uses.
+    #[token("&&")]
+    #[token("||")]
+    #[token("!")]
+    ForeignLogic(&'src str),
     /// A `// …` comment to the end of the line.
     #[regex(r"//[^\n]*", allow_greedy = true)]
     LineComment,
@@ -155,7 +200,7 @@ impl Token<'_> {
     /// The keywords of the language, as written (the highlighting grammar must list them all).
     pub const KEYWORDS: &'static [&'static str] = &[
         "let", "object", "light", "for", "in", "include", "camera", "render", "at", "rotate", "scale", "with", "mesh",
-        "true", "false",
+        "true", "false", "if", "then", "else", "and", "or", "not",
     ];
 }
 
@@ -175,6 +220,12 @@ impl fmt::Display for Token<'_> {
             Token::Scale => "scale",
             Token::With => "with",
             Token::Mesh => "mesh",
+            Token::If => "if",
+            Token::Then => "then",
+            Token::Else => "else",
+            Token::And => "and",
+            Token::Or => "or",
+            Token::Not => "not",
             Token::Bool(true) => "true",
             Token::Bool(false) => "false",
             Token::Number(s)
@@ -184,6 +235,7 @@ impl fmt::Display for Token<'_> {
             | Token::BadNumber(s)
             | Token::BadColor(s)
             | Token::UnterminatedStr(s)
+            | Token::ForeignLogic(s)
             | Token::Error(s) => s,
             Token::LParen => "(",
             Token::RParen => ")",
@@ -199,6 +251,13 @@ impl fmt::Display for Token<'_> {
             Token::Slash => "/",
             Token::Percent => "%",
             Token::DotDot => "..",
+            Token::EqEq => "==",
+            Token::NotEq => "!=",
+            Token::Lt => "<",
+            Token::Le => "<=",
+            Token::Gt => ">",
+            Token::Ge => ">=",
+            Token::Arrow => "=>",
             Token::BlockComment(_) => "/*",
             Token::LineComment => "//",
         };
