@@ -167,6 +167,9 @@ pub enum MathFn {
     Sqrt,
     Abs,
     Floor,
+    Ceil,
+    Sign,
+    Random,
 }
 
 /// `min` and `max`.
@@ -382,6 +385,12 @@ pub const BUILTINS: &[Builtin] = &[
     f("sqrt", Ctor::Math(MathFn::Sqrt), X, Ty::Num, "square root of a non-negative number"),
     f("abs", Ctor::Math(MathFn::Abs), X, Ty::Num, "absolute value"),
     f("floor", Ctor::Math(MathFn::Floor), X, Ty::Num, "largest whole number not above `x`"),
+    f("ceil", Ctor::Math(MathFn::Ceil), X, Ty::Num, "smallest whole number not below `x`"),
+    f("sign", Ctor::Math(MathFn::Sign), X, Ty::Num, "-1, 0 or 1 as `x` is negative, zero or positive"),
+    f(
+        "random", Ctor::Math(MathFn::Random), &[p("seed", Ty::Num, Req)], Ty::Num,
+        "a number in [0, 1) that depends only on `seed` (the same on every machine): `random(i * 7 + 3)`",
+    ),
     variadic("min", Ctor::Extreme(Extreme::Min), Ty::Num, &[], Ty::Num, "smallest of the numbers"),
     variadic("max", Ctor::Extreme(Extreme::Max), Ty::Num, &[], Ty::Num, "largest of the numbers"),
     f("len", Ctor::Len, &[p("list", Ty::List, Req)], Ty::Int, "number of elements of a list"),
