@@ -18,6 +18,7 @@ mod construct;
 mod control;
 mod env;
 mod expr;
+mod include;
 pub mod index;
 mod range;
 mod transform;
@@ -25,16 +26,16 @@ mod value;
 
 use std::cell::Cell;
 use std::collections::HashMap;
-use std::path::{Component, Path, PathBuf};
+use std::path::{Path, PathBuf};
 use std::rc::Rc;
 
 use glam::DVec3;
 
 use crate::diag::{codes, Diagnostic};
 use crate::ir::{self, Camera, Scene, Settings};
-use crate::source::{io_reason, FileId, Loader, SourceMap, MAX_FILE_BYTES};
+use crate::source::{FileId, Loader, SourceMap};
 use crate::span::Span;
-use crate::syntax::{self, ast};
+use crate::syntax::ast;
 pub use construct::{
     EPSILON_RULE, MAX_DEPTH, MAX_GENERATED_TRIANGLES, MAX_IMAGE_SIDE, MAX_MESH_RESOLUTION, MAX_PIXELS, MAX_REPEAT,
     MAX_SAMPLES, MAX_STEPS, MIN_EPSILON,
@@ -364,15 +365,7 @@ impl Ctx<'_> {
             }
             ast::StmtKind::For { each, body } => self.for_loop(each, body, stmt.span),
             ast::StmtKind::If { branches, otherwise } => self.if_stmt(branches, otherwise.as_deref()),
-            ast::StmtKind::Include { path, path_span } => {
-                let root = self.include_stack.len() == 1;
-                let outer = self.export;
-                if root {
-                    self.export = Some((stmt.span.end, self.block_end, self.env.depth().unwrap_or(0)));
-                }
-                self.include(path, *path_span);
-                self.export = outer;
-            }
+            ast::StmtKind::Include { path, path_span } => self.include_stmt(path, *path_span, stmt.span),
         }
     }
 
@@ -510,93 +503,6 @@ impl Ctx<'_> {
         self.objects.push(ir::Object { geometry, span: stmt_span });
     }
 
-    fn include(&mut self, written: &str, span: Span) {
-        let path = normalize(&self.dir.join(written));
-        if let Some(pos) = self.include_stack.iter().position(|p| *p == path) {
-            let chain: Vec<String> = self.include_stack[pos..]
-                .iter()
-                .chain(std::iter::once(&path))
-                .map(|p| p.display().to_string())
-                .collect();
-            self.report(
-                Diagnostic::error(
-                    codes::INCLUDE_CYCLE,
-                    span,
-                    format!("`{written}` includes itself"),
-                    "this include closes a cycle",
-                )
-                .with_note(format!("include chain: {}", chain.join(" → "))),
-            );
-            return;
-        }
-        self.includes += 1;
-        if self.includes > MAX_INCLUDES {
-            self.halted = true;
-            self.report(
-                Diagnostic::error(codes::INCLUDE_DEPTH, span, "too many includes", "include number 1,001 is here")
-                    .with_note(format!("a compile may carry out at most {MAX_INCLUDES} includes in all")),
-            );
-            return;
-        }
-        if self.include_stack.len() >= MAX_INCLUDE_DEPTH {
-            self.report(
-                Diagnostic::error(
-                    codes::INCLUDE_DEPTH,
-                    span,
-                    "includes nest too deeply",
-                    format!("include depth {MAX_INCLUDE_DEPTH} is exceeded here"),
-                )
-                .with_note(format!("files may include each other at most {MAX_INCLUDE_DEPTH} levels deep")),
-            );
-            return;
-        }
-        let text = match self.loader.read(&path) {
-            Ok(text) if text.len() > MAX_FILE_BYTES => {
-                self.report(Diagnostic::error(
-                    codes::TOO_LARGE,
-                    span,
-                    format!("`{written}` is too large"),
-                    format!("larger than {} MiB", MAX_FILE_BYTES >> 20),
-                ));
-                return;
-            }
-            Ok(text) => text,
-            Err(e) => {
-                self.report(
-                    Diagnostic::error(codes::INCLUDE_READ, span, format!("cannot read `{written}`"), io_reason(&e))
-                        .with_note(format!("looked for {}", path.display())),
-                );
-                return;
-            }
-        };
-        let Some(id) = self.map.add(written, &path, text) else {
-            self.report(Diagnostic::error(
-                codes::TOO_LARGE,
-                span,
-                "the scene's files are too large in total",
-                "including this file exceeds the limit",
-            ));
-            return;
-        };
-        self.run_file(id);
-    }
-
-    fn run_file(&mut self, id: FileId) {
-        let (file, diags) = {
-            let f = self.map.file(id);
-            syntax::parse(&f.text, f.base)
-        };
-        for d in diags {
-            self.report(d);
-        }
-        let path = self.map.file(id).path.clone();
-        let old_dir = std::mem::replace(&mut self.dir, Rc::from(path.parent().unwrap_or(Path::new(""))));
-        self.include_stack.push(normalize(&path));
-        self.stmts(&file.stmts);
-        self.include_stack.pop();
-        self.dir = old_dir;
-    }
-
     fn finish(mut self) -> (Option<Scene>, Vec<Diagnostic>) {
         let mut unused: Vec<(Span, String)> = self
             .lets
@@ -684,27 +590,6 @@ fn behind_camera(obj: &ir::Object, camera: &Camera) -> Option<f64> {
     let forward = (camera.look_at - camera.position).normalize();
     let depth = (centre - camera.position).dot(forward);
     (depth + radius < 0.0).then_some(-(depth + radius))
-}
-
-/// Lexically normalises `a/./b/../c` to `a/c`, for include-cycle detection.
-fn normalize(path: &Path) -> PathBuf {
-    let mut out = PathBuf::new();
-    for c in path.components() {
-        match c {
-            Component::CurDir => {}
-            Component::ParentDir => {
-                if !out.pop() {
-                    out.push("..");
-                }
-            }
-            c => out.push(c),
-        }
-    }
-    // `include "."` from a file in the working directory names that directory, not "".
-    if out.as_os_str().is_empty() {
-        out.push(".");
-    }
-    out
 }
 
 #[allow(clippy::type_complexity, reason = "the three results of one compile")]
