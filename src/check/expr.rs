@@ -333,7 +333,10 @@ impl Ctx<'_> {
         }
         match op {
             BinOp::Eq | BinOp::Ne => return self.equality(op, &a, a_span, &b, b_span, span),
-            BinOp::Lt | BinOp::Le | BinOp::Gt | BinOp::Ge => return self.ordering(op, &a, a_span, &b, b_span, span),
+            BinOp::Lt => return self.ordering(op, |x, y| x < y, &a, a_span, &b, b_span, span),
+            BinOp::Le => return self.ordering(op, |x, y| x <= y, &a, a_span, &b, b_span, span),
+            BinOp::Gt => return self.ordering(op, |x, y| x > y, &a, a_span, &b, b_span, span),
+            BinOp::Ge => return self.ordering(op, |x, y| x >= y, &a, a_span, &b, b_span, span),
             BinOp::And | BinOp::Or => {
                 let what = format!("an operand of `{}`", op.symbol());
                 let (x, y) = (self.condition(&a, a_span, &what), self.condition(&b, b_span, &what));
@@ -503,16 +506,20 @@ impl Ctx<'_> {
         }
     }
 
-    fn ordering(&mut self, op: BinOp, a: &Value, a_span: Span, b: &Value, b_span: Span, span: Span) -> Value {
+    /// `<`, `<=`, `>`, `>=` (`op`, which `holds` computes) on two numbers.
+    #[allow(clippy::too_many_arguments, reason = "both operands with their spans, and the whole")]
+    fn ordering(
+        &mut self,
+        op: BinOp,
+        holds: fn(f64, f64) -> bool,
+        a: &Value,
+        a_span: Span,
+        b: &Value,
+        b_span: Span,
+        span: Span,
+    ) -> Value {
         if let (Value::Num(x), Value::Num(y)) = (a, b) {
-            return Value::Bool(match op {
-                BinOp::Lt => x < y,
-                BinOp::Le => x <= y,
-                BinOp::Gt => x > y,
-                BinOp::Ge => x >= y,
-                BinOp::Add | BinOp::Sub | BinOp::Mul | BinOp::Div | BinOp::Rem => false,
-                BinOp::Eq | BinOp::Ne | BinOp::And | BinOp::Or => false,
-            });
+            return Value::Bool(holds(*x, *y));
         }
         let (bad, bad_span) = if matches!(a, Value::Num(_)) { (b, b_span) } else { (a, a_span) };
         self.report(

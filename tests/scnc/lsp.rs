@@ -98,6 +98,12 @@ impl Client {
 
     /// The next diagnostics published for `uri`.
     fn diagnostics(&mut self, uri: &str) -> Vec<Value> {
+        let msg = self.publication(uri);
+        msg["params"]["diagnostics"].as_array().cloned().unwrap_or_default()
+    }
+
+    /// The next `publishDiagnostics` message for `uri`, whole (with its version).
+    fn publication(&mut self, uri: &str) -> Value {
         let deadline = Instant::now() + TIMEOUT;
         loop {
             let found = self
@@ -105,8 +111,7 @@ impl Client {
                 .iter()
                 .position(|m| m["method"] == "textDocument/publishDiagnostics" && m["params"]["uri"] == json!(uri));
             if let Some(i) = found {
-                let msg = self.pending.remove(i);
-                return msg["params"]["diagnostics"].as_array().cloned().unwrap_or_default();
+                return self.pending.remove(i);
             }
             let msg = self.next(deadline);
             self.pending.push(msg);
@@ -382,18 +387,7 @@ fn an_edit_cancels_the_analysis_it_makes_stale() {
     client.stdin.flush().expect("flushing");
     let hover = client.at("textDocument/hover", &u, 0, 8);
     assert!(hover.to_string().contains("ambient"), "the hover reads the new text: {hover}");
-    let deadline = Instant::now() + TIMEOUT;
-    let first = loop {
-        let found = client
-            .pending
-            .iter()
-            .position(|m| m["method"] == "textDocument/publishDiagnostics" && m["params"]["uri"] == json!(u));
-        if let Some(i) = found {
-            break client.pending.remove(i);
-        }
-        let msg = client.next(deadline);
-        client.pending.push(msg);
-    };
+    let first = client.publication(&u);
     assert_eq!(first["params"]["version"], json!(2), "the stale analysis published nothing: {first}");
     let codes: Vec<&Value> =
         first["params"]["diagnostics"].as_array().into_iter().flatten().map(|d| &d["code"]).collect();

@@ -134,21 +134,27 @@ fn amplified_examples_end_by_a_budget() {
     fn unclosed(rng: &mut Rng) -> String {
         "for i in 0..1 {\n".repeat(1 + rng.below(200))
     }
+    /// `first`, then `depth` lines each doubling the one before (`step(i)` writes line
+    /// `i`), then `last(depth)`.
+    fn doubling(first: &str, depth: usize, step: impl Fn(usize) -> String, last: impl Fn(usize) -> String) -> String {
+        let steps: String = (1..=depth).map(step).collect();
+        format!("{first}\n{steps}{}\n", last(depth))
+    }
     fn doubling_calls(rng: &mut Rng) -> String {
-        let depth = 4 + rng.below(22);
-        let mut s = String::from("let g0(x) = x + 1\n");
-        for i in 1..=depth {
-            s += &format!("let g{i}(x) = g{}(x) + g{}(x)\n", i - 1, i - 1);
-        }
-        s + &format!("object sphere(g{depth}(0) * 0 + 1) at [0, 0, 9]\n")
+        doubling(
+            "let g0(x) = x + 1",
+            4 + rng.below(22),
+            |i| format!("let g{i}(x) = g{}(x) + g{}(x)\n", i - 1, i - 1),
+            |d| format!("object sphere(g{d}(0) * 0 + 1) at [0, 0, 9]"),
+        )
     }
     fn doubling_shapes(rng: &mut Rng) -> String {
-        let depth = 4 + rng.below(24);
-        let mut s = String::from("let d0 = sphere(0.1)\n");
-        for i in 1..=depth {
-            s += &format!("let d{i} = union(d{}, d{} at [0.001, 0, 0])\n", i - 1, i - 1);
-        }
-        s + &format!("object d{depth} at [0, 0, 9]\n")
+        doubling(
+            "let d0 = sphere(0.1)",
+            4 + rng.below(24),
+            |i| format!("let d{i} = union(d{}, d{} at [0.001, 0, 0])\n", i - 1, i - 1),
+            |d| format!("object d{d} at [0, 0, 9]"),
+        )
     }
     fn error_loop(rng: &mut Rng) -> String {
         format!("for i in 0..{} {{ object nowhere(i) }}\n", 1 + rng.below(1_000_000))
