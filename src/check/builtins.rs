@@ -33,6 +33,8 @@ pub enum Ty {
     Light,
     /// A list.
     List,
+    /// A number, a `vec3` or a colour: what can be scaled and added (`mix`, `sum`).
+    Linear,
 }
 
 impl fmt::Display for Ty {
@@ -50,6 +52,7 @@ impl fmt::Display for Ty {
             Ty::Mesh => "mesh",
             Ty::Light => "light",
             Ty::List => "list",
+            Ty::Linear => "num, vec3 or color",
         };
         f.write_str(s)
     }
@@ -114,6 +117,10 @@ pub enum Ctor {
     Light(LightFn),
     /// A function of one number.
     Math(MathFn),
+    /// Another function of numbers (several, or giving a list or colour).
+    Numeric(NumFn),
+    /// A function of vectors.
+    Vector(VecFn),
     /// `min` or `max` of numbers.
     Extreme(Extreme),
     /// `len(list)`.
@@ -170,6 +177,35 @@ pub enum MathFn {
     Ceil,
     Sign,
     Random,
+    Exp,
+    Log,
+    Asin,
+    Acos,
+    Atan,
+    Round,
+}
+
+/// Functions of several numbers, or giving a list or a colour.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(missing_docs, reason = "each variant is the builtin of the same name, documented in BUILTINS")]
+pub enum NumFn {
+    Pow,
+    Atan2,
+    Clamp,
+    Mix,
+    Hsv,
+    Range,
+    Sum,
+}
+
+/// Functions of vectors.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(missing_docs, reason = "each variant is the builtin of the same name, documented in BUILTINS")]
+pub enum VecFn {
+    Dot,
+    Cross,
+    Normalize,
+    Length,
 }
 
 /// `min` and `max`.
@@ -222,6 +258,8 @@ impl Builtin {
             | Ctor::Rgb
             | Ctor::Light(_)
             | Ctor::Math(_)
+            | Ctor::Numeric(_)
+            | Ctor::Vector(_)
             | Ctor::Extreme(_)
             | Ctor::Len => Kind::Function,
             Ctor::Generator(_) => Kind::MeshGenerator,
@@ -391,6 +429,54 @@ pub const BUILTINS: &[Builtin] = &[
         "random", Ctor::Math(MathFn::Random), &[p("seed", Ty::Num, Req)], Ty::Num,
         "a number in [0, 1) that depends only on `seed` (the same on every machine): `random(i * 7 + 3)`",
     ),
+    f("exp", Ctor::Math(MathFn::Exp), X, Ty::Num, "e raised to `x`"),
+    f("log", Ctor::Math(MathFn::Log), X, Ty::Num, "natural logarithm of a positive number"),
+    f("asin", Ctor::Math(MathFn::Asin), X, Ty::Num, "arcsine in degrees, of a number in [-1, 1]"),
+    f("acos", Ctor::Math(MathFn::Acos), X, Ty::Num, "arccosine in degrees, of a number in [-1, 1]"),
+    f("atan", Ctor::Math(MathFn::Atan), X, Ty::Num, "arctangent in degrees"),
+    // `round(x)` beside the shape modifier `round(shape, r)`: the first argument's type
+    // chooses (see `overload`).
+    f("round", Ctor::Math(MathFn::Round), X, Ty::Num, "nearest whole number, halves away from zero"),
+    f(
+        "pow", Ctor::Numeric(NumFn::Pow), &[p("x", Ty::Num, Req), p("y", Ty::Num, Req)], Ty::Num,
+        "`x` raised to the power `y` (a whole `y` when `x` is negative)",
+    ),
+    f(
+        "atan2", Ctor::Numeric(NumFn::Atan2), &[p("y", Ty::Num, Req), p("x", Ty::Num, Req)], Ty::Num,
+        "angle in degrees, in (-180, 180], of the point (x, y) from the +x axis",
+    ),
+    f(
+        "clamp", Ctor::Numeric(NumFn::Clamp),
+        &[p("x", Ty::Num, Req), p("lo", Ty::Num, Req), p("hi", Ty::Num, Req)],
+        Ty::Num,
+        "`x` limited to [lo, hi]",
+    ),
+    f(
+        "mix", Ctor::Numeric(NumFn::Mix),
+        &[p("a", Ty::Linear, Req), p("b", Ty::Linear, Req), p("t", Ty::Num, Req)],
+        Ty::Linear,
+        "`a + (b - a) * t`: numbers, vectors or colours, `a` and `b` of one type",
+    ),
+    f(
+        "hsv", Ctor::Numeric(NumFn::Hsv),
+        &[p("h", Ty::Num, Req), p("s", Ty::Num, Req), p("v", Ty::Num, Req)],
+        Ty::Color,
+        "a colour from hue in degrees (0 red, 120 green, 240 blue), saturation and value in [0, 1]",
+    ),
+    f(
+        "range", Ctor::Numeric(NumFn::Range),
+        &[p("from", Ty::Num, Req), p("to", Ty::Num, Req), p("step", Ty::Num, N(1.0))],
+        Ty::List,
+        "the list of every `from + i * step` (i = 0, 1, …) before `to`: `range(0, 1, 0.25)` is [0, 0.25, 0.5, 0.75]",
+    ),
+    f(
+        "sum", Ctor::Numeric(NumFn::Sum), &[p("list", Ty::List, Req)], Ty::Linear,
+        "sum of a list of numbers, vectors or colours (0 for an empty list)",
+    ),
+    f("dot", Ctor::Vector(VecFn::Dot), &[p("a", Ty::Vec3, Req), p("b", Ty::Vec3, Req)], Ty::Num, "dot product"),
+    f("cross", Ctor::Vector(VecFn::Cross), &[p("a", Ty::Vec3, Req), p("b", Ty::Vec3, Req)], Ty::Vec3, "cross product"),
+    f("normalize", Ctor::Vector(VecFn::Normalize), &[p("v", Ty::Vec3, Req)], Ty::Vec3, "`v` scaled to length 1 (not zero)"),
+    f("length", Ctor::Vector(VecFn::Length), &[p("v", Ty::Vec3, Req)], Ty::Num, "Euclidean length of a vector"),
     variadic("min", Ctor::Extreme(Extreme::Min), Ty::Num, &[], Ty::Num, "smallest of the numbers"),
     variadic("max", Ctor::Extreme(Extreme::Max), Ty::Num, &[], Ty::Num, "largest of the numbers"),
     f("len", Ctor::Len, &[p("list", Ty::List, Req)], Ty::Int, "number of elements of a list"),
@@ -493,6 +579,13 @@ pub fn lookup(name: &str, kind: Kind) -> Option<&'static Builtin> {
     BUILTINS.iter().find(|b| b.name == name && b.kind() == kind)
 }
 
+/// `b` and the other entries of its name and kind (overloads told apart by the type of
+/// their first parameter, such as `round(x)` and `round(shape, r)`), `b` first.
+pub fn overloads(b: &'static Builtin) -> impl Iterator<Item = &'static Builtin> {
+    let others = BUILTINS.iter().filter(move |o| o.name == b.name && o.kind() == b.kind() && !std::ptr::eq(*o, b));
+    std::iter::once(b).chain(others)
+}
+
 /// Names of builtins of one kind (for suggestions).
 pub fn names(kind: Kind) -> impl Iterator<Item = &'static str> {
     BUILTINS.iter().filter(move |b| b.kind() == kind).map(|b| b.name)
@@ -502,13 +595,19 @@ pub fn names(kind: Kind) -> impl Iterator<Item = &'static str> {
 mod tests {
     use super::*;
 
-    /// Each constructor belongs to one entry, and a name to one entry of each kind.
+    /// Each constructor belongs to one entry, and a name to one entry of each kind, or
+    /// to overloads whose first parameters no value fits both of.
     #[test]
     fn constructors_and_names_are_unique() {
         for (i, a) in BUILTINS.iter().enumerate() {
             for b in &BUILTINS[i + 1..] {
                 assert_ne!(a.ctor, b.ctor, "`{}` and `{}` share a constructor", a.name, b.name);
-                assert!(a.name != b.name || a.kind() != b.kind(), "`{}` is listed twice", a.name);
+                if a.name == b.name && a.kind() == b.kind() {
+                    let (x, y) = (a.params[0].ty, b.params[0].ty);
+                    let distinct =
+                        [x, y].contains(&Ty::Shape) && x != y && a.variadic.is_none() && b.variadic.is_none();
+                    assert!(distinct, "`{}` is listed twice and its overloads cannot be told apart", a.name);
+                }
             }
         }
     }

@@ -83,8 +83,43 @@ impl Ctx<'_> {
             let _ = self.eval_args(args);
             return Value::Error;
         };
-        self.note_builtin(callee.span, builtin);
-        self.apply_builtin(builtin, args, span)
+        self.apply_builtin(builtin, callee.span, args, span)
+    }
+
+    /// Among `b`'s overloads (`round(x)`, `round(shape, r)`), the one whose first
+    /// parameter takes the first argument. `b` itself when it has none, or when no
+    /// argument decides (its binding reports what is missing); `None` after reporting
+    /// a first argument that fits none of them.
+    fn overload(&mut self, b: &'static Builtin, args: &[ArgVal]) -> Option<&'static Builtin> {
+        let all: Vec<&'static Builtin> = builtins::overloads(b).collect();
+        if all.len() == 1 {
+            return Some(b);
+        }
+        let mut decider = None;
+        for o in &all {
+            if let Some(arg) = first_arg(o, args) {
+                if arg.value.is_error() || admits(o.params[0].ty, &arg.value) {
+                    return Some(o);
+                }
+                decider = decider.or(Some(arg));
+            }
+        }
+        let Some(arg) = decider else {
+            return Some(b);
+        };
+        let found = arg.value.ty_name();
+        let expected: Vec<String> = all.iter().map(|o| format!("`{}`", o.params[0].ty)).collect();
+        let mut d = Diagnostic::error(
+            codes::TYPE_MISMATCH,
+            arg.span,
+            format!("expected {}, found `{found}`", expected.join(" or ")),
+            format!("this is a `{found}`"),
+        );
+        for o in &all {
+            d = d.with_note(format!("{}: {}", o.signature(), o.doc));
+        }
+        self.report(d);
+        None
     }
 
     /// Records in the index that `span` names `builtin`.
@@ -94,9 +129,14 @@ impl Ctx<'_> {
         }
     }
 
-    /// Evaluates the arguments, binds them and builds the builtin's value.
-    fn apply_builtin(&mut self, builtin: &'static Builtin, args: &[ast::Arg], span: Span) -> Value {
+    /// Evaluates the arguments, picks the overload they fit, binds them and builds the
+    /// builtin's value; `name` is the callee's span, for the editor's index.
+    fn apply_builtin(&mut self, builtin: &'static Builtin, name: Span, args: &[ast::Arg], span: Span) -> Value {
         let args = self.eval_args(args);
+        let Some(builtin) = self.overload(builtin, &args) else {
+            return Value::Error;
+        };
+        self.note_builtin(name, builtin);
         match self.bind_builtin(builtin, args, span) {
             Some(bound) => self.construct(builtin, bound),
             None => Value::Error,
@@ -131,8 +171,7 @@ impl Ctx<'_> {
             let _ = self.eval_args(args);
             return Value::Error;
         };
-        self.note_builtin(generator.span, builtin);
-        self.apply_builtin(builtin, args, span)
+        self.apply_builtin(builtin, generator.span, args, span)
     }
 
     /// Matches arguments to parameter slots: positional ones in order (or all into `rest`
@@ -315,7 +354,6 @@ impl Ctx<'_> {
     fn coerce(&mut self, v: &Value, ty: Ty, span: Span, what: &dyn Fn() -> String) -> Option<Value> {
         let ok = match (ty, v) {
             (_, Value::Error) => return Some(Value::Error),
-            (Ty::Num, Value::Num(_)) => true,
             (Ty::Int, Value::Num(x)) => {
                 if x.fract() != 0.0 {
                     self.report(
@@ -333,11 +371,11 @@ impl Ctx<'_> {
                 true
             }
             (Ty::Size, Value::Num(x)) => return Some(Value::Vec3(DVec3::splat(*x))),
-            (Ty::Size | Ty::Vec3, Value::Vec3(_)) => true,
-            (Ty::Bool, Value::Bool(_)) | (Ty::Str, Value::Str(_)) | (Ty::Color, Value::Color(_)) => true,
-            (Ty::Material, Value::Material(_)) | (Ty::Shape, Value::Shape(_)) | (Ty::Mesh, Value::Mesh(_)) => true,
-            (Ty::Light, Value::Light(_)) | (Ty::List, Value::List(_)) => true,
-            _ => false,
+            // `[1, 2, 3]` reads as a vector, but is a list of numbers too, as in `for`.
+            (Ty::List, Value::Vec3(v)) => {
+                return Some(Value::List(std::rc::Rc::new(v.to_array().map(Value::Num).to_vec())))
+            }
+            _ => admits(ty, v),
         };
         if ok {
             return Some(v.clone());
@@ -432,4 +470,32 @@ impl Ctx<'_> {
         }
         v
     }
+}
+
+/// Whether a value of `v`'s type fills a parameter of type `ty` (an `int` must also be
+/// whole; `coerce` checks that).
+fn admits(ty: Ty, v: &Value) -> bool {
+    match ty {
+        Ty::Num | Ty::Int => matches!(v, Value::Num(_)),
+        Ty::Size => matches!(v, Value::Num(_) | Value::Vec3(_)),
+        Ty::Vec3 => matches!(v, Value::Vec3(_)),
+        Ty::Linear => matches!(v, Value::Num(_) | Value::Vec3(_) | Value::Color(_)),
+        Ty::Bool => matches!(v, Value::Bool(_)),
+        Ty::Str => matches!(v, Value::Str(_)),
+        Ty::Color => matches!(v, Value::Color(_)),
+        Ty::Material => matches!(v, Value::Material(_)),
+        Ty::Shape => matches!(v, Value::Shape(_)),
+        Ty::Mesh => matches!(v, Value::Mesh(_)),
+        Ty::Light => matches!(v, Value::Light(_)),
+        Ty::List => matches!(v, Value::List(_) | Value::Vec3(_)),
+    }
+}
+
+/// The argument an overload of `b` is chosen by: the one named like its first
+/// parameter, or else the first positional one.
+fn first_arg<'a>(o: &Builtin, args: &'a [ArgVal]) -> Option<&'a ArgVal> {
+    let first = o.params[0].name;
+    args.iter()
+        .find(|a| a.name.as_ref().is_some_and(|n| n.name == first))
+        .or_else(|| args.iter().find(|a| a.name.is_none()))
 }

@@ -213,3 +213,36 @@ fn editor_queries_never_panic() {
         let _ = a.fixable(0..len);
     }
 }
+
+/// Every builtin function of numbers and vectors, called with every combination of
+/// extreme arguments (zeros of both signs, ±1, the ends of f64, tiny values), compiles
+/// or reports an error: no panic.
+#[test]
+fn numeric_builtins_take_extreme_arguments() {
+    use scnc::check::builtins::{Kind, Ty, BUILTINS};
+    const EXTREMES: &[&str] = &["0", "-0", "1", "-1", "0.5", "1e308", "-1e308", "1e-308", "360", "-2"];
+    let numeric = |t: Ty| matches!(t, Ty::Num | Ty::Int | Ty::Size | Ty::Vec3 | Ty::Linear);
+    for b in BUILTINS.iter().filter(|b| b.kind() == Kind::Function) {
+        if !b.params.iter().all(|p| numeric(p.ty)) || b.variadic.is_some_and(|t| !numeric(t)) {
+            continue;
+        }
+        let n = b.params.len().clamp(1, 3);
+        for combo in 0..EXTREMES.len().pow(n as u32) {
+            let args: Vec<String> = (0..n)
+                .map(|i| {
+                    let x = EXTREMES[combo / EXTREMES.len().pow(i as u32) % EXTREMES.len()];
+                    if b.params.get(i).is_some_and(|p| p.ty == Ty::Vec3) {
+                        format!("[{x}, {x}, {x}]")
+                    } else {
+                        x.to_string()
+                    }
+                })
+                .collect();
+            let text =
+                format!("let v = {}({})\nlet w = [v, v]\nobject sphere(1) at [0, 0, 5]\n", b.name, args.join(", "));
+            let c = scnc::compile_source("x.scn", Path::new("x.scn"), text.clone(), &Examples);
+            let errors = c.diagnostics.iter().filter(|d| d.severity == scnc::diag::Severity::Error).count();
+            assert!(c.scene.is_some() || errors > 0, "{text}");
+        }
+    }
+}

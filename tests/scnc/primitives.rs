@@ -23,6 +23,7 @@ fn argument(ty: Ty) -> &'static str {
         Ty::Mesh => "mesh box(0.5)",
         Ty::Light => "ambient(1)",
         Ty::List => "[1, 2]",
+        Ty::Linear => "0.5",
     }
 }
 

@@ -2,6 +2,7 @@
 //! One exhaustive match per family over the builtin's [`Ctor`]: shapes, meshes, and
 //! plain values (materials, colours, lights, numbers).
 
+mod maths;
 mod meshes;
 mod shapes;
 mod values;
@@ -179,6 +180,8 @@ impl Ctx<'_> {
             Ctor::Rgb => self.rgb(b, &a),
             Ctor::Light(l) => self.light(b, l, &a),
             Ctor::Math(f) => self.math(b, f, &a),
+            Ctor::Numeric(f) => self.numeric(b, f, &a),
+            Ctor::Vector(f) => self.vector(b, f, &a),
             Ctor::Extreme(e) => self.extreme(b, e, &a),
             Ctor::Len => match a.value(b, 0) {
                 Value::List(items) => Value::Num(items.len() as f64),
