@@ -38,6 +38,8 @@ struct Formatter<'t> {
     /// Open `{` blocks.
     braces: usize,
     line: usize,
+    /// The indentation level of each output line that was indented (0 otherwise).
+    levels: Vec<usize>,
     /// The previous token (not a comment), for spacing.
     prev: Option<Token<'t>>,
     /// The last `-` was a negation.
@@ -100,9 +102,7 @@ impl<'t> Formatter<'t> {
 
     fn indent(&mut self, tok: &Token<'_>) {
         let mut lines: Vec<usize> = self.brackets.clone();
-        if matches!(tok, Token::RParen | Token::RBracket) {
-            lines.pop();
-        }
+        let closes = if matches!(tok, Token::RParen | Token::RBracket) { lines.pop() } else { None };
         lines.dedup();
         let mut level = self.braces + lines.len();
         let continues = self.in_statement && lines.is_empty() && !starts_statement(tok, self.prev.as_ref());
@@ -112,6 +112,14 @@ impl<'t> Formatter<'t> {
         if matches!(tok, Token::RBrace) {
             level = level.saturating_sub(1);
         }
+        // A closing bracket that begins a line lines up with the line that opened it.
+        if let Some(opened) = closes {
+            level = self.levels.get(opened).copied().unwrap_or(0);
+        }
+        if self.levels.len() <= self.line {
+            self.levels.resize(self.line + 1, 0);
+        }
+        self.levels[self.line] = level;
         for _ in 0..level {
             self.out.push_str(INDENT);
         }
@@ -125,7 +133,10 @@ impl<'t> Formatter<'t> {
             && ((starts_statement(tok, self.prev.as_ref()) && depth0)
                 || matches!(tok, Token::RBrace) && !matches!(self.prev, Some(Token::LBrace))
                 || matches!(self.prev, Some(Token::LBrace)) && !self.after_comment && !matches!(tok, Token::RBrace));
-        if newlines > 0 || forced {
+        // A block's `{` ends its header's line, and `else` follows the `}` it continues.
+        let joined = !self.after_comment
+            && (matches!(tok, Token::LBrace) || matches!(tok, Token::Else) && matches!(self.prev, Some(Token::RBrace)));
+        if (newlines > 0 && !joined) || forced {
             self.newline(newlines > 1);
         }
         // No blank line right before a closing brace.

@@ -3,7 +3,7 @@
 use super::{Range, MAX_REPEAT, NONNEG, POS};
 use crate::check::builtins::{Builtin, Modifier, Prim};
 use crate::check::expr::BoundArgs;
-use crate::check::{direction, Ctx, Value};
+use crate::check::{direction, Ctx, Value, MAX_OBJECTS};
 use crate::diag::{codes, Diagnostic};
 use crate::ir::{dump_vec, CsgOp, Primitive, ShapeKind};
 
@@ -54,6 +54,22 @@ impl Ctx<'_> {
                     "no shapes given",
                 )
                 .with_hint(format!("try `{}(sphere(1), box(1))`", b.name)),
+            );
+            return None;
+        }
+        // As many parts as a scene may have objects: the same parts as separate objects
+        // would be refused at that count, and a list could join two full lists here.
+        if a.rest.len() > MAX_OBJECTS {
+            self.report(
+                Diagnostic::error(
+                    codes::TOO_LARGE,
+                    a.call,
+                    format!("`{}` of too many parts", b.name),
+                    format!("this combines {} shapes", a.rest.len()),
+                )
+                .with_note(format!(
+                    "one CSG operation may combine at most {MAX_OBJECTS} shapes, as many as a scene's objects"
+                )),
             );
             return None;
         }
