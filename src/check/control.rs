@@ -5,6 +5,14 @@
 //! condition is unknown (poison, as in a function body checked at its definition), both
 //! branches are evaluated without emitting anything, so their mistakes are still
 //! reported and an `if` expression's branch types are compared.
+//!
+//! A branch that does not run (and the right side of `and`/`or` the left side decided,
+//! and a comprehension's body that its filter always rejects) is explored once: run
+//! without emitting, on a small fuel budget, reporting only the mistakes that would be
+//! mistakes whatever the values — misspelt names, arguments and parameters — because
+//! the others are what the condition guards against (`if n != 0 { … 1 / n … }`). The
+//! editor gets types and definitions inside it, its uses count as uses, and an `if`
+//! expression's branch types are compared when both are known.
 
 use std::rc::Rc;
 
@@ -12,6 +20,25 @@ use super::{index, Bound, Ctx, Value, MAX_ITERATIONS, MAX_LIST};
 use crate::diag::{codes, Diagnostic};
 use crate::span::Span;
 use crate::syntax::ast::{self, Generator, Iterable};
+
+/// Fuel one exploration of a branch that does not run may spend.
+const EXPLORE_FUEL: u64 = 100_000;
+
+/// Whether a mistake of this code is one in code that does not run, too: it does not
+/// depend on any value.
+pub(super) fn holds_in_dead_code(code: &str) -> bool {
+    [
+        codes::UNKNOWN_NAME,
+        codes::UNKNOWN_FUNCTION,
+        codes::DUPLICATE_PARAM,
+        codes::NOT_A_VALUE,
+        codes::UNKNOWN_ARG,
+        codes::DUPLICATE_ARG,
+        codes::NOT_A_MESH_GENERATOR,
+        codes::UNUSED,
+    ]
+    .contains(&code)
+}
 
 /// What a `for` runs over, evaluated.
 enum Items {
@@ -64,32 +91,73 @@ impl Ctx<'_> {
         }
     }
 
+    /// Runs `run` over code that does not run, the first time only (see the module doc);
+    /// its result, or `None` when it was explored before.
+    pub(super) fn explore<R>(&mut self, key: Span, run: impl FnOnce(&mut Self) -> R) -> Option<R> {
+        if self.halted || !self.explored.insert(key) {
+            return None;
+        }
+        let fuel = self.fuel;
+        let budget = fuel.min(EXPLORE_FUEL);
+        self.fuel = budget;
+        self.quiet += 1;
+        self.dry += 1;
+        let r = run(self);
+        self.dry -= 1;
+        self.quiet -= 1;
+        self.fuel = fuel - (budget - self.fuel);
+        // Running out of the budget stops the exploration, not the compile.
+        if self.halted && !self.cancelled && self.error_reports < super::MAX_ERROR_REPORTS {
+            self.halted = false;
+        }
+        Some(r)
+    }
+
     /// `if cond then a else b`.
     pub(super) fn if_expr(&mut self, cond: &ast::Expr, then: &ast::Expr, otherwise: &ast::Expr) -> Value {
         let c = self.expr(cond);
-        match self.condition(&c, cond.span, "the condition of `if`") {
-            Some(true) => self.expr(then),
-            Some(false) => self.expr(otherwise),
+        let taken = self.condition(&c, cond.span, "the condition of `if`");
+        let (ran, other) = match taken {
+            Some(true) => (then, otherwise),
+            Some(false) => (otherwise, then),
             None => {
+                // Both are checked here, so neither needs exploring later.
+                self.explored.extend([then.span, otherwise.span]);
                 self.dry += 1;
                 let a = self.expr(then);
                 let b = self.expr(otherwise);
                 self.dry -= 1;
-                if !a.is_error() && !b.is_error() && !a.same_type(&b) {
-                    self.report(
-                        Diagnostic::error(
-                            codes::BRANCH_MISMATCH,
-                            otherwise.span,
-                            format!("`if` branches have different types: `{}` and `{}`", a.ty_name(), b.ty_name()),
-                            format!("this is a `{}`", b.ty_name()),
-                        )
-                        .with_label(then.span, format!("this is a `{}`", a.ty_name()))
-                        .with_note("both branches must give the same type"),
-                    );
-                }
-                Value::Error
+                self.branches_agree((then, &a), (otherwise, &b));
+                return Value::Error;
+            }
+        };
+        let v = self.expr(ran);
+        if let Some(w) = self.explore(other.span, |this| this.expr(other)) {
+            let (a, b) =
+                if taken == Some(true) { ((then, &v), (otherwise, &w)) } else { ((then, &w), (otherwise, &v)) };
+            if self.branches_agree(a, b) {
+                return Value::Error;
             }
         }
+        v
+    }
+
+    /// Reports branches of known, different types; `true` if it did.
+    fn branches_agree(&mut self, (then, a): (&ast::Expr, &Value), (otherwise, b): (&ast::Expr, &Value)) -> bool {
+        if a.is_error() || b.is_error() || a.same_type(b) {
+            return false;
+        }
+        self.report(
+            Diagnostic::error(
+                codes::BRANCH_MISMATCH,
+                otherwise.span,
+                format!("`if` branches have different types: `{}` and `{}`", a.ty_name(), b.ty_name()),
+                format!("this is a `{}`", b.ty_name()),
+            )
+            .with_label(then.span, format!("this is a `{}`", a.ty_name()))
+            .with_note("both branches must give the same type"),
+        );
+        true
     }
 
     /// `if c { … } else if d { … } else { … }`: the first branch whose condition holds.
@@ -97,10 +165,26 @@ impl Ctx<'_> {
         for (i, (cond, body)) in branches.iter().enumerate() {
             let c = self.expr(cond);
             match self.condition(&c, cond.span, "the condition of `if`") {
-                Some(true) => return self.block(body),
-                Some(false) => {}
+                Some(true) => {
+                    self.block(body);
+                    for (cond, body) in &branches[i + 1..] {
+                        let _ = self.explore(cond.span, |this| {
+                            let _ = this.expr(cond);
+                            this.block(body);
+                        });
+                    }
+                    if let Some(body) = otherwise.filter(|b| !b.is_empty()) {
+                        let _ = self.explore(body[0].span, |this| this.block(body));
+                    }
+                    return;
+                }
+                Some(false) => {
+                    let _ = self.explore(cond.span, |this| this.block(body));
+                }
                 None => {
                     // Which branch runs is unknown: check the rest without emitting.
+                    self.explored.extend(branches[i..].iter().map(|(c, _)| c.span));
+                    self.explored.extend(otherwise.and_then(|b| b.first()).map(|s| s.span));
                     self.dry += 1;
                     self.block(body);
                     for (cond, body) in &branches[i + 1..] {
@@ -252,7 +336,10 @@ impl Ctx<'_> {
                 let c = self.expr(f);
                 match self.condition(&c, f.span, "a comprehension's filter") {
                     Some(true) => {}
-                    Some(false) => return true,
+                    Some(false) => {
+                        let _ = self.explore(body.span, |this| this.expr(body));
+                        return true;
+                    }
                     None => {
                         let _ = self.expr(body);
                         return false;

@@ -465,8 +465,10 @@ impl Ctx<'_> {
         let what = format!("an operand of `{}`", op.symbol());
         let a = self.expr(lhs);
         match (op, self.condition(&a, lhs.span, &what)) {
-            (BinOp::And, Some(false)) => Value::Bool(false),
-            (BinOp::Or, Some(true)) => Value::Bool(true),
+            (BinOp::And, Some(false)) | (BinOp::Or, Some(true)) => {
+                let _ = self.explore(rhs.span, |this| this.expr(rhs));
+                Value::Bool(op == BinOp::Or)
+            }
             (_, Some(_)) => {
                 let b = self.expr(rhs);
                 self.condition(&b, rhs.span, &what).map_or(Value::Error, Value::Bool)

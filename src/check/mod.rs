@@ -25,7 +25,7 @@ mod transform;
 mod value;
 
 use std::cell::Cell;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
 
@@ -138,6 +138,11 @@ struct Ctx<'a> {
     dir: Rc<Path>,
     /// > 0 while evaluating code only to find mistakes (nothing is emitted).
     dry: u32,
+    /// Non-zero while exploring code that does not run: only mistakes that do not
+    /// depend on values are reported (`control::explore`).
+    quiet: u32,
+    /// The branches explored so, each once.
+    explored: HashSet<Span>,
     too_many_objects: bool,
     /// Set once "expression nests too deeply" was reported, so it is reported once.
     too_deep: bool,
@@ -153,6 +158,9 @@ struct Ctx<'a> {
 impl Ctx<'_> {
     /// Records a diagnostic; the same one again (code, span and message) only counts.
     fn report(&mut self, d: Diagnostic) {
+        if self.quiet > 0 && !control::holds_in_dead_code(d.code) {
+            return;
+        }
         let is_error = d.is_error();
         let key = (d.code, d.span(), d.message.clone());
         match self.reported.get(&key) {
@@ -629,6 +637,8 @@ fn run(
         include_stack: Vec::new(),
         dir,
         dry: 0,
+        quiet: 0,
+        explored: HashSet::new(),
         too_many_objects: false,
         too_deep: false,
         index: indexed.then(index::Index::default),

@@ -394,3 +394,57 @@ fn an_edit_cancels_the_analysis_it_makes_stale() {
     assert!(codes.contains(&&json!("E0201")), "{first}");
     client.stop();
 }
+
+/// Comprehensions and conditions: their variables are hovered, defined and completed
+/// where they are in scope only, an `if` shows the type it gives, an overloaded builtin
+/// shows the signature its arguments chose, and an `if` statement is in the outline.
+#[test]
+fn comprehensions_and_conditions_in_the_editor() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let doc = uri(&dir.path().join("scene.scn"));
+    let text = "light ambient(0.2)
+let n = 6
+let blobs = [for i in 0..n, j in 0..2 if i != j => sphere(0.2) at [i, j, 5]]
+let r = if n > 3 then round(2.6) else 1
+if n > 2 {
+  object union(blobs, smooth = 0.1)
+} else {
+  object sphere(r) at [0, 0, 5]
+}
+";
+    let mut c = Client::start();
+    c.open(&doc, text);
+    let hover = |c: &mut Client, line, col| {
+        let h = c.at("textDocument/hover", &doc, line, col);
+        h["contents"]["value"].as_str().unwrap_or_default().to_string()
+    };
+    // The comprehension's variables, its type, an `if` expression's type, the overload.
+    assert!(hover(&mut c, 2, 68).contains("for i: num"));
+    assert!(hover(&mut c, 2, 41).contains("for i: num"), "in the filter");
+    assert!(hover(&mut c, 2, 13).contains("list<shape>"));
+    assert!(hover(&mut c, 3, 8).contains("num"), "the `if` expression's type");
+    assert!(hover(&mut c, 3, 22).contains("round(x: num)"), "the overload the number chose");
+    assert!(hover(&mut c, 5, 10).contains("union(shape…"), "inside the branch that ran");
+    assert!(hover(&mut c, 7, 10).contains("sphere(r: num)"), "inside the branch that did not run");
+    assert!(hover(&mut c, 7, 16).contains("let r: num"), "a use inside the branch that did not run");
+    let d = c.at("textDocument/definition", &doc, 2, 68);
+    assert_eq!(d, json!({ "uri": doc, "range": range(2, 17, 18) }));
+
+    // Generator variables complete in the body and nowhere else.
+    let labels = |c: &mut Client, line, col| -> Vec<String> {
+        let items = c.at("textDocument/completion", &doc, line, col);
+        items.as_array().expect("items").iter().filter_map(|i| i["label"].as_str().map(String::from)).collect()
+    };
+    let body = labels(&mut c, 2, 67);
+    assert!(body.iter().any(|l| l == "i") && body.iter().any(|l| l == "j"), "{body:?}");
+    let branch = labels(&mut c, 5, 15);
+    assert!(!branch.iter().any(|l| l == "i") && branch.iter().any(|l| l == "blobs"), "{branch:?}");
+
+    // The `if` statement is a node of the outline with both branches' objects below it.
+    let symbols = c.request("textDocument/documentSymbol", json!({ "textDocument": { "uri": doc } }));
+    assert_eq!(symbols[4]["name"], "if n > 2", "{symbols}");
+    let inner: Vec<&str> =
+        symbols[4]["children"].as_array().expect("children").iter().filter_map(|s| s["name"].as_str()).collect();
+    assert_eq!(inner, ["object union(…)", "object sphere(…)"]);
+    c.stop();
+}
