@@ -303,7 +303,7 @@ fn isosurface_object(
             CellFrom::Detail => d.with_hint("try a higher `--detail`"),
         });
     }
-    let (dist, mat) = Builder { materials, bytes: 0 }.build(shape, grid, material);
+    let (dist, mat) = Builder::new(materials).build(shape, grid, material);
     let mesh = isosurface::extract(&*dist, bounds.min, bounds.max, cell).map_err(|e| match e {
         isosurface::IsoError::TooManyCells { cells, min_cell } => {
             let d = Diagnostic::error(

@@ -8,6 +8,8 @@ use std::sync::Arc;
 use glam::{Affine3A, DAffine3, DMat3, Vec3A};
 
 use super::prim;
+use super::union::{self, Gathered, PartTree};
+use crate::accel::Aabb;
 use crate::ir::{CsgOp, Primitive, Shape, ShapeKind};
 use crate::render::MaterialTable;
 
@@ -22,12 +24,20 @@ pub struct Builder<'a> {
     pub materials: &'a mut MaterialTable,
     /// Bytes of captured closure state and reference-counted headers.
     pub bytes: usize,
+    /// Whether unions skip the parts their hierarchy rules out (always, but for the
+    /// tests that compare against evaluating every part).
+    pub prune: bool,
 }
 
 /// Arc header (two counts) that every closure allocation carries.
 const ARC_HEADER: usize = 16;
 
-impl Builder<'_> {
+impl<'a> Builder<'a> {
+    /// A builder interning materials into `materials`.
+    pub fn new(materials: &'a mut MaterialTable) -> Builder<'a> {
+        Builder { materials, bytes: 0, prune: true }
+    }
+
     fn sdf<F: Fn(Vec3A) -> f32 + Send + Sync + 'static>(&mut self, f: F) -> Sdf {
         self.bytes += std::mem::size_of_val(&f) + ARC_HEADER;
         Arc::new(f)
@@ -46,6 +56,13 @@ impl Builder<'_> {
             ShapeKind::Paint { child, material } => {
                 let id = self.materials.intern(material);
                 self.build(child, xf, id)
+            }
+            ShapeKind::Csg { op: CsgOp::Union, children, smooth } if *smooth == 0.0 && children.len() >= MANY => {
+                let kids: Vec<(Sdf, MatSdf)> = children.iter().map(|c| self.build(c, xf, mat)).collect();
+                match part_boxes(children, xf) {
+                    Some(boxes) => self.pruned_union(kids, boxes, 0.0),
+                    None => self.combine(kids, CsgOp::Union),
+                }
             }
             ShapeKind::Csg { op, children, smooth } if *smooth == 0.0 => {
                 let kids: Vec<(Sdf, MatSdf)> = children.iter().map(|c| self.build(c, xf, mat)).collect();
@@ -136,7 +153,10 @@ impl Builder<'_> {
         match &shape.kind {
             ShapeKind::Csg { op, children, smooth } => {
                 let kids: Vec<(Sdf, MatSdf)> = children.iter().map(|c| self.build(c, id, mat)).collect();
-                self.smooth(kids, *op, *smooth as f32)
+                match (op, part_boxes(children, id)) {
+                    (CsgOp::Union, Some(boxes)) => self.pruned_union(kids, boxes, *smooth as f32),
+                    _ => self.smooth(kids, *op, *smooth as f32),
+                }
             }
             ShapeKind::Round { child, radius } => {
                 let (d, m) = self.build(child, id, mat);
@@ -204,16 +224,72 @@ impl Builder<'_> {
         }
     }
 
+    /// A union of bounded parts, walked through a hierarchy of their boxes (see
+    /// [`union`](super::union)); `k` is the blend radius, 0 for a sharp union.
+    fn pruned_union(&mut self, kids: Vec<(Sdf, MatSdf)>, boxes: Vec<Aabb>, k: f32) -> (Sdf, MatSdf) {
+        let tree = Arc::new(PartTree::new(boxes, self.prune));
+        let (ds, ms): (Vec<Sdf>, Vec<MatSdf>) = kids.into_iter().unzip();
+        self.bytes += ds.len() * 2 * std::mem::size_of::<Sdf>() + tree.bytes();
+        let t = tree.clone();
+        let d = if k == 0.0 {
+            self.sdf(move |p| {
+                let mut best = f32::INFINITY;
+                t.visit(p, 0.0, |i, outside| {
+                    let v = union::clamp(ds[i](p), outside);
+                    best = best.min(v);
+                    v
+                });
+                best
+            })
+        } else {
+            self.sdf(move |p| {
+                let mut values = Gathered::new();
+                t.visit(p, k, |i, outside| {
+                    let v = union::clamp(ds[i](p), outside);
+                    values.push(v);
+                    v
+                });
+                values.smooth(k)
+            })
+        };
+        let m = self.mat(move |p| {
+            let (mut best, mut first, mut id) = (f32::INFINITY, usize::MAX, 0);
+            let mut values = Gathered::new();
+            tree.visit(p, k, |i, outside| {
+                let (v, material) = ms[i](p);
+                let v = union::clamp(v, outside);
+                // Ties go to the part written first, whatever order the walk takes.
+                if v < best || (v == best && i < first) {
+                    (best, first, id) = (v, i, material);
+                }
+                values.push(v);
+                v
+            });
+            (if k == 0.0 { best } else { values.smooth(k) }, id)
+        });
+        (d, m)
+    }
+
     fn smooth(&mut self, kids: Vec<(Sdf, MatSdf)>, op: CsgOp, k: f32) -> (Sdf, MatSdf) {
         let (ds, ms): (Vec<Sdf>, Vec<MatSdf>) = kids.into_iter().unzip();
         self.bytes += ds.len() * 2 * std::mem::size_of::<Sdf>();
         // intersect = −smin(−a, −b); subtract(a, b) = −smin(−a, b).
         let fold = move |vals: &mut dyn Iterator<Item = f32>| -> f32 {
-            let first = vals.next().unwrap_or(f32::INFINITY);
             match op {
-                CsgOp::Union => vals.fold(first, |a, b| prim::smin(a, b, k)),
-                CsgOp::Intersect => -vals.fold(-first, |a, b| prim::smin(a, -b, k)),
-                CsgOp::Subtract => -vals.fold(-first, |a, b| prim::smin(a, b, k)),
+                // Nearest first, like a union of bounded parts (see `union`).
+                CsgOp::Union => {
+                    let mut gathered = Gathered::new();
+                    vals.for_each(|v| gathered.push(v));
+                    gathered.smooth(k)
+                }
+                CsgOp::Intersect => {
+                    let first = vals.next().unwrap_or(f32::INFINITY);
+                    -vals.fold(-first, |a, b| prim::smin(a, -b, k))
+                }
+                CsgOp::Subtract => {
+                    let first = vals.next().unwrap_or(f32::INFINITY);
+                    -vals.fold(-first, |a, b| prim::smin(a, b, k))
+                }
             }
         };
         let fold2 = fold;
@@ -230,6 +306,28 @@ impl Builder<'_> {
         });
         (d, m)
     }
+}
+
+/// Unions of at least this many sharp parts are walked through a hierarchy of their
+/// boxes; below it a plain loop is as fast. Every bounded smooth union is (its blend
+/// is defined by the nearest-first fold of [`union`](super::union)).
+const MANY: usize = 8;
+
+/// Each child's bounds seen through `xf`, padded to f32; `None` if one is unbounded.
+fn part_boxes(children: &[Arc<Shape>], xf: DAffine3) -> Option<Vec<Aabb>> {
+    children
+        .iter()
+        .map(|c| {
+            let b = crate::ir::shape_bounds(c)?.transform(&xf);
+            // An empty intersection has no box to walk to; it takes the plain path.
+            if !b.min.cmple(b.max).all() {
+                return None;
+            }
+            // Widen by a few ulps so the f32 box never clips the surface.
+            let pad = b.max.abs().max(b.min.abs()).max_element() * 1e-6 + 1e-6;
+            Some(Aabb { min: (b.min - pad).as_vec3a(), max: (b.max + pad).as_vec3a() })
+        })
+        .collect()
 }
 
 /// Finite repetition: `count` copies per axis, `period` apart, centred at the origin.

@@ -9,6 +9,7 @@
 mod build;
 pub mod march;
 pub mod prim;
+pub mod union;
 
 use glam::{DAffine3, Vec3A};
 

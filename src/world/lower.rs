@@ -66,7 +66,7 @@ pub fn lower(
     // Render space: world translated so the camera is at the origin, composed in f64.
     let to_render = DAffine3::from_translation(-frame.origin);
     let max_distance = frame.max_distance as f64;
-    let mut builder = sdf::Builder { materials: &mut frame.materials, bytes: 0 };
+    let mut builder = sdf::Builder::new(&mut frame.materials);
     // In scene order: materials are interned and the triangle budget spent as objects
     // come, so ids and errors do not depend on timing. Meshes are built afterwards.
     let mut lowered = Vec::with_capacity(scene.objects.len());

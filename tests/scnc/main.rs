@@ -11,6 +11,7 @@ mod lsp;
 mod mesh;
 mod nopanic;
 mod primitives;
+mod pruning;
 mod render;
 mod skip;
 mod stability;

@@ -1,0 +1,222 @@
+//! Unions of many bounded parts, evaluated in time that depends on the parts near the
+//! point rather than on how many there are.
+//!
+//! Each part's distance is taken as at least the distance to its bounding box (both
+//! are lower bounds of the distance to the part, so their maximum is one too, and it
+//! is 1-Lipschitz). A bounding volume hierarchy over the boxes is walked nearest first;
+//! a node is skipped when the point lies outside its box by at least the best value so
+//! far plus the blend radius `k` (0 for a sharp union). Every part it skips has a value
+//! at least that large, so:
+//! - a sharp union (the minimum) is exactly the minimum over all parts;
+//! - a smooth union is defined as the polynomial smooth minimum folded over the parts
+//!   in increasing order of distance, which stops at the first part `k` or more above
+//!   the running value (the blend of such a part is exactly zero). Folding nearest
+//!   first makes the result independent of the order the parts were written in and of
+//!   the pruning, and keeps it 1-Lipschitz (a fold of `smin`, each 1-Lipschitz in the
+//!   max norm, over order statistics).
+//!
+//! The point query is the idea of Barbier et al., *Lipschitz Pruning* (Eurographics
+//! 2025), per point instead of per cell: no pruned tree is built, the hierarchy is the
+//! cache.
+
+use glam::Vec3A;
+
+use super::prim;
+use crate::accel::Aabb;
+
+/// Parts per leaf of the hierarchy.
+const LEAF: usize = 2;
+/// Deepest walk stack: a median split of at most 2³² parts is 32 levels deep.
+const STACK: usize = 64;
+/// Values kept on the stack while gathering a smooth union's parts.
+const INLINE: usize = 32;
+
+/// One node: its box, and either two children (`count == 0`, at `first` and
+/// `first + 1`) or `count` parts at `order[first..]`.
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    min: Vec3A,
+    max: Vec3A,
+    first: u32,
+    count: u32,
+}
+
+/// The hierarchy over the parts' boxes.
+#[derive(Clone, Debug)]
+pub struct PartTree {
+    nodes: Vec<Node>,
+    /// Part indices in leaf order.
+    order: Vec<u32>,
+    /// Each part's box, by part index.
+    boxes: Vec<Aabb>,
+    /// Whether nodes may be skipped (always, but in tests comparing with every part).
+    prune: bool,
+}
+
+/// Distance from `p` to the box (0 inside).
+#[inline]
+fn outside(min: Vec3A, max: Vec3A, p: Vec3A) -> f32 {
+    (min - p).max(p - max).max(Vec3A::ZERO).length()
+}
+
+/// A part's value raised to its box distance outside the box. Inside, the part's own
+/// value stands, so a point inside a part keeps its negative distance.
+#[inline]
+pub fn clamp(value: f32, box_distance: f32) -> f32 {
+    if box_distance > 0.0 {
+        value.max(box_distance)
+    } else {
+        value
+    }
+}
+
+impl PartTree {
+    /// The hierarchy over `boxes` (one per part, none empty): median splits on the
+    /// longest axis of the centres, which for a point query does as well as SAH.
+    /// `prune = false` visits every part (the reference the tests compare with).
+    pub fn new(boxes: Vec<Aabb>, prune: bool) -> PartTree {
+        let mut order: Vec<u32> = (0..boxes.len() as u32).collect();
+        let mut tree = PartTree { nodes: Vec::with_capacity(2 * boxes.len()), order: Vec::new(), boxes, prune };
+        tree.nodes.push(Node { min: Vec3A::ZERO, max: Vec3A::ZERO, first: 0, count: 0 });
+        tree.split(0, &mut order, 0);
+        tree.order = order;
+        tree
+    }
+
+    fn split(&mut self, node: usize, parts: &mut [u32], first: u32) {
+        let bounds = parts.iter().fold(Aabb::EMPTY, |b, &i| b.union(self.boxes[i as usize]));
+        self.nodes[node].min = bounds.min;
+        self.nodes[node].max = bounds.max;
+        if parts.len() <= LEAF {
+            self.nodes[node].first = first;
+            self.nodes[node].count = parts.len() as u32;
+            return;
+        }
+        let centres = parts.iter().fold(Aabb::EMPTY, |b, &i| {
+            let c = self.boxes[i as usize].centre();
+            b.union(Aabb { min: c, max: c })
+        });
+        let extent = centres.max - centres.min;
+        let axis = if extent.x >= extent.y && extent.x >= extent.z {
+            0
+        } else if extent.y >= extent.z {
+            1
+        } else {
+            2
+        };
+        let mid = parts.len() / 2;
+        let boxes = &self.boxes;
+        parts.select_nth_unstable_by(mid, |&a, &b| {
+            boxes[a as usize].centre()[axis].total_cmp(&boxes[b as usize].centre()[axis])
+        });
+        let left = self.nodes.len();
+        self.nodes[node].first = left as u32;
+        self.nodes.push(Node { min: Vec3A::ZERO, max: Vec3A::ZERO, first: 0, count: 0 });
+        self.nodes.push(Node { min: Vec3A::ZERO, max: Vec3A::ZERO, first: 0, count: 0 });
+        let (a, b) = parts.split_at_mut(mid);
+        self.split(left, a, first);
+        self.split(left + 1, b, first + mid as u32);
+    }
+
+    /// Bytes held, for `--stats`.
+    pub fn bytes(&self) -> usize {
+        self.nodes.len() * std::mem::size_of::<Node>()
+            + self.order.len() * 4
+            + self.boxes.len() * std::mem::size_of::<Aabb>()
+    }
+
+    /// Walks the parts nearest first, calling `part(i, box_distance)` for each part not
+    /// skipped; it returns the part's clamped value. A node is skipped when `p` is
+    /// outside it by at least the smallest value so far plus `k`.
+    #[inline]
+    pub fn visit(&self, p: Vec3A, k: f32, mut part: impl FnMut(usize, f32) -> f32) {
+        let mut best = f32::INFINITY;
+        let mut stack = [(0u32, 0f32); STACK];
+        stack[0] = (0, outside(self.nodes[0].min, self.nodes[0].max, p));
+        let mut sp = 1;
+        while sp > 0 {
+            sp -= 1;
+            let (n, d) = stack[sp];
+            if d > 0.0 && d >= best + k && self.prune {
+                continue;
+            }
+            let node = self.nodes[n as usize];
+            if node.count > 0 {
+                for &i in &self.order[node.first as usize..(node.first + node.count) as usize] {
+                    let b = self.boxes[i as usize];
+                    let v = part(i as usize, outside(b.min, b.max, p));
+                    best = best.min(v);
+                }
+                continue;
+            }
+            let (l, r) = (node.first, node.first + 1);
+            let (nl, nr) = (self.nodes[l as usize], self.nodes[r as usize]);
+            let dl = outside(nl.min, nl.max, p);
+            let dr = outside(nr.min, nr.max, p);
+            // The nearer child is popped first.
+            let (near, far) = if dl <= dr { ((l, dl), (r, dr)) } else { ((r, dr), (l, dl)) };
+            stack[sp] = far;
+            stack[sp + 1] = near;
+            sp += 2;
+        }
+    }
+}
+
+/// The smooth minimum of `values` folded nearest first with blend radius `k`; a value
+/// `k` or more above the running result blends by exactly nothing, and so does every
+/// value after it.
+pub fn smooth_fold(values: &mut [f32], k: f32) -> f32 {
+    values.sort_unstable_by(f32::total_cmp);
+    let Some((&first, rest)) = values.split_first() else {
+        return f32::INFINITY;
+    };
+    let mut acc = first;
+    for &v in rest {
+        if v - acc >= k {
+            break;
+        }
+        acc = prim::smin(acc, v, k);
+    }
+    acc
+}
+
+/// Values gathered during a walk: on the stack up to [`INLINE`], then on the heap.
+pub struct Gathered {
+    inline: [f32; INLINE],
+    len: usize,
+    spill: Vec<f32>,
+}
+
+impl Gathered {
+    /// Empty.
+    #[inline]
+    pub fn new() -> Gathered {
+        Gathered { inline: [0.0; INLINE], len: 0, spill: Vec::new() }
+    }
+
+    /// Adds a value.
+    #[inline]
+    pub fn push(&mut self, v: f32) {
+        if self.len < INLINE {
+            self.inline[self.len] = v;
+            self.len += 1;
+        } else {
+            self.spill.push(v);
+        }
+    }
+
+    /// The smooth fold of the values gathered (see [`smooth_fold`]).
+    pub fn smooth(mut self, k: f32) -> f32 {
+        if self.spill.is_empty() {
+            return smooth_fold(&mut self.inline[..self.len], k);
+        }
+        self.spill.extend_from_slice(&self.inline[..self.len]);
+        smooth_fold(&mut self.spill, k)
+    }
+}
+
+impl Default for Gathered {
+    fn default() -> Gathered {
+        Gathered::new()
+    }
+}

@@ -1,0 +1,89 @@
+//! Unions walked through a hierarchy of their parts' boxes give exactly what
+//! evaluating every part gives, on random CSG trees, and stay 1-Lipschitz.
+
+use glam::{DAffine3, Vec3A};
+use scnc::render::MaterialTable;
+use scnc::sdf::{Builder, MatSdf, Sdf};
+
+use crate::support::{scene, Rng};
+
+/// A random solid of at most `budget` leaves, as source text.
+fn solid(rng: &mut Rng, depth: u32, budget: &mut usize) -> String {
+    let num = |rng: &mut Rng, lo: f32, hi: f32| lo + (hi - lo) * rng.f32();
+    if depth == 0 || *budget <= 1 || rng.below(3) == 0 {
+        *budget = budget.saturating_sub(1);
+        let (a, b, c) = (num(rng, 0.05, 0.4), num(rng, 0.05, 0.4), num(rng, 0.05, 0.4));
+        let leaf = match rng.below(6) {
+            0 => format!("sphere({a})"),
+            1 => format!("box({a}, {b}, {c})"),
+            2 => format!("cylinder({a}, {b})"),
+            3 => format!("torus({}, {b})", a + b),
+            4 => format!("capsule({a}, {b})"),
+            _ => format!("cone({a}, {b})"),
+        };
+        let (x, y, z) = (num(rng, -2.0, 2.0), num(rng, -2.0, 2.0), num(rng, -2.0, 2.0));
+        let moved = match rng.below(4) {
+            0 => format!("{leaf} rotate [{}, {}, 0] at [{x}, {y}, {z}]", rng.below(90), rng.below(90)),
+            // A non-uniform scale makes the part's distance a loose bound.
+            1 => format!("{leaf} scale [{}, 1, {}] at [{x}, {y}, {z}]", num(rng, 0.5, 2.0), num(rng, 0.5, 2.0)),
+            _ => format!("{leaf} at [{x}, {y}, {z}]"),
+        };
+        return format!("({moved})");
+    }
+    let kids = |rng: &mut Rng, n: usize, budget: &mut usize| -> Vec<String> {
+        (0..n).map(|_| solid(rng, depth - 1, budget)).collect()
+    };
+    match rng.below(7) {
+        0 => format!("intersect({})", kids(rng, 2, budget).join(", ")),
+        1 => format!("subtract({})", kids(rng, 2, budget).join(", ")),
+        2 => format!("round({}, {})", solid(rng, depth - 1, budget), num(rng, 0.01, 0.1)),
+        3 => format!("shell({}, {})", solid(rng, depth - 1, budget), num(rng, 0.01, 0.1)),
+        n => {
+            let count = 2 + rng.below(if depth > 2 { 60 } else { 12 });
+            let parts = kids(rng, count, budget).join(", ");
+            if n == 4 {
+                format!("union({parts})")
+            } else {
+                format!("union({parts}, smooth = {})", num(rng, 0.02, 0.3))
+            }
+        }
+    }
+}
+
+fn build(shape: &scnc::ir::Shape, prune: bool) -> (Sdf, MatSdf) {
+    let mut materials = MaterialTable::default();
+    let mut b = Builder::new(&mut materials);
+    b.prune = prune;
+    b.build(shape, DAffine3::IDENTITY, 0)
+}
+
+#[test]
+fn pruned_unions_equal_every_part_and_stay_lipschitz() {
+    let mut rng = Rng(0x0dd_ba11);
+    let mut leaves = 0;
+    for case in 0..60 {
+        let mut budget = 300;
+        let text = format!(
+            "light ambient(1)\nobject {} with material(color = #ff0000) at [0, 0, 8]\n",
+            solid(&mut rng, 4, &mut budget)
+        );
+        leaves += 300 - budget;
+        let s = scene(&text);
+        let scnc::ir::Geometry::Shape(shape) = &s.objects[0].geometry else { panic!("not a shape") };
+        let (fast, fast_mat) = build(shape, true);
+        let (every, every_mat) = build(shape, false);
+        for _ in 0..1_000 {
+            let p = Vec3A::new(rng.f32() * 6.0 - 3.0, rng.f32() * 6.0 - 3.0, rng.f32() * 6.0 + 5.0);
+            let (a, b) = (fast(p), every(p));
+            assert_eq!(a.to_bits(), b.to_bits(), "case {case} at {p}: pruned {a}, every part {b}\n{text}");
+            assert_eq!(fast_mat(p), every_mat(p), "case {case} at {p}\n{text}");
+            assert_eq!(fast_mat(p).0.to_bits(), a.to_bits(), "case {case}: material and distance disagree");
+            let step = 0.01 + rng.f32() * 0.5;
+            let dir = Vec3A::new(rng.f32() - 0.5, rng.f32() - 0.5, rng.f32() - 0.5).normalize_or(Vec3A::X);
+            let q = p + dir * step;
+            let slope = (fast(q) - a).abs();
+            assert!(slope <= step * 1.001 + 1e-5, "case {case}: |f(p) - f(q)| = {slope} > |p - q| = {step}\n{text}");
+        }
+    }
+    assert!(leaves > 3_000, "the trees were too small: {leaves} leaves");
+}
