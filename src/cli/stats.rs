@@ -13,6 +13,7 @@ pub(crate) fn stats_text(c: &Counters, g: &World, map: &SourceMap, lower_s: f64,
   time            lower {:.3} s (tessellation and BVH builds), trace {:.3} s
   rays            {} primary, {} shadow, {} reflection, {} occlusion ({} total, {:.2} M/s)
   sdf evaluations {} marching ({:.1} per ray, max {} on one ray), {} for normals and materials
+  primitives      {} evaluations ({:.1} per ray), inside those
   step budget     {} marches ran out of steps (counted as misses)
   bvh             {} node visits ({:.2} per ray), {} triangle tests ({:.2} per ray)
   memory          {} bytes in total: {} SDF objects with {} bytes of closures, {} bytes of top-level BVH
@@ -29,6 +30,8 @@ pub(crate) fn stats_text(c: &Counters, g: &World, map: &SourceMap, lower_s: f64,
         c.sdf_evals as f64 / rays,
         c.max_evals_per_ray,
         c.sdf_shading_evals,
+        c.leaf_evals,
+        c.leaf_evals as f64 / rays,
         c.budget_misses,
         c.node_visits,
         c.node_visits as f64 / rays,

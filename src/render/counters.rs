@@ -15,6 +15,9 @@ pub struct Counters {
     pub sdf_evals: u64,
     /// SDF evaluations for normals and materials at hits.
     pub sdf_shading_evals: u64,
+    /// Primitive (leaf) evaluations inside those, marching and shading together: the
+    /// cost of the trees.
+    pub leaf_evals: u64,
     /// Most SDF evaluations spent on one ray.
     pub max_evals_per_ray: u64,
     /// Marches that ran out of steps before deciding (counted as misses).
@@ -39,6 +42,7 @@ impl Counters {
         self.occlusion_rays += o.occlusion_rays;
         self.sdf_evals += o.sdf_evals;
         self.sdf_shading_evals += o.sdf_shading_evals;
+        self.leaf_evals += o.leaf_evals;
         self.max_evals_per_ray = self.max_evals_per_ray.max(o.max_evals_per_ray);
         self.budget_misses += o.budget_misses;
         self.node_visits += o.node_visits;

@@ -66,6 +66,8 @@ fn rows<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const AO
         .flat_map_iter(|strip| {
             let (y, rows_here) = (4 * strip, (h - 4 * strip).min(4));
             let mut c = Counters::default();
+            // Leaves are counted per thread; a strip runs on one thread from start to end.
+            let _ = crate::sdf::take_leaf_evals();
             let mut rows: Vec<Vec<u8>> = (0..rows_here).map(|_| Vec::with_capacity(w as usize * 3)).collect();
             for x in (0..w).step_by(4) {
                 let cols = (w - x).min(4);
@@ -75,6 +77,7 @@ fn rows<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const AO
                     row.extend(px[4 * dy..4 * dy + cols as usize].iter().flatten());
                 }
             }
+            c.leaf_evals += crate::sdf::take_leaf_evals();
             for _ in 0..rows_here {
                 progress();
             }

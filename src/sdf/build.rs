@@ -85,15 +85,18 @@ impl<'a> Builder<'a> {
                 if let Some(scale) = similarity(xf.matrix3) {
                     let c = Vec3A::from(xf.translation.as_vec3());
                     let r = (radius * scale) as f32;
-                    let d = self.sdf(move |p| prim::sphere(p - c, r));
-                    let m = self.mat(move |p| (prim::sphere(p - c, r), mat));
+                    let d = self.leaf(move |p| prim::sphere(p - c, r));
+                    let m = self.mat(move |p| {
+                        super::count_leaf();
+                        (prim::sphere(p - c, r), mat)
+                    });
                     return (d, m);
                 }
-                self.sdf(move |p| prim::sphere(p, r))
+                self.leaf(move |p| prim::sphere(p, r))
             }
             Primitive::Box { half } => {
                 let b = half.as_vec3a();
-                self.sdf(move |p| prim::cuboid(p, b))
+                self.leaf(move |p| prim::cuboid(p, b))
             }
             Primitive::Cylinder { radius, half_height } => self.leaf2(prim::cylinder, radius, half_height),
             Primitive::Torus { major, minor } => self.leaf2(prim::torus, major, minor),
@@ -102,8 +105,11 @@ impl<'a> Builder<'a> {
                 let n_world = (xf.matrix3.inverse().transpose() * normal).normalize();
                 let point = xf.transform_point3(normal * offset);
                 let (n, o) = (n_world.as_vec3a(), n_world.dot(point) as f32);
-                let d = self.sdf(move |p| prim::plane(p, n, o));
-                let m = self.mat(move |p| (prim::plane(p, n, o), mat));
+                let d = self.leaf(move |p| prim::plane(p, n, o));
+                let m = self.mat(move |p| {
+                    super::count_leaf();
+                    (prim::plane(p, n, o), mat)
+                });
                 return (d, m);
             }
             Primitive::Capsule { radius, half_height } => self.leaf2(prim::capsule, radius, half_height),
@@ -120,7 +126,15 @@ impl<'a> Builder<'a> {
     /// primitive's closure is its own type with the distance inlined (no indirect call).
     fn leaf2<F: Fn(Vec3A, f32, f32) -> f32 + Send + Sync + 'static>(&mut self, f: F, a: f64, b: f64) -> Sdf {
         let (a, b) = (a as f32, b as f32);
-        self.sdf(move |p| f(p, a, b))
+        self.leaf(move |p| f(p, a, b))
+    }
+
+    /// A primitive's distance closure, counted in [`leaf_evals`](super::take_leaf_evals).
+    fn leaf<F: Fn(Vec3A) -> f32 + Send + Sync + 'static>(&mut self, f: F) -> Sdf {
+        self.sdf(move |p| {
+            super::count_leaf();
+            f(p)
+        })
     }
 
     /// Applies `xf` (render from local) to a local-frame evaluator: the inverse maps the

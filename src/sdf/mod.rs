@@ -11,6 +11,8 @@ pub mod march;
 pub mod prim;
 pub mod union;
 
+use std::cell::Cell;
+
 use glam::{DAffine3, Vec3A};
 
 pub use build::{min_singular_value, Builder, MatSdf, Sdf};
@@ -18,6 +20,23 @@ pub use march::MarchParams;
 
 use crate::ir;
 use crate::render::{Counters, Hit, Ray};
+
+thread_local! {
+    /// Primitive evaluations on this thread, for `--stats`: how much a tree costs,
+    /// where the march counts only evaluations of a whole object.
+    static LEAVES: Cell<u64> = const { Cell::new(0) };
+}
+
+/// Counts one primitive evaluation.
+#[inline(always)]
+fn count_leaf() {
+    LEAVES.with(|c| c.set(c.get() + 1));
+}
+
+/// Primitive (leaf) evaluations on this thread since the last call.
+pub fn take_leaf_evals() -> u64 {
+    LEAVES.with(|c| c.replace(0))
+}
 
 /// One shape object ready for marching, in render space.
 pub struct SdfObject {

@@ -53,6 +53,7 @@ const COLUMNS: &[(&str, &str, Cell)] = &[
     ("wall_ms", "wall", Cell::Fixed { get: |r| r.wall_ms, csv: 3, md: 1, scale: 1.0, unit: " ms" }),
     ("rays_per_s", "rays/s", Cell::Fixed { get: |r| r.rays_per_s, csv: 0, md: 2, scale: 1e-6, unit: " M" }),
     ("sdf_evals_per_ray", "evals/ray", fixed(|r| r.evals_per_ray, 3, 2)),
+    ("leaf_evals_per_ray", "primitives/ray", fixed(|r| r.leaves_per_ray, 3, 2)),
     ("node_visits_per_ray", "visits/ray", fixed(|r| r.visits_per_ray, 3, 2)),
     ("triangle_tests_per_ray", "tri tests/ray", fixed(|r| r.tests_per_ray, 3, 2)),
     ("geometry_bytes", "bytes", Cell::Count(|r| r.bytes)),
@@ -108,6 +109,7 @@ mod tests {
             wall_ms: 12.34567,
             rays_per_s: 4_567_890.4,
             evals_per_ray: 1.23456,
+            leaves_per_ray: 9.87654,
             visits_per_ray: 7.5,
             tests_per_ray: 0.0,
             bytes: 123_456,
@@ -130,14 +132,14 @@ mod tests {
         assert_eq!(lines[0], csv_header());
         assert_eq!(
             lines[1],
-            "mesh,detail 28,12.346,4567890,1.235,7.500,0.000,123456,789,2048,1.5e-4,2.25e-3,0.1235,3,1.2346,45.68"
+            "mesh,detail 28,12.346,4567890,1.235,9.877,7.500,0.000,123456,789,2048,1.5e-4,2.25e-3,0.1235,3,1.2346,45.68"
         );
         assert_eq!(
             lines[2],
-            "mesh,detail 28,12.346,4567890,1.235,7.500,0.000,123456,789,,1.5e-4,2.25e-3,0.1235,3,1.2346,45.68"
+            "mesh,detail 28,12.346,4567890,1.235,9.877,7.500,0.000,123456,789,,1.5e-4,2.25e-3,0.1235,3,1.2346,45.68"
         );
         let md = markdown(&[row(Some(2048))], "t");
-        assert!(md.contains("| mesh | detail 28 | 12.3 ms | 4.57 M | 1.23 | 7.50 | 0.00 | 123456 | 789 | 2.0 MiB | 1.50e-4 | 2.25e-3 | 0.123 | 3 | 1.23 | 45.7 dB |"), "{md}");
+        assert!(md.contains("| mesh | detail 28 | 12.3 ms | 4.57 M | 1.23 | 9.88 | 7.50 | 0.00 | 123456 | 789 | 2.0 MiB | 1.50e-4 | 2.25e-3 | 0.123 | 3 | 1.23 | 45.7 dB |"), "{md}");
         assert!(markdown(&[row(None)], "t").contains("| 789 | n/a |"));
     }
 }

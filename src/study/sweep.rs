@@ -97,6 +97,8 @@ pub struct Row {
     pub rays_per_s: f64,
     /// SDF evaluations per ray (marching).
     pub evals_per_ray: f64,
+    /// Primitive (leaf) evaluations per ray, marching and shading: the cost of the trees.
+    pub leaves_per_ray: f64,
     /// BVH nodes visited per ray.
     pub visits_per_ray: f64,
     /// Triangle tests per ray.
@@ -224,6 +226,7 @@ pub fn run(scene: &Scene, settings: &[Setting], opts: &Options<'_>) -> Result<Ve
             wall_ms: m.wall_ms,
             rays_per_s: c.rays() as f64 / (m.wall_ms / 1e3).max(1e-9),
             evals_per_ray: c.sdf_evals as f64 / rays,
+            leaves_per_ray: c.leaf_evals as f64 / rays,
             visits_per_ray: c.node_visits as f64 / rays,
             tests_per_ray: c.triangle_tests as f64 / rays,
             bytes: m.bytes,

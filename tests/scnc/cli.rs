@@ -144,7 +144,7 @@ fn render_rejects_bad_flags_with_exit_2() {
 }
 
 /// The columns of `sweep.csv`.
-const SWEEP_COLUMNS: &str = "backend,setting,wall_ms,rays_per_s,sdf_evals_per_ray,node_visits_per_ray,triangle_tests_per_ray,geometry_bytes,triangles,peak_rss_kib,geo_error_mean,geo_error_max,geo_error_max_pixels,coverage_error_px,rmse,psnr_db";
+const SWEEP_COLUMNS: &str = "backend,setting,wall_ms,rays_per_s,sdf_evals_per_ray,leaf_evals_per_ray,node_visits_per_ray,triangle_tests_per_ray,geometry_bytes,triangles,peak_rss_kib,geo_error_mean,geo_error_max,geo_error_max_pixels,coverage_error_px,rmse,psnr_db";
 
 /// The sweep runs on a seed scene at a tiny size with two settings per back-end, writes
 /// the expected columns, and errors fall where the maths says they must.

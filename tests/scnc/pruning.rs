@@ -87,3 +87,27 @@ fn pruned_unions_equal_every_part_and_stay_lipschitz() {
     }
     assert!(leaves > 3_000, "the trees were too small: {leaves} leaves");
 }
+
+/// `--stats` counts primitive evaluations: one per evaluation of a lone sphere, and for
+/// a union of a thousand spheres a handful per evaluation, not a thousand.
+#[test]
+fn primitive_evaluations_are_counted_and_pruned() {
+    use crate::support::lower;
+    use scnc::world::Mode;
+    let render = |text: &str| {
+        let s = scene(text);
+        let (frame, world) = lower(&s, 48, Mode::Sdf);
+        scnc::render::render(&world, &frame, &|| {}).1
+    };
+    let c = render("light ambient(1)\nobject sphere(1) at [0, 0, 5]\n");
+    assert!(c.sdf_evals > 0);
+    assert_eq!(c.leaf_evals, c.sdf_evals + c.sdf_shading_evals);
+    let c = render(
+        "light ambient(1)\nlight point(1) at [2, 4, -3]\n\
+         object union([for i in 0..1000 => sphere(0.08) at [i % 10, floor(i / 10) % 10, floor(i / 100)] * 0.3 - [1.35, 1.35, 1.35]])\
+         at [0, 0, 5]\n",
+    );
+    let per_eval = c.leaf_evals as f64 / (c.sdf_evals + c.sdf_shading_evals) as f64;
+    assert!(per_eval < 12.0, "{per_eval:.1} primitives per evaluation of a union of 1000");
+    assert!(c.leaf_evals > c.sdf_evals, "a union evaluates more than one primitive somewhere");
+}
