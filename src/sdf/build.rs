@@ -8,7 +8,7 @@ use std::sync::Arc;
 use glam::{Affine3A, DAffine3, DMat3, Vec3A};
 
 use super::prim;
-use super::union::{self, Gathered, PartTree};
+use super::union::{self, Gathered, PartTree, RayParts};
 use crate::accel::Aabb;
 use crate::ir::{CsgOp, Primitive, Shape, ShapeKind};
 use crate::render::MaterialTable;
@@ -27,6 +27,18 @@ pub struct Builder<'a> {
     /// Whether unions skip the parts their hierarchy rules out (always, but for the
     /// tests that compare against evaluating every part).
     pub prune: bool,
+    /// The union built last through a hierarchy (its node's address, hierarchy, parts
+    /// and blend radius), for [`build_root`](Self::build_root).
+    last_union: Option<LastUnion>,
+}
+
+/// A union built through a hierarchy: its node's address, the hierarchy, its parts'
+/// closures and its blend radius.
+struct LastUnion {
+    node: usize,
+    tree: Arc<PartTree>,
+    parts: Arc<[Sdf]>,
+    k: f32,
 }
 
 /// Arc header (two counts) that every closure allocation carries.
@@ -35,7 +47,43 @@ const ARC_HEADER: usize = 16;
 impl<'a> Builder<'a> {
     /// A builder interning materials into `materials`.
     pub fn new(materials: &'a mut MaterialTable) -> Builder<'a> {
-        Builder { materials, bytes: 0, prune: true }
+        Builder { materials, bytes: 0, prune: true, last_union: None }
+    }
+
+    /// [`build`](Self::build), and when the shape is a union of bounded parts (under
+    /// transforms and paint) that a ray can march part by part, what it needs for that.
+    pub fn build_root(&mut self, shape: &Shape, xf: DAffine3, mat: u32) -> (Sdf, MatSdf, Option<RayParts>) {
+        self.last_union = None;
+        let (d, m) = self.build(shape, xf, mat);
+        let mut node = shape;
+        let mut acc = xf;
+        loop {
+            match &node.kind {
+                ShapeKind::Transform { child, xf: inner } => {
+                    acc *= *inner;
+                    node = child;
+                }
+                ShapeKind::Paint { child, .. } => node = child,
+                _ => break,
+            }
+        }
+        let parts = match self.last_union.take() {
+            Some(LastUnion { node: addr, tree, parts, k }) if addr == node as *const Shape as usize => {
+                // Sharp unions are built in render space; smooth ones in their own frame.
+                let (inv, scale) = if k == 0.0 || acc == DAffine3::IDENTITY {
+                    (Affine3A::IDENTITY, 1.0)
+                } else {
+                    let inv = acc.inverse();
+                    let inv32 = Affine3A::from_mat3_translation(inv.matrix3.as_mat3(), inv.translation.as_vec3());
+                    let scale =
+                        if acc.matrix3 == DMat3::IDENTITY { 1.0 } else { min_singular_value(acc.matrix3) as f32 };
+                    (inv32, scale)
+                };
+                Some(RayParts { inv, scale, tree, parts, k })
+            }
+            _ => None,
+        };
+        (d, m, parts)
     }
 
     fn sdf<F: Fn(Vec3A) -> f32 + Send + Sync + 'static>(&mut self, f: F) -> Sdf {
@@ -60,7 +108,7 @@ impl<'a> Builder<'a> {
             ShapeKind::Csg { op: CsgOp::Union, children, smooth } if *smooth == 0.0 && children.len() >= MANY => {
                 let kids: Vec<(Sdf, MatSdf)> = children.iter().map(|c| self.build(c, xf, mat)).collect();
                 match part_boxes(children, xf) {
-                    Some(boxes) => self.pruned_union(kids, boxes, 0.0),
+                    Some(boxes) => self.pruned_union(shape, kids, boxes, 0.0),
                     None => self.combine(kids, CsgOp::Union),
                 }
             }
@@ -168,7 +216,7 @@ impl<'a> Builder<'a> {
             ShapeKind::Csg { op, children, smooth } => {
                 let kids: Vec<(Sdf, MatSdf)> = children.iter().map(|c| self.build(c, id, mat)).collect();
                 match (op, part_boxes(children, id)) {
-                    (CsgOp::Union, Some(boxes)) => self.pruned_union(kids, boxes, *smooth as f32),
+                    (CsgOp::Union, Some(boxes)) => self.pruned_union(shape, kids, boxes, *smooth as f32),
                     _ => self.smooth(kids, *op, *smooth as f32),
                 }
             }
@@ -240,10 +288,13 @@ impl<'a> Builder<'a> {
 
     /// A union of bounded parts, walked through a hierarchy of their boxes (see
     /// [`union`](super::union)); `k` is the blend radius, 0 for a sharp union.
-    fn pruned_union(&mut self, kids: Vec<(Sdf, MatSdf)>, boxes: Vec<Aabb>, k: f32) -> (Sdf, MatSdf) {
+    fn pruned_union(&mut self, node: &Shape, kids: Vec<(Sdf, MatSdf)>, boxes: Vec<Aabb>, k: f32) -> (Sdf, MatSdf) {
         let tree = Arc::new(PartTree::new(boxes, self.prune));
         let (ds, ms): (Vec<Sdf>, Vec<MatSdf>) = kids.into_iter().unzip();
+        let ds: Arc<[Sdf]> = ds.into();
         self.bytes += ds.len() * 2 * std::mem::size_of::<Sdf>() + tree.bytes();
+        self.last_union =
+            Some(LastUnion { node: node as *const Shape as usize, tree: tree.clone(), parts: ds.clone(), k });
         let t = tree.clone();
         let d = if k == 0.0 {
             self.sdf(move |p| {

@@ -46,13 +46,15 @@ pub struct SdfObject {
     pub mat: MatSdf,
     /// Whether the shape is a convex solid ([`ir::Shape::is_convex`]).
     convex: bool,
+    /// A union at the root, marched part by part ([`union::RayParts`]).
+    parts: Option<union::RayParts>,
 }
 
 impl SdfObject {
     /// Lowers a shape seen through `xf` (render from world) into closures.
     pub fn new(shape: &ir::Shape, xf: DAffine3, builder: &mut Builder<'_>) -> SdfObject {
-        let (dist, mat) = builder.build(shape, xf, 0);
-        SdfObject { dist, mat, convex: shape.is_convex() }
+        let (dist, mat, parts) = builder.build_root(shape, xf, 0);
+        SdfObject { dist, mat, parts, convex: shape.is_convex() }
     }
 
     /// Marches the ray over `[t0, t1]`; on a hit, its distance and the threshold there
@@ -65,7 +67,10 @@ impl SdfObject {
         c: &mut Counters,
         evals: &mut u64,
     ) -> Option<(f32, f32)> {
-        march::march(&*self.dist, ray, t0, t1, params, c, evals)
+        match &self.parts {
+            Some(parts) => parts.march(ray, (t0, t1), params, c, evals),
+            None => march::march(&*self.dist, ray, t0, t1, params, c, evals),
+        }
     }
 
     /// The surface at a hit found by [`closest`](Self::closest): normal from the gradient

@@ -111,3 +111,50 @@ fn primitive_evaluations_are_counted_and_pruned() {
     assert!(per_eval < 12.0, "{per_eval:.1} primitives per evaluation of a union of 1000");
     assert!(c.leaf_evals > c.sdf_evals, "a union evaluates more than one primitive somewhere");
 }
+
+/// A union at an object's root is marched part by part along each ray; it finds the
+/// same surface as marching the whole union's field: the same rays hit, within the
+/// hit threshold of each other.
+#[test]
+fn unions_marched_part_by_part_hit_where_the_whole_field_does() {
+    use scnc::render::{Counters, Ray};
+    use scnc::sdf::{march, MarchParams, SdfObject};
+    let mut rng = Rng(0xfee1_900d);
+    let params = MarchParams { epsilon: 1e-4, max_steps: 2_000 };
+    let (mut hits, mut rays) = (0, 0);
+    for case in 0..40 {
+        let mut budget = 200;
+        let n = 8 + rng.below(40);
+        let parts: Vec<String> = (0..n).map(|_| solid(&mut rng, 2, &mut budget)).collect();
+        let smooth = if case % 2 == 0 { String::new() } else { format!(", smooth = {}", 0.02 + 0.3 * rng.f32()) };
+        let placed = match case % 4 {
+            0 | 1 => "at [0, 0, 8]".to_string(),
+            2 => "rotate [20, 30, 0] at [0, 0, 8]".to_string(),
+            _ => "scale [1.5, 0.7, 1] at [0, 0, 8]".to_string(),
+        };
+        let text = format!("light ambient(1)\nobject union({}{smooth}) {placed}\n", parts.join(", "));
+        let s = scene(&text);
+        let scnc::ir::Geometry::Shape(shape) = &s.objects[0].geometry else { panic!("not a shape") };
+        let mut materials = MaterialTable::default();
+        let object = SdfObject::new(shape, DAffine3::IDENTITY, &mut Builder::new(&mut materials));
+        let mut c = Counters::default();
+        for _ in 0..400 {
+            let target = Vec3A::new(rng.f32() * 5.0 - 2.5, rng.f32() * 5.0 - 2.5, 8.0 + rng.f32() * 5.0 - 2.5);
+            let ray = Ray::new(Vec3A::ZERO, target.normalize(), 100.0);
+            let mut evals = 0;
+            let by_parts = object.closest(&ray, (0.0, 100.0), params, &mut c, &mut evals);
+            let whole = march::march(&*object.dist, &ray, 0.0, 100.0, params, &mut c, &mut evals);
+            rays += 1;
+            match (by_parts, whole) {
+                (None, None) => {}
+                (Some((a, ea)), Some((b, eb))) => {
+                    hits += 1;
+                    // Both stop within their threshold of the surface, which is 1-Lipschitz.
+                    assert!((a - b).abs() <= 2.0 * (ea + eb) + 1e-4, "case {case}: {a} vs {b}\n{text}");
+                }
+                (a, b) => panic!("case {case}: part by part {a:?}, whole field {b:?}\n{text}"),
+            }
+        }
+    }
+    assert!(hits > rays / 10 && hits < rays * 9 / 10, "{hits} hits of {rays} rays: the test sees too little");
+}
