@@ -1,6 +1,6 @@
 //! Conservative axis-aligned bounds of shapes and meshes, in world units.
 
-use glam::{DAffine3, DVec3};
+use glam::{DAffine3, DMat3, DVec3};
 
 use super::{CsgOp, Geometry, Mesh, MeshSource, Shape, ShapeKind};
 
@@ -53,28 +53,43 @@ impl Aabb {
 
 /// Bounds of a shape tree; `None` when it is unbounded (it contains a half-space).
 pub fn shape_bounds(shape: &Shape) -> Option<Aabb> {
-    let children = |kids: &[std::sync::Arc<Shape>]| kids.iter().map(|k| shape_bounds(k)).collect::<Vec<_>>();
+    bounds_within(shape, 0.0)
+}
+
+/// Bounds of where the shape's field is at most `g`: the solid grown by `g` in the
+/// field's own units. A transform's field is its child's scaled by the smallest
+/// singular value `σ` of the map (the SDF back-end's bound), so at `g` it reaches
+/// `g / σ` in the child's frame, and the map may stretch that by more than `σ`: a
+/// `round` of a non-uniformly scaled part grows further than its radius.
+fn bounds_within(shape: &Shape, g: f64) -> Option<Aabb> {
+    let children =
+        |kids: &[std::sync::Arc<Shape>], g: f64| kids.iter().map(|k| bounds_within(k, g)).collect::<Vec<_>>();
     match &shape.kind {
-        ShapeKind::Primitive(p) => p.bounds(),
+        // Primitives' fields are exact distances.
+        ShapeKind::Primitive(p) => p.bounds().map(|b| b.grow(g)),
+        // A smooth union's field is at least the plain minimum less `smooth` (the
+        // nearest-first fold stops blending at a gap of `smooth`), so it reaches as far
+        // as the parts grown by it.
         ShapeKind::Csg { op: CsgOp::Union, children: kids, smooth } => {
-            let all: Option<Vec<Aabb>> = children(kids).into_iter().collect();
-            all?.into_iter().reduce(Aabb::union).map(|b| b.grow(*smooth))
+            let all: Option<Vec<Aabb>> = children(kids, g + smooth).into_iter().collect();
+            all?.into_iter().reduce(Aabb::union)
         }
         ShapeKind::Csg { op: CsgOp::Intersect, children: kids, smooth } => {
-            children(kids).into_iter().flatten().reduce(Aabb::intersect).map(|b| b.grow(*smooth))
+            children(kids, g + smooth).into_iter().flatten().reduce(Aabb::intersect)
         }
-        ShapeKind::Csg { op: CsgOp::Subtract, children: kids, smooth } => {
-            shape_bounds(kids.first()?).map(|b| b.grow(*smooth))
-        }
-        ShapeKind::Round { child, radius } => shape_bounds(child).map(|b| b.grow(*radius)),
-        ShapeKind::Shell { child, thickness } => shape_bounds(child).map(|b| b.grow(thickness * 0.5)),
+        ShapeKind::Csg { op: CsgOp::Subtract, children: kids, smooth } => bounds_within(kids.first()?, g + smooth),
+        ShapeKind::Round { child, radius } => bounds_within(child, g + radius),
+        ShapeKind::Shell { child, thickness } => bounds_within(child, g + thickness * 0.5),
         ShapeKind::Repeat { child, period, count } => {
-            let b = shape_bounds(child)?;
+            let b = bounds_within(child, g)?;
             let reach = *period * (DVec3::new(count[0] as f64, count[1] as f64, count[2] as f64) - 1.0) * 0.5;
             Some(Aabb { min: b.min - reach, max: b.max + reach })
         }
-        ShapeKind::Transform { child, xf } => shape_bounds(child).map(|b| b.transform(xf)),
-        ShapeKind::Paint { child, .. } => shape_bounds(child),
+        ShapeKind::Transform { child, xf } => {
+            let inner = if g == 0.0 { 0.0 } else { g / min_singular_value(xf.matrix3) };
+            bounds_within(child, inner).map(|b| b.transform(xf))
+        }
+        ShapeKind::Paint { child, .. } => bounds_within(child, g),
     }
 }
 
@@ -106,33 +121,35 @@ pub fn bounding_sphere(g: &Geometry) -> Option<(DVec3, f64)> {
 /// A bounding sphere (centre, radius) of a shape tree, tight for primitives under
 /// similarities (a sphere's bound is the sphere itself); `None` when unbounded.
 pub fn shape_sphere(shape: &Shape) -> Option<(DVec3, f64)> {
+    sphere_within(shape, 0.0)
+}
+
+/// A sphere around where the shape's field is at most `g` (see [`bounds_within`]).
+fn sphere_within(shape: &Shape, g: f64) -> Option<(DVec3, f64)> {
     let from_box = |b: Aabb| (b.centre(), (b.max - b.min).length() * 0.5);
     match &shape.kind {
-        ShapeKind::Primitive(p) => p.sphere_radius().map(|r| (DVec3::ZERO, r)),
+        ShapeKind::Primitive(p) => p.sphere_radius().map(|r| (DVec3::ZERO, r + g)),
         ShapeKind::Csg { op: CsgOp::Union, children, smooth } => {
-            let spheres: Option<Vec<(DVec3, f64)>> = children.iter().map(|c| shape_sphere(c)).collect();
+            let spheres: Option<Vec<(DVec3, f64)>> = children.iter().map(|c| sphere_within(c, g + smooth)).collect();
             let spheres = spheres?;
             let boxes = spheres.iter().map(|(c, r)| Aabb { min: *c - *r, max: *c + *r });
             let centre = boxes.reduce(Aabb::union)?.centre();
             let radius = spheres.iter().map(|(c, r)| (*c - centre).length() + r).fold(0.0, f64::max);
-            Some((centre, radius + smooth))
+            Some((centre, radius))
         }
-        ShapeKind::Csg { op: CsgOp::Intersect, children, smooth } => children
-            .iter()
-            .filter_map(|c| shape_sphere(c))
-            .min_by(|a, b| a.1.total_cmp(&b.1))
-            .map(|(c, r)| (c, r + smooth)),
-        ShapeKind::Csg { op: CsgOp::Subtract, children, smooth } => {
-            shape_sphere(children.first()?).map(|(c, r)| (c, r + smooth))
+        ShapeKind::Csg { op: CsgOp::Intersect, children, smooth } => {
+            children.iter().filter_map(|c| sphere_within(c, g + smooth)).min_by(|a, b| a.1.total_cmp(&b.1))
         }
-        ShapeKind::Round { child, radius } => shape_sphere(child).map(|(c, r)| (c, r + radius)),
-        ShapeKind::Shell { child, thickness } => shape_sphere(child).map(|(c, r)| (c, r + thickness * 0.5)),
-        ShapeKind::Repeat { .. } => shape_bounds(shape).map(from_box),
+        ShapeKind::Csg { op: CsgOp::Subtract, children, smooth } => sphere_within(children.first()?, g + smooth),
+        ShapeKind::Round { child, radius } => sphere_within(child, g + radius),
+        ShapeKind::Shell { child, thickness } => sphere_within(child, g + thickness * 0.5),
+        ShapeKind::Repeat { .. } => bounds_within(shape, g).map(from_box),
         ShapeKind::Transform { child, xf } => {
-            let (c, r) = shape_sphere(child)?;
+            let inner = if g == 0.0 { 0.0 } else { g / min_singular_value(xf.matrix3) };
+            let (c, r) = sphere_within(child, inner)?;
             Some((xf.transform_point3(c), r * max_stretch(xf.matrix3)))
         }
-        ShapeKind::Paint { child, .. } => shape_sphere(child),
+        ShapeKind::Paint { child, .. } => sphere_within(child, g),
     }
 }
 
@@ -144,4 +161,63 @@ pub fn max_stretch(m: glam::DMat3) -> f64 {
     let rows = [mtm.row(0), mtm.row(1), mtm.row(2)];
     let bound = rows.iter().map(|r| r.abs().element_sum()).fold(0.0, f64::max);
     bound.sqrt()
+}
+
+/// `Some(k)` when `m` is a rotation times a uniform scale `k`.
+pub fn similarity(m: DMat3) -> Option<f64> {
+    let mtm = m.transpose() * m;
+    let k2 = mtm.x_axis.x;
+    let eye = DMat3::from_diagonal(DVec3::splat(k2));
+    let close = (mtm - eye).to_cols_array().iter().all(|x| x.abs() <= 1e-12 * k2.max(1.0));
+    (close && k2 > 0.0).then(|| k2.sqrt())
+}
+
+/// The smallest singular value of `m`: the square root of the smallest eigenvalue of
+/// the symmetric `mᵀm`, by the closed-form trigonometric method (Smith 1961).
+pub fn min_singular_value(m: DMat3) -> f64 {
+    if let Some(k) = similarity(m) {
+        return k;
+    }
+    let a = m.transpose() * m;
+    let (a11, a22, a33) = (a.x_axis.x, a.y_axis.y, a.z_axis.z);
+    let (a12, a13, a23) = (a.y_axis.x, a.z_axis.x, a.z_axis.y);
+    let p1 = a12 * a12 + a13 * a13 + a23 * a23;
+    let smallest = if p1 == 0.0 {
+        a11.min(a22).min(a33)
+    } else {
+        let q = (a11 + a22 + a33) / 3.0;
+        let p2 = (a11 - q).powi(2) + (a22 - q).powi(2) + (a33 - q).powi(2) + 2.0 * p1;
+        let p = (p2 / 6.0).sqrt();
+        let b = (a - DMat3::from_diagonal(DVec3::splat(q))) * (1.0 / p);
+        let r = (b.determinant() / 2.0).clamp(-1.0, 1.0);
+        let phi = r.acos() / 3.0;
+        // Eigenvalues q + 2p·cos(phi + 2πk/3); the smallest has k = 1.
+        q + 2.0 * p * (phi + 2.0 * std::f64::consts::PI / 3.0).cos()
+    };
+    // Shave a hair so rounding never makes the bound overstep.
+    smallest.max(0.0).sqrt() * (1.0 - 1e-9)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn min_singular_value_matches_known_cases() {
+        let s = DMat3::from_diagonal(glam::DVec3::new(2.0, 0.5, 3.0));
+        assert!((min_singular_value(s) - 0.5).abs() < 1e-9);
+        let r = DMat3::from_rotation_x(0.3) * DMat3::from_rotation_y(1.1);
+        assert!((min_singular_value(r * 4.0) - 4.0).abs() < 1e-9);
+        // Rotation does not change singular values.
+        let m = r * s * DMat3::from_rotation_z(0.7);
+        assert!((min_singular_value(m) - 0.5).abs() < 1e-9);
+        // Never above the true value (it is used as a bound).
+        let shear = DMat3::from_cols_array(&[1.0, 0.0, 0.0, 0.9, 1.0, 0.0, 0.0, 0.0, 1.0]);
+        let k = min_singular_value(shear);
+        for i in 0..1000 {
+            let a = i as f64 * 0.01;
+            let v = glam::DVec3::new(a.cos(), a.sin(), 0.0);
+            assert!((shear * v).length() >= k - 1e-12);
+        }
+    }
 }

@@ -17,7 +17,9 @@ use std::sync::Arc;
 
 use glam::{DAffine3, DVec3};
 
-pub use bounds::{bounding_sphere, max_stretch, mesh_bounds, shape_bounds, shape_sphere, Aabb};
+pub use bounds::{
+    bounding_sphere, max_stretch, mesh_bounds, min_singular_value, shape_bounds, shape_sphere, similarity, Aabb,
+};
 pub use dump::dump;
 pub(crate) use dump::{num as dump_num, vec as dump_vec};
 pub use primitive::{Facets, Primitive};

@@ -10,7 +10,7 @@ use glam::{Affine3A, DAffine3, DMat3, Vec3A};
 use super::prim;
 use super::union::{self, Gathered, PartTree, RayParts};
 use crate::accel::Aabb;
-use crate::ir::{CsgOp, Primitive, Shape, ShapeKind};
+use crate::ir::{min_singular_value, similarity, CsgOp, Primitive, Shape, ShapeKind};
 use crate::render::MaterialTable;
 
 /// A distance bound: never more than the true distance to the surface.
@@ -107,8 +107,8 @@ impl<'a> Builder<'a> {
             }
             ShapeKind::Csg { op: CsgOp::Union, children, smooth } if *smooth == 0.0 && children.len() >= MANY => {
                 let kids: Vec<(Sdf, MatSdf)> = children.iter().map(|c| self.build(c, xf, mat)).collect();
-                match part_boxes(children, xf) {
-                    Some(boxes) => self.pruned_union(shape, kids, boxes, 0.0),
+                match part_bounds(children, xf) {
+                    Some(bounds) => self.pruned_union(shape, kids, bounds, 0.0),
                     None => self.combine(kids, CsgOp::Union),
                 }
             }
@@ -215,8 +215,8 @@ impl<'a> Builder<'a> {
         match &shape.kind {
             ShapeKind::Csg { op, children, smooth } => {
                 let kids: Vec<(Sdf, MatSdf)> = children.iter().map(|c| self.build(c, id, mat)).collect();
-                match (op, part_boxes(children, id)) {
-                    (CsgOp::Union, Some(boxes)) => self.pruned_union(shape, kids, boxes, *smooth as f32),
+                match (op, part_bounds(children, id)) {
+                    (CsgOp::Union, Some(bounds)) => self.pruned_union(shape, kids, bounds, *smooth as f32),
                     _ => self.smooth(kids, *op, *smooth as f32),
                 }
             }
@@ -288,8 +288,8 @@ impl<'a> Builder<'a> {
 
     /// A union of bounded parts, walked through a hierarchy of their boxes (see
     /// [`union`](super::union)); `k` is the blend radius, 0 for a sharp union.
-    fn pruned_union(&mut self, node: &Shape, kids: Vec<(Sdf, MatSdf)>, boxes: Vec<Aabb>, k: f32) -> (Sdf, MatSdf) {
-        let tree = Arc::new(PartTree::new(boxes, self.prune));
+    fn pruned_union(&mut self, node: &Shape, kids: Vec<(Sdf, MatSdf)>, bounds: PartBounds, k: f32) -> (Sdf, MatSdf) {
+        let tree = Arc::new(PartTree::new(bounds.boxes, bounds.spheres, self.prune));
         let (ds, ms): (Vec<Sdf>, Vec<MatSdf>) = kids.into_iter().unzip();
         let ds: Arc<[Sdf]> = ds.into();
         self.bytes += ds.len() * 2 * std::mem::size_of::<Sdf>() + tree.bytes();
@@ -378,21 +378,34 @@ impl<'a> Builder<'a> {
 /// is defined by the nearest-first fold of [`union`](super::union)).
 const MANY: usize = 8;
 
-/// Each child's bounds seen through `xf`, padded to f32; `None` if one is unbounded.
-fn part_boxes(children: &[Arc<Shape>], xf: DAffine3) -> Option<Vec<Aabb>> {
-    children
-        .iter()
-        .map(|c| {
-            let b = crate::ir::shape_bounds(c)?.transform(&xf);
-            // An empty intersection has no box to walk to; it takes the plain path.
-            if !b.min.cmple(b.max).all() {
-                return None;
-            }
-            // Widen by a few ulps so the f32 box never clips the surface.
-            let pad = b.max.abs().max(b.min.abs()).max_element() * 1e-6 + 1e-6;
-            Some(Aabb { min: (b.min - pad).as_vec3a(), max: (b.max + pad).as_vec3a() })
-        })
-        .collect()
+/// Each child's box and bounding sphere seen through `xf`, padded to f32; `None` if one
+/// is unbounded.
+fn part_bounds(children: &[Arc<Shape>], xf: DAffine3) -> Option<PartBounds> {
+    let stretch = crate::ir::max_stretch(xf.matrix3);
+    let mut out = PartBounds { boxes: Vec::with_capacity(children.len()), spheres: Vec::with_capacity(children.len()) };
+    for c in children {
+        let b = crate::ir::shape_bounds(c)?.transform(&xf);
+        // An empty intersection has no box to walk to; it takes the plain path.
+        if !b.min.cmple(b.max).all() {
+            return None;
+        }
+        // Widen by a few ulps so the f32 bounds never clip the surface.
+        let pad = b.max.abs().max(b.min.abs()).max_element() * 1e-6 + 1e-6;
+        out.boxes.push(Aabb { min: (b.min - pad).as_vec3a(), max: (b.max + pad).as_vec3a() });
+        let (centre, radius) = match crate::ir::shape_sphere(c) {
+            Some((centre, r)) => (xf.transform_point3(centre), r * stretch),
+            None => (b.centre(), (b.max - b.min).length() * 0.5),
+        };
+        let pad = (centre.abs().max_element() + radius) * 1e-6 + 1e-6;
+        out.spheres.push((centre.as_vec3a(), (radius + pad) as f32));
+    }
+    Some(out)
+}
+
+/// The bounds of a union's parts, by part.
+struct PartBounds {
+    boxes: Vec<Aabb>,
+    spheres: Vec<(Vec3A, f32)>,
 }
 
 /// Finite repetition: `count` copies per axis, `period` apart, centred at the origin.
@@ -437,64 +450,5 @@ impl Repeat {
 
     fn eval_mat(&self, p: Vec3A, f: impl Fn(Vec3A) -> (f32, u32)) -> (f32, u32) {
         self.cells(p).map(f).fold((f32::INFINITY, 0), |a, b| if b.0 < a.0 { b } else { a })
-    }
-}
-
-/// `Some(k)` when `m` is a rotation times a uniform scale `k`.
-fn similarity(m: DMat3) -> Option<f64> {
-    let mtm = m.transpose() * m;
-    let k2 = mtm.x_axis.x;
-    let eye = DMat3::from_diagonal(glam::DVec3::splat(k2));
-    let close = (mtm - eye).to_cols_array().iter().all(|x| x.abs() <= 1e-12 * k2.max(1.0));
-    (close && k2 > 0.0).then(|| k2.sqrt())
-}
-
-/// The smallest singular value of `m`: the square root of the smallest eigenvalue of
-/// the symmetric `mᵀm`, by the closed-form trigonometric method (Smith 1961).
-pub fn min_singular_value(m: DMat3) -> f64 {
-    if let Some(k) = similarity(m) {
-        return k;
-    }
-    let a = m.transpose() * m;
-    let (a11, a22, a33) = (a.x_axis.x, a.y_axis.y, a.z_axis.z);
-    let (a12, a13, a23) = (a.y_axis.x, a.z_axis.x, a.z_axis.y);
-    let p1 = a12 * a12 + a13 * a13 + a23 * a23;
-    let smallest = if p1 == 0.0 {
-        a11.min(a22).min(a33)
-    } else {
-        let q = (a11 + a22 + a33) / 3.0;
-        let p2 = (a11 - q).powi(2) + (a22 - q).powi(2) + (a33 - q).powi(2) + 2.0 * p1;
-        let p = (p2 / 6.0).sqrt();
-        let b = (a - DMat3::from_diagonal(glam::DVec3::splat(q))) * (1.0 / p);
-        let r = (b.determinant() / 2.0).clamp(-1.0, 1.0);
-        let phi = r.acos() / 3.0;
-        // Eigenvalues q + 2p·cos(phi + 2πk/3); the smallest has k = 1.
-        q + 2.0 * p * (phi + 2.0 * std::f64::consts::PI / 3.0).cos()
-    };
-    // Shave a hair so rounding never makes the bound overstep.
-    smallest.max(0.0).sqrt() * (1.0 - 1e-9)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn min_singular_value_matches_known_cases() {
-        let s = DMat3::from_diagonal(glam::DVec3::new(2.0, 0.5, 3.0));
-        assert!((min_singular_value(s) - 0.5).abs() < 1e-9);
-        let r = DMat3::from_rotation_x(0.3) * DMat3::from_rotation_y(1.1);
-        assert!((min_singular_value(r * 4.0) - 4.0).abs() < 1e-9);
-        // Rotation does not change singular values.
-        let m = r * s * DMat3::from_rotation_z(0.7);
-        assert!((min_singular_value(m) - 0.5).abs() < 1e-9);
-        // Never above the true value (it is used as a bound).
-        let shear = DMat3::from_cols_array(&[1.0, 0.0, 0.0, 0.9, 1.0, 0.0, 0.0, 0.0, 1.0]);
-        let k = min_singular_value(shear);
-        for i in 0..1000 {
-            let a = i as f64 * 0.01;
-            let v = glam::DVec3::new(a.cos(), a.sin(), 0.0);
-            assert!((shear * v).length() >= k - 1e-12);
-        }
     }
 }

@@ -15,7 +15,8 @@ use std::cell::Cell;
 
 use glam::{DAffine3, Vec3A};
 
-pub use build::{min_singular_value, Builder, MatSdf, Sdf};
+pub use crate::ir::min_singular_value;
+pub use build::{Builder, MatSdf, Sdf};
 pub use march::MarchParams;
 
 use crate::ir;

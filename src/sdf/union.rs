@@ -22,7 +22,7 @@
 use glam::Vec3A;
 
 use super::prim;
-use crate::accel::Aabb;
+use crate::accel::{Aabb, ROBUST};
 
 /// Parts per leaf of the hierarchy.
 const LEAF: usize = 2;
@@ -49,6 +49,9 @@ pub struct PartTree {
     order: Vec<u32>,
     /// Each part's box, by part index.
     boxes: Vec<Aabb>,
+    /// Each part's bounding sphere (centre, radius), by part index: tight for a
+    /// primitive under a similarity, where a ray entering it is on the surface.
+    spheres: Vec<(Vec3A, f32)>,
     /// Whether nodes may be skipped (always, but in tests comparing with every part).
     prune: bool,
 }
@@ -74,9 +77,10 @@ impl PartTree {
     /// The hierarchy over `boxes` (one per part, none empty): median splits on the
     /// longest axis of the centres, which for a point query does as well as SAH.
     /// `prune = false` visits every part (the reference the tests compare with).
-    pub fn new(boxes: Vec<Aabb>, prune: bool) -> PartTree {
+    pub fn new(boxes: Vec<Aabb>, spheres: Vec<(Vec3A, f32)>, prune: bool) -> PartTree {
         let mut order: Vec<u32> = (0..boxes.len() as u32).collect();
-        let mut tree = PartTree { nodes: Vec::with_capacity(2 * boxes.len()), order: Vec::new(), boxes, prune };
+        let mut tree =
+            PartTree { nodes: Vec::with_capacity(2 * boxes.len()), order: Vec::new(), boxes, spheres, prune };
         tree.nodes.push(Node { min: Vec3A::ZERO, max: Vec3A::ZERO, first: 0, count: 0 });
         tree.split(0, &mut order, 0);
         tree.order = order;
@@ -123,6 +127,7 @@ impl PartTree {
         self.nodes.len() * std::mem::size_of::<Node>()
             + self.order.len() * 4
             + self.boxes.len() * std::mem::size_of::<Aabb>()
+            + self.spheres.len() * std::mem::size_of::<(Vec3A, f32)>()
     }
 
     /// Walks the parts nearest first, calling `part(i, box_distance)` for each part not
@@ -270,7 +275,14 @@ impl PartTree {
             if node.count > 0 {
                 for &i in &self.order[node.first as usize..(node.first + node.count) as usize] {
                     let b = self.boxes[i as usize];
-                    if let Some((a, z)) = enter(b.min, b.max) {
+                    let (centre, radius) = self.spheres[i as usize];
+                    let (Some((a, z)), Some((a2, z2))) =
+                        (enter(b.min, b.max), sphere_interval(origin, inv_dir, centre, radius + grow))
+                    else {
+                        continue;
+                    };
+                    let (a, z) = (a.max(a2), z.min(z2 * ROBUST));
+                    if a <= z {
                         out.push((a, z, i));
                     }
                 }
@@ -346,7 +358,10 @@ impl RayParts {
         let part = |j: u32| {
             let i = spans[j as usize].2 as usize;
             let b = self.tree.boxes[i];
-            clamp(self.parts[i](q), outside(b.min, b.max, q))
+            let (centre, radius) = self.tree.spheres[i];
+            // The sphere is a lower bound too; for a sphere part it is the distance.
+            let bound = outside(b.min, b.max, q).max((q - centre).length() - radius);
+            clamp(self.parts[i](q), bound)
         };
         let local = if self.k == 0.0 {
             active.iter().fold(f32::INFINITY, |a, &j| a.min(part(j)))
@@ -357,4 +372,22 @@ impl RayParts {
         };
         local * self.scale
     }
+}
+
+/// Where the line `origin + t·dir` is inside the sphere, `dir` of any length (`inv_dir`
+/// is its reciprocal): the perpendicular form, which stays accurate far from the
+/// centre.
+fn sphere_interval(origin: Vec3A, inv_dir: Vec3A, centre: Vec3A, radius: f32) -> Option<(f32, f32)> {
+    let dir = inv_dir.recip();
+    let len = dir.length();
+    let unit = dir / len;
+    let oc = origin - centre;
+    let b = oc.dot(unit);
+    let perp = oc - unit * b;
+    let disc = radius * radius - perp.length_squared();
+    if disc < 0.0 {
+        return None;
+    }
+    let s = disc.sqrt();
+    Some(((-b - s) / len, (-b + s) / len))
 }
