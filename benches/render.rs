@@ -1,6 +1,7 @@
 //! Criterion benchmarks: one SDF evaluation per primitive, primary rays (one by one, in
 //! 2×2 packets and in 4×4 blocks, shading off) over seed scenes 1 and 6 and a frame-filling sphere, and
-//! whole renders of every seed scene at a reduced size on one thread.
+//! whole renders of every seed scene at a reduced size on one thread, and unions of
+//! 10 to 10,000 spheres against the same spheres as objects.
 
 use std::hint::black_box;
 use std::path::Path;
@@ -148,6 +149,22 @@ fn renders(c: &mut Criterion) {
     group.finish();
 }
 
+/// Issue 21's scenes: the same N jittered spheres as N objects, one union and one smooth
+/// union (`benches/scenes/{objects,union,smooth}-N.scn`), rendered at 200×200 on both
+/// threads; the ratios between the three at each N are what the README reports.
+fn csg_scale(c: &mut Criterion) {
+    let mut group = c.benchmark_group("csg scale 200x200");
+    group.sample_size(10);
+    for n in [10, 100, 1_000, 10_000] {
+        for kind in ["objects", "union", "smooth"] {
+            let (frame, g) = lower(&format!("benches/scenes/{kind}-{n}.scn"), 200, 200);
+            group.throughput(Throughput::Elements(200 * 200));
+            group.bench_function(BenchmarkId::new(kind, n), |b| b.iter(|| scnc::render::render(&g, &frame, &|| {})));
+        }
+    }
+    group.finish();
+}
+
 fn bvh(c: &mut Criterion) {
     let mut group = c.benchmark_group("bvh");
     group.sample_size(10);
@@ -169,5 +186,5 @@ fn bvh(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, primitives, march, renders, bvh);
+criterion_group!(benches, primitives, march, renders, csg_scale, bvh);
 criterion_main!(benches);

@@ -201,3 +201,21 @@ fn bounds_contain_the_solid() {
     }
     assert!(inside > 1_000, "only {inside} points fell inside the solids");
 }
+
+/// The same spheres as one union and as separate objects make the same picture: the
+/// union's part-by-part march finds what the world's object hierarchy finds.
+#[test]
+fn a_union_of_spheres_looks_like_the_spheres() {
+    use crate::render::render_scene;
+    let load = |kind: &str| crate::support::compile(std::path::Path::new(&format!("benches/scenes/{kind}-1000.scn")));
+    let (union, objects) = (load("union"), load("objects"));
+    let (a, _) = render_scene(union.scene.expect("union compiles"), 96, 96, 2);
+    let (b, _) = render_scene(objects.scene.expect("objects compile"), 96, 96, 2);
+    let differing = a
+        .pixels
+        .chunks(3)
+        .zip(b.pixels.chunks(3))
+        .filter(|(x, y)| x.iter().zip(*y).any(|(p, q)| p.abs_diff(*q) > 8))
+        .count();
+    assert!(differing <= 96 * 96 / 200, "{differing} of {} pixels differ", 96 * 96);
+}
