@@ -299,8 +299,8 @@ impl<'a> Builder<'a> {
         let d = if k == 0.0 {
             self.sdf(move |p| {
                 let mut best = f32::INFINITY;
-                t.visit(p, 0.0, |i, outside| {
-                    let v = union::clamp(ds[i](p), outside);
+                t.visit(p, 0.0, |i, bound| {
+                    let v = union::clamp(ds[i](p), bound);
                     best = best.min(v);
                     v
                 });
@@ -309,8 +309,8 @@ impl<'a> Builder<'a> {
         } else {
             self.sdf(move |p| {
                 let mut values = Gathered::new();
-                t.visit(p, k, |i, outside| {
-                    let v = union::clamp(ds[i](p), outside);
+                t.visit(p, k, |i, bound| {
+                    let v = union::clamp(ds[i](p), bound);
                     values.push(v);
                     v
                 });
@@ -320,9 +320,9 @@ impl<'a> Builder<'a> {
         let m = self.mat(move |p| {
             let (mut best, mut first, mut id) = (f32::INFINITY, usize::MAX, 0);
             let mut values = Gathered::new();
-            tree.visit(p, k, |i, outside| {
+            tree.visit(p, k, |i, bound| {
                 let (v, material) = ms[i](p);
-                let v = union::clamp(v, outside);
+                let v = union::clamp(v, bound);
                 // Ties go to the part written first, whatever order the walk takes.
                 if v < best || (v == best && i < first) {
                     (best, first, id) = (v, i, material);

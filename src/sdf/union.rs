@@ -1,9 +1,9 @@
 //! Unions of many bounded parts, evaluated in time that depends on the parts near the
 //! point rather than on how many there are.
 //!
-//! Each part's distance is taken as at least the distance to its bounding box (both
-//! are lower bounds of the distance to the part, so their maximum is one too, and it
-//! is 1-Lipschitz). A bounding volume hierarchy over the boxes is walked nearest first;
+//! Each part's distance is taken as at least the distance to its bounding box and to
+//! its bounding sphere (all are lower bounds of the distance to the part, so their
+//! maximum is one too, and it is 1-Lipschitz; for a sphere part it is exact). A bounding volume hierarchy over the boxes is walked nearest first;
 //! a node is skipped when the point lies outside its box by at least the best value so
 //! far plus the blend radius `k` (0 for a sharp union). Every part it skips has a value
 //! at least that large, so:
@@ -62,12 +62,13 @@ fn outside(min: Vec3A, max: Vec3A, p: Vec3A) -> f32 {
     (min - p).max(p - max).max(Vec3A::ZERO).length()
 }
 
-/// A part's value raised to its box distance outside the box. Inside, the part's own
-/// value stands, so a point inside a part keeps its negative distance.
+/// A part's value raised to `bound` (its box and sphere distance) where that is positive.
+/// Inside both, the part's own value stands, so a point inside a part keeps its
+/// negative distance.
 #[inline]
-pub fn clamp(value: f32, box_distance: f32) -> f32 {
-    if box_distance > 0.0 {
-        value.max(box_distance)
+pub fn clamp(value: f32, bound: f32) -> f32 {
+    if bound > 0.0 {
+        value.max(bound)
     } else {
         value
     }
@@ -130,7 +131,15 @@ impl PartTree {
             + self.spheres.len() * std::mem::size_of::<(Vec3A, f32)>()
     }
 
-    /// Walks the parts nearest first, calling `part(i, box_distance)` for each part not
+    /// How far `p` is at least from part `i`: outside its box or its sphere (0 inside both).
+    #[inline]
+    pub fn bound(&self, i: usize, p: Vec3A) -> f32 {
+        let b = self.boxes[i];
+        let (centre, radius) = self.spheres[i];
+        outside(b.min, b.max, p).max((p - centre).length() - radius)
+    }
+
+    /// Walks the parts nearest first, calling `part(i, bound)` (see [`bound`](Self::bound)) for each part not
     /// skipped; it returns the part's clamped value. A node is skipped when `p` is
     /// outside it by at least the smallest value so far plus `k`.
     #[inline]
@@ -148,8 +157,7 @@ impl PartTree {
             let node = self.nodes[n as usize];
             if node.count > 0 {
                 for &i in &self.order[node.first as usize..(node.first + node.count) as usize] {
-                    let b = self.boxes[i as usize];
-                    let v = part(i as usize, outside(b.min, b.max, p));
+                    let v = part(i as usize, self.bound(i as usize, p));
                     best = best.min(v);
                 }
                 continue;
@@ -227,11 +235,11 @@ impl Default for Gathered {
 }
 
 /// A union at the root of an object, ready to be marched part by part along a ray: only
-/// the parts whose box (grown by the blend radius) the ray is inside at `t` are
-/// evaluated there, and a march between parts jumps to the next box.
+/// the parts whose box and sphere (grown by the blend radius) the ray is inside at `t`
+/// are evaluated there, and a march between parts jumps to the next one.
 ///
-/// Why this is exact: on a stretch of the ray outside every other part's grown box,
-/// each other part's value exceeds `k`, so wherever the full union is at or below zero
+/// Why this is exact: on a stretch of the ray outside every other part's grown box or
+/// sphere, each other part's value (at least its box and sphere distance) exceeds `k`, so wherever the full union is at or below zero
 /// (the surface and inside) those parts blend by exactly nothing and the field of the
 /// parts in force equals the full one. That field is 1-Lipschitz, so a step by it never
 /// crosses one of its zeros, and therefore never crosses the surface; a step never runs
@@ -357,11 +365,7 @@ impl RayParts {
         let q = self.inv.transform_point3a(p);
         let part = |j: u32| {
             let i = spans[j as usize].2 as usize;
-            let b = self.tree.boxes[i];
-            let (centre, radius) = self.tree.spheres[i];
-            // The sphere is a lower bound too; for a sphere part it is the distance.
-            let bound = outside(b.min, b.max, q).max((q - centre).length() - radius);
-            clamp(self.parts[i](q), bound)
+            clamp(self.parts[i](q), self.tree.bound(i, q))
         };
         let local = if self.k == 0.0 {
             active.iter().fold(f32::INFINITY, |a, &j| a.min(part(j)))
