@@ -287,7 +287,7 @@ impl<'a> Builder<'a> {
     }
 
     /// A union of bounded parts, walked through a hierarchy of their boxes (see
-    /// [`union`](super::union)); `k` is the blend radius, 0 for a sharp union.
+    /// [`union`]); `k` is the blend radius, 0 for a sharp union.
     fn pruned_union(&mut self, node: &Shape, kids: Vec<(Sdf, MatSdf)>, bounds: PartBounds, k: f32) -> (Sdf, MatSdf) {
         let tree = Arc::new(PartTree::new(bounds.boxes, bounds.spheres, self.prune));
         let (ds, ms): (Vec<Sdf>, Vec<MatSdf>) = kids.into_iter().unzip();
@@ -375,7 +375,7 @@ impl<'a> Builder<'a> {
 
 /// Unions of at least this many sharp parts are walked through a hierarchy of their
 /// boxes; below it a plain loop is as fast. Every bounded smooth union is (its blend
-/// is defined by the nearest-first fold of [`union`](super::union)).
+/// is defined by the nearest-first fold of [`union`]).
 const MANY: usize = 8;
 
 /// Each child's box and bounding sphere seen through `xf`, padded to f32; `None` if one

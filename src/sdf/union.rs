@@ -194,7 +194,7 @@ pub fn smooth_fold(values: &mut [f32], k: f32) -> f32 {
 }
 
 /// Values gathered during a walk: on the stack up to [`INLINE`], then on the heap.
-pub struct Gathered {
+pub(crate) struct Gathered {
     inline: [f32; INLINE],
     len: usize,
     spill: Vec<f32>,
