@@ -112,6 +112,16 @@ impl<'a> Builder<'a> {
                     None => self.combine(kids, CsgOp::Union),
                 }
             }
+            ShapeKind::Csg { op: CsgOp::Subtract, children, smooth } if *smooth == 0.0 && children.len() > MANY => {
+                let kids: Vec<(Sdf, MatSdf)> = children.iter().map(|c| self.build(c, xf, mat)).collect();
+                match part_bounds(&children[1..], xf) {
+                    Some(bounds) => {
+                        let (first, cutters) = (kids[0].clone(), kids[1..].to_vec());
+                        self.pruned_subtract(first, cutters, bounds)
+                    }
+                    None => self.combine(kids, CsgOp::Subtract),
+                }
+            }
             ShapeKind::Csg { op, children, smooth } if *smooth == 0.0 => {
                 let kids: Vec<(Sdf, MatSdf)> = children.iter().map(|c| self.build(c, xf, mat)).collect();
                 self.combine(kids, *op)
@@ -299,20 +309,21 @@ impl<'a> Builder<'a> {
         let d = if k == 0.0 {
             self.sdf(move |p| {
                 let mut best = f32::INFINITY;
-                t.visit(p, 0.0, |i, bound| {
-                    let v = union::clamp(ds[i](p), bound);
-                    best = best.min(v);
-                    v
+                t.visit(p, f32::INFINITY, |i, bound| {
+                    best = best.min(union::clamp(ds[i](p), bound));
+                    best
                 });
                 best
             })
         } else {
             self.sdf(move |p| {
                 let mut values = Gathered::new();
-                t.visit(p, k, |i, bound| {
+                let mut best = f32::INFINITY;
+                t.visit(p, f32::INFINITY, |i, bound| {
                     let v = union::clamp(ds[i](p), bound);
                     values.push(v);
-                    v
+                    best = best.min(v);
+                    best + k
                 });
                 values.smooth(k)
             })
@@ -320,7 +331,7 @@ impl<'a> Builder<'a> {
         let m = self.mat(move |p| {
             let (mut best, mut first, mut id) = (f32::INFINITY, usize::MAX, 0);
             let mut values = Gathered::new();
-            tree.visit(p, k, |i, bound| {
+            tree.visit(p, f32::INFINITY, |i, bound| {
                 let (v, material) = ms[i](p);
                 let v = union::clamp(v, bound);
                 // Ties go to the part written first, whatever order the walk takes.
@@ -328,9 +339,49 @@ impl<'a> Builder<'a> {
                     (best, first, id) = (v, i, material);
                 }
                 values.push(v);
-                v
+                best + k
             });
             (if k == 0.0 { best } else { values.smooth(k) }, id)
+        });
+        (d, m)
+    }
+
+    /// `subtract(a, cutters…)` with many bounded cutters, walked through a hierarchy of
+    /// their bounds: a cutter removes material only where its value is below minus the
+    /// result so far, so where `p` is outside a node by at least that much (and outside
+    /// it at all), nothing in it can change the result. Exact, cutters clamped to their
+    /// bounds as a union's parts are.
+    fn pruned_subtract(
+        &mut self,
+        (first, first_mat): (Sdf, MatSdf),
+        cutters: Vec<(Sdf, MatSdf)>,
+        bounds: PartBounds,
+    ) -> (Sdf, MatSdf) {
+        let tree = Arc::new(PartTree::new(bounds.boxes, bounds.spheres, self.prune));
+        let (cs, ms): (Vec<Sdf>, Vec<MatSdf>) = cutters.into_iter().unzip();
+        self.bytes += (cs.len() + 1) * 2 * std::mem::size_of::<Sdf>() + tree.bytes();
+        let t = tree.clone();
+        let d = self.sdf(move |p| {
+            let mut acc = first(p);
+            t.visit(p, -acc, |i, bound| {
+                acc = acc.max(-union::clamp(cs[i](p), bound));
+                -acc
+            });
+            acc
+        });
+        let m = self.mat(move |p| {
+            let (mut acc, mut id) = first_mat(p);
+            let mut cutter = usize::MAX;
+            tree.visit(p, -acc, |i, bound| {
+                let (v, material) = ms[i](p);
+                let v = -union::clamp(v, bound);
+                // The cut faces take the material of the cutter; ties go to the first.
+                if v > acc || (v == acc && cutter != usize::MAX && i < cutter) {
+                    (acc, id, cutter) = (v, material, i);
+                }
+                -acc
+            });
+            (acc, id)
         });
         (d, m)
     }

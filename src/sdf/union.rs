@@ -139,26 +139,26 @@ impl PartTree {
         outside(b.min, b.max, p).max((p - centre).length() - radius)
     }
 
-    /// Walks the parts nearest first, calling `part(i, bound)` (see [`bound`](Self::bound)) for each part not
-    /// skipped; it returns the part's clamped value. A node is skipped when `p` is
-    /// outside it by at least the smallest value so far plus `k`.
+    /// Walks the parts nearest first, calling `part(i, bound)` (see [`bound`](Self::bound))
+    /// for each part not skipped. `part` returns the threshold from then on: a node is
+    /// skipped when `p` is outside it by at least the threshold (`start` at first). A
+    /// union's threshold is its best value plus `k`; a subtraction's, minus its value.
     #[inline]
-    pub fn visit(&self, p: Vec3A, k: f32, mut part: impl FnMut(usize, f32) -> f32) {
-        let mut best = f32::INFINITY;
+    pub fn visit(&self, p: Vec3A, start: f32, mut part: impl FnMut(usize, f32) -> f32) {
+        let mut threshold = start;
         let mut stack = [(0u32, 0f32); STACK];
         stack[0] = (0, outside(self.nodes[0].min, self.nodes[0].max, p));
         let mut sp = 1;
         while sp > 0 {
             sp -= 1;
             let (n, d) = stack[sp];
-            if d > 0.0 && d >= best + k && self.prune {
+            if d > 0.0 && d >= threshold && self.prune {
                 continue;
             }
             let node = self.nodes[n as usize];
             if node.count > 0 {
                 for &i in &self.order[node.first as usize..(node.first + node.count) as usize] {
-                    let v = part(i as usize, self.bound(i as usize, p));
-                    best = best.min(v);
+                    threshold = part(i as usize, self.bound(i as usize, p));
                 }
                 continue;
             }

@@ -35,7 +35,11 @@ fn solid(rng: &mut Rng, depth: u32, budget: &mut usize) -> String {
     };
     match rng.below(7) {
         0 => format!("intersect({})", kids(rng, 2, budget).join(", ")),
-        1 => format!("subtract({})", kids(rng, 2, budget).join(", ")),
+        // Many cutters take the subtraction's hierarchy.
+        1 => {
+            let cutters = 1 + rng.below(if depth > 2 { 30 } else { 3 });
+            format!("subtract({})", kids(rng, 1 + cutters, budget).join(", "))
+        }
         2 => format!("round({}, {})", solid(rng, depth - 1, budget), num(rng, 0.01, 0.1)),
         3 => format!("shell({}, {})", solid(rng, depth - 1, budget), num(rng, 0.01, 0.1)),
         n => {
@@ -220,4 +224,24 @@ fn a_union_of_spheres_looks_like_the_spheres() {
         .filter(|(x, y)| x.iter().zip(*y).any(|(p, q)| p.abs_diff(*q) > 8))
         .count();
     assert!(differing <= 96 * 96 / 200, "{differing} of {} pixels differ", 96 * 96);
+}
+
+/// A plate with a hundred holes: the subtraction's hierarchy of cutters gives what
+/// subtracting every cutter gives, inside the plate (where cutters matter) and out.
+#[test]
+fn a_perforated_plate_equals_every_cut() {
+    let text = "light ambient(1)\nobject subtract(box(2, 0.3, 2) rotate [10, 20, 0], \
+                [for i in 0..100 => sphere(0.05 + 0.1 * random(i)) at [(i % 10) * 0.4 - 1.8, 0.3 * random(i + 0.5) - 0.15, floor(i / 10) * 0.4 - 1.8]]) \
+                with material(color = #ff0000) at [0, 0, 8]\n";
+    let s = scene(text);
+    let scnc::ir::Geometry::Shape(shape) = &s.objects[0].geometry else { panic!("not a shape") };
+    let (fast, fast_mat) = build(shape, true);
+    let (every, every_mat) = build(shape, false);
+    let mut rng = Rng(0x9e7f_07a7e);
+    for _ in 0..20_000 {
+        let p = Vec3A::new(rng.f32() * 4.4 - 2.2, rng.f32() * 1.2 - 0.6, rng.f32() * 4.4 + 5.8);
+        let (a, b) = (fast(p), every(p));
+        assert_eq!(a.to_bits(), b.to_bits(), "at {p}: pruned {a}, every cutter {b}");
+        assert_eq!(fast_mat(p), every_mat(p), "at {p}");
+    }
 }
