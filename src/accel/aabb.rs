@@ -1,7 +1,32 @@
-//! Axis-aligned boxes in render space and the robust ray/box slab test, in one place:
-//! the scalar test here and the 4-wide one ([`enters4`]) every hierarchy walk uses.
+//! Axis-aligned boxes and bounding spheres in render space, and the robust ray tests
+//! against them, in one place: the scalar slab test here and the 4-wide one
+//! ([`enters4`]) every hierarchy walk uses, and the ray/sphere interval.
 
 use glam::{Vec3A, Vec4};
+
+/// Where the ray `origin + t·dir` (`dir` of unit length) is inside the sphere, or
+/// `None`. The discriminant is computed from the perpendicular distance to the centre
+/// (Haines et al., *Ray Tracing Gems* ch. 7), which stays accurate for distant spheres
+/// where `b² − c` would cancel catastrophically.
+#[inline]
+pub fn sphere_interval(origin: Vec3A, dir: Vec3A, centre: Vec3A, radius: f32) -> Option<(f32, f32)> {
+    let oc = origin - centre;
+    let b = oc.dot(dir);
+    let perp = oc - dir * b;
+    let disc = radius * radius - perp.length_squared();
+    if disc < 0.0 {
+        return None;
+    }
+    let s = disc.sqrt();
+    Some((-b - s, -b + s))
+}
+
+/// A bounding sphere (f64, render space) in f32, its radius widened like
+/// [`Aabb::padded`].
+pub fn padded_sphere(centre: glam::DVec3, radius: f64) -> (Vec3A, f32) {
+    let pad = (centre.abs().max_element() + radius) * 1e-6 + 1e-6;
+    (centre.as_vec3a(), (radius + pad) as f32)
+}
 
 /// The far distance of every slab test is scaled by 1 + 2γ₃ (Ize 2013, "Robust BVH Ray
 /// Traversal"), so rounding never rejects a ray that touches a box, e.g. through a mesh
@@ -18,6 +43,13 @@ pub struct Aabb {
 }
 
 impl Aabb {
+    /// `b` (f64, render space) in f32, widened by a few ulps so rounding never clips
+    /// the surface it bounds.
+    pub fn padded(b: crate::ir::Aabb) -> Aabb {
+        let pad = b.max.abs().max(b.min.abs()).max_element() * 1e-6 + 1e-6;
+        Aabb { min: (b.min - pad).as_vec3a(), max: (b.max + pad).as_vec3a() }
+    }
+
     /// The empty box (contains nothing; the identity of `union`).
     pub const EMPTY: Aabb = Aabb { min: Vec3A::splat(f32::INFINITY), max: Vec3A::splat(f32::NEG_INFINITY) };
 
@@ -108,6 +140,41 @@ fn nan_keeps_second(native: Vec4, a_wins: glam::BVec4A, a: Vec4, b: Vec4) -> Vec
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The perpendicular-distance form stays accurate where `b² − c` cancels: a unit
+    /// sphere 1e4 and 1e5 away, hit near its silhouette, against the same maths in f64.
+    #[test]
+    fn sphere_interval_is_stable_far_away() {
+        for dist in [10.0f64, 1e4, 1e5] {
+            for offset in [0.0f64, 0.5, 0.9, 0.999] {
+                let centre = glam::DVec3::new(offset, 0.0, dist);
+                let dir = glam::DVec3::Z;
+                let b = centre.dot(dir);
+                let perp = (centre - dir * b).length_squared();
+                let s = (1.0 - perp).sqrt();
+                let (t0, t1) = (b - s, b + s);
+                let (a0, a1) =
+                    sphere_interval(Vec3A::ZERO, Vec3A::Z, centre.as_vec3a(), 1.0).expect("the ray hits the sphere");
+                // Within a few f32 ulps of the distance, not the much larger cancellation error.
+                let tol = dist * 4.0 * f32::EPSILON as f64;
+                assert!(
+                    (a0 as f64 - t0).abs() <= tol && (a1 as f64 - t1).abs() <= tol,
+                    "at {dist}, offset {offset}: ({a0}, {a1}) vs ({t0}, {t1})"
+                );
+                // The naive form b² − c loses the chord entirely this far away.
+                if dist >= 1e4 && offset > 0.9 {
+                    let c32 = centre.as_vec3().length_squared() - 1.0;
+                    let b32 = b as f32;
+                    let naive = b32 * b32 - c32;
+                    let truth = 1.0 - perp;
+                    assert!(
+                        (naive as f64 - truth).abs() > 0.5 * truth,
+                        "this case should defeat the naive form ({naive} vs {truth})"
+                    );
+                }
+            }
+        }
+    }
 
     /// A NaN lane (a ray in a face plane) leaves the bound so far, on every target.
     #[test]

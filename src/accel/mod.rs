@@ -4,5 +4,5 @@
 mod aabb;
 pub mod bvh;
 
-pub use aabb::{Aabb, ROBUST};
+pub use aabb::{padded_sphere, sphere_interval, Aabb, ROBUST};
 pub use bvh::{Bvh, Rays4};

@@ -9,7 +9,7 @@ use glam::{Affine3A, DAffine3, DMat3, Vec3A};
 
 use super::prim;
 use super::union::{self, Gathered, PartTree, RayParts};
-use crate::accel::Aabb;
+use crate::accel::{padded_sphere, Aabb};
 use crate::ir::{min_singular_value, similarity, CsgOp, Primitive, Shape, ShapeKind};
 use crate::render::MaterialTable;
 
@@ -440,15 +440,12 @@ fn part_bounds(children: &[Arc<Shape>], xf: DAffine3) -> Option<PartBounds> {
         if !b.min.cmple(b.max).all() {
             return None;
         }
-        // Widen by a few ulps so the f32 bounds never clip the surface.
-        let pad = b.max.abs().max(b.min.abs()).max_element() * 1e-6 + 1e-6;
-        out.boxes.push(Aabb { min: (b.min - pad).as_vec3a(), max: (b.max + pad).as_vec3a() });
+        out.boxes.push(Aabb::padded(b));
         let (centre, radius) = match crate::ir::shape_sphere(c) {
             Some((centre, r)) => (xf.transform_point3(centre), r * stretch),
             None => (b.centre(), (b.max - b.min).length() * 0.5),
         };
-        let pad = (centre.abs().max_element() + radius) * 1e-6 + 1e-6;
-        out.spheres.push((centre.as_vec3a(), (radius + pad) as f32));
+        out.spheres.push(padded_sphere(centre, radius));
     }
     Some(out)
 }

@@ -22,7 +22,7 @@
 use glam::Vec3A;
 
 use super::prim;
-use crate::accel::{Aabb, ROBUST};
+use crate::accel::{sphere_interval, Aabb, ROBUST};
 
 /// Parts per leaf of the hierarchy.
 const LEAF: usize = 2;
@@ -266,9 +266,14 @@ thread_local! {
 }
 
 impl PartTree {
-    /// Every part whose box grown by `grow` the ray `origin + t·dir` enters for `t` in
-    /// `[t0, t1]`, as (entry, exit, part), in no particular order.
-    fn along(&self, origin: Vec3A, inv_dir: Vec3A, (t0, t1): (f32, f32), grow: f32, out: &mut Vec<(f32, f32, u32)>) {
+    /// Every part whose box and sphere grown by `grow` the ray `origin + t·dir` (`dir` of
+    /// any length) enters for `t` in `[t0, t1]`, as (entry, exit, part), in no
+    /// particular order.
+    fn along(&self, origin: Vec3A, dir: Vec3A, (t0, t1): (f32, f32), grow: f32, out: &mut Vec<(f32, f32, u32)>) {
+        let inv_dir = dir.recip();
+        // The sphere test wants a unit direction; its distances are divided back.
+        let len = dir.length();
+        let unit = dir / len;
         let enter = |min: Vec3A, max: Vec3A| {
             Aabb { min: min - Vec3A::splat(grow), max: max + Vec3A::splat(grow) }.slab(origin, inv_dir, t0, t1)
         };
@@ -285,11 +290,11 @@ impl PartTree {
                     let b = self.boxes[i as usize];
                     let (centre, radius) = self.spheres[i as usize];
                     let (Some((a, z)), Some((a2, z2))) =
-                        (enter(b.min, b.max), sphere_interval(origin, inv_dir, centre, radius + grow))
+                        (enter(b.min, b.max), sphere_interval(origin, unit, centre, radius + grow))
                     else {
                         continue;
                     };
-                    let (a, z) = (a.max(a2), z.min(z2 * ROBUST));
+                    let (a, z) = (a.max(a2 / len), z.min(z2 / len * ROBUST));
                     if a <= z {
                         out.push((a, z, i));
                     }
@@ -321,7 +326,7 @@ impl RayParts {
             active.clear();
             let origin = self.inv.transform_point3a(ray.origin);
             let dir = self.inv.transform_vector3a(ray.dir);
-            self.tree.along(origin, dir.recip(), (t0, t1), self.k, spans);
+            self.tree.along(origin, dir, (t0, t1), self.k, spans);
             spans.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
             let base = ray.origin.length();
             let (mut t, mut next) = (t0, 0);
@@ -376,22 +381,4 @@ impl RayParts {
         };
         local * self.scale
     }
-}
-
-/// Where the line `origin + t·dir` is inside the sphere, `dir` of any length (`inv_dir`
-/// is its reciprocal): the perpendicular form, which stays accurate far from the
-/// centre.
-fn sphere_interval(origin: Vec3A, inv_dir: Vec3A, centre: Vec3A, radius: f32) -> Option<(f32, f32)> {
-    let dir = inv_dir.recip();
-    let len = dir.length();
-    let unit = dir / len;
-    let oc = origin - centre;
-    let b = oc.dot(unit);
-    let perp = oc - unit * b;
-    let disc = radius * radius - perp.length_squared();
-    if disc < 0.0 {
-        return None;
-    }
-    let s = disc.sqrt();
-    Some(((-b - s) / len, (-b + s) / len))
 }

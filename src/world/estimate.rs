@@ -3,8 +3,9 @@
 
 use glam::Vec3A;
 
-use super::query::{sphere_interval, Query};
+use super::query::Query;
 use super::{Object, ObjectKind, World};
+use crate::accel::sphere_interval;
 use crate::render::{Counters, Ray};
 use crate::sdf::SdfObject;
 
@@ -19,7 +20,7 @@ impl World {
         let mut visibility = 1.0f32;
         for (o, s) in sdfs {
             let (t0, t1) = match o.sphere {
-                Some((centre, radius)) => match sphere_interval(ray, centre, radius + widen) {
+                Some((centre, radius)) => match sphere_interval(ray.origin, ray.dir, centre, radius + widen) {
                     Some((a, b)) => (a.max(ray.t_min), b.min(ray.t_max)),
                     None => continue,
                 },

@@ -5,7 +5,7 @@ use glam::{DAffine3, Vec3A};
 use rayon::prelude::*;
 
 use super::{Mode, Object, ObjectKind, World};
-use crate::accel::{Aabb, Bvh};
+use crate::accel::{padded_sphere, Aabb, Bvh};
 use crate::diag::Diagnostic;
 use crate::ir;
 use crate::mesh;
@@ -17,12 +17,6 @@ use crate::source::Loader;
 enum Lowered {
     Sdf(SdfObject, Option<Aabb>, Option<(Vec3A, f32)>),
     Mesh(mesh::MeshJob),
-}
-
-fn pad_box(b: ir::Aabb) -> Aabb {
-    // Widen by a few ulps so the f32 box never clips the surface.
-    let pad = b.max.abs().max(b.min.abs()).max_element() * 1e-6 + 1e-6;
-    Aabb { min: (b.min - pad).as_vec3a(), max: (b.max + pad).as_vec3a() }
 }
 
 /// Builds the frame for `effects` and lowers the scene into a world, with the scene's
@@ -73,12 +67,8 @@ pub fn lower(
     for obj in &scene.objects {
         let part = match (&obj.geometry, mode) {
             (ir::Geometry::Shape(shape), Mode::Sdf) => {
-                let bounds = ir::shape_bounds(shape).map(|b| pad_box(b.transform(&to_render)));
-                let sphere = ir::shape_sphere(shape).map(|(c, r)| {
-                    let c = to_render.transform_point3(c);
-                    let pad = (c.abs().max_element() + r) * 1e-6 + 1e-6;
-                    (c.as_vec3a(), (r + pad) as f32)
-                });
+                let bounds = ir::shape_bounds(shape).map(|b| Aabb::padded(b.transform(&to_render)));
+                let sphere = ir::shape_sphere(shape).map(|(c, r)| padded_sphere(to_render.transform_point3(c), r));
                 Lowered::Sdf(SdfObject::new(shape, to_render, &mut builder), bounds, sphere)
             }
             (ir::Geometry::Shape(shape), Mode::Mesh(detail)) => Lowered::Mesh(mesh::lower::tessellate(

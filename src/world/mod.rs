@@ -18,7 +18,6 @@ mod query;
 use glam::Vec3A;
 
 pub use lower::{lower, prepare, prepare_within};
-pub use query::sphere_interval;
 
 use crate::accel::{Aabb, Bvh};
 use crate::mesh::{Detail, MeshMemory, MeshObject};

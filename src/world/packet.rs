@@ -121,7 +121,7 @@ impl World {
 
 /// The lanes of a packet that may reach object `o` before their `t_max`: its bounding
 /// sphere tested for four rays at once, lane by lane the arithmetic of
-/// [`sphere_interval`](super::query::sphere_interval) and [`clip_to_sphere`](super::query::clip_to_sphere) (a mesh object's box is its BVH's root,
+/// [`sphere_interval`](crate::accel::sphere_interval) and [`clip_to_sphere`](super::query::clip_to_sphere) (a mesh object's box is its BVH's root,
 /// which the walk tests anyway).
 #[inline]
 fn sphere_lanes(o: &Object, rays: &Rays4, dir: &[Vec4; 3], t_max: Vec4) -> u32 {

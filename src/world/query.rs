@@ -4,6 +4,7 @@
 use glam::Vec3A;
 
 use super::{Object, ObjectKind, World};
+use crate::accel::sphere_interval;
 use crate::mesh::{self, MeshObject};
 use crate::render::{Counters, Geometry, Hit, Packet, Ray};
 use crate::sdf::SdfObject;
@@ -145,28 +146,12 @@ impl<'a> Query<'a> {
 pub(super) fn clip_to_sphere(o: &Object, ray: &Ray, (t0, t1): (f32, f32)) -> Option<(f32, f32)> {
     let (t0, t1) = match o.sphere {
         Some((centre, radius)) => {
-            let (s0, s1) = sphere_interval(ray, centre, radius)?;
+            let (s0, s1) = sphere_interval(ray.origin, ray.dir, centre, radius)?;
             (t0.max(s0), t1.min(s1))
         }
         None => (t0, t1),
     };
     (t0 <= t1).then_some((t0, t1))
-}
-
-/// Where the ray is inside the sphere, or `None`. The discriminant is computed from the
-/// perpendicular distance to the centre (Haines et al., *Ray Tracing Gems* ch. 7), which
-/// stays accurate for distant spheres where `b² − c` would cancel catastrophically.
-#[inline]
-pub fn sphere_interval(ray: &Ray, centre: Vec3A, radius: f32) -> Option<(f32, f32)> {
-    let oc = ray.origin - centre;
-    let b = oc.dot(ray.dir);
-    let perp = oc - ray.dir * b;
-    let disc = radius * radius - perp.length_squared();
-    if disc < 0.0 {
-        return None;
-    }
-    let s = disc.sqrt();
-    Some((-b - s, -b + s))
 }
 
 impl Geometry for World {
@@ -213,45 +198,5 @@ impl Geometry for World {
 
     fn bytes(&self) -> usize {
         self.memory().total()
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The perpendicular-distance form stays accurate where `b² − c` cancels: a unit
-    /// sphere 1e4 and 1e5 away, hit near its silhouette, against the same maths in f64.
-    #[test]
-    fn sphere_interval_is_stable_far_away() {
-        for dist in [10.0f64, 1e4, 1e5] {
-            for offset in [0.0f64, 0.5, 0.9, 0.999] {
-                let centre = glam::DVec3::new(offset, 0.0, dist);
-                let dir = glam::DVec3::Z;
-                let b = centre.dot(dir);
-                let perp = (centre - dir * b).length_squared();
-                let s = (1.0 - perp).sqrt();
-                let (t0, t1) = (b - s, b + s);
-                let ray = Ray::new(Vec3A::ZERO, Vec3A::Z, f32::MAX);
-                let (a0, a1) = sphere_interval(&ray, centre.as_vec3a(), 1.0).expect("the ray hits the sphere");
-                // Within a few f32 ulps of the distance, not the much larger cancellation error.
-                let tol = dist * 4.0 * f32::EPSILON as f64;
-                assert!(
-                    (a0 as f64 - t0).abs() <= tol && (a1 as f64 - t1).abs() <= tol,
-                    "at {dist}, offset {offset}: ({a0}, {a1}) vs ({t0}, {t1})"
-                );
-                // The naive form b² − c loses the chord entirely this far away.
-                if dist >= 1e4 && offset > 0.9 {
-                    let c32 = centre.as_vec3().length_squared() - 1.0;
-                    let b32 = b as f32;
-                    let naive = b32 * b32 - c32;
-                    let truth = 1.0 - perp;
-                    assert!(
-                        (naive as f64 - truth).abs() > 0.5 * truth,
-                        "this case should defeat the naive form ({naive} vs {truth})"
-                    );
-                }
-            }
-        }
     }
 }
