@@ -8,7 +8,7 @@ use std::sync::Arc;
 use glam::{Affine3A, DAffine3, DMat3, Vec3A};
 
 use super::prim;
-use super::union::{self, Gathered, PartTree, RayParts};
+use super::union::{self, Fold, PartTree, RayParts};
 use crate::accel::{padded_sphere, Aabb};
 use crate::ir::{min_singular_value, similarity, CsgOp, Primitive, Shape, ShapeKind};
 use crate::render::MaterialTable;
@@ -306,42 +306,23 @@ impl<'a> Builder<'a> {
         self.last_union =
             Some(LastUnion { node: node as *const Shape as usize, tree: tree.clone(), parts: ds.clone(), k });
         let t = tree.clone();
-        let d = if k == 0.0 {
-            self.sdf(move |p| {
-                let mut best = f32::INFINITY;
-                t.visit(p, f32::INFINITY, |i, bound| {
-                    best = best.min(union::clamp(ds[i](p), bound));
-                    best
-                });
-                best
-            })
-        } else {
-            self.sdf(move |p| {
-                let mut values = Gathered::new();
-                let mut best = f32::INFINITY;
-                t.visit(p, f32::INFINITY, |i, bound| {
-                    let v = union::clamp(ds[i](p), bound);
-                    values.push(v);
-                    best = best.min(v);
-                    best + k
-                });
-                values.smooth(k)
-            })
-        };
+        let d = self.sdf(move |p| {
+            let mut fold = Fold::new(k);
+            t.visit(p, f32::INFINITY, |i, bound| fold.push(union::clamp(ds[i](p), bound)));
+            fold.finish()
+        });
         let m = self.mat(move |p| {
-            let (mut best, mut first, mut id) = (f32::INFINITY, usize::MAX, 0);
-            let mut values = Gathered::new();
+            let (mut fold, mut first, mut id) = (Fold::new(k), usize::MAX, 0);
             tree.visit(p, f32::INFINITY, |i, bound| {
                 let (v, material) = ms[i](p);
                 let v = union::clamp(v, bound);
                 // Ties go to the part written first, whatever order the walk takes.
-                if v < best || (v == best && i < first) {
-                    (best, first, id) = (v, i, material);
+                if v < fold.best() || (v == fold.best() && i < first) {
+                    (first, id) = (i, material);
                 }
-                values.push(v);
-                best + k
+                fold.push(v)
             });
-            (if k == 0.0 { best } else { values.smooth(k) }, id)
+            (fold.finish(), id)
         });
         (d, m)
     }
@@ -394,9 +375,11 @@ impl<'a> Builder<'a> {
             match op {
                 // Nearest first, like a union of bounded parts (see `union`).
                 CsgOp::Union => {
-                    let mut gathered = Gathered::new();
-                    vals.for_each(|v| gathered.push(v));
-                    gathered.smooth(k)
+                    let mut fold = Fold::new(k);
+                    vals.for_each(|v| {
+                        fold.push(v);
+                    });
+                    fold.finish()
                 }
                 CsgOp::Intersect => {
                     let first = vals.next().unwrap_or(f32::INFINITY);

@@ -178,7 +178,7 @@ impl PartTree {
 /// The smooth minimum of `values` folded nearest first with blend radius `k`; a value
 /// `k` or more above the running result blends by exactly nothing, and so does every
 /// value after it.
-pub fn smooth_fold(values: &mut [f32], k: f32) -> f32 {
+fn smooth_fold(values: &mut [f32], k: f32) -> f32 {
     values.sort_unstable_by(f32::total_cmp);
     let Some((&first, rest)) = values.split_first() else {
         return f32::INFINITY;
@@ -193,44 +193,56 @@ pub fn smooth_fold(values: &mut [f32], k: f32) -> f32 {
     acc
 }
 
-/// Values gathered during a walk: on the stack up to [`INLINE`], then on the heap.
-pub(crate) struct Gathered {
+/// A union's value, gathered part by part: the minimum for a sharp union (`k = 0`), the
+/// nearest-first smooth fold for a smooth one, whose values are kept on the stack up to
+/// [`INLINE`], then on the heap.
+pub(crate) struct Fold {
+    k: f32,
+    best: f32,
     inline: [f32; INLINE],
     len: usize,
     spill: Vec<f32>,
 }
 
-impl Gathered {
-    /// Empty.
+impl Fold {
+    /// Nothing gathered yet, blend radius `k`.
     #[inline]
-    pub fn new() -> Gathered {
-        Gathered { inline: [0.0; INLINE], len: 0, spill: Vec::new() }
+    pub fn new(k: f32) -> Fold {
+        Fold { k, best: f32::INFINITY, inline: [0.0; INLINE], len: 0, spill: Vec::new() }
     }
 
-    /// Adds a value.
+    /// The smallest value so far.
     #[inline]
-    pub fn push(&mut self, v: f32) {
-        if self.len < INLINE {
-            self.inline[self.len] = v;
-            self.len += 1;
-        } else {
-            self.spill.push(v);
+    pub fn best(&self) -> f32 {
+        self.best
+    }
+
+    /// Adds a part's value; returns the threshold of [`PartTree::visit`] from then on
+    /// (parts at least `k` above the smallest value change nothing).
+    #[inline]
+    pub fn push(&mut self, v: f32) -> f32 {
+        self.best = self.best.min(v);
+        if self.k > 0.0 {
+            if self.len < INLINE {
+                self.inline[self.len] = v;
+                self.len += 1;
+            } else {
+                self.spill.push(v);
+            }
         }
+        self.best + self.k
     }
 
-    /// The smooth fold of the values gathered (see [`smooth_fold`]).
-    pub fn smooth(mut self, k: f32) -> f32 {
+    /// The union's value.
+    pub fn finish(mut self) -> f32 {
+        if self.k == 0.0 {
+            return self.best;
+        }
         if self.spill.is_empty() {
-            return smooth_fold(&mut self.inline[..self.len], k);
+            return smooth_fold(&mut self.inline[..self.len], self.k);
         }
         self.spill.extend_from_slice(&self.inline[..self.len]);
-        smooth_fold(&mut self.spill, k)
-    }
-}
-
-impl Default for Gathered {
-    fn default() -> Gathered {
-        Gathered::new()
+        smooth_fold(&mut self.spill, self.k)
     }
 }
 
@@ -372,13 +384,10 @@ impl RayParts {
             let i = spans[j as usize].2 as usize;
             clamp(self.parts[i](q), self.tree.bound(i, q))
         };
-        let local = if self.k == 0.0 {
-            active.iter().fold(f32::INFINITY, |a, &j| a.min(part(j)))
-        } else {
-            let mut values = Gathered::new();
-            active.iter().for_each(|&j| values.push(part(j)));
-            values.smooth(self.k)
-        };
-        local * self.scale
+        let mut fold = Fold::new(self.k);
+        for &j in active {
+            fold.push(part(j));
+        }
+        fold.finish() * self.scale
     }
 }
