@@ -372,9 +372,7 @@ impl Ctx<'_> {
             }
             (Ty::Size, Value::Num(x)) => return Some(Value::Vec3(DVec3::splat(*x))),
             // `[1, 2, 3]` reads as a vector, but is a list of numbers too, as in `for`.
-            (Ty::List, Value::Vec3(v)) => {
-                return Some(Value::List(std::rc::Rc::new(v.to_array().map(Value::Num).to_vec())))
-            }
+            (Ty::List, Value::Vec3(v)) => return Some(Value::List(Value::numbers(*v))),
             _ => admits(ty, v),
         };
         if ok {

@@ -226,7 +226,7 @@ impl Ctx<'_> {
             }
             Iterable::List(e) => match self.expr(e) {
                 Value::List(items) => Items::List(items),
-                Value::Vec3(v) => Items::List(Rc::new(v.to_array().map(Value::Num).to_vec())),
+                Value::Vec3(v) => Items::List(Value::numbers(v)),
                 Value::Error => Items::Unknown,
                 other => {
                     self.report(
@@ -347,15 +347,7 @@ impl Ctx<'_> {
                 }
             }
             if out.len() >= MAX_LIST {
-                self.report(
-                    Diagnostic::error(
-                        codes::TOO_LARGE,
-                        span,
-                        "list is too long",
-                        "this comprehension makes too many elements",
-                    )
-                    .with_note(format!("lists may hold at most {MAX_LIST} elements")),
-                );
+                self.list_too_long(span, "this comprehension makes too many elements".into());
                 return false;
             }
             let v = self.expr(body);

@@ -215,15 +215,7 @@ impl Ctx<'_> {
 
     fn list(&mut self, items: &[ast::Expr], span: Span) -> Value {
         if items.len() > MAX_LIST {
-            self.report(
-                Diagnostic::error(
-                    codes::TOO_LARGE,
-                    span,
-                    "list is too long",
-                    format!("this list has {} elements", items.len()),
-                )
-                .with_note(format!("lists may hold at most {MAX_LIST} elements")),
-            );
+            self.list_too_long(span, format!("this list has {} elements", items.len()));
             return Value::Error;
         }
         let values: Vec<(Value, Span)> = items.iter().map(|e| (self.expr(e), e.span)).collect();
@@ -419,21 +411,25 @@ impl Ctx<'_> {
                 return Value::Error;
             }
         };
-        let finite = match &result {
-            Num(x) => x.is_finite(),
-            Vec3(v) | Value::Color(v) => v.is_finite(),
-            _ => true,
-        };
-        if !finite {
-            self.report(Diagnostic::error(
-                codes::NOT_FINITE,
-                span,
-                "arithmetic overflowed",
-                "the result is not a finite number",
-            ));
-            return Value::Error;
+        self.finite(result, span, || "arithmetic overflowed".into())
+    }
+
+    /// `v`, or poison after reporting at `span` that a number in it overflowed (E0401);
+    /// `message` is formatted only then.
+    pub(super) fn finite(&mut self, v: Value, span: Span, message: impl FnOnce() -> String) -> Value {
+        if v.is_finite() {
+            return v;
         }
-        result
+        self.report(Diagnostic::error(codes::NOT_FINITE, span, message(), "the result is not a finite number"));
+        Value::Error
+    }
+
+    /// Reports a list over [`MAX_LIST`] elements at `span`, `label` saying how long.
+    pub(super) fn list_too_long(&mut self, span: Span, label: String) {
+        self.report(
+            Diagnostic::error(codes::TOO_LARGE, span, "list is too long", label)
+                .with_note(format!("lists may hold at most {MAX_LIST} elements")),
+        );
     }
 }
 

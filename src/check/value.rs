@@ -81,6 +81,20 @@ impl Value {
         key(self) == key(other)
     }
 
+    /// A vector's three numbers as a list, as `for` and list parameters read `[x, y, z]`.
+    pub fn numbers(v: DVec3) -> Rc<Vec<Value>> {
+        Rc::new(v.to_array().map(Value::Num).to_vec())
+    }
+
+    /// False when a number in it is infinite or NaN.
+    pub fn is_finite(&self) -> bool {
+        match self {
+            Value::Num(x) => x.is_finite(),
+            Value::Vec3(v) | Value::Color(v) => v.is_finite(),
+            _ => true,
+        }
+    }
+
     /// True for poison.
     pub fn is_error(&self) -> bool {
         matches!(self, Value::Error)

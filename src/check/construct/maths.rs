@@ -11,7 +11,6 @@ use crate::check::expr::BoundArgs;
 use crate::check::{direction, Ctx, Value, MAX_LIST};
 use crate::diag::{codes, Diagnostic};
 use crate::ir::{dump_num, dump_vec};
-use crate::span::Span;
 
 /// The rule of `asin` and `acos`.
 const UNIT: &str = "between -1 and 1";
@@ -54,7 +53,7 @@ impl Ctx<'_> {
             MathFn::Acos => x.acos().to_degrees(),
             MathFn::Atan => x.atan().to_degrees(),
         };
-        self.finite(b, Value::Num(y), a.call)
+        self.finite(Value::Num(y), a.call, || format!("`{}` overflowed", b.name))
     }
 
     /// A function of several numbers, or one giving a list or a colour.
@@ -93,7 +92,7 @@ impl Ctx<'_> {
             NumFn::Range => return self.range(b, a),
             NumFn::Sum => return self.sum(b, a),
         };
-        self.finite(b, v, a.call)
+        self.finite(v, a.call, || format!("`{}` overflowed", b.name))
     }
 
     /// `mix(a, b, t)`: `a·(1 − t) + b·t`, which is exactly `a` at 0 and `b` at 1.
@@ -118,7 +117,7 @@ impl Ctx<'_> {
                 return Value::Error;
             }
         };
-        self.finite(b, v, a.call)
+        self.finite(v, a.call, || format!("`{}` overflowed", b.name))
     }
 
     /// `range(from, to, step)`: every `from + i·step` before `to`. Each element is
@@ -132,15 +131,7 @@ impl Ctx<'_> {
         let before = |x: f64| if step > 0.0 { x < to } else { x > to };
         let estimate = ((to - from) / step).ceil();
         if estimate > MAX_LIST as f64 || !estimate.is_finite() {
-            self.report(
-                Diagnostic::error(
-                    codes::TOO_LARGE,
-                    a.call,
-                    "list is too long",
-                    format!("this range has about {} elements", dump_num(estimate)),
-                )
-                .with_note(format!("lists may hold at most {MAX_LIST} elements")),
-            );
+            self.list_too_long(a.call, format!("this range has about {} elements", dump_num(estimate)));
             return Value::Error;
         }
         // The estimate is off by one at most where rounding puts an element on `to`.
@@ -197,7 +188,7 @@ impl Ctx<'_> {
             Value::Color(_) => Value::Color(total),
             _ => Value::Vec3(total),
         };
-        self.finite(b, v, a.call)
+        self.finite(v, a.call, || format!("`{}` overflowed", b.name))
     }
 
     /// A function of vectors.
@@ -215,7 +206,7 @@ impl Ctx<'_> {
                 }
             },
         };
-        self.finite(b, v, a.call)
+        self.finite(v, a.call, || format!("`{}` overflowed", b.name))
     }
 
     /// `min` or `max` of at least one number.
@@ -234,26 +225,6 @@ impl Ctx<'_> {
             Extreme::Min => nums.fold(f64::INFINITY, f64::min),
             Extreme::Max => nums.fold(f64::NEG_INFINITY, f64::max),
         })
-    }
-
-    /// `v`, or an error at the call when a number in it overflowed (`exp(1000)`,
-    /// `pow(0, -1)`).
-    fn finite(&mut self, b: &Builtin, v: Value, call: Span) -> Value {
-        let ok = match &v {
-            Value::Num(x) => x.is_finite(),
-            Value::Vec3(v) | Value::Color(v) => v.is_finite(),
-            _ => true,
-        };
-        if ok {
-            return v;
-        }
-        self.report(Diagnostic::error(
-            codes::NOT_FINITE,
-            call,
-            format!("`{}` overflowed", b.name),
-            "the result is not a finite number",
-        ));
-        Value::Error
     }
 }
 
