@@ -91,10 +91,11 @@ impl Ctx<'_> {
     /// argument decides (its binding reports what is missing); `None` after reporting
     /// a first argument that fits none of them.
     fn overload(&mut self, b: &'static Builtin, args: &[ArgVal]) -> Option<&'static Builtin> {
-        let all: Vec<&'static Builtin> = builtins::overloads(b).collect();
-        if all.len() == 1 {
+        // Nearly every builtin has one entry: decide that without collecting anything.
+        if builtins::overloads(b).nth(1).is_none() {
             return Some(b);
         }
+        let all: Vec<&'static Builtin> = builtins::overloads(b).collect();
         let mut decider = None;
         for o in &all {
             if let Some(arg) = first_arg(o, args) {
