@@ -54,6 +54,14 @@ fn solid(rng: &mut Rng, depth: u32, budget: &mut usize) -> String {
     }
 }
 
+/// The shape of the first object of `text`.
+fn shape_of(text: &str) -> std::sync::Arc<scnc::ir::Shape> {
+    match &scene(text).objects[0].geometry {
+        scnc::ir::Geometry::Shape(shape) => shape.clone(),
+        scnc::ir::Geometry::Mesh(_) => panic!("not a shape:\n{text}"),
+    }
+}
+
 fn build(shape: &scnc::ir::Shape, prune: bool) -> (Sdf, MatSdf) {
     let mut materials = MaterialTable::default();
     let mut b = Builder::new(&mut materials);
@@ -74,8 +82,7 @@ fn pruned_unions_equal_every_part_and_stay_lipschitz() {
             solid(&mut rng, 4, &mut budget)
         );
         leaves += 300 - budget;
-        let s = scene(&text);
-        let scnc::ir::Geometry::Shape(shape) = &s.objects[0].geometry else { panic!("not a shape") };
+        let shape = &shape_of(&text);
         let (fast, fast_mat) = build(shape, true);
         let (every, every_mat) = build(shape, false);
         for _ in 0..1_000 {
@@ -140,8 +147,7 @@ fn unions_marched_part_by_part_hit_where_the_whole_field_does() {
             _ => "scale [1.5, 0.7, 1] at [0, 0, 8]".to_string(),
         };
         let text = format!("light ambient(1)\nobject union({}{smooth}) {placed}\n", parts.join(", "));
-        let s = scene(&text);
-        let scnc::ir::Geometry::Shape(shape) = &s.objects[0].geometry else { panic!("not a shape") };
+        let shape = &shape_of(&text);
         let mut materials = MaterialTable::default();
         let object = SdfObject::new(shape, DAffine3::IDENTITY, &mut Builder::new(&mut materials));
         let mut c = Counters::default();
@@ -184,8 +190,7 @@ fn bounds_contain_the_solid() {
             _ => part,
         };
         let text = format!("light ambient(1)\nobject {wrapped} at [0, 0, 8]\n");
-        let s = scene(&text);
-        let scnc::ir::Geometry::Shape(shape) = &s.objects[0].geometry else { panic!("not a shape") };
+        let shape = &shape_of(&text);
         let (Some(b), Some((centre, radius))) = (scnc::ir::shape_bounds(shape), scnc::ir::shape_sphere(shape)) else {
             continue;
         };
@@ -233,8 +238,7 @@ fn a_perforated_plate_equals_every_cut() {
     let text = "light ambient(1)\nobject subtract(box(2, 0.3, 2) rotate [10, 20, 0], \
                 [for i in 0..100 => sphere(0.05 + 0.1 * random(i)) at [(i % 10) * 0.4 - 1.8, 0.3 * random(i + 0.5) - 0.15, floor(i / 10) * 0.4 - 1.8]]) \
                 with material(color = #ff0000) at [0, 0, 8]\n";
-    let s = scene(text);
-    let scnc::ir::Geometry::Shape(shape) = &s.objects[0].geometry else { panic!("not a shape") };
+    let shape = &shape_of(text);
     let (fast, fast_mat) = build(shape, true);
     let (every, every_mat) = build(shape, false);
     let mut rng = Rng(0x9e7f_07a7e);
