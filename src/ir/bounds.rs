@@ -85,10 +85,7 @@ fn bounds_within(shape: &Shape, g: f64) -> Option<Aabb> {
             let reach = *period * (DVec3::new(count[0] as f64, count[1] as f64, count[2] as f64) - 1.0) * 0.5;
             Some(Aabb { min: b.min - reach, max: b.max + reach })
         }
-        ShapeKind::Transform { child, xf } => {
-            let inner = if g == 0.0 { 0.0 } else { g / min_singular_value(xf.matrix3) };
-            bounds_within(child, inner).map(|b| b.transform(xf))
-        }
+        ShapeKind::Transform { child, xf } => bounds_within(child, within_child(g, xf)).map(|b| b.transform(xf)),
         ShapeKind::Paint { child, .. } => bounds_within(child, g),
     }
 }
@@ -118,6 +115,16 @@ pub fn bounding_sphere(g: &Geometry) -> Option<(DVec3, f64)> {
     (b.min.cmple(b.max).all()).then(|| (b.centre(), (b.max - b.min).length() * 0.5))
 }
 
+/// The growth `g` of a transform's field in its child's units: the field is the child's
+/// scaled by the map's smallest singular value.
+fn within_child(g: f64, xf: &DAffine3) -> f64 {
+    if g == 0.0 {
+        0.0
+    } else {
+        g / min_singular_value(xf.matrix3)
+    }
+}
+
 /// A bounding sphere (centre, radius) of a shape tree, tight for primitives under
 /// similarities (a sphere's bound is the sphere itself); `None` when unbounded.
 pub fn shape_sphere(shape: &Shape) -> Option<(DVec3, f64)> {
@@ -145,8 +152,7 @@ fn sphere_within(shape: &Shape, g: f64) -> Option<(DVec3, f64)> {
         ShapeKind::Shell { child, thickness } => sphere_within(child, g + thickness * 0.5),
         ShapeKind::Repeat { .. } => bounds_within(shape, g).map(from_box),
         ShapeKind::Transform { child, xf } => {
-            let inner = if g == 0.0 { 0.0 } else { g / min_singular_value(xf.matrix3) };
-            let (c, r) = sphere_within(child, inner)?;
+            let (c, r) = sphere_within(child, within_child(g, xf))?;
             Some((xf.transform_point3(c), r * max_stretch(xf.matrix3)))
         }
         ShapeKind::Paint { child, .. } => sphere_within(child, g),
