@@ -5,4 +5,5 @@ mod aabb;
 pub mod bvh;
 
 pub use aabb::{padded_sphere, sphere_interval, Aabb, ROBUST};
+pub(crate) use bvh::Child;
 pub use bvh::{Bvh, Rays4};

@@ -79,7 +79,7 @@ impl<'a> Builder<'a> {
                         if acc.matrix3 == DMat3::IDENTITY { 1.0 } else { min_singular_value(acc.matrix3) as f32 };
                     (inv32, scale)
                 };
-                Some(RayParts { inv, scale, tree, parts, k })
+                Some(RayParts::new(inv, scale, tree, parts, k))
             }
             _ => None,
         };

@@ -14,6 +14,7 @@
 
 mod build;
 mod packet;
+mod point;
 mod walk;
 
 use glam::{Vec3A, Vec4};
@@ -260,6 +261,85 @@ mod tests {
             let (a, b) = (visited(&indexed, origin, dir, None), visited(&ordered, origin, dir, Some(&order)));
             assert_eq!(a, b, "the ordered tree visits what the indexed one does");
             assert!(expected.iter().all(|p| a.contains(p)), "ray {i} missed a box: {expected:?} ⊄ {a:?}");
+        }
+    }
+
+    /// Boxes scattered in a 10-unit cube, a few stacked at one spot.
+    fn scattered(n: usize) -> Vec<Aabb> {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        (0..n)
+            .map(|i| {
+                let c = if i % 9 == 0 { Vec3A::splat(5.0) } else { Vec3A::new(next(), next(), next()) * 10.0 };
+                Aabb { min: c, max: c + Vec3A::new(next(), next(), next()) * 0.6 }
+            })
+            .collect()
+    }
+
+    fn outside(b: Aabb, p: Vec3A) -> f32 {
+        (b.min - p).max(p - b.max).max(Vec3A::ZERO).length()
+    }
+
+    /// A union-like walk (threshold = nearest box so far + 0.3) reaches every box
+    /// nearer than its final threshold, and nothing is skipped without pruning.
+    #[test]
+    fn the_point_walk_reaches_every_box_within_the_threshold() {
+        let boxes = scattered(400);
+        let bvh = Bvh::build(&boxes, 2);
+        for i in 0..300 {
+            let f = i as f32;
+            let p =
+                Vec3A::new((f * 0.37).sin() * 7.0 + 5.0, (f * 0.11).cos() * 7.0 + 5.0, (f * 0.23).sin() * 6.0 + 4.0);
+            for prune in [true, false] {
+                let (mut seen, mut best) = (vec![false; boxes.len()], f32::INFINITY);
+                bvh.nearest_first(p, f32::INFINITY, prune, |k| {
+                    assert!(!std::mem::replace(&mut seen[k as usize], true), "box {k} visited twice");
+                    best = best.min(outside(boxes[k as usize], p));
+                    best + 0.3
+                });
+                for (k, b) in boxes.iter().enumerate() {
+                    let wanted = !prune || outside(*b, p) < best + 0.3;
+                    assert!(seen[k] || !wanted, "point {i}: box {k} at {} skipped, best {best}", outside(*b, p));
+                }
+            }
+        }
+    }
+
+    /// Opening up to `t` in steps reports each box once, every box whose grown box the
+    /// ray enters by `t`, and leaves closed only what begins after the frontier.
+    #[test]
+    fn the_resumable_ray_walk_opens_exactly_up_to_its_distance() {
+        let boxes = scattered(400);
+        let bvh = Bvh::build(&boxes, 2);
+        let grow = 0.2;
+        let mut closed = Vec::new();
+        for i in 0..200 {
+            let dir = Vec3A::new((i as f32 * 0.37).sin(), (i as f32 * 0.11).cos(), 1.0).normalize();
+            let origin = Vec3A::new(5.0, 5.0, -20.0);
+            let entry = |b: Aabb| {
+                let g = Aabb { min: b.min - Vec3A::splat(grow), max: b.max + Vec3A::splat(grow) };
+                g.slab(origin, dir.recip(), 0.0, 60.0).map(|(a, _)| a)
+            };
+            let walk = bvh.ray_walk(origin, dir.recip(), (0.0, 60.0), grow, &mut closed);
+            let mut seen = vec![false; boxes.len()];
+            let mut visits = 0;
+            for step in 0..=30 {
+                let t = step as f32 * 2.0;
+                let frontier = walk.open_until(t, &mut closed, &mut visits, |k| {
+                    assert!(!std::mem::replace(&mut seen[k as usize], true), "box {k} reported twice");
+                });
+                for (k, b) in boxes.iter().enumerate() {
+                    if let Some(a) = entry(*b) {
+                        assert!(seen[k] || a > t, "ray {i}: box {k} entered at {a} not opened by {t}");
+                        assert!(seen[k] || a >= frontier, "ray {i}: box {k} at {a} before frontier {frontier}");
+                    }
+                }
+            }
         }
     }
 

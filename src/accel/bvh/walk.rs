@@ -1,9 +1,11 @@
-//! The single-ray walks: closest hit and any hit, front to back.
+//! The single-ray walks: closest hit and any hit, front to back, and a walk that opens
+//! the tree only as far along the ray as a march has come.
 
 use glam::{Vec3A, Vec4, Vec4Swizzles};
 
 use super::{Bvh, Child, Deferred, Node};
 use crate::accel::aabb::enters4;
+use crate::accel::Aabb;
 
 /// Per-ray constants of the two-box slab test, splat across lanes.
 pub(super) struct RaySplat {
@@ -28,13 +30,20 @@ impl RaySplat {
     /// [`Aabb::slab`](crate::accel::Aabb::slab): it could only graze what the box holds, edge-on.
     #[inline(always)]
     pub(super) fn enters(&self, node: &Node, t_max: f32) -> (u32, Vec4) {
+        self.enters_planes([node.x, node.y, node.z], t_max)
+    }
+
+    /// [`enters`](Self::enters) for a node's planes per axis (`[left.min, right.min,
+    /// left.max, right.max]`), which a caller may have moved.
+    #[inline(always)]
+    fn enters_planes(&self, [x, y, z]: [Vec4; 3], t_max: f32) -> (u32, Vec4) {
         let axis = |planes: Vec4, k: usize| {
             let t = (planes - self.origin[k]) * self.inv_dir[k];
             // Lanes 2 and 3 moved to 0 and 1: each child's two planes side by side.
             let swapped = t.zwxy();
             (t.min(swapped), t.max(swapped))
         };
-        let axes = [axis(node.x, 0), axis(node.y, 1), axis(node.z, 2)];
+        let axes = [axis(x, 0), axis(y, 1), axis(z, 2)];
         let (enters, near) = enters4(axes, self.t_min, Vec4::splat(t_max));
         (enters & 0b11, near)
     }
@@ -162,5 +171,78 @@ impl Bvh {
                 }
             }
         }
+    }
+}
+
+/// A walk along one ray that opens nodes only up to the distance a caller has reached,
+/// to be resumed further on: what a sphere tracer needs when every primitive whose box
+/// the ray has entered by `t` must be known before stepping from `t`, and nothing
+/// beyond its hit should be opened. The nodes not yet opened, with the distance at
+/// which the ray enters each, live in a caller's vector so a march allocates nothing.
+pub(crate) struct RayWalk<'a> {
+    bvh: &'a Bvh,
+    ray: RaySplat,
+    t_max: f32,
+    /// Added to every node's planes: every box grown by the same margin.
+    grow: Vec4,
+}
+
+impl Bvh {
+    /// A walk along `origin + t·dir` (`inv_dir` its reciprocal) over `[t_min, t_max]`
+    /// through every box grown by `grow` on each side; `closed` is cleared and receives
+    /// the root if the ray enters its box.
+    pub(crate) fn ray_walk(
+        &self,
+        origin: Vec3A,
+        inv_dir: Vec3A,
+        (t_min, t_max): (f32, f32),
+        grow: f32,
+        closed: &mut Vec<(Child, f32)>,
+    ) -> RayWalk<'_> {
+        closed.clear();
+        if let Some((root_box, root)) = self.root() {
+            let grown = Aabb { min: root_box.min - Vec3A::splat(grow), max: root_box.max + Vec3A::splat(grow) };
+            if let Some((near, _)) = grown.slab(origin, inv_dir, t_min, t_max) {
+                closed.push((root, near));
+            }
+        }
+        let grow = Vec4::new(-grow, -grow, grow, grow);
+        RayWalk { bvh: self, ray: RaySplat::new(origin, inv_dir, t_min), t_max, grow }
+    }
+}
+
+impl RayWalk<'_> {
+    /// Opens every node in `closed` the ray enters at or before `t`, and their children
+    /// likewise, calling `prim` for each primitive of the leaves opened (each once over
+    /// the walk); returns the nearest entry among the nodes left closed (infinity when
+    /// none are), before which no further primitive's box begins.
+    #[inline]
+    pub(crate) fn open_until(
+        &self,
+        t: f32,
+        closed: &mut Vec<(Child, f32)>,
+        visits: &mut u64,
+        mut prim: impl FnMut(u32),
+    ) -> f32 {
+        // The vector is short (about one node per level passed), so a scan beats a heap;
+        // scanning from the end opens the children just pushed first, depth first.
+        while let Some(at) = closed.iter().rposition(|&(_, near)| near <= t) {
+            let (child, _) = closed.swap_remove(at);
+            if child.count > 0 {
+                (child.index..child.index + child.count).for_each(|k| prim(self.bvh.prim(k)));
+                continue;
+            }
+            *visits += 1;
+            let node = &self.bvh.nodes[child.index as usize];
+            let planes = [node.x + self.grow, node.y + self.grow, node.z + self.grow];
+            let (enters, near) = self.ray.enters_planes(planes, self.t_max);
+            if enters & 1 != 0 {
+                closed.push((node.children[0], near.x));
+            }
+            if enters & 2 != 0 {
+                closed.push((node.children[1], near.y));
+            }
+        }
+        closed.iter().fold(f32::INFINITY, |m, &(_, near)| m.min(near))
     }
 }
