@@ -38,6 +38,7 @@ struct LastUnion {
     node: usize,
     tree: Arc<PartTree>,
     parts: Arc<[Sdf]>,
+    mats: Arc<[MatSdf]>,
     k: f32,
 }
 
@@ -68,7 +69,7 @@ impl<'a> Builder<'a> {
             }
         }
         let parts = match self.last_union.take() {
-            Some(LastUnion { node: addr, tree, parts, k }) if addr == node as *const Shape as usize => {
+            Some(LastUnion { node: addr, tree, parts, mats, k }) if addr == node as *const Shape as usize => {
                 // Sharp unions are built in render space; smooth ones in their own frame.
                 let (inv, scale) = if k == 0.0 || acc == DAffine3::IDENTITY {
                     (Affine3A::IDENTITY, 1.0)
@@ -79,7 +80,7 @@ impl<'a> Builder<'a> {
                         if acc.matrix3 == DMat3::IDENTITY { 1.0 } else { min_singular_value(acc.matrix3) as f32 };
                     (inv32, scale)
                 };
-                Some(RayParts::new(inv, scale, tree, parts, k))
+                Some(RayParts { inv, scale, tree, parts, mats, k })
             }
             _ => None,
         };
@@ -301,10 +302,15 @@ impl<'a> Builder<'a> {
     fn pruned_union(&mut self, node: &Shape, kids: Vec<(Sdf, MatSdf)>, bounds: PartBounds, k: f32) -> (Sdf, MatSdf) {
         let tree = Arc::new(PartTree::new(bounds.boxes, bounds.spheres, self.prune));
         let (ds, ms): (Vec<Sdf>, Vec<MatSdf>) = kids.into_iter().unzip();
-        let ds: Arc<[Sdf]> = ds.into();
+        let (ds, ms): (Arc<[Sdf]>, Arc<[MatSdf]>) = (ds.into(), ms.into());
         self.bytes += ds.len() * 2 * std::mem::size_of::<Sdf>() + tree.bytes();
-        self.last_union =
-            Some(LastUnion { node: node as *const Shape as usize, tree: tree.clone(), parts: ds.clone(), k });
+        self.last_union = Some(LastUnion {
+            node: node as *const Shape as usize,
+            tree: tree.clone(),
+            parts: ds.clone(),
+            mats: ms.clone(),
+            k,
+        });
         let t = tree.clone();
         let d = self.sdf(move |p| {
             let mut fold = Fold::new(k);

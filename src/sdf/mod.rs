@@ -83,8 +83,13 @@ impl SdfObject {
     pub fn surface(&self, ray: &Ray, t: f32, error: f32, object: u32, c: &mut Counters) -> Hit {
         let point = ray.at(t);
         let h = error.max(point.abs().max_element() * 8.0 * f32::EPSILON);
-        let normal = march::normal(&*self.dist, point, h);
-        let (d, material) = (self.mat)(point);
+        let (normal, d, material) = match &self.parts {
+            Some(parts) => parts.surface(point, h),
+            None => {
+                let (d, material) = (self.mat)(point);
+                (march::normal(&*self.dist, point, h), d, material)
+            }
+        };
         c.sdf_shading_evals += 5;
         // The gradient of a convex solid's field is its outward normal, but only on the
         // surface: a ray starting inside the solid "hits" where it starts, below it.

@@ -48,26 +48,50 @@ impl Axis {
     }
 }
 
+/// One curve of a log–log chart: its name, colour and points (x, y, optional label).
+pub struct Series {
+    /// Legend entry.
+    pub name: String,
+    /// Line and point colour.
+    pub colour: RGBColor,
+    /// The points, joined in this order.
+    pub points: Vec<(f64, f64, Option<String>)>,
+}
+
 /// Plots `axis` against mean geometric error for every row.
 pub fn error_chart(rows: &[Row], axis: Axis, title: &str) -> Result<Image, String> {
+    let floor = 1e-9;
+    let series = [("sdf", RED), ("mesh", BLUE)].map(|(backend, colour)| {
+        let mut points: Vec<(f64, f64, Option<String>)> = rows
+            .iter()
+            .filter(|r| r.setting.backend() == backend)
+            .map(|r| (axis.value(r).max(floor), r.geo_mean.max(floor), Some(r.setting.label())))
+            .collect();
+        points.sort_by(|a, b| b.1.total_cmp(&a.1));
+        Series { name: backend.into(), colour, points }
+    });
+    loglog(title, axis.label(), "mean geometric error (world units)", &series)
+}
+
+/// A log–log chart of `series` (empty ones left out), 960×640.
+pub fn loglog(title: &str, x_desc: &str, y_desc: &str, series: &[Series]) -> Result<Image, String> {
     register_font();
     let (w, h) = (960u32, 640u32);
     let mut pixels = vec![255u8; (w * h * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut pixels, (w, h)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let floor = 1e-9;
-        let points: Vec<(f64, f64)> = rows.iter().map(|r| (axis.value(r).max(floor), r.geo_mean.max(floor))).collect();
+        let all = || series.iter().flat_map(|s| s.points.iter());
         let range = |v: &mut dyn Iterator<Item = f64>| {
             let (lo, hi) = v.fold((f64::INFINITY, 0.0f64), |(lo, hi), x| (lo.min(x), hi.max(x)));
-            if lo.is_finite() {
+            if lo.is_finite() && lo > 0.0 {
                 (lo / 1.6, hi * 1.6)
             } else {
-                (floor, 1.0)
+                (1e-9, 1.0)
             }
         };
-        let (x0, x1) = range(&mut points.iter().map(|p| p.0));
-        let (y0, y1) = range(&mut points.iter().map(|p| p.1));
+        let (x0, x1) = range(&mut all().map(|p| p.0));
+        let (y0, y1) = range(&mut all().map(|p| p.1));
         let mut chart = ChartBuilder::on(&root)
             .caption(title, ("sans-serif", 22))
             .margin(20)
@@ -77,35 +101,26 @@ pub fn error_chart(rows: &[Row], axis: Axis, title: &str) -> Result<Image, Strin
             .map_err(|e| e.to_string())?;
         chart
             .configure_mesh()
-            .x_desc(axis.label())
-            .y_desc("mean geometric error (world units)")
+            .x_desc(x_desc)
+            .y_desc(y_desc)
             .label_style(("sans-serif", 14))
             .draw()
             .map_err(|e| e.to_string())?;
-        for (backend, colour) in [("sdf", RED), ("mesh", BLUE)] {
-            let mut pts: Vec<(f64, f64, String)> = rows
-                .iter()
-                .zip(&points)
-                .filter(|(r, _)| r.setting.backend() == backend)
-                .map(|(r, p)| (p.0, p.1, r.setting.label()))
-                .collect();
-            if pts.is_empty() {
-                continue;
-            }
-            pts.sort_by(|a, b| b.1.total_cmp(&a.1));
+        for s in series.iter().filter(|s| !s.points.is_empty()) {
+            let colour = s.colour;
             chart
-                .draw_series(LineSeries::new(pts.iter().map(|p| (p.0, p.1)), colour.stroke_width(2)))
+                .draw_series(LineSeries::new(s.points.iter().map(|p| (p.0, p.1)), colour.stroke_width(2)))
                 .map_err(|e| e.to_string())?
-                .label(backend)
+                .label(s.name.as_str())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
             chart
-                .draw_series(pts.iter().map(|p| Circle::new((p.0, p.1), 4, colour.filled())))
+                .draw_series(s.points.iter().map(|p| Circle::new((p.0, p.1), 4, colour.filled())))
                 .map_err(|e| e.to_string())?;
             chart
-                .draw_series(
-                    pts.iter()
-                        .map(|p| Text::new(p.2.clone(), (p.0, p.1), ("sans-serif", 12).into_font().color(&colour))),
-                )
+                .draw_series(s.points.iter().filter_map(|p| {
+                    let label = p.2.clone()?;
+                    Some(Text::new(label, (p.0, p.1), ("sans-serif", 12).into_font().color(&colour)))
+                }))
                 .map_err(|e| e.to_string())?;
         }
         chart

@@ -127,7 +127,8 @@ fn primitive_evaluations_are_counted_and_pruned() {
 
 /// A union at an object's root is marched part by part along each ray; it never passes
 /// the first crossing of the whole union's field (found by a march with a hundredth of
-/// the threshold), and it finds that crossing.
+/// the threshold), and it finds that crossing. At the hit, the normal and material from
+/// the parts gathered around it are those of the whole field.
 #[test]
 fn unions_marched_part_by_part_hit_where_the_whole_field_does() {
     use scnc::render::{Counters, Ray};
@@ -165,6 +166,16 @@ fn unions_marched_part_by_part_hit_where_the_whole_field_does() {
                 (Some((a, ea)), Some((r, _))) => {
                     hits += 1;
                     assert!(a <= r + 2.0 * ea, "case {case}: part by part {a}, first crossing {r}\n{text}");
+                    let hit = object.surface(&ray, a, ea, 0, &mut c);
+                    let h = ea.max(hit.point.abs().max_element() * 8.0 * f32::EPSILON);
+                    let whole = march::normal(&*object.dist, hit.point, h);
+                    let (_, material) = (object.mat)(hit.point);
+                    assert!(
+                        hit.normal.dot(whole) > 1.0 - 1e-5,
+                        "case {case}: normal {} from nearby parts, {whole} from all\n{text}",
+                        hit.normal
+                    );
+                    assert_eq!(hit.material, material, "case {case}: material\n{text}");
                 }
                 (None, Some((r, _))) => panic!("case {case}: part by part missed the crossing at {r}\n{text}"),
                 (_, None) => {}
