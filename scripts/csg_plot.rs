@@ -6,6 +6,7 @@
 use std::io::{Read, Write};
 use std::process::ExitCode;
 
+use plotters::chart::SeriesLabelPosition;
 use plotters::style::{BLACK, BLUE, GREEN, RED};
 use scnc::study::chart::{loglog, Series};
 
@@ -41,9 +42,9 @@ fn main() -> ExitCode {
     }
     let chart = loglog(
         "one union of N spheres vs N objects (400×400, 2 threads, whole process)",
-        "N (spheres)",
-        "wall time (ms)",
+        ("N (spheres)", "wall time (ms)"),
         &series,
+        SeriesLabelPosition::UpperLeft,
     );
     let written = chart.map_err(|e| e.to_string()).and_then(|img| {
         image::save_buffer(&out, &img.pixels, img.width, img.height, image::ExtendedColorType::Rgb8)

@@ -70,11 +70,17 @@ pub fn error_chart(rows: &[Row], axis: Axis, title: &str) -> Result<Image, Strin
         points.sort_by(|a, b| b.1.total_cmp(&a.1));
         Series { name: backend.into(), colour, points }
     });
-    loglog(title, axis.label(), "mean geometric error (world units)", &series)
+    loglog(title, (axis.label(), "mean geometric error (world units)"), &series, SeriesLabelPosition::UpperRight)
 }
 
-/// A log–log chart of `series` (empty ones left out), 960×640.
-pub fn loglog(title: &str, x_desc: &str, y_desc: &str, series: &[Series]) -> Result<Image, String> {
+/// A log–log chart of `series` (empty ones left out), 960×640, axes described by
+/// `(x, y)`, the legend at `legend`.
+pub fn loglog(
+    title: &str,
+    (x_desc, y_desc): (&str, &str),
+    series: &[Series],
+    legend: SeriesLabelPosition,
+) -> Result<Image, String> {
     register_font();
     let (w, h) = (960u32, 640u32);
     let mut pixels = vec![255u8; (w * h * 3) as usize];
@@ -125,6 +131,7 @@ pub fn loglog(title: &str, x_desc: &str, y_desc: &str, series: &[Series]) -> Res
         }
         chart
             .configure_series_labels()
+            .position(legend)
             .background_style(WHITE)
             .border_style(BLACK)
             .label_font(("sans-serif", 14))
