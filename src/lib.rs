@@ -30,6 +30,7 @@
 pub mod accel;
 pub mod check;
 pub mod diag;
+pub mod export;
 pub mod fmt;
 pub mod ir;
 pub mod lsp;

@@ -54,6 +54,16 @@ pub(crate) fn check_output(path: &Path) -> Result<(), String> {
     if ext.as_deref() != Some("png") {
         return Err(format!("cannot write `{shown}`: scnc writes PNG images; try a `.png` file name"));
     }
+    check_output_as(path, "a file name ending in `.png`")
+}
+
+/// The usage error for an output path that names a directory or a file in a directory
+/// that does not exist, found before any work; `what` says what to give instead.
+pub(crate) fn check_output_as(path: &Path, what: &str) -> Result<(), String> {
+    let shown = path.display();
+    if path.as_os_str().to_string_lossy().ends_with(std::path::MAIN_SEPARATOR) {
+        return Err(format!("cannot write `{shown}`: it names a directory; give {what}"));
+    }
     let target = link_target(path);
     if target.is_dir() {
         return Err(format!("cannot write `{shown}`: it is a directory"));
@@ -94,7 +104,16 @@ pub(crate) fn write_atomic(
 ) -> std::io::Result<()> {
     let path = &link_target(path);
     let dir = parent_dir(path);
-    let mut tmp = tempfile::Builder::new().prefix(".scnc-").suffix(suffix).tempfile_in(dir)?;
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".scnc-").suffix(suffix);
+    // A new file gets the mode any tool gives one (0666 less the umask, applied by the
+    // system at creation), not the temporary file's private 0600.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let mut tmp = builder.tempfile_in(dir)?;
     let _pending = Pending::new(tmp.path());
     // Replacing a file keeps its permissions (a temporary file is private by default).
     if let Ok(meta) = std::fs::metadata(path) {

@@ -5,7 +5,9 @@
 //! - `stats`: what `render --stats` prints.
 //! - `files`: output written whole or not at all.
 //! - `fmt`: `scnc fmt`.
+//! - `export`: the scene as a mesh file.
 
+mod export;
 mod files;
 mod fmt;
 mod render;
@@ -57,6 +59,9 @@ enum Command {
     /// Render, then render again whenever the scene or a file it includes changes;
     /// on errors, print them and keep the last good image. Ctrl-C ends it.
     Watch(RenderArgs),
+    /// Write the scene's objects as a mesh file (STL, OBJ, PLY, 3MF or glb), meshed as
+    /// `render --geometry mesh` meshes them (written whole or not at all).
+    Export(export::ExportArgs),
     /// Render a scene across a ladder of accuracy settings for both back-ends and write
     /// time, work, memory and error for each to DIR/sweep.csv and DIR/sweep.md.
     Sweep(SweepArgs),
@@ -144,6 +149,7 @@ fn run(cli: Cli) -> ExitCode {
         Command::Render(args) => render::render_cmd(args),
         Command::Watch(args) => watch::watch_cmd(args),
         Command::Sweep(args) => sweep::sweep_cmd(args),
+        Command::Export(args) => export::export_cmd(args),
         Command::Fmt { files, check } => fmt::fmt_cmd(&files, check),
         Command::Lsp => match scnc::lsp::run_stdio(|why| {
             let _ = writeln!(std::io::stderr(), "scnc lsp: {why}");

@@ -89,7 +89,7 @@ pub(crate) struct RenderArgs {
     message_format: MessageFormat,
 }
 
-fn parse_detail(s: &str) -> Result<scnc::mesh::Detail, String> {
+pub(crate) fn parse_detail(s: &str) -> Result<scnc::mesh::Detail, String> {
     match s {
         "low" => Ok(scnc::mesh::Detail::Low),
         "high" => Ok(scnc::mesh::Detail::High),
@@ -110,7 +110,7 @@ fn parse_epsilon(s: &str) -> Result<f64, String> {
 }
 
 /// A byte count: a whole number, optionally with a K, M or G suffix (powers of 1024).
-fn parse_bytes(s: &str) -> Result<u64, String> {
+pub(crate) fn parse_bytes(s: &str) -> Result<u64, String> {
     let t = s.trim();
     let (digits, shift) = match t.char_indices().last() {
         Some((i, 'K' | 'k')) => (&t[..i], 10),

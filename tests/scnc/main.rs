@@ -4,6 +4,7 @@ mod budget;
 mod cli;
 mod conformance;
 mod effects;
+mod export;
 mod fmt;
 mod golden;
 mod grammar;

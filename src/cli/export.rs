@@ -1,0 +1,290 @@
+//! `scnc export`: a scene's objects as a mesh file (STL, OBJ + MTL, PLY, 3MF, glb),
+//! written whole or not at all.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+use clap::ValueEnum;
+
+use scnc::export::formats::{self, Format};
+use scnc::export::report::MeshReport;
+use scnc::export::{Frame, Up};
+use scnc::source::FsLoader;
+use scnc::study::tolerance::Tolerance;
+use scnc::Compiled;
+
+use super::files::{check_output_as, write_atomic};
+use super::render::{parse_bytes, parse_detail};
+use super::{compile, report, usage_error, worker_pool, MessageFormat};
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum FormatArg {
+    /// STL (binary; ASCII with `--ascii`).
+    Stl,
+    /// Wavefront OBJ with an MTL file beside it.
+    Obj,
+    /// PLY, binary, with vertex colours.
+    Ply,
+    /// 3MF, one object per scene object, with colours.
+    #[value(name = "3mf")]
+    ThreeMf,
+    /// Binary glTF 2.0.
+    Glb,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum UpArg {
+    /// Y up (glTF, OBJ and PLY viewers).
+    Y,
+    /// Z up (slicers, CAD).
+    Z,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum Units {
+    /// Millimetres.
+    Mm,
+    /// Centimetres.
+    Cm,
+    /// Metres.
+    M,
+    /// Inches.
+    In,
+}
+
+impl Units {
+    /// The 3MF `unit` attribute.
+    fn three_mf(self) -> &'static str {
+        match self {
+            Units::Mm => "millimeter",
+            Units::Cm => "centimeter",
+            Units::M => "meter",
+            Units::In => "inch",
+        }
+    }
+}
+
+#[derive(clap::Args)]
+pub(crate) struct ExportArgs {
+    /// The scene file.
+    file: PathBuf,
+    /// Output mesh file; its extension (.stl, .obj, .ply, .3mf, .glb) picks the format.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// The format, whatever the output's extension.
+    #[arg(long, value_enum)]
+    format: Option<FormatArg>,
+    /// Write ASCII STL instead of binary.
+    #[arg(long)]
+    ascii: bool,
+    /// Tessellation detail, as `render --geometry mesh`: `low`, `high` or N rings.
+    #[arg(long, value_parser = parse_detail, default_value = "high")]
+    detail: scnc::mesh::Detail,
+    /// Pick the detail expected to keep the surface within this many scene units (or a
+    /// pixel of the scene's camera with `pixel`), as `render --geometry mesh`.
+    #[arg(long, conflicts_with = "detail")]
+    tolerance: Option<Tolerance>,
+    /// The file's up axis (default: `z` for STL and 3MF, `y` for OBJ, PLY and glb).
+    #[arg(long, value_enum)]
+    up: Option<UpArg>,
+    /// File units per scene unit.
+    #[arg(long, value_parser = parse_scale, default_value = "1")]
+    scale: f64,
+    /// The unit a 3MF file declares (default: mm, one scene unit a millimetre).
+    #[arg(long, value_enum)]
+    units: Option<Units>,
+    /// Most memory the meshes may take while they are made (as `render`).
+    #[arg(long, value_parser = parse_bytes, default_value = "4G")]
+    memory_limit: u64,
+    /// Check each object's mesh: watertight and manifold, degenerate triangles dropped,
+    /// enclosed volume and bounds.
+    #[arg(long)]
+    stats: bool,
+    /// Worker threads (default: one per core).
+    #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024))]
+    threads: Option<u16>,
+    /// How to print diagnostics.
+    #[arg(long, value_enum, default_value = "human")]
+    message_format: MessageFormat,
+}
+
+/// A scale: a finite number greater than 0 that keeps a renderable scene finite in f32.
+fn parse_scale(s: &str) -> Result<f64, String> {
+    let x: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
+    if x > 0.0 && x.is_finite() && (1e-12..=1e12).contains(&x) {
+        Ok(x)
+    } else {
+        Err("must be a number from 1e-12 to 1e12".into())
+    }
+}
+
+impl ExportArgs {
+    /// The format: `--format`, else the output's extension.
+    fn format(&self) -> Result<Format, String> {
+        let format = match self.format {
+            Some(FormatArg::Stl) => Format::Stl,
+            Some(FormatArg::Obj) => Format::Obj,
+            Some(FormatArg::Ply) => Format::Ply,
+            Some(FormatArg::ThreeMf) => Format::ThreeMf,
+            Some(FormatArg::Glb) => Format::Glb,
+            None => {
+                self.output.extension().and_then(|e| e.to_str()).and_then(Format::from_extension).ok_or_else(|| {
+                    format!(
+                        "cannot tell the format of `{}`: name it .stl, .obj, .ply, .3mf or .glb, or give --format",
+                        self.output.display()
+                    )
+                })?
+            }
+        };
+        match (format, self.ascii) {
+            (Format::Stl, true) => Ok(Format::StlAscii),
+            (_, true) => Err("--ascii is for STL only".into()),
+            (f, false) => Ok(f),
+        }
+    }
+}
+
+pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
+    let format = match args.format() {
+        Ok(f) => f,
+        Err(e) => return usage_error(&e),
+    };
+    if args.units.is_some() && format != Format::ThreeMf {
+        return usage_error("--units is for 3MF, the one format that records units; use --scale to convert");
+    }
+    if let Err(e) = check_output_as(&args.output, "a mesh file") {
+        return usage_error(&e);
+    }
+    let mtl = mtl_path(&args.output);
+    if format == Format::Obj && mtl == args.output {
+        return usage_error("an OBJ export writes its materials beside it in a .mtl file; name the output .obj");
+    }
+    if let Err(e) = super::files::stop_on_interrupt(130) {
+        let _ = writeln!(std::io::stderr(), "warning: {e}");
+    }
+    let pool = match worker_pool(args.threads) {
+        Ok(p) => p,
+        Err(e) => return usage_error(&e),
+    };
+    let Some(mut compiled) = compile(&args.file, args.message_format) else { return ExitCode::from(1) };
+    if report(&compiled, args.message_format) {
+        return ExitCode::from(1);
+    }
+    let Some(scene) = compiled.scene.take() else { return ExitCode::from(1) };
+    let scene = &scene;
+    if scene.objects.is_empty() {
+        let _ = writeln!(std::io::stderr(), "error: `{}` has no objects to export", args.file.display());
+        return ExitCode::from(1);
+    }
+    let started = Instant::now();
+    let detail = match args.tolerance {
+        Some(tol) => {
+            let detail = scnc::study::tolerance::mesh_detail(scene, tol);
+            let _ = writeln!(std::io::stderr(), "tolerance {tol}: picked detail {}", detail.rings());
+            detail
+        }
+        None => args.detail,
+    };
+    let up = match args.up {
+        Some(UpArg::Y) => Up::Y,
+        Some(UpArg::Z) => Up::Z,
+        None if format.for_printing() => Up::Z,
+        None => Up::Y,
+    };
+    let frame = Frame { up, scale: args.scale };
+    let export = match pool.install(|| scnc::export::collect(scene, detail, frame, args.memory_limit, &FsLoader)) {
+        Ok(e) => e,
+        Err(d) => {
+            let c = Compiled { map: compiled.map, scene: None, diagnostics: vec![d] };
+            report(&c, args.message_format);
+            return ExitCode::from(1);
+        }
+    };
+    let units = args.units.unwrap_or(Units::Mm).three_mf();
+    let mtl_name = mtl.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+    let mut bytes = 0u64;
+    let mut write = |path: &Path, what: &dyn Fn(&mut dyn Write) -> std::io::Result<()>| {
+        write_atomic(path, ".tmp", |w| {
+            let mut counted = Counted { inner: w, bytes: 0 };
+            what(&mut counted)?;
+            bytes += counted.bytes;
+            Ok(())
+        })
+        .map_err(|e| format!("cannot write `{}`: {e}", path.display()))
+    };
+    let mut written = Ok(());
+    if format == Format::Obj {
+        written = write(&mtl, &|w| formats::mtl(&export, w));
+    }
+    if written.is_ok() {
+        written = write(&args.output, &|w| format.write(&export, units, &mtl_name, w));
+    }
+    if let Err(e) = written {
+        let _ = writeln!(std::io::stderr(), "error: {e}");
+        return ExitCode::from(1);
+    }
+    let mut err = std::io::stderr().lock();
+    let _ = writeln!(
+        err,
+        "exported {}: {} objects, {} triangles, {bytes} bytes in {:.3} s (up {}, detail {})",
+        args.output.display(),
+        export.parts.len(),
+        export.triangle_count(),
+        started.elapsed().as_secs_f64(),
+        if up == Up::Y { "y" } else { "z" },
+        detail.rings(),
+    );
+    if args.stats {
+        for part in &export.parts {
+            let r = MeshReport::of(part);
+            let (id, range) = compiled.map.local_range(part.span);
+            let (line, _) = compiled.map.line_col(id, range.start);
+            let (lo, hi) = r.bounds;
+            let _ = writeln!(
+                err,
+                "  {} ({}:{line}): {} triangles, {}, {} degenerate dropped, volume {:.6}, bounds [{:.4}, {:.4}, {:.4}] to [{:.4}, {:.4}, {:.4}]",
+                part.name,
+                compiled.map.file(id).name,
+                r.triangles,
+                if r.is_closed_manifold() {
+                    "watertight and manifold".to_string()
+                } else {
+                    format!("not closed: {} open edges, {} wound twice one way", r.open_edges, r.misoriented_edges)
+                },
+                r.degenerate,
+                r.volume,
+                lo.x,
+                lo.y,
+                lo.z,
+                hi.x,
+                hi.y,
+                hi.z,
+            );
+        }
+    }
+    ExitCode::SUCCESS
+}
+
+/// Where an OBJ export's MTL file goes: beside it, same stem.
+fn mtl_path(output: &Path) -> PathBuf {
+    output.with_extension("mtl")
+}
+
+/// A writer counting the bytes through it, for the summary line.
+struct Counted<'a> {
+    inner: &'a mut dyn Write,
+    bytes: u64,
+}
+
+impl Write for Counted<'_> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        let n = self.inner.write(buf)?;
+        self.bytes += n as u64;
+        Ok(n)
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.inner.flush()
+    }
+}

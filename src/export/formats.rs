@@ -1,0 +1,388 @@
+//! The mesh file formats `scnc export` writes. Each writer takes the whole [`Export`]
+//! and writes it to one stream (OBJ's materials go to a second, the MTL file); the
+//! command line writes the streams atomically. Numbers are written in Rust's shortest
+//! round-trip form, so a file is the same on every run and thread count.
+
+use std::io::{self, Write};
+
+use super::{Export, Part};
+
+/// A mesh file format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// STL, binary (80-byte header, 50 bytes per triangle).
+    Stl,
+    /// STL, ASCII.
+    StlAscii,
+    /// Wavefront OBJ, with an MTL file of the materials' colours.
+    Obj,
+    /// PLY, binary little-endian, with colours per vertex.
+    Ply,
+    /// 3MF: a ZIP package with the model's XML, one object per scene object.
+    ThreeMf,
+    /// Binary glTF 2.0 (`.glb`): one node per object, a PBR material per colour.
+    Glb,
+}
+
+impl Format {
+    /// The format an output file name asks for (by its extension), if any.
+    pub fn from_extension(ext: &str) -> Option<Format> {
+        match ext.to_ascii_lowercase().as_str() {
+            "stl" => Some(Format::Stl),
+            "obj" => Some(Format::Obj),
+            "ply" => Some(Format::Ply),
+            "3mf" => Some(Format::ThreeMf),
+            "glb" => Some(Format::Glb),
+            _ => None,
+        }
+    }
+
+    /// Whether the file is meant for printing (then Z is up by default).
+    pub fn for_printing(self) -> bool {
+        matches!(self, Format::Stl | Format::StlAscii | Format::ThreeMf)
+    }
+
+    /// Writes `export` in this format. OBJ's `mtl` names the MTL file its `mtllib` line
+    /// points to (written by [`mtl`]).
+    pub fn write(self, export: &Export, units: &str, mtl: &str, w: &mut dyn Write) -> io::Result<()> {
+        match self {
+            Format::Stl => stl_binary(export, w),
+            Format::StlAscii => stl_ascii(export, w),
+            Format::Obj => obj(export, mtl, w),
+            Format::Ply => ply(export, w),
+            Format::ThreeMf => three_mf(export, units, w),
+            Format::Glb => glb(export, w),
+        }
+    }
+}
+
+fn f32s(v: glam::DVec3) -> [f32; 3] {
+    v.as_vec3().to_array()
+}
+
+/// Every triangle of every part with its unit normal, in order.
+fn facets(export: &Export) -> impl ExactSizeIterator<Item = stl_io::Triangle> + '_ {
+    let all: Vec<(&Part, usize)> =
+        export.parts.iter().flat_map(|p| (0..p.triangles.len()).map(move |t| (p, t))).collect();
+    all.into_iter().map(|(p, t)| stl_io::Triangle {
+        normal: stl_io::Vector::new(f32s(p.face_normal(t))),
+        vertices: p.triangles[t].map(|i| stl_io::Vector::new(f32s(p.positions[i as usize]))),
+    })
+}
+
+fn stl_binary(export: &Export, w: &mut dyn Write) -> io::Result<()> {
+    stl_io::write_stl(&mut WriteRef(w), facets(export))
+}
+
+/// `&mut dyn Write` as a sized writer, for generic writers.
+struct WriteRef<'a>(&'a mut dyn Write);
+
+impl Write for WriteRef<'_> {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        self.0.write(buf)
+    }
+    fn flush(&mut self) -> io::Result<()> {
+        self.0.flush()
+    }
+}
+
+fn stl_ascii(export: &Export, w: &mut dyn Write) -> io::Result<()> {
+    writeln!(w, "solid scnc")?;
+    for f in facets(export) {
+        let [x, y, z] = f.normal.0;
+        writeln!(w, "  facet normal {x} {y} {z}")?;
+        writeln!(w, "    outer loop")?;
+        for v in f.vertices {
+            let [x, y, z] = v.0;
+            writeln!(w, "      vertex {x} {y} {z}")?;
+        }
+        writeln!(w, "    endloop")?;
+        writeln!(w, "  endfacet")?;
+    }
+    writeln!(w, "endsolid scnc")
+}
+
+/// The name of material `m` in OBJ/MTL, 3MF and glTF.
+fn material_name(m: u32) -> String {
+    format!("material_{m}")
+}
+
+fn obj(export: &Export, mtl: &str, w: &mut dyn Write) -> io::Result<()> {
+    writeln!(w, "# scnc export: {} objects, {} triangles", export.parts.len(), export.triangle_count())?;
+    writeln!(w, "mtllib {mtl}")?;
+    let mut base = 1u64;
+    for p in &export.parts {
+        writeln!(w, "o {}", p.name)?;
+        for v in &p.positions {
+            let [x, y, z] = f32s(*v);
+            writeln!(w, "v {x} {y} {z}")?;
+        }
+        let mut current = None;
+        for (t, tri) in p.triangles.iter().enumerate() {
+            if current != Some(p.materials[t]) {
+                current = Some(p.materials[t]);
+                writeln!(w, "usemtl {}", material_name(p.materials[t]))?;
+            }
+            let [a, b, c] = tri.map(|i| base + i as u64);
+            writeln!(w, "f {a} {b} {c}")?;
+        }
+        base += p.positions.len() as u64;
+    }
+    Ok(())
+}
+
+/// The MTL file of an OBJ export: each material used, its diffuse colour.
+pub fn mtl(export: &Export, w: &mut dyn Write) -> io::Result<()> {
+    writeln!(w, "# scnc export: material colours")?;
+    for m in used(export) {
+        let [r, g, b] = export.colours[m as usize].rgb8().map(|c| c as f32 / 255.0);
+        writeln!(w, "newmtl {}", material_name(m))?;
+        writeln!(w, "Kd {r} {g} {b}")?;
+    }
+    Ok(())
+}
+
+/// The materials any part uses, in increasing order.
+fn used(export: &Export) -> Vec<u32> {
+    let mut ms: Vec<u32> = export.parts.iter().flat_map(|p| p.materials.iter().copied()).collect();
+    ms.sort_unstable();
+    ms.dedup();
+    ms
+}
+
+fn ply(export: &Export, w: &mut dyn Write) -> io::Result<()> {
+    let groups: Vec<(&Part, Vec<super::Group>)> = export.parts.iter().map(|p| (p, p.groups())).collect();
+    let vertices: usize = groups.iter().flat_map(|(_, gs)| gs.iter().map(|g| g.vertices.len())).sum();
+    let faces = export.triangle_count();
+    write!(
+        w,
+        "ply\nformat binary_little_endian 1.0\ncomment scnc export\nelement vertex {vertices}\n\
+         property float x\nproperty float y\nproperty float z\n\
+         property uchar red\nproperty uchar green\nproperty uchar blue\n\
+         element face {faces}\nproperty list uchar uint vertex_indices\nend_header\n"
+    )?;
+    for (p, gs) in &groups {
+        for g in gs {
+            let rgb = export.colours[g.material as usize].rgb8();
+            for &v in &g.vertices {
+                for c in f32s(p.positions[v as usize]) {
+                    w.write_all(&c.to_le_bytes())?;
+                }
+                w.write_all(&rgb)?;
+            }
+        }
+    }
+    let mut base = 0u32;
+    for (_, gs) in &groups {
+        for g in gs {
+            for t in &g.triangles {
+                w.write_all(&[3])?;
+                for i in t {
+                    w.write_all(&(base + i).to_le_bytes())?;
+                }
+            }
+            base += g.vertices.len() as u32;
+        }
+    }
+    Ok(())
+}
+
+fn three_mf(export: &Export, units: &str, w: &mut dyn Write) -> io::Result<()> {
+    use zip::write::SimpleFileOptions;
+    let mut model = String::new();
+    xml_model(export, units, &mut model);
+    let mut zip = zip::ZipWriter::new(io::Cursor::new(Vec::new()));
+    // A fixed time stamp: the package is the same on every run.
+    let options = SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Deflated)
+        .last_modified_time(zip::DateTime::default());
+    let parts: [(&str, &str); 3] = [
+        (
+            "[Content_Types].xml",
+            "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<Types xmlns=\"http://schemas.openxmlformats.org/package/2006/content-types\">\
+             <Default Extension=\"rels\" ContentType=\"application/vnd.openxmlformats-package.relationships+xml\"/>\
+             <Default Extension=\"model\" ContentType=\"application/vnd.ms-package.3dmanufacturing-3dmodel+xml\"/></Types>\n",
+        ),
+        (
+            "_rels/.rels",
+            "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<Relationships xmlns=\"http://schemas.openxmlformats.org/package/2006/relationships\">\
+             <Relationship Target=\"/3D/3dmodel.model\" Id=\"rel0\" Type=\"http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel\"/></Relationships>\n",
+        ),
+        ("3D/3dmodel.model", &model),
+    ];
+    for (name, text) in parts {
+        zip.start_file(name, options).map_err(io::Error::other)?;
+        zip.write_all(text.as_bytes())?;
+    }
+    let bytes = zip.finish().map_err(io::Error::other)?.into_inner();
+    w.write_all(&bytes)
+}
+
+/// The 3MF model: one `basematerials` group holding every colour used (core
+/// specification, section 5.1), one mesh object per part whose triangles name their
+/// material, and a build item per object.
+fn xml_model(export: &Export, units: &str, out: &mut String) {
+    use std::fmt::Write as _;
+    let used = used(export);
+    let index = |m: u32| used.iter().position(|&u| u == m).unwrap_or(0);
+    let _ = write!(
+        out,
+        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<model unit=\"{units}\" xml:lang=\"en-US\" \
+         xmlns=\"http://schemas.microsoft.com/3dmanufacturing/core/2015/02\">\n\
+         <metadata name=\"Application\">scnc</metadata>\n<resources>\n<basematerials id=\"1\">\n"
+    );
+    for &m in &used {
+        let _ = writeln!(
+            out,
+            "<base name=\"{}\" displaycolor=\"{}\"/>",
+            material_name(m),
+            export.colours[m as usize].hex()
+        );
+    }
+    out.push_str("</basematerials>\n");
+    for (k, p) in export.parts.iter().enumerate() {
+        let first = p.materials.first().map_or(0, |&m| index(m));
+        let _ = writeln!(
+            out,
+            "<object id=\"{}\" name=\"{}\" type=\"model\" pid=\"1\" pindex=\"{first}\">\n<mesh>\n<vertices>",
+            k + 2,
+            p.name
+        );
+        for v in &p.positions {
+            let [x, y, z] = f32s(*v);
+            let _ = writeln!(out, "<vertex x=\"{x}\" y=\"{y}\" z=\"{z}\"/>");
+        }
+        out.push_str("</vertices>\n<triangles>\n");
+        for (t, [a, b, c]) in p.triangles.iter().enumerate() {
+            let _ = writeln!(
+                out,
+                "<triangle v1=\"{a}\" v2=\"{b}\" v3=\"{c}\" pid=\"1\" p1=\"{}\"/>",
+                index(p.materials[t])
+            );
+        }
+        out.push_str("</triangles>\n</mesh>\n</object>\n");
+    }
+    out.push_str("</resources>\n<build>\n");
+    for k in 0..export.parts.len() {
+        let _ = writeln!(out, "<item objectid=\"{}\"/>", k + 2);
+    }
+    out.push_str("</build>\n</model>\n");
+}
+
+/// Binary glTF: the JSON document, then one binary buffer holding, per part and
+/// material, positions (with their bounds, which glTF requires), normals for smooth
+/// parts, and `u32` indices.
+fn glb(export: &Export, w: &mut dyn Write) -> io::Result<()> {
+    use serde_json::json;
+    let mut bin: Vec<u8> = Vec::new();
+    let (mut views, mut accessors, mut meshes, mut nodes) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let used = used(export);
+    let index = |m: u32| used.iter().position(|&u| u == m).unwrap_or(0);
+    // Appends a buffer view of `bytes` (aligned to 4) and an accessor over it.
+    let mut push = |bin: &mut Vec<u8>, bytes: Vec<u8>, accessor: serde_json::Value, target: u32| {
+        while !bin.len().is_multiple_of(4) {
+            bin.push(0);
+        }
+        views.push(json!({ "buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len(), "target": target }));
+        bin.extend_from_slice(&bytes);
+        let mut a = accessor;
+        a["bufferView"] = json!(views.len() - 1);
+        accessors.push(a);
+        accessors.len() - 1
+    };
+    for p in &export.parts {
+        let normals = p.smooth.then(|| p.vertex_normals());
+        let mut primitives = Vec::new();
+        for g in p.groups() {
+            let points: Vec<[f32; 3]> = g.vertices.iter().map(|&v| f32s(p.positions[v as usize])).collect();
+            let (min, max) = points.iter().fold(([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]), |(lo, hi), q| {
+                (std::array::from_fn(|k| lo[k].min(q[k])), std::array::from_fn(|k| hi[k].max(q[k])))
+            });
+            let bytes = points.iter().flatten().flat_map(|c| c.to_le_bytes()).collect();
+            let position = push(
+                &mut bin,
+                bytes,
+                json!({ "componentType": 5126, "count": points.len(), "type": "VEC3", "min": min, "max": max }),
+                34962,
+            );
+            let mut attributes = json!({ "POSITION": position });
+            if let Some(n) = &normals {
+                let bytes =
+                    g.vertices.iter().flat_map(|&v| f32s(n[v as usize])).flat_map(|c| c.to_le_bytes()).collect();
+                let normal = push(
+                    &mut bin,
+                    bytes,
+                    json!({ "componentType": 5126, "count": g.vertices.len(), "type": "VEC3" }),
+                    34962,
+                );
+                attributes["NORMAL"] = json!(normal);
+            }
+            let bytes = g.triangles.iter().flatten().flat_map(|i| i.to_le_bytes()).collect();
+            let indices = push(
+                &mut bin,
+                bytes,
+                json!({ "componentType": 5125, "count": g.triangles.len() * 3, "type": "SCALAR" }),
+                34963,
+            );
+            primitives.push(
+                json!({ "attributes": attributes, "indices": indices, "material": index(g.material), "mode": 4 }),
+            );
+        }
+        // glTF wants at least one primitive per mesh: a part with no triangles left is
+        // a node without a mesh.
+        if primitives.is_empty() {
+            nodes.push(json!({ "name": p.name }));
+        } else {
+            meshes.push(json!({ "name": p.name, "primitives": primitives }));
+            nodes.push(json!({ "name": p.name, "mesh": meshes.len() - 1 }));
+        }
+    }
+    while !bin.len().is_multiple_of(4) {
+        bin.push(0);
+    }
+    let materials: Vec<serde_json::Value> = used
+        .iter()
+        .map(|&m| {
+            let [r, g, b] = export.colours[m as usize].linear();
+            json!({
+                "name": material_name(m),
+                "pbrMetallicRoughness": { "baseColorFactor": [r, g, b, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.8 },
+            })
+        })
+        .collect();
+    let mut doc = json!({
+        "asset": { "version": "2.0", "generator": "scnc export" },
+        "scene": 0,
+        "scenes": [{ "nodes": (0..nodes.len()).collect::<Vec<_>>() }],
+        "nodes": nodes,
+        "meshes": meshes,
+        "materials": materials,
+        "accessors": accessors,
+        "bufferViews": views,
+    });
+    if !bin.is_empty() {
+        doc["buffers"] = json!([{ "byteLength": bin.len() }]);
+    }
+    // glTF's arrays, where present, hold at least one item.
+    if let Some(fields) = doc.as_object_mut() {
+        fields.retain(|_, v| v.as_array().is_none_or(|a| !a.is_empty()));
+    }
+    let mut text = serde_json::to_vec(&doc).map_err(io::Error::other)?;
+    while !text.len().is_multiple_of(4) {
+        text.push(b' ');
+    }
+    let total = 12 + 8 + text.len() + if bin.is_empty() { 0 } else { 8 + bin.len() };
+    let total = u32::try_from(total).map_err(|_| io::Error::other("a .glb file holds at most 4 GiB"))?;
+    w.write_all(b"glTF")?;
+    w.write_all(&2u32.to_le_bytes())?;
+    w.write_all(&total.to_le_bytes())?;
+    w.write_all(&(text.len() as u32).to_le_bytes())?;
+    w.write_all(b"JSON")?;
+    w.write_all(&text)?;
+    if !bin.is_empty() {
+        w.write_all(&(bin.len() as u32).to_le_bytes())?;
+        w.write_all(b"BIN\0")?;
+        w.write_all(&bin)?;
+    }
+    Ok(())
+}

@@ -1,0 +1,240 @@
+//! `scnc export`: every object of a scene as a triangle mesh, in the output frame of a
+//! mesh file, ready for the writers in [`formats`].
+//!
+//! Objects are meshed exactly as `render --geometry mesh` meshes them (the same
+//! generators and isosurfaces, at the same detail), but in world coordinates rather
+//! than camera-relative ones. scnc is left-handed (x right, y up, z forward), while STL,
+//! OBJ, PLY, 3MF and glTF are read as right-handed, so positions are mirrored into the
+//! output frame (`--up y`: `(x, y, −z)`; `--up z`: `(x, z, y)`) and every triangle's
+//! winding is reversed with them: a part keeps its shape (it is not mirrored in a slicer)
+//! and its triangles stay wound outward.
+
+pub mod formats;
+pub mod report;
+
+use glam::{DAffine3, DVec3};
+
+use crate::diag::{codes, Diagnostic};
+use crate::ir::{self, Scene};
+use crate::mesh::{self, Detail};
+use crate::render::MaterialTable;
+use crate::source::Loader;
+use crate::span::Span;
+
+/// Which output axis is up.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Up {
+    /// Y up, as in glTF, OBJ and PLY viewers (and scnc).
+    Y,
+    /// Z up, as slicers and CAD tools expect.
+    Z,
+}
+
+/// How scene coordinates become the file's.
+#[derive(Clone, Copy, Debug)]
+pub struct Frame {
+    /// The up axis of the file.
+    pub up: Up,
+    /// File units per scene unit.
+    pub scale: f64,
+}
+
+impl Frame {
+    /// A scene point in the file's right-handed frame (a reflection of scnc's
+    /// left-handed one, see the module's comment).
+    pub fn place(&self, p: DVec3) -> DVec3 {
+        let q = match self.up {
+            Up::Y => DVec3::new(p.x, p.y, -p.z),
+            Up::Z => DVec3::new(p.x, p.z, p.y),
+        };
+        q * self.scale
+    }
+}
+
+/// One material's colour, as the scene gives it (0–255 per channel).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Colour(pub [f64; 3]);
+
+impl Colour {
+    /// The colour in 8 bits per channel, as scnc writes it to PNG.
+    pub fn rgb8(self) -> [u8; 3] {
+        self.0.map(|c| c.round().clamp(0.0, 255.0) as u8)
+    }
+
+    /// The colour as `#RRGGBB`.
+    pub fn hex(self) -> String {
+        let [r, g, b] = self.rgb8();
+        format!("#{r:02X}{g:02X}{b:02X}")
+    }
+
+    /// Linear-light components in [0, 1], reading the 8-bit value as sRGB-encoded (what
+    /// a PNG viewer shows), for formats whose colours are linear (glTF).
+    pub fn linear(self) -> [f64; 3] {
+        self.rgb8().map(|c| {
+            let c = c as f64 / 255.0;
+            if c <= 0.04045 {
+                c / 12.92
+            } else {
+                ((c + 0.055) / 1.055).powf(2.4)
+            }
+        })
+    }
+}
+
+/// One scene object as a mesh in the file's frame.
+#[derive(Clone, Debug)]
+pub struct Part {
+    /// A name for the object: `object_N`, N counting the scene's objects from 1.
+    pub name: String,
+    /// The `object` statement.
+    pub span: Span,
+    /// Vertex positions in the file's frame.
+    pub positions: Vec<DVec3>,
+    /// Triangles, counter-clockwise seen from outside in the file's frame.
+    pub triangles: Vec<[u32; 3]>,
+    /// Each triangle's material, an index into [`Export::colours`].
+    pub materials: Vec<u32>,
+    /// Whether the surface is smooth (shaded with interpolated normals when rendered).
+    pub smooth: bool,
+    /// Triangles dropped because they had no area.
+    pub degenerate: usize,
+}
+
+impl Part {
+    /// The triangles as a [`mesh::TriMesh`] (for volumes and edge checks).
+    pub fn tri_mesh(&self) -> mesh::TriMesh {
+        mesh::TriMesh { positions: self.positions.clone(), triangles: self.triangles.clone() }
+    }
+
+    /// Unit normal of triangle `t` (zero for none, which [`collect`] never keeps).
+    pub fn face_normal(&self, t: usize) -> DVec3 {
+        let [a, b, c] = self.triangles[t].map(|i| self.positions[i as usize]);
+        (b - a).cross(c - a).normalize_or_zero()
+    }
+
+    /// Area-weighted vertex normals, for smooth surfaces.
+    pub fn vertex_normals(&self) -> Vec<DVec3> {
+        let mut n = vec![DVec3::ZERO; self.positions.len()];
+        for t in &self.triangles {
+            let [a, b, c] = t.map(|i| self.positions[i as usize]);
+            let face = (b - a).cross(c - a);
+            for &i in t {
+                n[i as usize] += face;
+            }
+        }
+        n.into_iter().map(|v| v.normalize_or(DVec3::Y)).collect()
+    }
+
+    /// The part split by material: for each material used, its own vertices (shared
+    /// vertices are copied into every material that uses them) and triangles. Formats
+    /// with colours per vertex or one material per primitive write these.
+    pub fn groups(&self) -> Vec<Group> {
+        let mut groups: Vec<Group> = Vec::new();
+        let mut remap = std::collections::HashMap::new();
+        for (t, tri) in self.triangles.iter().enumerate() {
+            let material = self.materials[t];
+            let g = match groups.iter().position(|g| g.material == material) {
+                Some(g) => g,
+                None => {
+                    groups.push(Group { material, vertices: Vec::new(), triangles: Vec::new() });
+                    groups.len() - 1
+                }
+            };
+            let corners = tri.map(|v| {
+                *remap.entry((g, v)).or_insert_with(|| {
+                    groups[g].vertices.push(v);
+                    groups[g].vertices.len() as u32 - 1
+                })
+            });
+            groups[g].triangles.push(corners);
+        }
+        groups
+    }
+}
+
+/// The triangles of one material of a [`Part`], over their own vertices.
+#[derive(Clone, Debug)]
+pub struct Group {
+    /// The material, an index into [`Export::colours`].
+    pub material: u32,
+    /// Indices into the part's positions.
+    pub vertices: Vec<u32>,
+    /// Triangles over `vertices`.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// A scene's objects as meshes, with the colours they use.
+#[derive(Clone, Debug)]
+pub struct Export {
+    /// The objects, in scene order.
+    pub parts: Vec<Part>,
+    /// Every material's colour (a part's materials index this).
+    pub colours: Vec<Colour>,
+}
+
+impl Export {
+    /// Triangles of every part.
+    pub fn triangle_count(&self) -> usize {
+        self.parts.iter().map(|p| p.triangles.len()).sum()
+    }
+}
+
+/// Meshes every object of `scene` at `detail` into `frame`, within `memory_limit`
+/// bytes of meshes (as `render` counts them). An unbounded shape (a `plane`, an
+/// infinite `repeat`) cannot be a mesh file's solid: it is an error at its object.
+pub fn collect(
+    scene: &Scene,
+    detail: Detail,
+    frame: Frame,
+    memory_limit: u64,
+    loader: &dyn Loader,
+) -> Result<Export, Diagnostic> {
+    let mut materials = MaterialTable::default();
+    let mut budget = mesh::lower::Budget::new(memory_limit);
+    let mut parts = Vec::with_capacity(scene.objects.len());
+    for (n, obj) in scene.objects.iter().enumerate() {
+        let job = match &obj.geometry {
+            ir::Geometry::Shape(shape) => {
+                if ir::shape_bounds(shape).is_none() {
+                    return Err(unbounded(obj.span));
+                }
+                // Only planes use the far limit, and they were refused above.
+                mesh::lower::tessellate(shape, DAffine3::IDENTITY, detail, 0.0, &mut budget, &mut materials)?
+            }
+            ir::Geometry::Mesh(m) => mesh::lower::explicit(m, DAffine3::IDENTITY, &mut budget, &mut materials, loader)?,
+        };
+        budget.confirm()?;
+        let positions: Vec<DVec3> =
+            job.mesh.positions.iter().map(|&p| frame.place(job.xf.transform_point3(p))).collect();
+        // The reflection into the file's frame turns every triangle inside out; a
+        // transform that mirrors (negative determinant) turns it back.
+        let flip = job.xf.matrix3.determinant() > 0.0;
+        let (mut triangles, mut mats, mut degenerate) = (Vec::new(), Vec::new(), 0);
+        for (t, &[a, b, c]) in job.mesh.triangles.iter().enumerate() {
+            let [pa, pb, pc] = [a, b, c].map(|i| positions[i as usize]);
+            if a == b || b == c || a == c || (pb - pa).cross(pc - pa).length_squared() == 0.0 {
+                degenerate += 1;
+                continue;
+            }
+            triangles.push(if flip { [a, c, b] } else { [a, b, c] });
+            mats.push(job.per_triangle.as_ref().map_or(job.material, |m| m[t]));
+        }
+        parts.push(Part {
+            name: format!("object_{}", n + 1),
+            span: obj.span,
+            positions,
+            triangles,
+            materials: mats,
+            smooth: job.smooth,
+            degenerate,
+        });
+    }
+    let colours = materials.materials.iter().map(|m| Colour(m.color.as_dvec3().to_array())).collect();
+    Ok(Export { parts, colours })
+}
+
+fn unbounded(span: Span) -> Diagnostic {
+    Diagnostic::error(codes::LOWERING, span, "cannot export an unbounded shape", "this object has no finite extent")
+        .with_note("a mesh file holds closed solids; a `plane` or an infinite `repeat` has no finite surface")
+        .with_hint("intersect it with a `box` to bound it, or leave the object out of the exported scene")
+}

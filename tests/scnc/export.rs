@@ -1,0 +1,320 @@
+//! `scnc export`: every format read back by a real reader (stl_io, the gltf crate's
+//! validating reader, the threemf crate, scnc's own OBJ reader, and a PLY header and
+//! body parsed here), golden OBJ/MTL and ASCII STL files, and the errors.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use glam::DVec3;
+
+use super::support::check_golden;
+
+fn scnc(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_scnc")).args(args).env("NO_COLOR", "1").output().expect("running scnc")
+}
+
+/// Exports `scene` to `dir/name` with `extra` flags; the file's bytes.
+fn export(scene: &str, dir: &Path, name: &str, extra: &[&str]) -> Vec<u8> {
+    let out = dir.join(name);
+    let mut args = vec!["export", scene, "-o", out.to_str().expect("utf-8 path")];
+    args.extend_from_slice(extra);
+    let run = scnc(&args);
+    assert_eq!(run.status.code(), Some(0), "{}", String::from_utf8_lossy(&run.stderr));
+    std::fs::read(&out).expect("the export")
+}
+
+/// Signed volume and bounds of a triangle soup.
+fn measure(triangles: &[[DVec3; 3]]) -> (f64, DVec3, DVec3) {
+    let volume = triangles.iter().map(|[a, b, c]| a.dot(b.cross(*c)) / 6.0).sum();
+    let (lo, hi) =
+        triangles.iter().flatten().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    (volume, lo, hi)
+}
+
+fn close(a: DVec3, b: DVec3, tol: f64) -> bool {
+    (a - b).abs().max_element() <= tol
+}
+
+/// `unit.scn` in a Y-up right-handed frame: the sphere at x = −2, the box at x = 2
+/// (mirrored z is still 0 at their centres).
+const SPHERE: f64 = 4.0 * std::f64::consts::PI / 3.0;
+
+#[test]
+fn stl_reads_back_through_stl_io_with_its_volume_and_bounds() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    for ascii in [false, true] {
+        let extra: &[&str] = if ascii { &["--ascii", "--detail", "28"] } else { &["--detail", "28"] };
+        let bytes = export("tests/data/export/unit.scn", dir.path(), "unit.stl", extra);
+        assert_eq!(bytes.starts_with(b"solid scnc"), ascii);
+        let mesh = stl_io::read_stl(&mut std::io::Cursor::new(bytes)).expect("stl_io reads it");
+        let tris: Vec<[DVec3; 3]> =
+            mesh.faces.iter().map(|f| f.vertices.map(|v| DVec3::from(mesh.vertices[v].0.map(f64::from)))).collect();
+        // Z up by default for STL: the box (side 2, at y = 1 in the scene) is at z ≈ 1.
+        let box_tris: Vec<[DVec3; 3]> = tris.iter().copied().filter(|t| t[0].x > 0.0).collect();
+        let sphere_tris: Vec<[DVec3; 3]> = tris.iter().copied().filter(|t| t[0].x < 0.0).collect();
+        assert_eq!(box_tris.len(), 12);
+        let (box_volume, _, _) = measure(&box_tris);
+        assert!((box_volume - 8.0).abs() < 1e-4, "box volume {box_volume}");
+        let (v, lo, hi) = measure(&sphere_tris);
+        assert!((v - SPHERE).abs() < 0.01 * SPHERE, "sphere volume {v} at detail 28");
+        assert!(close(lo, DVec3::new(-3.0, -1.0, -1.0), 1e-3) && close(hi, DVec3::new(-1.0, 1.0, 1.0), 1e-3));
+        let (_, blo, bhi) = measure(&box_tris);
+        assert!((blo.z + bhi.z) / 2.0 > 0.9, "Z is up: the box's centre is at z = 1, bounds {blo}..{bhi}");
+    }
+}
+
+/// At the default `--detail high` (14 rings) a unit sphere's polyhedron holds 2.1% less
+/// than the sphere: the chord error the README's accuracy table gives for 14 rings.
+#[test]
+fn the_default_detail_loses_the_chord_volume_and_no_more() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let bytes = export("tests/data/export/unit.scn", dir.path(), "unit.stl", &[]);
+    let mesh = stl_io::read_stl(&mut std::io::Cursor::new(bytes)).expect("stl_io reads it");
+    let tris: Vec<[DVec3; 3]> = mesh
+        .faces
+        .iter()
+        .filter(|f| mesh.vertices[f.vertices[0]].0[0] < 0.0)
+        .map(|f| f.vertices.map(|v| DVec3::from(mesh.vertices[v].0.map(f64::from))))
+        .collect();
+    let (v, _, _) = measure(&tris);
+    assert!(v < SPHERE && v > 0.975 * SPHERE, "sphere volume {v} of {SPHERE}");
+}
+
+#[test]
+fn obj_reads_back_through_scncs_reader_with_its_colours() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let bytes = export("tests/data/export/unit.scn", dir.path(), "unit.obj", &["--detail", "28"]);
+    let text = String::from_utf8(bytes).expect("text");
+    let mesh = scnc::mesh::obj::parse(&text).expect("scnc reads it");
+    let tris: Vec<[DVec3; 3]> = mesh.triangles.iter().map(|t| t.map(|i| mesh.positions[i as usize])).collect();
+    let (v, lo, hi) = measure(&tris);
+    assert!((v - 8.0 - SPHERE).abs() < 0.01 * SPHERE, "volume {v}");
+    // Y up, right-handed: z mirrored, the box's top at y = 1 + √3 at most.
+    assert!(close(lo, DVec3::new(-3.0, -1.0, -1.8), 0.1) || lo.x == -3.0, "bounds {lo}..{hi}");
+    assert!(text.contains("mtllib unit.mtl\no object_1\n") && text.contains("\no object_2\n"));
+    let mtl = std::fs::read_to_string(dir.path().join("unit.mtl")).expect("the MTL beside it");
+    let kd: Vec<&str> = mtl.lines().filter(|l| l.starts_with("Kd ")).collect();
+    assert_eq!(kd.len(), 2, "{mtl}");
+    assert!(kd.iter().any(|l| l.starts_with("Kd 0.78431374 0.11764706 0.11764706")), "{mtl}");
+}
+
+#[test]
+fn glb_passes_the_gltf_crates_validation_with_nodes_colours_and_normals() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let bytes = export("tests/data/export/smooth.scn", dir.path(), "s.glb", &["--detail", "low"]);
+    let gltf = gltf::Gltf::from_slice(&bytes).expect("a valid glTF");
+    let blob = gltf.blob.clone().expect("a binary chunk");
+    let nodes: Vec<String> = gltf.nodes().map(|n| n.name().unwrap_or("").to_string()).collect();
+    assert_eq!(nodes, ["object_1", "object_2"]);
+    let mut tris = Vec::new();
+    let mut smooth = Vec::new();
+    for mesh in gltf.meshes() {
+        let mut has_normals = false;
+        for p in mesh.primitives() {
+            let reader = p.reader(|_| Some(&blob[..]));
+            let positions: Vec<DVec3> =
+                reader.read_positions().expect("positions").map(|p| DVec3::from(p.map(f64::from))).collect();
+            has_normals |= reader.read_normals().is_some();
+            let indices: Vec<u32> = reader.read_indices().expect("indices").into_u32().collect();
+            tris.extend(indices.chunks(3).map(|c| [0, 1, 2].map(|k| positions[c[k] as usize])));
+            let colour = p.material().pbr_metallic_roughness().base_color_factor();
+            assert!(colour[3] == 1.0 && colour[..3].iter().all(|c| (0.0..=1.0).contains(c)));
+        }
+        smooth.push(has_normals);
+    }
+    // Normals for the smooth-shaded mesh sphere only.
+    assert_eq!(smooth, [false, true]);
+    let (v, _, _) = measure(&tris);
+    assert!(v > 0.0, "wound outward: volume {v}");
+    let colours: Vec<[f32; 4]> = gltf.materials().map(|m| m.pbr_metallic_roughness().base_color_factor()).collect();
+    // rgb(255, 128, 0) in linear light.
+    assert!(colours.iter().any(|c| c[0] == 1.0 && (c[1] - 0.2158605).abs() < 1e-5 && c[2] == 0.0), "{colours:?}");
+}
+
+#[test]
+fn three_mf_reads_back_through_the_threemf_crate_with_units_and_colours() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let bytes = export("tests/data/export/unit.scn", dir.path(), "unit.3mf", &["--detail", "28", "--units", "cm"]);
+    let models = threemf::read(std::io::Cursor::new(bytes.clone())).expect("threemf reads it");
+    assert_eq!(models.len(), 1);
+    let objects = &models[0].resources.object;
+    assert_eq!(objects.len(), 2);
+    assert_eq!(models[0].build.item.len(), 2);
+    let mut volumes = Vec::new();
+    for o in objects {
+        let mesh = o.mesh.as_ref().expect("a mesh object");
+        let v: Vec<DVec3> = mesh.vertices.vertex.iter().map(|v| DVec3::new(v.x, v.y, v.z)).collect();
+        let tris: Vec<[DVec3; 3]> = mesh.triangles.triangle.iter().map(|t| [v[t.v1], v[t.v2], v[t.v3]]).collect();
+        volumes.push(measure(&tris).0);
+    }
+    assert!((volumes[0] - SPHERE).abs() < 0.01 * SPHERE && (volumes[1] - 8.0).abs() < 1e-4, "{volumes:?}");
+    assert!(matches!(models[0].unit, threemf::model::Unit::Centimeter));
+    // The colours are core-specification base materials, which this reader skips: read
+    // the model's XML for them.
+    let mut zip = zip::ZipArchive::new(std::io::Cursor::new(bytes)).expect("a ZIP package");
+    let mut model = String::new();
+    std::io::Read::read_to_string(&mut zip.by_name("3D/3dmodel.model").expect("the model part"), &mut model)
+        .expect("text");
+    assert!(model.contains("displaycolor=\"#C81E1E\"") && model.contains("displaycolor=\"#1EC81E\""), "{model}");
+}
+
+/// A PLY vertex: position and colour.
+type PlyVertex = (DVec3, [u8; 3]);
+
+/// A binary PLY: the header's counts, then every vertex's position and colour.
+fn read_ply(bytes: &[u8]) -> (Vec<PlyVertex>, Vec<[u32; 3]>) {
+    let end = bytes.windows(11).position(|w| w == b"end_header\n").expect("a header") + 11;
+    let header = std::str::from_utf8(&bytes[..end]).expect("text header");
+    assert!(header.starts_with("ply\nformat binary_little_endian 1.0\n"), "{header}");
+    let count = |element: &str| -> usize {
+        let line = header.lines().find(|l| l.starts_with(&format!("element {element} "))).expect("element");
+        line.rsplit(' ').next().and_then(|n| n.parse().ok()).expect("count")
+    };
+    let (nv, nf) = (count("vertex"), count("face"));
+    let mut at = end;
+    let f32_at = |at: &mut usize| {
+        let v = f32::from_le_bytes(bytes[*at..*at + 4].try_into().expect("4 bytes"));
+        *at += 4;
+        v as f64
+    };
+    let mut vertices = Vec::new();
+    for _ in 0..nv {
+        let p = DVec3::new(f32_at(&mut at), f32_at(&mut at), f32_at(&mut at));
+        vertices.push((p, [bytes[at], bytes[at + 1], bytes[at + 2]]));
+        at += 3;
+    }
+    let mut faces = Vec::new();
+    for _ in 0..nf {
+        assert_eq!(bytes[at], 3);
+        let idx = |k: usize| u32::from_le_bytes(bytes[at + 1 + 4 * k..at + 5 + 4 * k].try_into().expect("4 bytes"));
+        faces.push([idx(0), idx(1), idx(2)]);
+        at += 13;
+    }
+    assert_eq!(at, bytes.len(), "nothing after the faces");
+    (vertices, faces)
+}
+
+#[test]
+fn ply_has_colours_per_vertex_and_the_same_solid() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (vertices, faces) =
+        read_ply(&export("tests/data/export/unit.scn", dir.path(), "unit.ply", &["--detail", "28"]));
+    let tris: Vec<[DVec3; 3]> = faces.iter().map(|f| f.map(|i| vertices[i as usize].0)).collect();
+    let (v, _, _) = measure(&tris);
+    assert!((v - 8.0 - SPHERE).abs() < 0.01 * SPHERE, "volume {v}");
+    for f in &faces {
+        let [a, b, c] = f.map(|i| vertices[i as usize]);
+        assert!(a.1 == b.1 && b.1 == c.1, "one colour per triangle");
+        let expected = if a.0.x < 0.0 { [200, 30, 30] } else { [30, 200, 30] };
+        assert_eq!(a.1, expected);
+    }
+}
+
+/// OBJ/MTL and ASCII STL of a small scene, byte for byte, the same with one thread or two.
+#[test]
+fn obj_mtl_and_ascii_stl_match_their_golden_files() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let data = PathBuf::from("tests/data/export");
+    let mut failures = Vec::new();
+    for threads in ["1", "2"] {
+        let flags = ["--detail", "low", "--threads", threads];
+        let obj = export("tests/data/export/small.scn", dir.path(), "small.obj", &flags);
+        let mtl = std::fs::read(dir.path().join("small.mtl")).expect("mtl");
+        let mut ascii = flags.to_vec();
+        ascii.push("--ascii");
+        let stl = export("tests/data/export/small.scn", dir.path(), "small.stl", &ascii);
+        for (name, bytes) in [("small.obj", obj), ("small.mtl", mtl), ("small.stl", stl)] {
+            let text = String::from_utf8(bytes).expect("text");
+            failures.extend(check_golden(&data.join(name), &text));
+        }
+    }
+    super::support::finish(failures);
+}
+
+#[test]
+fn every_example_exports_to_every_format_or_names_its_unbounded_object() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut scenes: Vec<PathBuf> = ["examples/seed", "examples/features"]
+        .iter()
+        .flat_map(|d| super::support::cases(d))
+        .filter(|p| !p.ends_with("lights.scn"))
+        .collect();
+    scenes.sort();
+    assert!(scenes.len() >= 15, "{scenes:?}");
+    for scene in &scenes {
+        for ext in ["stl", "obj", "ply", "3mf", "glb"] {
+            let out = dir.path().join(format!("out.{ext}"));
+            let run =
+                scnc(&["export", scene.to_str().expect("path"), "-o", out.to_str().expect("path"), "--detail", "low"]);
+            let err = String::from_utf8_lossy(&run.stderr);
+            if run.status.code() == Some(0) {
+                assert!(err.starts_with(&format!("exported {}", out.display())), "{}: {err}", scene.display());
+                assert!(std::fs::metadata(&out).is_ok_and(|m| m.len() > 0));
+            } else {
+                assert_eq!(run.status.code(), Some(1), "{}: {err}", scene.display());
+                assert!(
+                    err.contains("cannot export an unbounded shape") && err.contains(".scn:"),
+                    "{}: {err}",
+                    scene.display()
+                );
+                assert!(!out.exists(), "nothing written for {}", scene.display());
+            }
+            let _ = std::fs::remove_file(&out);
+        }
+    }
+}
+
+#[test]
+fn bad_exports_are_clear_errors_and_write_nothing() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let at = |name: &str| dir.path().join(name).to_str().expect("path").to_string();
+    let cases: [(Vec<String>, i32, &str); 6] = [
+        (vec![at("x.dae")], 2, "cannot tell the format of"),
+        (vec![at("x.obj"), "--ascii".into()], 2, "--ascii is for STL only"),
+        (vec![at("x.stl"), "--units".into(), "mm".into()], 2, "--units is for 3MF"),
+        (vec![at("no/such/dir/x.stl")], 2, "does not exist"),
+        (vec![at("x.stl"), "--scale".into(), "0".into()], 2, "must be a number from 1e-12 to 1e12"),
+        (vec![at("x.stl"), "--scale".into(), "inf".into()], 2, "must be a number from 1e-12 to 1e12"),
+    ];
+    for (rest, code, message) in cases {
+        let mut args = vec!["export".to_string(), "tests/data/export/small.scn".into(), "-o".into()];
+        args.extend(rest);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let run = scnc(&args);
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(code), "{args:?}: {err}");
+        assert!(err.contains(message), "{args:?}: {err}");
+    }
+    let run = scnc(&["export", "tests/data/export/plane.scn", "-o", &at("p.stl")]);
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(1));
+    assert!(err.contains("E0800") && err.contains("plane.scn:5:1"), "{err}");
+    assert_eq!(std::fs::read_dir(dir.path()).expect("dir").count(), 0, "nothing written");
+}
+
+#[test]
+fn stats_report_each_object_closed_and_scale_multiplies_lengths() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("u.stl");
+    let run = scnc(&[
+        "export",
+        "tests/data/export/unit.scn",
+        "-o",
+        out.to_str().expect("path"),
+        "--stats",
+        "--scale",
+        "10",
+        "--up",
+        "y",
+    ]);
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(0), "{err}");
+    let lines: Vec<&str> = err.lines().collect();
+    assert!(lines[0].starts_with(&format!("exported {}: 2 objects, 740 triangles", out.display())), "{err}");
+    assert!(
+        lines[1].contains("object_1 (tests/data/export/unit.scn:6): 728 triangles, watertight and manifold"),
+        "{err}"
+    );
+    // A side-2 box scaled by 10: 8000 cubic units, wherever it is turned.
+    assert!(lines[2].contains("12 triangles, watertight and manifold, 0 degenerate dropped, volume 8000.000"), "{err}");
+}
