@@ -215,11 +215,17 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
         .map_err(|e| format!("cannot write `{}`: {e}", path.display()))
     };
     let mut written = Ok(());
+    // The MTL goes first (an OBJ must not name a file that is not there); if the OBJ
+    // then fails, a new MTL is removed again, so a failed export leaves nothing behind.
+    let mtl_existed = mtl.exists();
     if format == Format::Obj {
         written = write(&mtl, &|w| formats::mtl(&export, w));
     }
     if written.is_ok() {
         written = write(&args.output, &|w| format.write(&export, units, &mtl_name, w));
+        if written.is_err() && format == Format::Obj && !mtl_existed {
+            let _ = std::fs::remove_file(&mtl);
+        }
     }
     if let Err(e) = written {
         let _ = writeln!(std::io::stderr(), "error: {e}");
