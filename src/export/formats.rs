@@ -70,20 +70,8 @@ fn facets(export: &Export) -> impl ExactSizeIterator<Item = stl_io::Triangle> + 
     })
 }
 
-fn stl_binary(export: &Export, w: &mut dyn Write) -> io::Result<()> {
-    stl_io::write_stl(&mut WriteRef(w), facets(export))
-}
-
-/// `&mut dyn Write` as a sized writer, for generic writers.
-struct WriteRef<'a>(&'a mut dyn Write);
-
-impl Write for WriteRef<'_> {
-    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
-        self.0.write(buf)
-    }
-    fn flush(&mut self) -> io::Result<()> {
-        self.0.flush()
-    }
+fn stl_binary(export: &Export, mut w: &mut dyn Write) -> io::Result<()> {
+    stl_io::write_stl(&mut w, facets(export))
 }
 
 fn stl_ascii(export: &Export, w: &mut dyn Write) -> io::Result<()> {
