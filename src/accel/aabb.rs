@@ -58,6 +58,16 @@ impl Aabb {
         Aabb { min: self.min.min(o.min), max: self.max.max(o.max) }
     }
 
+    /// Grown by `d` on every side.
+    pub fn grow(self, d: f32) -> Aabb {
+        Aabb { min: self.min - Vec3A::splat(d), max: self.max + Vec3A::splat(d) }
+    }
+
+    /// Squared distance from `p` to the box (0 inside).
+    pub fn outside_squared(self, p: Vec3A) -> f32 {
+        (self.min - p).max(p - self.max).max(Vec3A::ZERO).length_squared()
+    }
+
     /// Centre point.
     pub fn centre(self) -> Vec3A {
         (self.min + self.max) * 0.5

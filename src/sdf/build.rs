@@ -317,19 +317,7 @@ impl<'a> Builder<'a> {
             t.visit(p, f32::INFINITY, |i, bound| fold.push(union::clamp(ds[i](p), bound)));
             fold.finish()
         });
-        let m = self.mat(move |p| {
-            let (mut fold, mut first, mut id) = (Fold::new(k), usize::MAX, 0);
-            tree.visit(p, f32::INFINITY, |i, bound| {
-                let (v, material) = ms[i](p);
-                let v = union::clamp(v, bound);
-                // Ties go to the part written first, whatever order the walk takes.
-                if v < fold.best() || (v == fold.best() && i < first) {
-                    (first, id) = (i, material);
-                }
-                fold.push(v)
-            });
-            (fold.finish(), id)
-        });
+        let m = self.mat(move |p| tree.material(&ms, k, p, 0.0, |_| {}));
         (d, m)
     }
 

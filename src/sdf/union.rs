@@ -3,10 +3,11 @@
 //!
 //! Each part's distance is taken as at least the distance to its bounding box and to
 //! its bounding sphere (all are lower bounds of the distance to the part, so their
-//! maximum is one too, and it is 1-Lipschitz; for a sphere part it is exact). A bounding volume hierarchy over the boxes is walked nearest first;
-//! a node is skipped when the point lies outside its box by at least the best value so
-//! far plus the blend radius `k` (0 for a sharp union). Every part it skips has a value
-//! at least that large, so:
+//! maximum is one too, and it is 1-Lipschitz; for a sphere part it is exact). A
+//! bounding volume hierarchy over the boxes is walked nearest first; a node is skipped
+//! when the point lies outside its box by at least the best value so far plus the blend
+//! radius `k` (0 for a sharp union). Every part it skips has a value at least that
+//! large, so:
 //! - a sharp union (the minimum) is exactly the minimum over all parts;
 //! - a smooth union is defined as the polynomial smooth minimum folded over the parts
 //!   in increasing order of distance, which stops at the first part `k` or more above
@@ -71,9 +72,33 @@ impl PartTree {
     /// How far `p` is at least from part `i`: outside its box or its sphere (0 inside both).
     #[inline]
     pub fn bound(&self, i: usize, p: Vec3A) -> f32 {
-        let b = self.boxes[i];
         let (centre, radius) = self.spheres[i];
-        (b.min - p).max(p - b.max).max(Vec3A::ZERO).length().max((p - centre).length() - radius)
+        self.boxes[i].outside_squared(p).sqrt().max((p - centre).length() - radius)
+    }
+
+    /// The union's value and material at `p` from the parts' distance-and-material
+    /// closures `mats`, blend radius `k`: ties go to the part written first, whatever
+    /// order the walk takes. Every part within `extra` beyond the union's own pruning
+    /// reach (best value + `k`) is also walked, and each part walked is passed to `seen`.
+    pub fn material(
+        &self,
+        mats: &[super::MatSdf],
+        k: f32,
+        p: Vec3A,
+        extra: f32,
+        mut seen: impl FnMut(usize),
+    ) -> (f32, u32) {
+        let (mut fold, mut first, mut id) = (Fold::new(k), usize::MAX, 0);
+        self.visit(p, f32::INFINITY, |i, bound| {
+            seen(i);
+            let (v, material) = mats[i](p);
+            let v = clamp(v, bound);
+            if v < fold.best() || (v == fold.best() && i < first) {
+                (first, id) = (i, material);
+            }
+            fold.push(v) + extra
+        });
+        (fold.finish(), id)
     }
 
     /// Walks the parts nearest first, calling `part(i, bound)` (see [`bound`](Self::bound))
@@ -165,8 +190,8 @@ impl Fold {
 /// behind it.
 ///
 /// Why this is exact: on a stretch of the ray outside every other part's grown box or
-/// sphere, each other part's value (at least its box and sphere distance) exceeds `k`, so wherever the full union is at or below zero
-/// (the surface and inside) those parts blend by exactly nothing and the field of the
+/// sphere, each other part's value (at least its box and sphere distance) exceeds `k`,
+/// so wherever the full union is at or below zero (the surface and inside) those parts blend by exactly nothing and the field of the
 /// parts in force equals the full one. That field is 1-Lipschitz, so a step by it never
 /// crosses one of its zeros, and therefore never crosses the surface; a step never runs
 /// past the next part's entry either, where the parts in force change.
@@ -193,9 +218,6 @@ thread_local! {
     /// Per-ray scratch, kept between rays so marching allocates nothing.
     static SCRATCH: std::cell::RefCell<Scratch> =
         const { std::cell::RefCell::new((Vec::new(), Vec::new(), Vec::new())) };
-}
-
-thread_local! {
     /// The parts gathered around a hit for its normal and material.
     static NEAR: std::cell::RefCell<Vec<u32>> = const { std::cell::RefCell::new(Vec::new()) };
 }
@@ -213,43 +235,21 @@ impl RayParts {
             let near = &mut *near.borrow_mut();
             near.clear();
             let q = self.inv.transform_point3a(p);
-            let reach = self.k + 2.0 * h * 3f32.sqrt() / self.scale;
-            let (mut fold, mut first, mut id) = (Fold::new(self.k), usize::MAX, 0);
-            self.tree.visit(q, f32::INFINITY, |i, bound| {
-                near.push(i as u32);
-                let (v, material) = self.mats[i](q);
-                let v = clamp(v, bound);
-                // Ties go to the part written first, as in the union's material closure.
-                if v < fold.best() || (v == fold.best() && i < first) {
-                    (first, id) = (i, material);
-                }
-                fold.push(v);
-                fold.best() + reach
-            });
-            let value = fold.finish() * self.scale;
-            let at = |x: Vec3A| {
-                let q = self.inv.transform_point3a(x);
-                let mut fold = Fold::new(self.k);
-                for &i in near.iter() {
-                    let i = i as usize;
-                    fold.push(clamp(self.parts[i](q), self.tree.bound(i, q)));
-                }
-                fold.finish() * self.scale
-            };
-            (super::march::normal(&at, p, h), value, id)
+            let extra = 2.0 * h * 3f32.sqrt() / self.scale;
+            let (value, id) = self.tree.material(&self.mats, self.k, q, extra, |i| near.push(i as u32));
+            let at = |x: Vec3A| self.value(x, near.iter().copied());
+            (super::march::normal(&at, p, h), value * self.scale, id)
         })
     }
 
-    /// Where the ray `origin + t·dir` (`dir` of any length, `len` its length) is inside
-    /// part `i`'s box and sphere grown by `k`, within `[t0, t1]`.
+    /// Where `ray` (in the parts' frame) is inside part `i`'s box and sphere grown by
+    /// `k`, within `[t0, t1]`.
     #[inline]
-    fn span(&self, i: u32, origin: Vec3A, dir: Vec3A, len: f32, (t0, t1): (f32, f32)) -> Option<(f32, f32)> {
-        let b = self.tree.boxes[i as usize];
+    fn span(&self, i: u32, ray: &FrameRay, (t0, t1): (f32, f32)) -> Option<(f32, f32)> {
         let (centre, radius) = self.tree.spheres[i as usize];
-        let grow = Vec3A::splat(self.k);
-        let (a, z) = Aabb { min: b.min - grow, max: b.max + grow }.slab(origin, dir.recip(), t0, t1)?;
-        let (a2, z2) = sphere_interval(origin, dir / len, centre, radius + self.k)?;
-        let (a, z) = (a.max(a2 / len), z.min(z2 / len * ROBUST));
+        let (a, z) = self.tree.boxes[i as usize].grow(self.k).slab(ray.origin, ray.inv_dir, t0, t1)?;
+        let (a2, z2) = sphere_interval(ray.origin, ray.unit, centre, radius + self.k)?;
+        let (a, z) = (a.max(a2 / ray.len), z.min(z2 / ray.len * ROBUST));
         (a <= z).then_some((a, z))
     }
 
@@ -268,16 +268,14 @@ impl RayParts {
             let (closed, active, waiting) = &mut *s.borrow_mut();
             active.clear();
             waiting.clear();
-            let origin = self.inv.transform_point3a(ray.origin);
-            let dir = self.inv.transform_vector3a(ray.dir);
-            let len = dir.length();
-            let walk = self.tree.bvh.ray_walk(origin, dir.recip(), (t0, t1), self.k, closed);
+            let frame = FrameRay::new(self.inv.transform_point3a(ray.origin), self.inv.transform_vector3a(ray.dir));
+            let walk = self.tree.bvh.ray_walk(frame.origin, frame.inv_dir, (t0, t1), self.k, closed);
             let base = ray.origin.length();
             let mut t = t0;
             let mut steps = 0;
             while steps < params.max_steps {
                 let unopened = walk.open_until(t, closed, &mut c.node_visits, |i| {
-                    if let Some((a, z)) = self.span(i, origin, dir, len, (t0, t1)) {
+                    if let Some((a, z)) = self.span(i, &frame, (t0, t1)) {
                         waiting.push((a, z, i));
                     }
                 });
@@ -304,7 +302,7 @@ impl RayParts {
                     continue;
                 }
                 steps += 1;
-                let d = self.value(ray.origin + ray.dir * t, active);
+                let d = self.value(ray.origin + ray.dir * t, active.iter().map(|&(_, i)| i));
                 *evals += 1;
                 let threshold = params.epsilon * (base + t);
                 if d < threshold {
@@ -320,15 +318,33 @@ impl RayParts {
         })
     }
 
-    /// The union's value at render-space `p` from the parts in force.
+    /// The union's value at render-space `p` from the parts listed (the others being
+    /// known to blend by nothing there).
     #[inline]
-    fn value(&self, p: Vec3A, active: &[(f32, u32)]) -> f32 {
+    fn value(&self, p: Vec3A, parts: impl Iterator<Item = u32>) -> f32 {
         let q = self.inv.transform_point3a(p);
         let mut fold = Fold::new(self.k);
-        for &(_, i) in active {
+        for i in parts {
             let i = i as usize;
             fold.push(clamp(self.parts[i](q), self.tree.bound(i, q)));
         }
         fold.finish() * self.scale
+    }
+}
+
+/// A ray in the parts' frame, with what every part's span test needs of it, computed
+/// once per ray: its direction's reciprocal (slabs), unit direction and length
+/// (spheres, whose distances are divided back by the length).
+struct FrameRay {
+    origin: Vec3A,
+    inv_dir: Vec3A,
+    unit: Vec3A,
+    len: f32,
+}
+
+impl FrameRay {
+    fn new(origin: Vec3A, dir: Vec3A) -> FrameRay {
+        let len = dir.length();
+        FrameRay { origin, inv_dir: dir.recip(), unit: dir / len, len }
     }
 }

@@ -233,15 +233,19 @@ mod tests {
         seen
     }
 
-    #[test]
-    fn ordered_and_indexed_trees_find_what_brute_force_finds() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
+    /// Numbers in [0, 1) from a xorshift generator seeded with `state`.
+    fn xorshift(mut state: u64) -> impl FnMut() -> f32 {
+        move || {
             state ^= state << 13;
             state ^= state >> 7;
             state ^= state << 17;
             (state >> 40) as f32 / (1u64 << 24) as f32
-        };
+        }
+    }
+
+    #[test]
+    fn ordered_and_indexed_trees_find_what_brute_force_finds() {
+        let mut next = xorshift(0x2545_f491_4f6c_dd1d);
         let boxes: Vec<Aabb> = (0..500)
             .map(|i| {
                 let c = if i % 7 == 0 { Vec3A::ONE } else { Vec3A::new(next(), next(), next()) * 10.0 };
@@ -266,13 +270,7 @@ mod tests {
 
     /// Boxes scattered in a 10-unit cube, a few stacked at one spot.
     fn scattered(n: usize) -> Vec<Aabb> {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut next = xorshift(0x9e37_79b9_7f4a_7c15);
         (0..n)
             .map(|i| {
                 let c = if i % 9 == 0 { Vec3A::splat(5.0) } else { Vec3A::new(next(), next(), next()) * 10.0 };
@@ -282,7 +280,7 @@ mod tests {
     }
 
     fn outside(b: Aabb, p: Vec3A) -> f32 {
-        (b.min - p).max(p - b.max).max(Vec3A::ZERO).length()
+        b.outside_squared(p).sqrt()
     }
 
     /// A union-like walk (threshold = nearest box so far + 0.3) reaches every box
@@ -321,10 +319,7 @@ mod tests {
         for i in 0..200 {
             let dir = Vec3A::new((i as f32 * 0.37).sin(), (i as f32 * 0.11).cos(), 1.0).normalize();
             let origin = Vec3A::new(5.0, 5.0, -20.0);
-            let entry = |b: Aabb| {
-                let g = Aabb { min: b.min - Vec3A::splat(grow), max: b.max + Vec3A::splat(grow) };
-                g.slab(origin, dir.recip(), 0.0, 60.0).map(|(a, _)| a)
-            };
+            let entry = |b: Aabb| b.grow(grow).slab(origin, dir.recip(), 0.0, 60.0).map(|(a, _)| a);
             let walk = bvh.ray_walk(origin, dir.recip(), (0.0, 60.0), grow, &mut closed);
             let mut seen = vec![false; boxes.len()];
             let mut visits = 0;

@@ -33,8 +33,7 @@ impl Bvh {
         let mut threshold = start;
         // Compared squared: `d ≥ threshold` for `d > 0` is `threshold ≤ 0 or d² ≥ threshold²`.
         let skip = |d2: f32, threshold: f32| prune && d2 > 0.0 && (threshold <= 0.0 || d2 >= threshold * threshold);
-        let outside = (root_box.min - p).max(p - root_box.max).max(Vec3A::ZERO).length_squared();
-        if skip(outside, threshold) {
+        if skip(root_box.outside_squared(p), threshold) {
             return;
         }
         let ps = splat3(p);

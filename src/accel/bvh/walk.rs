@@ -5,7 +5,6 @@ use glam::{Vec3A, Vec4, Vec4Swizzles};
 
 use super::{Bvh, Child, Deferred, Node};
 use crate::accel::aabb::enters4;
-use crate::accel::Aabb;
 
 /// Per-ray constants of the two-box slab test, splat across lanes.
 pub(super) struct RaySplat {
@@ -201,8 +200,7 @@ impl Bvh {
     ) -> RayWalk<'_> {
         closed.clear();
         if let Some((root_box, root)) = self.root() {
-            let grown = Aabb { min: root_box.min - Vec3A::splat(grow), max: root_box.max + Vec3A::splat(grow) };
-            if let Some((near, _)) = grown.slab(origin, inv_dir, t_min, t_max) {
+            if let Some((near, _)) = root_box.grow(grow).slab(origin, inv_dir, t_min, t_max) {
                 closed.push((root, near));
             }
         }
