@@ -110,10 +110,10 @@ pub(crate) struct ExportArgs {
     message_format: MessageFormat,
 }
 
-/// A scale: a finite number greater than 0 that keeps a renderable scene finite in f32.
+/// A scale from 1e-12 to 1e12, which keeps a renderable scene finite in f32.
 fn parse_scale(s: &str) -> Result<f64, String> {
     let x: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
-    if x > 0.0 && x.is_finite() && (1e-12..=1e12).contains(&x) {
+    if (1e-12..=1e12).contains(&x) {
         Ok(x)
     } else {
         Err("must be a number from 1e-12 to 1e12".into())

@@ -63,10 +63,10 @@ fn f32s(v: glam::DVec3) -> [f32; 3] {
 /// Every triangle of every part with its unit normal, in order.
 fn facets(export: &Export) -> impl ExactSizeIterator<Item = stl_io::Triangle> + '_ {
     let all: Vec<(&Part, usize)> =
-        export.parts.iter().flat_map(|p| (0..p.triangles.len()).map(move |t| (p, t))).collect();
+        export.parts.iter().flat_map(|p| (0..p.mesh.triangles.len()).map(move |t| (p, t))).collect();
     all.into_iter().map(|(p, t)| stl_io::Triangle {
         normal: stl_io::Vector::new(f32s(p.face_normal(t))),
-        vertices: p.triangles[t].map(|i| stl_io::Vector::new(f32s(p.positions[i as usize]))),
+        vertices: p.mesh.triangles[t].map(|i| stl_io::Vector::new(f32s(p.mesh.positions[i as usize]))),
     })
 }
 
@@ -101,12 +101,12 @@ fn obj(export: &Export, mtl: &str, w: &mut dyn Write) -> io::Result<()> {
     let mut base = 1u64;
     for p in &export.parts {
         writeln!(w, "o {}", p.name)?;
-        for v in &p.positions {
+        for v in &p.mesh.positions {
             let [x, y, z] = f32s(*v);
             writeln!(w, "v {x} {y} {z}")?;
         }
         let mut current = None;
-        for (t, tri) in p.triangles.iter().enumerate() {
+        for (t, tri) in p.mesh.triangles.iter().enumerate() {
             if current != Some(p.materials[t]) {
                 current = Some(p.materials[t]);
                 writeln!(w, "usemtl {}", material_name(p.materials[t]))?;
@@ -114,7 +114,7 @@ fn obj(export: &Export, mtl: &str, w: &mut dyn Write) -> io::Result<()> {
             let [a, b, c] = tri.map(|i| base + i as u64);
             writeln!(w, "f {a} {b} {c}")?;
         }
-        base += p.positions.len() as u64;
+        base += p.mesh.positions.len() as u64;
     }
     Ok(())
 }
@@ -138,6 +138,12 @@ fn used(export: &Export) -> Vec<u32> {
     ms
 }
 
+/// Material `m`'s position in `used` (sorted; every part's materials are in it): its
+/// index among a 3MF file's base materials and a glb file's materials.
+fn slot(used: &[u32], m: u32) -> usize {
+    used.binary_search(&m).unwrap_or(0)
+}
+
 fn ply(export: &Export, w: &mut dyn Write) -> io::Result<()> {
     let groups: Vec<(&Part, Vec<super::Group>)> = export.parts.iter().map(|p| (p, p.groups())).collect();
     let vertices: usize = groups.iter().flat_map(|(_, gs)| gs.iter().map(|g| g.vertices.len())).sum();
@@ -153,7 +159,7 @@ fn ply(export: &Export, w: &mut dyn Write) -> io::Result<()> {
         for g in gs {
             let rgb = export.colours[g.material as usize].rgb8();
             for &v in &g.vertices {
-                for c in f32s(p.positions[v as usize]) {
+                for c in f32s(p.mesh.positions[v as usize]) {
                     w.write_all(&c.to_le_bytes())?;
                 }
                 w.write_all(&rgb)?;
@@ -212,7 +218,6 @@ fn three_mf(export: &Export, units: &str, w: &mut dyn Write) -> io::Result<()> {
 fn xml_model(export: &Export, units: &str, out: &mut String) {
     use std::fmt::Write as _;
     let used = used(export);
-    let index = |m: u32| used.iter().position(|&u| u == m).unwrap_or(0);
     let _ = write!(
         out,
         "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<model unit=\"{units}\" xml:lang=\"en-US\" \
@@ -229,23 +234,23 @@ fn xml_model(export: &Export, units: &str, out: &mut String) {
     }
     out.push_str("</basematerials>\n");
     for (k, p) in export.parts.iter().enumerate() {
-        let first = p.materials.first().map_or(0, |&m| index(m));
+        let first = p.materials.first().map_or(0, |&m| slot(&used, m));
         let _ = writeln!(
             out,
             "<object id=\"{}\" name=\"{}\" type=\"model\" pid=\"1\" pindex=\"{first}\">\n<mesh>\n<vertices>",
             k + 2,
             p.name
         );
-        for v in &p.positions {
+        for v in &p.mesh.positions {
             let [x, y, z] = f32s(*v);
             let _ = writeln!(out, "<vertex x=\"{x}\" y=\"{y}\" z=\"{z}\"/>");
         }
         out.push_str("</vertices>\n<triangles>\n");
-        for (t, [a, b, c]) in p.triangles.iter().enumerate() {
+        for (t, [a, b, c]) in p.mesh.triangles.iter().enumerate() {
             let _ = writeln!(
                 out,
                 "<triangle v1=\"{a}\" v2=\"{b}\" v3=\"{c}\" pid=\"1\" p1=\"{}\"/>",
-                index(p.materials[t])
+                slot(&used, p.materials[t])
             );
         }
         out.push_str("</triangles>\n</mesh>\n</object>\n");
@@ -265,7 +270,6 @@ fn glb(export: &Export, w: &mut dyn Write) -> io::Result<()> {
     let mut bin: Vec<u8> = Vec::new();
     let (mut views, mut accessors, mut meshes, mut nodes) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let used = used(export);
-    let index = |m: u32| used.iter().position(|&u| u == m).unwrap_or(0);
     // Appends a buffer view of `bytes` (aligned to 4) and an accessor over it.
     let mut push = |bin: &mut Vec<u8>, bytes: Vec<u8>, accessor: serde_json::Value, target: u32| {
         while !bin.len().is_multiple_of(4) {
@@ -282,7 +286,7 @@ fn glb(export: &Export, w: &mut dyn Write) -> io::Result<()> {
         let normals = p.smooth.then(|| p.vertex_normals());
         let mut primitives = Vec::new();
         for g in p.groups() {
-            let points: Vec<[f32; 3]> = g.vertices.iter().map(|&v| f32s(p.positions[v as usize])).collect();
+            let points: Vec<[f32; 3]> = g.vertices.iter().map(|&v| f32s(p.mesh.positions[v as usize])).collect();
             let (min, max) = points.iter().fold(([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]), |(lo, hi), q| {
                 (std::array::from_fn(|k| lo[k].min(q[k])), std::array::from_fn(|k| hi[k].max(q[k])))
             });
@@ -313,7 +317,7 @@ fn glb(export: &Export, w: &mut dyn Write) -> io::Result<()> {
                 34963,
             );
             primitives.push(
-                json!({ "attributes": attributes, "indices": indices, "material": index(g.material), "mode": 4 }),
+                json!({ "attributes": attributes, "indices": indices, "material": slot(&used, g.material), "mode": 4 }),
             );
         }
         // glTF wants at least one primitive per mesh: a part with no triangles left is

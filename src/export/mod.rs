@@ -88,10 +88,8 @@ pub struct Part {
     pub name: String,
     /// The `object` statement.
     pub span: Span,
-    /// Vertex positions in the file's frame.
-    pub positions: Vec<DVec3>,
-    /// Triangles, counter-clockwise seen from outside in the file's frame.
-    pub triangles: Vec<[u32; 3]>,
+    /// The triangles in the file's frame, counter-clockwise seen from outside.
+    pub mesh: mesh::TriMesh,
     /// Each triangle's material, an index into [`Export::colours`].
     pub materials: Vec<u32>,
     /// Whether the surface is smooth (shaded with interpolated normals when rendered).
@@ -101,22 +99,17 @@ pub struct Part {
 }
 
 impl Part {
-    /// The triangles as a [`mesh::TriMesh`] (for volumes and edge checks).
-    pub fn tri_mesh(&self) -> mesh::TriMesh {
-        mesh::TriMesh { positions: self.positions.clone(), triangles: self.triangles.clone() }
-    }
-
     /// Unit normal of triangle `t` (zero for none, which [`collect`] never keeps).
     pub fn face_normal(&self, t: usize) -> DVec3 {
-        let [a, b, c] = self.triangles[t].map(|i| self.positions[i as usize]);
+        let [a, b, c] = self.mesh.triangles[t].map(|i| self.mesh.positions[i as usize]);
         (b - a).cross(c - a).normalize_or_zero()
     }
 
     /// Area-weighted vertex normals, for smooth surfaces.
     pub fn vertex_normals(&self) -> Vec<DVec3> {
-        let mut n = vec![DVec3::ZERO; self.positions.len()];
-        for t in &self.triangles {
-            let [a, b, c] = t.map(|i| self.positions[i as usize]);
+        let mut n = vec![DVec3::ZERO; self.mesh.positions.len()];
+        for t in &self.mesh.triangles {
+            let [a, b, c] = t.map(|i| self.mesh.positions[i as usize]);
             let face = (b - a).cross(c - a);
             for &i in t {
                 n[i as usize] += face;
@@ -131,7 +124,7 @@ impl Part {
     pub fn groups(&self) -> Vec<Group> {
         let mut groups: Vec<Group> = Vec::new();
         let mut remap = std::collections::HashMap::new();
-        for (t, tri) in self.triangles.iter().enumerate() {
+        for (t, tri) in self.mesh.triangles.iter().enumerate() {
             let material = self.materials[t];
             let g = match groups.iter().position(|g| g.material == material) {
                 Some(g) => g,
@@ -175,7 +168,7 @@ pub struct Export {
 impl Export {
     /// Triangles of every part.
     pub fn triangle_count(&self) -> usize {
-        self.parts.iter().map(|p| p.triangles.len()).sum()
+        self.parts.iter().map(|p| p.mesh.triangles.len()).sum()
     }
 }
 
@@ -191,8 +184,10 @@ pub fn collect(
 ) -> Result<Export, Diagnostic> {
     let mut materials = MaterialTable::default();
     let mut budget = mesh::lower::Budget::new(memory_limit);
-    let mut parts = Vec::with_capacity(scene.objects.len());
-    for (n, obj) in scene.objects.iter().enumerate() {
+    // As the world lowers: every object's mesh made in scene order (materials interned
+    // and the budget spent as they come), the memory confirmed once, then converted.
+    let mut jobs = Vec::with_capacity(scene.objects.len());
+    for obj in &scene.objects {
         let job = match &obj.geometry {
             ir::Geometry::Shape(shape) => {
                 if ir::shape_bounds(shape).is_none() {
@@ -203,34 +198,39 @@ pub fn collect(
             }
             ir::Geometry::Mesh(m) => mesh::lower::explicit(m, DAffine3::IDENTITY, &mut budget, &mut materials, loader)?,
         };
-        budget.confirm()?;
-        let positions: Vec<DVec3> =
-            job.mesh.positions.iter().map(|&p| frame.place(job.xf.transform_point3(p))).collect();
-        // The reflection into the file's frame turns every triangle inside out; a
-        // transform that mirrors (negative determinant) turns it back.
-        let flip = job.xf.matrix3.determinant() > 0.0;
-        let (mut triangles, mut mats, mut degenerate) = (Vec::new(), Vec::new(), 0);
-        for (t, &[a, b, c]) in job.mesh.triangles.iter().enumerate() {
-            let [pa, pb, pc] = [a, b, c].map(|i| positions[i as usize]);
-            if a == b || b == c || a == c || (pb - pa).cross(pc - pa).length_squared() == 0.0 {
-                degenerate += 1;
-                continue;
-            }
-            triangles.push(if flip { [a, c, b] } else { [a, b, c] });
-            mats.push(job.per_triangle.as_ref().map_or(job.material, |m| m[t]));
-        }
-        parts.push(Part {
-            name: format!("object_{}", n + 1),
-            span: obj.span,
-            positions,
-            triangles,
-            materials: mats,
-            smooth: job.smooth,
-            degenerate,
-        });
+        jobs.push((job, obj.span));
     }
+    budget.confirm()?;
+    let parts = jobs.into_iter().enumerate().map(|(n, (job, span))| part(n, job, span, frame)).collect();
     let colours = materials.materials.iter().map(|m| Colour(m.color.as_dvec3().to_array())).collect();
     Ok(Export { parts, colours })
+}
+
+/// Object `n`'s mesh in the file's frame, without its zero-area triangles.
+fn part(n: usize, job: mesh::MeshJob, span: Span, frame: Frame) -> Part {
+    let positions: Vec<DVec3> = job.mesh.positions.iter().map(|&p| frame.place(job.xf.transform_point3(p))).collect();
+    // The reflection into the file's frame turns every triangle inside out; a transform
+    // that mirrors (negative determinant) turns it back.
+    let flip = job.xf.matrix3.determinant() > 0.0;
+    let (mut triangles, mut materials, mut degenerate) = (Vec::new(), Vec::new(), 0);
+    for (t, &[a, b, c]) in job.mesh.triangles.iter().enumerate() {
+        // Repeated corners included: they give a zero cross product too.
+        let [pa, pb, pc] = [a, b, c].map(|i| positions[i as usize]);
+        if (pb - pa).cross(pc - pa).length_squared() == 0.0 {
+            degenerate += 1;
+            continue;
+        }
+        triangles.push(if flip { [a, c, b] } else { [a, b, c] });
+        materials.push(job.per_triangle.as_ref().map_or(job.material, |m| m[t]));
+    }
+    Part {
+        name: format!("object_{}", n + 1),
+        span,
+        mesh: mesh::TriMesh { positions, triangles },
+        materials,
+        smooth: job.smooth,
+        degenerate,
+    }
 }
 
 fn unbounded(span: Span) -> Diagnostic {

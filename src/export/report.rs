@@ -26,12 +26,12 @@ pub struct MeshReport {
 impl MeshReport {
     /// Checks `part`.
     pub fn of(part: &Part) -> MeshReport {
-        let mesh = part.tri_mesh();
+        let mesh = &part.mesh;
         let (open_edges, misoriented_edges) = mesh.open_edges();
         let bounds =
-            part.positions.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+            mesh.positions.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
         MeshReport {
-            triangles: part.triangles.len(),
+            triangles: mesh.triangles.len(),
             open_edges,
             misoriented_edges,
             degenerate: part.degenerate,
