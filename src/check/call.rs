@@ -383,7 +383,7 @@ impl Ctx<'_> {
             codes::TYPE_MISMATCH,
             span,
             format!("expected `{ty}`, found `{}`", v.ty_name()),
-            format!("this is a `{}`", v.ty_name()),
+            v.this_is(),
         )
         .with_note(format!("{} is a `{ty}`", what()));
         match (ty, v) {

@@ -79,7 +79,7 @@ impl Ctx<'_> {
                     codes::NOT_A_BOOL,
                     span,
                     format!("expected `bool`, found `{}`", other.ty_name()),
-                    format!("this is a `{}`", other.ty_name()),
+                    other.this_is(),
                 )
                 .with_note(format!("{what} must be `true` or `false`"));
                 if matches!(other, Value::Num(_)) {
@@ -152,9 +152,9 @@ impl Ctx<'_> {
                 codes::BRANCH_MISMATCH,
                 otherwise.span,
                 format!("`if` branches have different types: `{}` and `{}`", a.ty_name(), b.ty_name()),
-                format!("this is a `{}`", b.ty_name()),
+                b.this_is(),
             )
-            .with_label(then.span, format!("this is a `{}`", a.ty_name()))
+            .with_label(then.span, a.this_is())
             .with_note("both branches must give the same type"),
         );
         true
@@ -234,7 +234,7 @@ impl Ctx<'_> {
                             codes::NOT_ITERABLE,
                             e.span,
                             format!("cannot run `for` over a `{}`", other.ty_name()),
-                            format!("this is a `{}`", other.ty_name()),
+                            other.this_is(),
                         )
                         .with_note("`for` runs over a range `a..b` or a list")
                         .with_hint("for whole numbers, try `for i in 0..n`"),

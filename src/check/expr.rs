@@ -118,7 +118,7 @@ impl Ctx<'_> {
                             codes::BAD_OPERANDS,
                             e.span,
                             format!("cannot negate a `{}`", other.ty_name()),
-                            format!("this is a `{}`", other.ty_name()),
+                            other.this_is(),
                         )
                         .with_note("`-` applies to numbers and vectors"),
                     );
@@ -267,7 +267,7 @@ impl Ctx<'_> {
                         codes::TYPE_MISMATCH,
                         base_span,
                         format!("cannot index into a `{}`", other.ty_name()),
-                        format!("this is a `{}`", other.ty_name()),
+                        other.this_is(),
                     )
                     .with_note("only lists and vectors can be indexed"),
                 );
@@ -397,8 +397,8 @@ impl Ctx<'_> {
                     format!("cannot apply `{}` to `{}` and `{}`", op.symbol(), a.ty_name(), b.ty_name()),
                     format!("`{}` {} `{}` is not defined", a.ty_name(), op.symbol(), b.ty_name()),
                 )
-                .with_label(a_span, format!("this is a `{}`", a.ty_name()))
-                .with_label(b_span, format!("this is a `{}`", b.ty_name()));
+                .with_label(a_span, a.this_is())
+                .with_label(b_span, b.this_is());
                 if matches!((&a, &b), (Value::Shape(_), Value::Shape(_))) {
                     let hint = match op {
                         BinOp::Add => "try `union(a, b)` to combine shapes",
@@ -493,8 +493,8 @@ impl Ctx<'_> {
                         format!("cannot compare `{}` with `{}`", a.ty_name(), b.ty_name()),
                         format!("`{}` {} `{}` is not defined", a.ty_name(), op.symbol(), b.ty_name()),
                     )
-                    .with_label(a_span, format!("this is a `{}`", a.ty_name()))
-                    .with_label(b_span, format!("this is a `{}`", b.ty_name()))
+                    .with_label(a_span, a.this_is())
+                    .with_label(b_span, b.this_is())
                     .with_note(
                         "`==` and `!=` compare two numbers, booleans, strings, vectors, colours or lists of them",
                     ),
@@ -525,7 +525,7 @@ impl Ctx<'_> {
                 codes::BAD_OPERANDS,
                 bad_span,
                 format!("`{}` orders numbers, not `{}`", op.symbol(), bad.ty_name()),
-                format!("this is a `{}`", bad.ty_name()),
+                bad.this_is(),
             )
             .with_label(span, "in this comparison"),
         );

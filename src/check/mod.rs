@@ -323,7 +323,7 @@ impl Ctx<'_> {
                     }
                     Value::Error => {}
                     other => self.report(
-                        Diagnostic::error(codes::NOT_A_LIGHT, e.span, format!("expected a light, found `{}`", other.ty_name()), format!("this is a `{}`", other.ty_name()))
+                        Diagnostic::error(codes::NOT_A_LIGHT, e.span, format!("expected a light, found `{}`", other.ty_name()), other.this_is())
                             .with_hint("try `light ambient(0.2)`, `light point(0.6) at [2, 1, 0]` or `light directional(0.2, towards = [1, 4, 4])`"),
                     ),
                 }
@@ -450,7 +450,7 @@ impl Ctx<'_> {
                     codes::NOT_AN_OBJECT,
                     expr_span,
                     format!("expected a shape or a mesh, found `{}`", other.ty_name()),
-                    format!("this is a `{}`", other.ty_name()),
+                    other.this_is(),
                 );
                 if matches!(other, Value::Light(_)) {
                     d = d.with_hint("lights are added with `light …`, not `object …`");

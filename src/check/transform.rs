@@ -35,7 +35,7 @@ impl Ctx<'_> {
                     format!("cannot apply `{kw}` to a `{}`", target.ty_name()),
                     format!("`{kw}` needs a shape or a mesh"),
                 )
-                .with_label(target_span, format!("this is a `{}`", target.ty_name()))
+                .with_label(target_span, target.this_is())
                 .with_note(note.to_string()),
             );
             Value::Error
@@ -72,7 +72,7 @@ impl Ctx<'_> {
                     codes::TYPE_MISMATCH,
                     arg_span,
                     format!("expected `material`, found `{}`", arg.ty_name()),
-                    format!("this is a `{}`", arg.ty_name()),
+                    arg.this_is(),
                 )
                 .with_note("`with` takes a material");
                 if matches!(arg, Value::Color(_)) {
@@ -135,7 +135,7 @@ impl Ctx<'_> {
                     codes::TYPE_MISMATCH,
                     arg_span,
                     format!("expected `{expected}`, found `{}`", arg.ty_name()),
-                    format!("this is a `{}`", arg.ty_name()),
+                    arg.this_is(),
                 )
                 .with_note(format!("`{kw}` takes a `{expected}`"));
                 if let Value::Num(x) = arg {

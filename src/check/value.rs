@@ -55,6 +55,11 @@ impl Value {
         })
     }
 
+    /// The label under a value of the wrong type: "this is a `T`".
+    pub fn this_is(&self) -> String {
+        format!("this is a `{}`", self.ty_name())
+    }
+
     /// The type as users read it (`num` for any number).
     pub fn ty_name(&self) -> String {
         match self {

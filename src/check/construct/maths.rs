@@ -109,9 +109,9 @@ impl Ctx<'_> {
                         codes::TYPE_MISMATCH,
                         a.span(1),
                         format!("expected `{}`, found `{}`", from.ty_name(), to.ty_name()),
-                        format!("this is a `{}`", to.ty_name()),
+                        to.this_is(),
                     )
-                    .with_label(a.span(0), format!("this is a `{}`", from.ty_name()))
+                    .with_label(a.span(0), from.this_is())
                     .with_note("`mix` blends two values of one type"),
                 );
                 return Value::Error;
