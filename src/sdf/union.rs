@@ -273,12 +273,16 @@ impl RayParts {
             let base = ray.origin.length();
             let mut t = t0;
             let mut steps = 0;
+            // Where the nearest node still closed begins: nothing opens before it.
+            let mut unopened = f32::NEG_INFINITY;
             while steps < params.max_steps {
-                let unopened = walk.open_until(t, closed, &mut c.node_visits, |i| {
-                    if let Some((a, z)) = self.span(i, &frame, (t0, t1)) {
-                        waiting.push((a, z, i));
-                    }
-                });
+                if t >= unopened {
+                    unopened = walk.open_until(t, closed, &mut c.node_visits, |i| {
+                        if let Some((a, z)) = self.span(i, &frame, (t0, t1)) {
+                            waiting.push((a, z, i));
+                        }
+                    });
+                }
                 // The next distance where the parts in force change by one beginning.
                 let mut next = unopened;
                 let mut w = 0;
