@@ -2,7 +2,11 @@
 //! argument list, with parameter names, types, defaults and a one-line doc. The checker,
 //! the docs and (later) the editor tooling read this one table.
 
+use std::collections::HashMap;
 use std::fmt;
+use std::sync::OnceLock;
+
+use foldhash::fast::FixedState;
 
 use crate::ir::CsgOp;
 
@@ -97,6 +101,11 @@ pub enum Kind {
     Camera,
     /// The argument list of the `render` statement.
     Render,
+}
+
+impl Kind {
+    /// How many kinds there are (`Render` is the last).
+    const COUNT: usize = Kind::Render as usize + 1;
 }
 
 /// What a builtin makes: the checker's constructors match on it exhaustively, so an
@@ -322,7 +331,7 @@ use self::Default::{Bool as B, Derived, Num as N, Required as Req, Vec3 as V};
 const X: &[Param] = &[p("x", Ty::Num, Req)];
 
 /// Every builtin function, mesh generator and statement argument list.
-pub const BUILTINS: &[Builtin] = &[
+pub static BUILTINS: &[Builtin] = &[
     // Shapes.
     f("sphere", Ctor::Primitive(Prim::Sphere), &[p("r", Ty::Num, Req)], Ty::Shape, "sphere of radius `r` centred at the origin"),
     f(
@@ -574,16 +583,34 @@ pub const BUILTINS: &[Builtin] = &[
 /// Named constants.
 pub const CONSTANTS: &[(&str, f64)] = &[("pi", std::f64::consts::PI)];
 
-/// Looks a builtin up by name and kind.
-pub fn lookup(name: &str, kind: Kind) -> Option<&'static Builtin> {
-    BUILTINS.iter().find(|b| b.name == name && b.kind() == kind)
+/// The entries of each name, by kind (in [`Kind`]'s order), in table order.
+type Index = HashMap<&'static str, [Vec<&'static Builtin>; Kind::COUNT], FixedState>;
+
+/// Builtins by name and kind, built once: a generated scene calls builtins for every
+/// part it makes, and scanning the table by name for each call (and again for its
+/// overloads) was the largest single cost of evaluating
+/// `benches/scenes/union-10000.scn` (`perf record scnc check …`).
+fn index() -> &'static Index {
+    static INDEX: OnceLock<Index> = OnceLock::new();
+    INDEX.get_or_init(|| {
+        let mut index = Index::default();
+        for b in BUILTINS {
+            index.entry(b.name).or_default()[b.kind() as usize].push(b);
+        }
+        index
+    })
 }
 
-/// `b` and the other entries of its name and kind (overloads told apart by the type of
-/// their first parameter, such as `round(x)` and `round(shape, r)`), `b` first.
-pub fn overloads(b: &'static Builtin) -> impl Iterator<Item = &'static Builtin> {
-    let others = BUILTINS.iter().filter(move |o| o.name == b.name && o.kind() == b.kind() && !std::ptr::eq(*o, b));
-    std::iter::once(b).chain(others)
+/// Looks a builtin up by name and kind (the first entry of that name and kind).
+pub fn lookup(name: &str, kind: Kind) -> Option<&'static Builtin> {
+    overloads(name, kind).first().copied()
+}
+
+/// Every entry of a name and kind, in table order: overloads told apart by the type of
+/// their first parameter, such as `round(x)` and `round(shape, r)`. Empty when there
+/// is none.
+pub fn overloads(name: &str, kind: Kind) -> &'static [&'static Builtin] {
+    index().get(name).map_or(&[], |kinds| kinds[kind as usize].as_slice())
 }
 
 /// Names of builtins of one kind (for suggestions).

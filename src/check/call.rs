@@ -62,7 +62,8 @@ impl Ctx<'_> {
                 }
             }
         }
-        let Some(builtin) = builtins::lookup(&callee.name, Kind::Function) else {
+        let all = builtins::overloads(&callee.name, Kind::Function);
+        if all.is_empty() {
             let mut candidates: Vec<String> = self.names_in_scope(true);
             candidates.extend(builtins::names(Kind::Function).map(str::to_string));
             let mut d = Diagnostic::error(
@@ -82,22 +83,21 @@ impl Ctx<'_> {
             // Still evaluate the arguments, to report their own mistakes.
             let _ = self.eval_args(args);
             return Value::Error;
-        };
-        self.apply_builtin(builtin, callee.span, args, span)
+        }
+        self.apply_builtin(all, callee.span, args, span)
     }
 
-    /// Among `b`'s overloads (`round(x)`, `round(shape, r)`), the one whose first
-    /// parameter takes the first argument. `b` itself when it has none, or when no
-    /// argument decides (its binding reports what is missing); `None` after reporting
-    /// a first argument that fits none of them.
-    fn overload(&mut self, b: &'static Builtin, args: &[ArgVal]) -> Option<&'static Builtin> {
-        // Nearly every builtin has one entry: decide that without collecting anything.
-        if builtins::overloads(b).nth(1).is_none() {
+    /// Among a builtin's overloads `all` (`round(x)`, `round(shape, r)`; never empty),
+    /// the one whose first parameter takes the first argument. The first when there is
+    /// one, or when no argument decides (its binding reports what is missing); `None`
+    /// after reporting a first argument that fits none of them.
+    fn overload(&mut self, all: &'static [&'static Builtin], args: &[ArgVal]) -> Option<&'static Builtin> {
+        let b = all[0];
+        if all.len() == 1 {
             return Some(b);
         }
-        let all: Vec<&'static Builtin> = builtins::overloads(b).collect();
         let mut decider = None;
-        for o in &all {
+        for o in all {
             if let Some(arg) = first_arg(o, args) {
                 if arg.value.is_error() || admits(o.params[0].ty, &arg.value) {
                     return Some(o);
@@ -116,7 +116,7 @@ impl Ctx<'_> {
             format!("expected {}, found `{found}`", expected.join(" or ")),
             format!("this is a `{found}`"),
         );
-        for o in &all {
+        for o in all {
             d = d.with_note(format!("{}: {}", o.signature(), o.doc));
         }
         self.report(d);
@@ -130,11 +130,11 @@ impl Ctx<'_> {
         }
     }
 
-    /// Evaluates the arguments, picks the overload they fit, binds them and builds the
-    /// builtin's value; `name` is the callee's span, for the editor's index.
-    fn apply_builtin(&mut self, builtin: &'static Builtin, name: Span, args: &[ast::Arg], span: Span) -> Value {
+    /// Evaluates the arguments, picks the overload of `all` they fit, binds them and
+    /// builds the builtin's value; `name` is the callee's span, for the editor's index.
+    fn apply_builtin(&mut self, all: &'static [&'static Builtin], name: Span, args: &[ast::Arg], span: Span) -> Value {
         let args = self.eval_args(args);
-        let Some(builtin) = self.overload(builtin, &args) else {
+        let Some(builtin) = self.overload(all, &args) else {
             return Value::Error;
         };
         self.note_builtin(name, builtin);
@@ -145,7 +145,8 @@ impl Ctx<'_> {
     }
 
     pub(super) fn mesh_call(&mut self, generator: &ast::Ident, args: &[ast::Arg], span: Span) -> Value {
-        let Some(builtin) = builtins::lookup(&generator.name, Kind::MeshGenerator) else {
+        let all = builtins::overloads(&generator.name, Kind::MeshGenerator);
+        if all.is_empty() {
             let mut d = Diagnostic::error(
                 codes::NOT_A_MESH_GENERATOR,
                 generator.span,
@@ -171,8 +172,8 @@ impl Ctx<'_> {
             self.report(d);
             let _ = self.eval_args(args);
             return Value::Error;
-        };
-        self.apply_builtin(builtin, generator.span, args, span)
+        }
+        self.apply_builtin(all, generator.span, args, span)
     }
 
     /// Matches arguments to parameter slots: positional ones in order (or all into `rest`
@@ -275,6 +276,9 @@ impl Ctx<'_> {
                 }
             }
         }
+        if let Some(fast) = self.bind_positional(b, &args, call) {
+            return fast;
+        }
         let recovered = args.iter().any(|a| a.value.is_error() && a.name.is_none());
         // `box(x, y, z)`: three numbers are one size vector.
         if b.name == "box"
@@ -348,6 +352,44 @@ impl Ctx<'_> {
         }
         let poisoned = vals.iter().flatten().any(|(v, _)| v.is_error()) || rest.iter().any(|(v, _)| v.is_error());
         (ok && !poisoned && !recovered).then_some(BoundArgs { vals, rest, call })
+    }
+
+    /// The common call, `floor(x)` or `sphere(r)`: positional arguments, no more than
+    /// the parameters, none poisoned, a builtin that takes no variadic arguments. Binds
+    /// it without matching names (and the allocations that takes), reporting what the
+    /// general binding would in the same order; `None` for any other call.
+    fn bind_positional(&mut self, b: &'static Builtin, args: &[ArgVal], call: Span) -> Option<Option<BoundArgs>> {
+        let plain = b.variadic.is_none()
+            && args.len() <= b.params.len()
+            && args.iter().all(|a| a.name.is_none() && !a.value.is_error())
+            && !(b.name == "box" && args.len() == 3);
+        if !plain {
+            return None;
+        }
+        let mut ok = true;
+        for p in &b.params[args.len()..] {
+            if p.default == builtins::Default::Required {
+                self.report(
+                    Diagnostic::error(
+                        codes::MISSING_ARG,
+                        call,
+                        format!("missing argument `{}` of `{}`", p.name, b.name),
+                        format!("`{}` is required", p.name),
+                    )
+                    .with_note(format!("signature: {}", b.signature())),
+                );
+                ok = false;
+            }
+        }
+        let mut vals = Vec::with_capacity(b.params.len());
+        for (p, a) in b.params.iter().zip(args) {
+            match self.coerce(&a.value, p.ty, a.span, &|| format!("parameter `{}` of `{}`", p.name, b.name)) {
+                Some(v) => vals.push(Some((v, a.span))),
+                None => ok = false,
+            }
+        }
+        vals.resize(b.params.len(), None);
+        Some(ok.then_some(BoundArgs { vals, rest: Vec::new(), call }))
     }
 
     /// Converts `v` to `ty` or reports a mismatch; poison passes through. `what` names

@@ -10,6 +10,8 @@ use std::cell::Cell;
 use std::collections::HashMap;
 use std::rc::Rc;
 
+use foldhash::fast::FixedState;
+
 use super::{Bound, Value};
 use crate::span::Span;
 use crate::syntax::ast::{self, ExprKind};
@@ -41,23 +43,30 @@ pub(super) struct Captured {
     slots: Vec<(Rc<str>, Slot)>,
     /// Positions in `slots` by name, for bodies that mention many names; a short list
     /// is faster to scan than a name is to hash.
-    index: Option<HashMap<Rc<str>, usize>>,
+    index: Option<NameMap<usize>>,
 }
 
 /// Above this many slots, names are found through a hash map.
 const SCAN_LIMIT: usize = 8;
 
+/// A map keyed by names. Hashed with a fast fixed-seed hasher: a lookup is made for
+/// every name a scene evaluates, and SipHash was a visible share of evaluating
+/// generated scenes (`valgrind --tool=callgrind scnc check
+/// benches/scenes/union-10000.scn`); a fixed seed keeps any order derived from it the
+/// same from run to run.
+type NameMap<V> = HashMap<Rc<str>, V, FixedState>;
+
 impl Captured {
     /// Resolves the free names of `body` in `env`; `params` shadow them (the first of
     /// a repeated name binds). Costs what the body mentions, not what is in scope.
     pub fn new(env: &Env, params: &[ast::Ident], body: &ast::Expr) -> Captured {
-        let mut slots: HashMap<Rc<str>, Slot> = HashMap::new();
+        let mut slots: NameMap<Slot> = NameMap::default();
         for (i, p) in params.iter().enumerate() {
             slots.entry(Rc::from(p.name.as_str())).or_insert(Slot::Param(i, p.span));
         }
         let mut stack = vec![body];
         while let Some(e) = stack.pop() {
-            let mention = |name: &str, slots: &mut HashMap<Rc<str>, Slot>| {
+            let mention = |name: &str, slots: &mut NameMap<Slot>| {
                 if !slots.contains_key(name) {
                     if let Some(b) = env.binding(name) {
                         slots.insert(b.name.clone(), Slot::Outer(b));
@@ -135,7 +144,7 @@ pub(super) struct Env {
 #[derive(Default)]
 struct Scopes {
     /// Each name's bindings, innermost last.
-    table: HashMap<Rc<str>, Vec<Rc<Binding>>>,
+    table: NameMap<Vec<Rc<Binding>>>,
     /// Names bound, in order, so a scope can be closed.
     log: Vec<Rc<str>>,
     /// Where each open scope starts in `log`.

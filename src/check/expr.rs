@@ -81,10 +81,10 @@ impl Ctx<'_> {
     fn expr_inner(&mut self, e: &ast::Expr) -> Value {
         match &e.kind {
             ExprKind::Error => Value::Error,
-            // Malformed numbers were reported by the lexer and arrive empty.
-            ExprKind::Number(text) if text.is_empty() => Value::Error,
-            ExprKind::Number(text) => match text.parse::<f64>() {
-                Ok(x) if x.is_finite() => Value::Num(x),
+            // Malformed numbers were reported by the lexer and arrive as `None`.
+            ExprKind::Number(None) => Value::Error,
+            ExprKind::Number(Some(x)) => match *x {
+                x if x.is_finite() => Value::Num(x),
                 _ => {
                     self.report(
                         Diagnostic::error(

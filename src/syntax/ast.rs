@@ -193,8 +193,9 @@ impl TransformOp {
 /// The expressions of the language.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ExprKind {
-    /// A number literal (its text, parsed by the checker).
-    Number(String),
+    /// A number literal, parsed once here (infinite when it overflows, which the
+    /// checker reports); `None` when malformed (the lexer reported it).
+    Number(Option<f64>),
     /// `true` / `false`.
     Bool(bool),
     /// A string literal, escapes resolved.

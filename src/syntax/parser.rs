@@ -100,7 +100,7 @@ where
 {
     recursive(|expr| {
         let literal = select! {
-            Token::Number(s) => ExprKind::Number(s.to_string()),
+            Token::Number(s) => ExprKind::Number((!s.is_empty()).then(|| s.parse::<f64>().unwrap_or(f64::INFINITY))),
             Token::Bool(b) => ExprKind::Bool(b),
             Token::Str(s) => ExprKind::Str(unescape(s)),
             Token::HexColor(s) => ExprKind::HexColor(hex_color(s)),
