@@ -6,7 +6,7 @@
 use glam::{DAffine3, DVec3};
 
 use super::tessellate::count;
-use super::{isosurface, obj, tessellate, Detail, MeshJob, TriMesh};
+use super::{isosurface, obj, octree, tessellate, Detail, MeshJob, TriMesh};
 use crate::diag::{codes, Diagnostic};
 use crate::ir::{self, MeshSource, Primitive, Shape, ShapeKind};
 use crate::render::MaterialTable;
@@ -236,6 +236,15 @@ fn mib(bytes: u64) -> String {
     format!("{:.0} MiB", bytes as f64 / (1u64 << 20) as f64)
 }
 
+/// A count as people say it: millions above a million.
+fn millions(n: f64) -> String {
+    if n >= 1e6 {
+        format!("{:.1} million", n / 1e6)
+    } else {
+        format!("{}", n.round())
+    }
+}
+
 /// A size as people write it: exponent form when it is huge.
 fn short(x: f64) -> String {
     if x.abs() >= 1e6 {
@@ -304,22 +313,27 @@ fn isosurface_object(
         });
     }
     let (dist, mat) = Builder::new(materials).build(shape, grid, material);
-    let mesh = isosurface::extract(&*dist, bounds.min, bounds.max, cell).map_err(|e| match e {
-        isosurface::IsoError::TooManyCells { cells, min_cell } => {
-            let d = Diagnostic::error(
-                codes::LOWERING,
-                span,
-                "isosurface grid is too fine",
-                format!("cell {} needs {cells} grid cells", ir::dump_num(cell)),
-            )
-            .with_note(format!("an isosurface may use at most {} cells", isosurface::MAX_CELLS));
-            match from {
-                CellFrom::Scene => {
-                    d.with_hint(format!("try `cell = {}` or more", ir::dump_num((min_cell * 1.001 * 1e6).ceil() / 1e6)))
-                }
-                CellFrom::Detail => d.with_hint("try a lower `--detail`"),
+    let too_fine = |cells: f64, min_cell: f64| {
+        let d = Diagnostic::error(
+            codes::LOWERING,
+            span,
+            "isosurface grid is too fine",
+            format!("cell {} would refine about {} cells near the surface", ir::dump_num(cell), millions(cells)),
+        )
+        .with_note(format!("an isosurface may refine at most {} cells", isosurface::MAX_CELLS));
+        match from {
+            CellFrom::Scene => {
+                d.with_hint(format!("try `cell = {}` or more", ir::dump_num((min_cell * 1.001 * 1e6).ceil() / 1e6)))
             }
+            CellFrom::Detail => d.with_hint("try a lower `--detail`"),
         }
+    };
+    let lattice = octree::Grid::new(bounds.min, bounds.max, cell).map_err(|side| {
+        let min_cell = cell * side / (1u64 << octree::MAX_LEVELS) as f64;
+        too_fine(side * side, min_cell)
+    })?;
+    let mesh = isosurface::extract(&*dist, &lattice).map_err(|e| match e {
+        isosurface::IsoError::TooManyCells { cells, min_cell } => too_fine(cells, min_cell),
         isosurface::IsoError::NoSurface => {
             let d = Diagnostic::error(
                 codes::LOWERING,

@@ -11,6 +11,8 @@ mod detail;
 pub mod isosurface;
 pub mod lower;
 pub mod obj;
+pub mod octree;
+mod qef;
 pub mod tessellate;
 pub mod triangle;
 
