@@ -364,6 +364,8 @@ pub mod codes {
     pub const NO_OBJECTS: &str = "W0004";
     /// Object entirely behind the camera.
     pub const BEHIND_CAMERA: &str = "W0005";
+    /// Parts of a shape too small for its isosurface's cell, left out of the mesh.
+    pub const LOST_PARTS: &str = "W0801";
 }
 
 /// Edit distance for "did you mean" suggestions.

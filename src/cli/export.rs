@@ -195,7 +195,10 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
     };
     let frame = Frame { up, scale: args.scale };
     let export = match pool.install(|| scnc::export::collect(scene, detail, frame, args.memory_limit, &FsLoader)) {
-        Ok(e) => e,
+        Ok(e) => {
+            super::report_in(&compiled.map, &e.warnings, args.message_format);
+            e
+        }
         Err(d) => {
             let c = Compiled { map: compiled.map, scene: None, diagnostics: vec![d] };
             report(&c, args.message_format);

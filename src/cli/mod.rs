@@ -117,17 +117,23 @@ pub(crate) fn compile(path: &Path, format: MessageFormat) -> Option<Compiled> {
 
 /// Prints diagnostics to stderr; returns whether any was an error.
 pub(crate) fn report(c: &Compiled, format: MessageFormat) -> bool {
+    report_in(&c.map, &c.diagnostics, format)
+}
+
+/// Prints diagnostics about the files of `map` to stderr (lowering's warnings come after
+/// the checker's); returns whether any was an error.
+pub(crate) fn report_in(map: &scnc::source::SourceMap, diagnostics: &[Diagnostic], format: MessageFormat) -> bool {
     let color = std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none();
     let mut err = std::io::stderr().lock();
-    let mut sources = scnc::diag::Sources::new(&c.map);
-    for d in &c.diagnostics {
+    let mut sources = scnc::diag::Sources::new(map);
+    for d in diagnostics {
         let text = match format {
             MessageFormat::Human => d.render_with(&mut sources, color),
-            MessageFormat::Json => format!("{}\n", d.to_json(&c.map)),
+            MessageFormat::Json => format!("{}\n", d.to_json(map)),
         };
         let _ = err.write_all(text.as_bytes());
     }
-    c.diagnostics.iter().any(Diagnostic::is_error)
+    diagnostics.iter().any(Diagnostic::is_error)
 }
 
 /// A usage problem found after argument parsing: printed like clap's, exit 2.

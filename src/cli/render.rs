@@ -224,7 +224,10 @@ fn render_compiled(args: &RenderArgs, pool: &rayon::ThreadPool, compiled: Compil
     };
     let lowered = pool.install(|| scnc::world::prepare_within(&scene, effects, mode, &FsLoader, args.memory_limit));
     let (frame, geometry) = match lowered {
-        Ok(g) => g,
+        Ok(g) => {
+            super::report_in(&compiled.map, &g.1.warnings, args.message_format);
+            g
+        }
         Err(d) => {
             let c = Compiled { map: compiled.map, scene: None, diagnostics: vec![d] };
             report(&c, args.message_format);

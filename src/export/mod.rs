@@ -163,6 +163,8 @@ pub struct Export {
     pub parts: Vec<Part>,
     /// Every material's colour (a part's materials index this).
     pub colours: Vec<Colour>,
+    /// What meshing found wrong but survivable, in scene order (parts an isosurface lost).
+    pub warnings: Vec<crate::diag::Diagnostic>,
 }
 
 impl Export {
@@ -201,9 +203,10 @@ pub fn collect(
         jobs.push((job, obj.span));
     }
     budget.confirm()?;
+    let warnings = jobs.iter_mut().flat_map(|(job, _)| std::mem::take(&mut job.warnings)).collect();
     let parts = jobs.into_iter().enumerate().map(|(n, (job, span))| part(n, job, span, frame)).collect();
     let colours = materials.materials.iter().map(|m| Colour(m.color.as_dvec3().to_array())).collect();
-    Ok(Export { parts, colours })
+    Ok(Export { parts, colours, warnings })
 }
 
 /// Object `n`'s mesh in the file's frame, without its zero-area triangles.

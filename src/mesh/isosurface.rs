@@ -464,6 +464,42 @@ mod tests {
         }
     }
 
+    /// Connected components of a mesh, by shared vertices.
+    fn components(m: &TriMesh) -> usize {
+        let mut parent: Vec<usize> = (0..m.positions.len()).collect();
+        fn root(p: &mut [usize], mut i: usize) -> usize {
+            while p[i] != i {
+                p[i] = p[p[i]];
+                i = p[i];
+            }
+            i
+        }
+        for t in &m.triangles {
+            for k in 1..3 {
+                let (a, b) = (root(&mut parent, t[0] as usize), root(&mut parent, t[k] as usize));
+                parent[a] = b;
+            }
+        }
+        let used: std::collections::BTreeSet<usize> =
+            m.triangles.iter().flatten().map(|&v| root(&mut parent, v as usize)).collect();
+        used.len()
+    }
+
+    /// Many small disjoint parts (a 5×5×5 lattice of spheres 2.5 cells across, spread
+    /// over a box 80 cells wide) each come out as their own closed piece.
+    #[test]
+    fn many_small_parts_are_all_kept() {
+        let centre = |i: usize| DVec3::new((i % 5) as f64, ((i / 5) % 5) as f64, (i / 25) as f64) * 0.4 - 0.8;
+        let f = move |p: Vec3A| {
+            let p = p.as_dvec3();
+            (0..125).map(|i| (p - centre(i)).length() - 0.025).fold(f64::INFINITY, f64::min) as f32
+        };
+        let m = extract(&f, &Grid::new(DVec3::splat(-0.83), DVec3::splat(0.83), 0.02).unwrap()).expect("surface");
+        assert_eq!(m.open_edges(), (0, 0), "open or doubled edges");
+        assert_eq!(components(&m), 125, "every sphere is its own piece");
+        assert!(m.signed_volume() > 0.0, "wound outward");
+    }
+
     #[test]
     fn limits_are_reported() {
         let f = |p: Vec3A| p.length() - 1.0;

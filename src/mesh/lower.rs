@@ -6,7 +6,7 @@
 use glam::{DAffine3, DVec3};
 
 use super::tessellate::count;
-use super::{isosurface, obj, octree, tessellate, Detail, MeshJob, TriMesh};
+use super::{isosurface, obj, octree, parts, tessellate, Detail, MeshJob, TriMesh};
 use crate::diag::{codes, Diagnostic};
 use crate::ir::{self, MeshSource, Primitive, Shape, ShapeKind};
 use crate::render::MaterialTable;
@@ -57,7 +57,15 @@ pub fn tessellate(
             budget.spend(triangles, shape.span)?;
             // A generator's polytope is convex exactly when its shape is (tested for each);
             // isosurfaces (below) may dent even a convex shape, so they are never marked.
-            Ok(MeshJob { mesh: make(), xf, material, per_triangle: None, smooth: false, convex: node.is_convex() })
+            Ok(MeshJob {
+                mesh: make(),
+                xf,
+                material,
+                per_triangle: None,
+                smooth: false,
+                convex: node.is_convex(),
+                warnings: Vec::new(),
+            })
         }
         Generator::Square { normal, offset } => {
             budget.spend(tessellate::count::SQUARE, shape.span)?;
@@ -73,7 +81,15 @@ pub fn tessellate(
             let reach = max_distance * inv.matrix3.to_cols_array().iter().fold(0.0f64, |a, x| a.max(x.abs())) * 2.0;
             let square = tessellate::square(reach.max(1.0));
             // Flat: a ray leaving its front never meets it again.
-            Ok(MeshJob { mesh: square, xf: xf * frame, material, per_triangle: None, smooth: false, convex: true })
+            Ok(MeshJob {
+                mesh: square,
+                xf: xf * frame,
+                material,
+                per_triangle: None,
+                smooth: false,
+                convex: true,
+                warnings: Vec::new(),
+            })
         }
         Generator::None => {
             // An isosurface of the subtree in render space, at a cell size that follows the
@@ -236,6 +252,17 @@ fn mib(bytes: u64) -> String {
     format!("{:.0} MiB", bytes as f64 / (1u64 << 20) as f64)
 }
 
+/// A positive length to three significant digits, as people read it.
+fn approx(x: f64) -> String {
+    let digits = (3 - x.abs().log10().ceil() as i32).clamp(0, 12) as usize;
+    let s = format!("{x:.digits$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
 /// A count as people say it: millions above a million.
 fn millions(n: f64) -> String {
     if n >= 1e6 {
@@ -356,7 +383,42 @@ fn isosurface_object(
             mat(((a + b + c) / 3.0).as_vec3a()).1
         })
         .collect();
-    Ok(MeshJob { mesh, xf: place, material, per_triangle: Some(per_triangle), smooth, convex: false })
+    let mut solid = Vec::new();
+    parts::solid_parts(shape, grid, &mut solid);
+    let lost = parts::lost(&solid, &lattice, &*dist);
+    let warnings = lost_parts(&lost, solid.len(), span, cell, across, from).into_iter().collect();
+    Ok(MeshJob { mesh, xf: place, material, per_triangle: Some(per_triangle), smooth, convex: false, warnings })
+}
+
+/// The warning for parts an isosurface at `cell` lost, of `total` solid parts of a
+/// shape `across` wide; `None` when none was.
+fn lost_parts(
+    lost: &[&parts::Part],
+    total: usize,
+    span: Span,
+    cell: f64,
+    across: f64,
+    from: CellFrom,
+) -> Option<Diagnostic> {
+    let smallest = lost.iter().min_by(|a, b| a.across().total_cmp(&b.across()))?;
+    let plural = if lost.len() == 1 { "part was" } else { "parts were" };
+    // A grid point lies inside any part at least twice the cell across.
+    let needed = smallest.across() / 2.0;
+    let d = Diagnostic::warning(
+        codes::LOST_PARTS,
+        span,
+        format!("{} of {total} {plural} not meshed: smaller than the isosurface cell", lost.len()),
+        format!("meshed at cell {}", approx(cell)),
+    )
+    .with_label(smallest.span, format!("the smallest lost part, {} across, is made here", approx(smallest.across())))
+    .with_note("no grid point lies inside these parts, so the mesh has no surface there");
+    Some(match from {
+        CellFrom::Scene => d.with_hint(format!("try `cell = {}` or less", approx(needed))),
+        CellFrom::Detail => {
+            let rings = (across / (4.0 * needed)).ceil();
+            d.with_hint(format!("try `--detail {}` or a `--tolerance` below {}", short(rings), approx(needed / 2.0)))
+        }
+    })
 }
 
 /// Lowers an explicit `mesh …` object.
@@ -431,7 +493,15 @@ pub fn explicit(
     if expected.is_none() {
         budget.spend(local.triangles.len() as u64, m.span)?;
     }
-    Ok(MeshJob { mesh: local, xf, material, per_triangle: None, smooth: m.smooth, convex: m.is_convex() })
+    Ok(MeshJob {
+        mesh: local,
+        xf,
+        material,
+        per_triangle: None,
+        smooth: m.smooth,
+        warnings: Vec::new(),
+        convex: m.is_convex(),
+    })
 }
 
 #[cfg(test)]

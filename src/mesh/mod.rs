@@ -12,6 +12,7 @@ pub mod isosurface;
 pub mod lower;
 pub mod obj;
 pub mod octree;
+pub mod parts;
 mod qef;
 pub mod tessellate;
 pub mod triangle;
@@ -77,6 +78,8 @@ pub struct MeshJob {
     /// Whether the triangles bound a convex polytope (or lie in one plane), as the
     /// generator guarantees: secondary rays leaving a face outward may then skip the mesh.
     pub convex: bool,
+    /// What making the mesh found wrong but survivable (parts an isosurface lost).
+    pub warnings: Vec<crate::diag::Diagnostic>,
 }
 
 impl MeshJob {

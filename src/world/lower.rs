@@ -86,6 +86,13 @@ pub fn lower(
         lowered.push((part, obj.span));
     }
     budget.confirm()?;
+    let warnings = lowered
+        .iter_mut()
+        .flat_map(|(part, _)| match part {
+            Lowered::Mesh(job) => std::mem::take(&mut job.warnings),
+            Lowered::Sdf(..) => Vec::new(),
+        })
+        .collect();
     // Building the meshes (vertices to render space, BVHs) is most of the lowering time
     // of a scene of many meshes; they are independent, so they are built in parallel.
     let objects: Vec<Object> = lowered
@@ -114,5 +121,5 @@ pub fn lower(
     debug_assert!(bvh.validate(&boxes).is_ok());
     let has_meshes = objects.iter().any(|o| matches!(o.kind, ObjectKind::Mesh(_)));
     let share_walks = has_meshes || bvh.node_count() > 1;
-    Ok(World { objects, bvh, bounded, unbounded, params, closure_bytes, has_meshes, share_walks })
+    Ok(World { objects, bvh, bounded, unbounded, params, closure_bytes, has_meshes, share_walks, warnings })
 }

@@ -63,6 +63,8 @@ pub struct World {
     /// a lone SDF object the packet set-up measured 10–20% slower than single rays (bench
     /// `primary rays/packets sdf/01-sphere` against `intersect sdf/01-sphere`).
     share_walks: bool,
+    /// What lowering found wrong but survivable, in scene order (parts an isosurface lost).
+    pub warnings: Vec<crate::diag::Diagnostic>,
 }
 
 /// Memory of the world by structure, for `--stats`.

@@ -109,8 +109,8 @@ fn every_code_is_documented() {
     }
 }
 
-/// Lowering problems (mesh files, isosurface limits) are diagnostics at the object's
-/// source, rendered exactly as in `NAME.txt`.
+/// Lowering problems (mesh files, isosurface limits, parts an isosurface loses) are
+/// diagnostics at the object's source, rendered exactly as in `NAME.txt`.
 #[test]
 fn lowering_diagnostics() {
     let mut failures = Vec::new();
@@ -122,7 +122,11 @@ fn lowering_diagnostics() {
         };
         let effects = scnc::render::effects::derive(scene);
         match scnc::world::prepare(scene, effects, scnc::world::Mode::Sdf, &scnc::source::FsLoader) {
-            Ok(_) => failures.push(format!("{}: lowered without an error", path.display())),
+            Ok((_, world)) if !world.warnings.is_empty() => {
+                let text: String = world.warnings.iter().map(|d| d.render(&c.map, false)).collect();
+                failures.extend(check_golden(&path.with_extension("txt"), &text));
+            }
+            Ok(_) => failures.push(format!("{}: lowered without an error or a warning", path.display())),
             Err(d) => failures.extend(check_golden(&path.with_extension("txt"), &d.render(&c.map, false))),
         }
     }
