@@ -1,7 +1,7 @@
 //! Isosurface extraction by dual contouring on the cells an octree keeps
 //! ([`octree`](super::octree)): every finest cell the surface crosses gets one vertex per
 //! sheet of surface inside it, placed by a quadric error function
-//! ([`qef`](super::qef)) on the tangent planes at its edge crossings, so that a box keeps
+//! (`mesh::qef`) on the tangent planes at its edge crossings, so that a box keeps
 //! its edges and corners; every grid edge the surface crosses gets a quad joining the
 //! vertices of the four cells around it.
 //!

@@ -15,7 +15,7 @@ use rayon::prelude::*;
 /// one more than its cells, still fit).
 const BITS: u32 = 21;
 
-/// The most levels of refinement, so that grid points fit in [`BITS`].
+/// The most levels of refinement, so that grid points fit in a key (21 bits a coordinate).
 pub const MAX_LEVELS: u32 = BITS - 1;
 
 /// Nodes expanded between two checks of the cell limit: the limit is overshot by at

@@ -67,7 +67,7 @@ pub fn solid_parts(shape: &Shape, xf: DAffine3, out: &mut Vec<Part>) {
     }
 }
 
-/// The parts smaller than [`CHECKED_BELOW`] cells that no point of `grid` inside their
+/// The parts under four cells across (`CHECKED_BELOW`) that no point of `grid` inside their
 /// bounds finds inside the shape `f`, in the order given.
 pub fn lost<'a>(parts: &'a [Part], grid: &Grid, f: &(dyn Fn(Vec3A) -> f32 + Sync)) -> Vec<&'a Part> {
     parts.par_iter().filter(|p| p.across() < CHECKED_BELOW * grid.cell && !seen(p, grid, f)).collect::<Vec<_>>()

@@ -158,6 +158,32 @@ fn mesh_high_coverage_agrees_with_sdf() {
     }
 }
 
+/// At `--tolerance pixel` the mesh render covers the pixels the SDF render covers, to
+/// within 1 % of them, on every feature scene (CSG, modifiers and capsules meshed as
+/// isosurfaces) and on the 1,000-sphere smooth chain, at the detail the tolerance picks.
+#[test]
+fn mesh_at_pixel_tolerance_covers_what_sdf_covers() {
+    const SIZE: u32 = 128;
+    let mut paths = crate::support::cases("examples/features");
+    paths.push("benches/scenes/chain-1000.scn".into());
+    for path in paths {
+        let mut scene = compile(&path).scene.expect("scene compiles");
+        scene.settings.width = SIZE;
+        scene.settings.height = SIZE;
+        let detail = scnc::study::tolerance::mesh_detail(&scene, scnc::study::tolerance::Tolerance::Pixel);
+        let sdf = coverage(&scene, Mode::Sdf, SIZE);
+        let mesh = coverage(&scene, Mode::Mesh(detail), SIZE);
+        let differing = sdf.iter().zip(&mesh).filter(|(a, b)| a != b).count();
+        let allowed = (SIZE * SIZE) as usize / 100;
+        assert!(
+            differing <= allowed,
+            "{} at detail {}: {differing} pixels differ in coverage (at most {allowed})",
+            path.display(),
+            detail.rings()
+        );
+    }
+}
+
 /// Each lane of a camera-ray packet finds what its ray finds traced alone, for every seed
 /// scene (in every mode, by `conformance.rs`), for 2×2 packets and 4×4 blocks of four,
 /// full and partial: hit or miss exactly, the distance up to rounding, and the same
