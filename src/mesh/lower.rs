@@ -263,9 +263,11 @@ fn approx(x: f64) -> String {
     }
 }
 
-/// A count as people say it: millions above a million.
+/// A count as people say it: millions above a million, powers of ten above a billion.
 fn millions(n: f64) -> String {
-    if n >= 1e6 {
+    if n >= 1e9 {
+        format!("{n:.1e}")
+    } else if n >= 1e6 {
         format!("{:.1} million", n / 1e6)
     } else {
         format!("{}", n.round())
@@ -356,8 +358,13 @@ fn isosurface_object(
         }
     };
     let lattice = octree::Grid::new(bounds.min, bounds.max, cell).map_err(|side| {
-        let min_cell = cell * side / (1u64 << octree::MAX_LEVELS) as f64;
-        too_fine(side * side, min_cell)
+        // Too many cells on a side for a key: a closed surface across the grid crosses
+        // about as many cells as a cube's six faces, so the cell must grow for both the
+        // key and the cell limit.
+        let cells = 6.0 * side * side;
+        let for_keys = cell * side / (1u64 << octree::MAX_LEVELS) as f64;
+        let for_limit = cell * (cells / isosurface::MAX_CELLS as f64).sqrt();
+        too_fine(cells, for_keys.max(for_limit))
     })?;
     let mesh = isosurface::extract(&*dist, &lattice).map_err(|e| match e {
         isosurface::IsoError::TooManyCells { cells, min_cell } => too_fine(cells, min_cell),
