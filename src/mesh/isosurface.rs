@@ -70,18 +70,23 @@ pub fn extract(f: &(dyn Fn(Vec3A) -> f32 + Sync), grid: &Grid) -> Result<TriMesh
         min_cell: grid.cell * (cells / MAX_CELLS as f64).sqrt(),
     };
     let mut cells = grid.surface_cells(f, MAX_CELLS).map_err(too_many)?;
-    let (corners, values, edges) = loop {
+    let (corners, values, edges, rings) = loop {
         let corners = corner_values(f, grid, &cells);
         // Each cell's eight corners, looked up once (the table is large: lookups miss
         // the cache, and every later step reads a cell's corners).
         let values: Vec<[f32; 8]> = cells.par_iter().map(|&c| cell_values(&corners, c)).collect();
         let edges = crossed_edges(&cells, &values);
+        // The cells around each crossed edge, by index: found once, for the check here
+        // and for the quads.
+        let rings: Vec<[Option<usize>; 4]> =
+            edges.par_iter().map(|&e| around(e).map(|c| cells.binary_search(&c?).ok())).collect();
         let mut missing: Vec<u64> = edges
             .par_iter()
-            .flat_map_iter(|&e| around(e).into_iter().flatten().filter(|c| cells.binary_search(c).is_err()))
+            .zip(&rings)
+            .flat_map_iter(|(&e, ring)| around(e).into_iter().zip(ring).filter_map(|(c, i)| i.is_none().then_some(c?)))
             .collect();
         if missing.is_empty() {
-            break (corners, values, edges);
+            break (corners, values, edges, rings);
         }
         missing.par_sort_unstable();
         missing.dedup();
@@ -106,23 +111,18 @@ pub fn extract(f: &(dyn Fn(Vec3A) -> f32 + Sync), grid: &Grid) -> Result<TriMesh
         mesh.positions.extend(vertices);
         sheets_of.push(s);
     }
-    let vertex = |cell: u64, local: usize| -> Option<u32> {
-        let s = &sheets_of[cells.binary_search(&cell).ok()?];
-        (s.of_edge[local] != NO_SHEET).then(|| s.first + s.of_edge[local] as u32)
-    };
     let quads: Vec<[[u32; 3]; 2]> = edges
         .par_iter()
-        .filter_map(|&e| {
-            let (corner, axis) = e;
-            let cells = around(e);
+        .zip(&rings)
+        .filter_map(|(&(corner, axis), ring)| {
             let mut v = [0u32; 4];
-            for (n, cell) in cells.iter().enumerate() {
-                let cell = (*cell)?;
-                v[n] = vertex(cell, local_edge(axis as usize, corner, cell))?;
+            for (n, i) in ring.iter().enumerate() {
+                let s = &sheets_of[(*i)?];
+                let sheet = s.of_edge[local_edge(axis as usize, corner, cells[(*i)?])];
+                v[n] = s.first + u32::from((sheet != NO_SHEET).then_some(sheet)?);
             }
             let [a, b, c, d] = v;
-            let inside = corner_value(&corners, corner) < 0.0;
-            Some(if inside { [[a, b, c], [a, c, d]] } else { [[a, c, b], [a, d, c]] })
+            Some(if inside(corner_value(&corners, corner)) { [[a, b, c], [a, c, d]] } else { [[a, c, b], [a, d, c]] })
         })
         .collect();
     mesh.triangles = quads.into_iter().flatten().collect();
@@ -134,8 +134,8 @@ fn corner_values(f: &(dyn Fn(Vec3A) -> f32 + Sync), grid: &Grid, cells: &[u64]) 
     let mut keys: Vec<u64> = cells
         .par_iter()
         .flat_map_iter(|&c| {
-            let [i, j, k] = unkey(c);
-            (0..8u64).map(move |n| key([i + (n & 1), j + ((n >> 1) & 1), k + (n >> 2)]))
+            let c = unkey(c);
+            (0..8).map(move |n| shifted(c, corner_offset(n)))
         })
         .collect();
     keys.par_sort_unstable();
@@ -155,10 +155,24 @@ fn corner_value(corners: &[(u64, f32)], at: u64) -> f32 {
 /// The values at a cell's corners, by corner index.
 fn cell_values(corners: &[(u64, f32)], cell: u64) -> [f32; 8] {
     let c = unkey(cell);
-    std::array::from_fn(|n| {
-        let n = n as u64;
-        corner_value(corners, key([c[0] + (n & 1), c[1] + ((n >> 1) & 1), c[2] + (n >> 2)]))
-    })
+    std::array::from_fn(|n| corner_value(corners, shifted(c, corner_offset(n))))
+}
+
+/// The key of the grid point at offsets `off` from `c`.
+fn shifted(c: [u64; 3], off: [u64; 3]) -> u64 {
+    key([c[0] + off[0], c[1] + off[1], c[2] + off[2]])
+}
+
+/// The offsets of corner `n` (x + 2y + 4z) from a cell's lowest corner.
+const fn corner_offset(n: usize) -> [u64; 3] {
+    [(n & 1) as u64, ((n >> 1) & 1) as u64, (n >> 2) as u64]
+}
+
+/// Whether local edge `e` of a cell with corner values `v` is crossed.
+fn crossed(v: &[f32; 8], e: usize) -> bool {
+    let (off, axis) = edge_start(e);
+    let start = corner_index(off);
+    inside(v[start]) != inside(v[start + (1 << axis)])
 }
 
 /// Whether a value is inside the shape. NaN counts as outside.
@@ -184,9 +198,7 @@ const fn edge_start(e: usize) -> ([u64; 3], usize) {
 /// The local number of the grid edge along `axis` from grid point `corner`, in `cell`.
 fn local_edge(axis: usize, corner: u64, cell: u64) -> usize {
     let (p, c) = (unkey(corner), unkey(cell));
-    let b1 = p[(axis + 1) % 3] - c[(axis + 1) % 3];
-    let b2 = p[(axis + 2) % 3] - c[(axis + 2) % 3];
-    4 * axis + (b1 + 2 * b2) as usize
+    edge_id(axis, [p[0] - c[0], p[1] - c[1], p[2] - c[2]])
 }
 
 /// The four cells around a grid edge, in the order that winds its quad about the
@@ -210,11 +222,9 @@ fn crossed_edges(cells: &[u64], values: &[[f32; 8]]) -> Vec<EdgeKey> {
         .zip(values)
         .flat_map_iter(|(&cell, v)| {
             let c = unkey(cell);
-            (0..12).filter_map(move |e| {
+            (0..12).filter(|&e| crossed(v, e)).map(move |e| {
                 let (off, axis) = edge_start(e);
-                let start = corner_index(off);
-                (inside(v[start]) != inside(v[start + (1 << axis)]))
-                    .then(|| (key([c[0] + off[0], c[1] + off[1], c[2] + off[2]]), axis as u8))
+                (shifted(c, off), axis as u8)
             })
         })
         .collect();
@@ -226,8 +236,9 @@ fn crossed_edges(cells: &[u64], values: &[[f32; 8]]) -> Vec<EdgeKey> {
 /// Where the surface crosses a grid edge, by false position on `f` (Illinois variant,
 /// from the linear estimate until `f` is within a ten-thousandth of a cell of zero:
 /// along a cell's edge a distance field is nearly linear and that takes a step or two,
-/// more where the edge passes a kink of a CSG field), and its normal there from four samples on a tetrahedron (the
-/// crossings are most of an isosurface's evaluations of a large CSG tree).
+/// more where the edge passes a kink of a CSG field), and its normal there from four
+/// samples on a tetrahedron (the crossings are most of an isosurface's evaluations of
+/// a large CSG tree).
 fn crossing(
     f: &(dyn Fn(Vec3A) -> f32 + Sync),
     grid: &Grid,
@@ -321,11 +332,7 @@ const fn edge_id(axis: usize, off: [u64; 3]) -> usize {
 /// face's pairing, each placed by the QEF of its crossings and kept inside the cell.
 fn sheets(grid: &Grid, cell: u64, v: &[f32; 8], edges: &[EdgeKey], crossings: &[Crossing]) -> (Sheets, Vec<DVec3>) {
     let c = unkey(cell);
-    let crossed: [bool; 12] = std::array::from_fn(|e| {
-        let (off, axis) = edge_start(e);
-        let start = corner_index(off);
-        inside(v[start]) != inside(v[start + (1 << axis)])
-    });
+    let crossed: [bool; 12] = std::array::from_fn(|e| crossed(v, e));
     // Union-find over the twelve edges, joined by each face's pairs.
     let mut parent: [usize; 12] = std::array::from_fn(|e| e);
     fn root(parent: &mut [usize; 12], mut e: usize) -> usize {
@@ -336,8 +343,13 @@ fn sheets(grid: &Grid, cell: u64, v: &[f32; 8], edges: &[EdgeKey], crossings: &[
         e
     }
     for face in &FACES {
-        let on: Vec<usize> = (0..4).filter(|&m| crossed[face.edges[m]]).collect();
-        let pairs: [(usize, usize); 2] = match on.len() {
+        let mut on = [0; 4];
+        let mut count = 0;
+        for m in (0..4).filter(|&m| crossed[face.edges[m]]) {
+            on[count] = m;
+            count += 1;
+        }
+        let pairs: [(usize, usize); 2] = match count {
             2 => [(on[0], on[1]); 2],
             4 => {
                 let [a, b, cc, d] = face.corners.map(|k| v[k] as f64);
@@ -365,27 +377,28 @@ fn sheets(grid: &Grid, cell: u64, v: &[f32; 8], edges: &[EdgeKey], crossings: &[
             parent[rx] = ry;
         }
     }
-    // Sheets numbered in the order of their lowest edge; one QEF each.
+    // Sheets numbered in the order of their lowest edge; one QEF each. Every sheet is
+    // a cycle of at least three of the twelve edges, so there are at most four.
     let mut of_edge = [NO_SHEET; 12];
-    let mut qefs: Vec<Qef> = Vec::new();
+    let mut qefs = [Qef::default(); 4];
+    let mut count = 0;
     let mut sheet_of_root = [NO_SHEET; 12];
     for e in (0..12).filter(|&e| crossed[e]) {
         let r = root(&mut parent, e);
         if sheet_of_root[r] == NO_SHEET {
-            sheet_of_root[r] = qefs.len() as u8;
-            qefs.push(Qef::default());
+            sheet_of_root[r] = count as u8;
+            count += 1;
         }
         of_edge[e] = sheet_of_root[r];
         let (off, axis) = edge_start(e);
-        let start = key([c[0] + off[0], c[1] + off[1], c[2] + off[2]]);
-        if let Ok(i) = edges.binary_search(&(start, axis as u8)) {
+        if let Ok(i) = edges.binary_search(&(shifted(c, off), axis as u8)) {
             let x = crossings[i];
             qefs[of_edge[e] as usize].add(x.point, x.normal);
         }
     }
     let lo = grid.point(c);
     let hi = lo + grid.cell;
-    let vertices = qefs.iter().map(|q| q.solve().clamp(lo, hi)).collect();
+    let vertices = qefs[..count].iter().map(|q| q.solve().clamp(lo, hi)).collect();
     (Sheets { of_edge, first: 0 }, vertices)
 }
 
