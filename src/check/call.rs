@@ -276,9 +276,6 @@ impl Ctx<'_> {
                 }
             }
         }
-        if let Some(fast) = self.bind_positional(b, &args, call) {
-            return fast;
-        }
         let recovered = args.iter().any(|a| a.value.is_error() && a.name.is_none());
         // `box(x, y, z)`: three numbers are one size vector.
         if b.name == "box"
@@ -290,10 +287,22 @@ impl Ctx<'_> {
             let v = DVec3::new(n(&args[0]), n(&args[1]), n(&args[2]));
             args = vec![ArgVal { name: None, value: Value::Vec3(v), span }];
         }
-        let names: Vec<&str> = b.params.iter().map(|p| p.name).collect();
-        // A misspelt name is one mistake: the parameter it meant is not also "missing".
-        let misspelt = args.iter().any(|a| a.name.as_ref().is_some_and(|n| !names.contains(&n.name.as_str())));
-        let (mut vals, mut rest, mut ok) = self.bind_slots(b.name, &names, b.variadic.is_some(), args, call, Some(b));
+        let (mut vals, mut rest, mut ok, misspelt) =
+            if b.variadic.is_none() && args.len() <= b.params.len() && args.iter().all(|a| a.name.is_none()) {
+                // The common call, `floor(x)` or `sphere(r)`: the arguments fill the first
+                // slots in order, with nothing to report; no names to match (nor the
+                // allocations that takes).
+                let mut vals = Vec::with_capacity(b.params.len());
+                vals.extend(args.into_iter().map(|a| Some((a.value, a.span))));
+                vals.resize(b.params.len(), None);
+                (vals, Vec::new(), true, false)
+            } else {
+                let names: Vec<&str> = b.params.iter().map(|p| p.name).collect();
+                // A misspelt name is one mistake: the parameter it meant is not also "missing".
+                let misspelt = args.iter().any(|a| a.name.as_ref().is_some_and(|n| !names.contains(&n.name.as_str())));
+                let (vals, rest, ok) = self.bind_slots(b.name, &names, b.variadic.is_some(), args, call, Some(b));
+                (vals, rest, ok, misspelt)
+            };
         if !recovered && !misspelt {
             for (p, v) in b.params.iter().zip(&vals) {
                 if v.is_none() && p.default == builtins::Default::Required {
@@ -352,44 +361,6 @@ impl Ctx<'_> {
         }
         let poisoned = vals.iter().flatten().any(|(v, _)| v.is_error()) || rest.iter().any(|(v, _)| v.is_error());
         (ok && !poisoned && !recovered).then_some(BoundArgs { vals, rest, call })
-    }
-
-    /// The common call, `floor(x)` or `sphere(r)`: positional arguments, no more than
-    /// the parameters, none poisoned, a builtin that takes no variadic arguments. Binds
-    /// it without matching names (and the allocations that takes), reporting what the
-    /// general binding would in the same order; `None` for any other call.
-    fn bind_positional(&mut self, b: &'static Builtin, args: &[ArgVal], call: Span) -> Option<Option<BoundArgs>> {
-        let plain = b.variadic.is_none()
-            && args.len() <= b.params.len()
-            && args.iter().all(|a| a.name.is_none() && !a.value.is_error())
-            && !(b.name == "box" && args.len() == 3);
-        if !plain {
-            return None;
-        }
-        let mut ok = true;
-        for p in &b.params[args.len()..] {
-            if p.default == builtins::Default::Required {
-                self.report(
-                    Diagnostic::error(
-                        codes::MISSING_ARG,
-                        call,
-                        format!("missing argument `{}` of `{}`", p.name, b.name),
-                        format!("`{}` is required", p.name),
-                    )
-                    .with_note(format!("signature: {}", b.signature())),
-                );
-                ok = false;
-            }
-        }
-        let mut vals = Vec::with_capacity(b.params.len());
-        for (p, a) in b.params.iter().zip(args) {
-            match self.coerce(&a.value, p.ty, a.span, &|| format!("parameter `{}` of `{}`", p.name, b.name)) {
-                Some(v) => vals.push(Some((v, a.span))),
-                None => ok = false,
-            }
-        }
-        vals.resize(b.params.len(), None);
-        Some(ok.then_some(BoundArgs { vals, rest: Vec::new(), call }))
     }
 
     /// Converts `v` to `ty` or reports a mismatch; poison passes through. `what` names
