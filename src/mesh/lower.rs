@@ -254,13 +254,8 @@ fn mib(bytes: u64) -> String {
 
 /// A positive length to three significant digits, as people read it.
 fn approx(x: f64) -> String {
-    let digits = (3 - x.abs().log10().ceil() as i32).clamp(0, 12) as usize;
-    let s = format!("{x:.digits$}");
-    if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        s
-    }
+    let scale = 10f64.powi((3 - x.abs().log10().ceil() as i32).clamp(0, 12));
+    short((x * scale).round() / scale)
 }
 
 /// A count as people say it: millions above a million, powers of ten above a billion.
