@@ -183,6 +183,21 @@ fn bvh(c: &mut Criterion) {
             })
         });
     }
+    // Issue 22's target: a million triangles generated and built in ≤ 0.3 s on 2 cores.
+    let (rings, segments) = (500, 1000);
+    group.throughput(Throughput::Elements(scnc::mesh::tessellate::count::uvsphere(rings, segments)));
+    group.bench_function("tessellate and build smooth uvsphere 998000", |b| {
+        b.iter(|| {
+            let mesh = scnc::mesh::tessellate::uvsphere(1.0, rings, segments);
+            scnc::mesh::MeshObject::new(
+                &mesh,
+                glam::DAffine3::from_translation(glam::DVec3::new(0.0, 0.0, 5.0)),
+                0,
+                None,
+                true,
+            )
+        })
+    });
     group.finish();
 }
 

@@ -147,9 +147,9 @@ pub const MAX_SCENE_TRIANGLES: u64 = 50_000_000;
 
 /// Bytes one triangle may take at the peak of lowering, an upper estimate: the mesh in
 /// f64 as generated, its camera-relative f32 copy with smooth normals and indices, the
-/// BVH build's boxes, centres and order, and the BVH. Measured: a 10 M-triangle smooth
-/// UV sphere peaks at 121 bytes per triangle of the whole process (`/usr/bin/time -f %M
-/// scnc render` of `uvsphere(rings = 2237, segments = 2237, smooth = true)`), 113 flat;
+/// BVH build's boxes with their order, and the BVH. Measured: a 10 M-triangle smooth
+/// UV sphere peaks at 109 bytes per triangle of the whole process (`/usr/bin/time -f %M
+/// scnc render` of `uvsphere(rings = 2237, segments = 2237, smooth = true)`), 101 flat;
 /// what meshes keep afterwards is checked in `tests/scnc/mesh.rs`
 /// (`memory_estimate_bounds_what_meshes_keep`).
 pub const BYTES_PER_TRIANGLE: u64 = 144;

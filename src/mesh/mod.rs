@@ -18,6 +18,7 @@ pub mod tessellate;
 pub mod triangle;
 
 use glam::{DAffine3, DVec3, Vec3A, Vec4};
+use rayon::prelude::*;
 
 pub use detail::Detail;
 
@@ -137,20 +138,24 @@ impl MeshObject {
         per_triangle: Option<Vec<u32>>,
         smooth: bool,
     ) -> MeshObject {
-        let positions: Vec<Vec3A> = mesh.positions.iter().map(|p| xf.transform_point3(*p).as_vec3a()).collect();
+        let positions: Vec<Vec3A> = mesh.positions.par_iter().map(|p| xf.transform_point3(*p).as_vec3a()).collect();
         // A mirroring map would turn the winding, and so every face normal, inward.
         let mirrored = xf.matrix3.determinant() < 0.0;
-        let mut triangles = Vec::with_capacity(mesh.triangles.len());
-        let mut mats = Vec::new();
-        for (i, t) in mesh.triangles.iter().enumerate() {
-            let t = if mirrored { [t[0], t[2], t[1]] } else { *t };
+        let mut triangles: Vec<[u32; 3]> =
+            mesh.triangles.par_iter().map(|t| if mirrored { [t[0], t[2], t[1]] } else { *t }).collect();
+        let mut per_triangle = per_triangle;
+        let area = |t: &[u32; 3]| {
             let [a, b, c] = t.map(|k| positions[k as usize]);
-            if (b - a).cross(c - a).length_squared() > 0.0 {
-                triangles.push(t);
-                if let Some(m) = &per_triangle {
-                    mats.push(m[i]);
-                }
+            (b - a).cross(c - a).length_squared() > 0.0
+        };
+        // Generators make no degenerate triangles; files and isosurfaces rarely do.
+        if !triangles.par_iter().all(area) {
+            let keep: Vec<bool> = triangles.par_iter().map(area).collect();
+            fn kept<T>(items: Vec<T>, keep: &[bool]) -> Vec<T> {
+                items.into_iter().zip(keep).filter_map(|(t, &k)| k.then_some(t)).collect()
             }
+            triangles = kept(triangles, &keep);
+            per_triangle = per_triangle.map(|m| kept(m, &keep));
         }
         let normals = smooth.then(|| {
             let mut n = vec![Vec3A::ZERO; positions.len()];
@@ -161,19 +166,19 @@ impl MeshObject {
                     n[*k as usize] += face;
                 }
             }
-            n.into_iter().map(|v| v.try_normalize().unwrap_or(Vec3A::Y)).collect()
+            n.into_par_iter().map(|v| v.try_normalize().unwrap_or(Vec3A::Y)).collect()
         });
-        let boxes: Vec<Aabb> = triangles
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|k| positions[k as usize]);
-                Aabb { min: a.min(b).min(c), max: a.max(b).max(c) }
-            })
-            .collect();
-        let (bvh, order) = Bvh::build_ordered(&boxes, 4);
-        let triangles: Vec<[u32; 3]> = order.iter().map(|&k| triangles[k as usize]).collect();
-        let mats: Vec<u32> = if mats.is_empty() { mats } else { order.iter().map(|&k| mats[k as usize]).collect() };
-        let bounds = boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(*b));
+        let bounds = |i: usize| {
+            let [a, b, c] = triangles[i].map(|k| positions[k as usize]);
+            Aabb { min: a.min(b).min(c), max: a.max(b).max(c) }
+        };
+        let (bvh, order) = Bvh::build_ordered(triangles.len(), bounds, 4);
+        let triangles: Vec<[u32; 3]> = order.par_iter().map(|&k| triangles[k as usize]).collect();
+        let mats: Vec<u32> = match &per_triangle {
+            Some(m) => order.par_iter().map(|&k| m[k as usize]).collect(),
+            None => Vec::new(),
+        };
+        let bounds = bvh.bounds();
         let materials = match per_triangle {
             Some(_) if mats.iter().any(|&m| m != mats[0]) => Materials::PerTriangle(mats),
             Some(_) => Materials::One(mats.first().copied().unwrap_or(material)),

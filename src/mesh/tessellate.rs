@@ -6,6 +6,7 @@ use std::collections::HashMap;
 use std::f64::consts::{PI, TAU};
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use super::TriMesh;
 
@@ -45,32 +46,49 @@ pub mod count {
 }
 
 /// UV sphere: `rings` latitude bands (≥ 2) and `segments` longitudes (≥ 3), poles on ±y.
+/// Made in parallel, each vertex and quad from its index (exact-length collects, the
+/// same mesh for any thread count).
 pub fn uvsphere(r: f64, rings: u32, segments: u32) -> TriMesh {
     let (rings, segments) = (rings.max(2), segments.max(3));
-    let mut m = TriMesh::default();
-    m.positions.push(DVec3::new(0.0, r, 0.0));
-    for i in 1..rings {
-        let theta = PI * i as f64 / rings as f64;
-        for j in 0..segments {
-            let phi = TAU * j as f64 / segments as f64;
-            m.positions.push(DVec3::new(r * theta.sin() * phi.cos(), r * theta.cos(), r * theta.sin() * phi.sin()));
-        }
-    }
-    let south = m.positions.len() as u32;
-    m.positions.push(DVec3::new(0.0, -r, 0.0));
-    let ring = |i: u32, j: u32| 1 + (i - 1) * segments + (j % segments);
-    for j in 0..segments {
-        m.triangles.push([0, ring(1, j + 1), ring(1, j)]);
-        m.triangles.push([south, ring(rings - 1, j), ring(rings - 1, j + 1)]);
-    }
-    for i in 1..rings - 1 {
-        for j in 0..segments {
+    let band = (rings - 1) * segments;
+    let positions = (0..band + 2)
+        .into_par_iter()
+        .map(|k| match k {
+            0 => DVec3::new(0.0, r, 0.0),
+            k if k > band => DVec3::new(0.0, -r, 0.0),
+            k => {
+                let (i, j) = ((k - 1) / segments + 1, (k - 1) % segments);
+                let theta = PI * i as f64 / rings as f64;
+                let phi = TAU * j as f64 / segments as f64;
+                DVec3::new(r * theta.sin() * phi.cos(), r * theta.cos(), r * theta.sin() * phi.sin())
+            }
+        })
+        .collect();
+    let south = band + 1;
+    let ring = move |i: u32, j: u32| 1 + (i - 1) * segments + (j % segments);
+    let caps = 2 * segments;
+    let triangles = (0..2 * band)
+        .into_par_iter()
+        .map(|k| {
+            if k < caps {
+                let j = k / 2;
+                return if k % 2 == 0 {
+                    [0, ring(1, j + 1), ring(1, j)]
+                } else {
+                    [south, ring(rings - 1, j), ring(rings - 1, j + 1)]
+                };
+            }
+            let q = (k - caps) / 2;
+            let (i, j) = (q / segments + 1, q % segments);
             let (a, b, c, d) = (ring(i, j), ring(i, j + 1), ring(i + 1, j), ring(i + 1, j + 1));
-            m.triangles.push([a, b, d]);
-            m.triangles.push([a, d, c]);
-        }
-    }
-    m
+            if k % 2 == 0 {
+                [a, b, d]
+            } else {
+                [a, d, c]
+            }
+        })
+        .collect();
+    TriMesh { positions, triangles }
 }
 
 /// Box with half-extents `h`: 8 vertices, 12 triangles.
@@ -133,26 +151,32 @@ pub fn cone(r: f64, h: f64, segments: u32) -> TriMesh {
 }
 
 /// Torus in the xz plane: `segments` around the major circle, `sides` around the tube.
+/// Made in parallel like [`uvsphere`].
 pub fn torus(major: f64, minor: f64, segments: u32, sides: u32) -> TriMesh {
     let (n, s) = (segments.max(3), sides.max(3));
-    let mut m = TriMesh::default();
-    for i in 0..n {
-        let phi = TAU * i as f64 / n as f64;
-        let dir = DVec3::new(phi.cos(), 0.0, phi.sin());
-        for j in 0..s {
-            let theta = TAU * j as f64 / s as f64;
-            m.positions.push(dir * (major + minor * theta.cos()) + DVec3::Y * (minor * theta.sin()));
-        }
-    }
-    let idx = |i: u32, j: u32| (i % n) * s + (j % s);
-    for i in 0..n {
-        for j in 0..s {
+    let positions = (0..n * s)
+        .into_par_iter()
+        .map(|k| {
+            let phi = TAU * (k / s) as f64 / n as f64;
+            let theta = TAU * (k % s) as f64 / s as f64;
+            let dir = DVec3::new(phi.cos(), 0.0, phi.sin());
+            dir * (major + minor * theta.cos()) + DVec3::Y * (minor * theta.sin())
+        })
+        .collect();
+    let idx = move |i: u32, j: u32| (i % n) * s + (j % s);
+    let triangles = (0..2 * n * s)
+        .into_par_iter()
+        .map(|k| {
+            let (i, j) = (k / 2 / s, k / 2 % s);
             let (a, b, c, d) = (idx(i, j), idx(i + 1, j), idx(i, j + 1), idx(i + 1, j + 1));
-            m.triangles.push([a, c, d]);
-            m.triangles.push([a, d, b]);
-        }
-    }
-    m
+            if k % 2 == 0 {
+                [a, c, d]
+            } else {
+                [a, d, b]
+            }
+        })
+        .collect();
+    TriMesh { positions, triangles }
 }
 
 /// A square of half-side `size` in the xz plane facing +y (two triangles; not closed).

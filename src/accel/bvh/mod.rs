@@ -36,7 +36,7 @@ pub(crate) struct Child {
 /// are stored across lanes, `[left.min, right.min, left.max, right.max]` per axis, so
 /// one pass of 4-wide arithmetic tests both children: a visit loads one line and
 /// decides which children the ray enters and in which order.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(64))]
 pub(crate) struct Node {
     x: Vec4,
@@ -128,6 +128,11 @@ impl Default for Bvh {
 }
 
 impl Bvh {
+    /// The box around every primitive (empty for an empty tree).
+    pub fn bounds(&self) -> Aabb {
+        self.root_box
+    }
+
     /// The root's box and reference, unless the tree is empty.
     fn root(&self) -> Option<(Aabb, Child)> {
         (self.root.count > 0 || !self.nodes.is_empty()).then_some((self.root_box, self.root))
@@ -254,7 +259,7 @@ mod tests {
             .collect();
         let indexed = Bvh::build(&boxes, 4);
         indexed.validate(&boxes).expect("indexed tree");
-        let (ordered, order) = Bvh::build_ordered(&boxes, 4);
+        let (ordered, order) = Bvh::build_ordered(boxes.len(), |i| boxes[i], 4);
         let reordered: Vec<Aabb> = order.iter().map(|&k| boxes[k as usize]).collect();
         ordered.validate(&reordered).expect("ordered tree");
         for i in 0..200 {
@@ -265,6 +270,29 @@ mod tests {
             let (a, b) = (visited(&indexed, origin, dir, None), visited(&ordered, origin, dir, Some(&order)));
             assert_eq!(a, b, "the ordered tree visits what the indexed one does");
             assert!(expected.iter().all(|p| a.contains(p)), "ray {i} missed a box: {expected:?} ⊄ {a:?}");
+        }
+    }
+
+    /// Large enough for subtrees built in parallel and nodes binned in parallel chunks:
+    /// the tree is valid, finds what brute force finds, and is the same node for node
+    /// on one thread as on four.
+    #[test]
+    fn parallel_builds_are_valid_and_independent_of_the_thread_count() {
+        let boxes = scattered(3 * build::PAR_BIN);
+        let on = |threads| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool");
+            pool.install(|| Bvh::build(&boxes, 4))
+        };
+        let (one, four) = (on(1), on(4));
+        four.validate(&boxes).expect("valid");
+        assert_eq!((&one.nodes, one.root, &one.prims), (&four.nodes, four.root, &four.prims));
+        assert_eq!(one.root_box, four.root_box);
+        for i in 0..50 {
+            let dir = Vec3A::new((i as f32 * 0.37).sin(), (i as f32 * 0.11).cos(), 1.0).normalize();
+            let origin = Vec3A::new(5.0, 5.0, -20.0);
+            let expected = brute(&boxes, origin, dir);
+            let seen = visited(&four, origin, dir, None);
+            assert!(expected.iter().all(|p| seen.contains(p)), "ray {i} missed a box");
         }
     }
 
