@@ -8,6 +8,7 @@ mod export;
 mod fmt;
 mod golden;
 mod grammar;
+mod isosurface;
 mod lsp;
 mod mesh;
 mod nopanic;

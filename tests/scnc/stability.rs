@@ -278,7 +278,9 @@ fn degenerate_input_is_an_error_or_defined() {
     assert_eq!(obj.triangle_count(), 12);
 }
 
-fn arb_shape() -> impl Strategy<Value = String> {
+/// Random CSG trees as source text: primitives, sharp and smooth operators, transforms
+/// and modifiers, up to 24 leaves.
+pub fn arb_shape() -> impl Strategy<Value = String> {
     let leaf = prop_oneof![
         (0.2f64..1.5).prop_map(|r| format!("sphere({r:.3})")),
         (0.2f64..1.0, 0.2f64..1.0, 0.2f64..1.0).prop_map(|(a, b, c)| format!("box({a:.3}, {b:.3}, {c:.3})")),
