@@ -56,7 +56,7 @@ pub(crate) fn stats_text(c: &Counters, g: &World, map: &SourceMap, lower_s: f64,
             let (id, r) = map.local_range(*span);
             let (line, _) = map.line_col(id, r.start);
             out.push_str(&format!(
-                "    {}:{line}: {} triangles; vertices {} B, indices {} B, BVH {} B ({} nodes, depth {})\n",
+                "    {}:{line}: {} triangles; vertices {} B, indices {} B, BVH {} B ({} nodes, depth {})",
                 map.file(id).name,
                 m.triangles,
                 m.vertex_bytes,
@@ -65,6 +65,15 @@ pub(crate) fn stats_text(c: &Counters, g: &World, map: &SourceMap, lower_s: f64,
                 m.bvh_nodes,
                 m.bvh_depth
             ));
+            if let Some(iso) = m.isosurface {
+                out.push_str(&format!(
+                    "; isosurface cell {:.3e}, farthest vertex {:.3e} ({:.3} cell)",
+                    iso.cell,
+                    iso.farthest,
+                    iso.farthest / iso.cell
+                ));
+            }
+            out.push('\n');
         }
         if mem.meshes.len() > 20 {
             out.push_str(&format!("    … and {} more mesh objects\n", mem.meshes.len() - 20));

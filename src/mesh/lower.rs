@@ -4,9 +4,10 @@
 //! that point at the source.
 
 use glam::{DAffine3, DVec3};
+use rayon::prelude::*;
 
 use super::tessellate::count;
-use super::{isosurface, obj, octree, parts, tessellate, Detail, MeshJob, TriMesh};
+use super::{isosurface, obj, octree, parts, tessellate, Detail, IsoAccuracy, MeshJob, TriMesh};
 use crate::diag::{codes, Diagnostic};
 use crate::ir::{self, MeshSource, Primitive, Shape, ShapeKind};
 use crate::render::MaterialTable;
@@ -65,6 +66,7 @@ pub fn tessellate(
                 smooth: false,
                 convex: node.is_convex(),
                 warnings: Vec::new(),
+                isosurface: None,
             })
         }
         Generator::Square { normal, offset } => {
@@ -89,6 +91,7 @@ pub fn tessellate(
                 smooth: false,
                 convex: true,
                 warnings: Vec::new(),
+                isosurface: None,
             })
         }
         Generator::None => {
@@ -389,7 +392,17 @@ fn isosurface_object(
     parts::solid_parts(shape, grid, &mut solid);
     let lost = parts::lost(&solid, &lattice, &*dist);
     let warnings = lost_parts(&lost, solid.len(), span, cell, across, from).into_iter().collect();
-    Ok(MeshJob { mesh, xf: place, material, per_triangle: Some(per_triangle), smooth, convex: false, warnings })
+    let farthest = mesh.positions.par_iter().map(|p| f64::from(dist(p.as_vec3a()).abs())).reduce(|| 0.0, f64::max);
+    Ok(MeshJob {
+        mesh,
+        xf: place,
+        material,
+        per_triangle: Some(per_triangle),
+        smooth,
+        convex: false,
+        warnings,
+        isosurface: Some(IsoAccuracy { cell, farthest }),
+    })
 }
 
 /// The warning for parts an isosurface at `cell` lost, of `total` solid parts of a
@@ -503,6 +516,7 @@ pub fn explicit(
         smooth: m.smooth,
         warnings: Vec::new(),
         convex: m.is_convex(),
+        isosurface: None,
     })
 }
 

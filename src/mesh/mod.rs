@@ -81,13 +81,26 @@ pub struct MeshJob {
     pub convex: bool,
     /// What making the mesh found wrong but survivable (parts an isosurface lost).
     pub warnings: Vec<crate::diag::Diagnostic>,
+    /// For an isosurface, its cell and how far its vertices lie from the surface.
+    pub isosurface: Option<IsoAccuracy>,
+}
+
+/// An isosurface's cell and measured accuracy, both in the units of the frame it was
+/// sampled in (the shape's own for `mesh isosurface(…)`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IsoAccuracy {
+    /// The finest cell's side.
+    pub cell: f64,
+    /// The largest `|f|` at a vertex: the farthest a vertex lies from the surface where
+    /// the distance function is exact, a lower bound on it elsewhere.
+    pub farthest: f64,
 }
 
 impl MeshJob {
     /// The mesh object, ready for tracing.
     pub fn build(self) -> MeshObject {
         let object = MeshObject::new(&self.mesh, self.xf, self.material, self.per_triangle, self.smooth);
-        MeshObject { convex: self.convex, ..object }
+        MeshObject { convex: self.convex, isosurface: self.isosurface, ..object }
     }
 }
 
@@ -103,6 +116,7 @@ pub struct MeshObject {
     bounds: Aabb,
     /// Whether the triangles bound a convex polytope (or lie in one plane).
     convex: bool,
+    isosurface: Option<IsoAccuracy>,
 }
 
 enum Materials {
@@ -125,6 +139,8 @@ pub struct MeshMemory {
     pub bvh_nodes: usize,
     /// BVH depth.
     pub bvh_depth: usize,
+    /// For an isosurface, its cell and accuracy.
+    pub isosurface: Option<IsoAccuracy>,
 }
 
 impl MeshObject {
@@ -184,7 +200,7 @@ impl MeshObject {
             Some(_) => Materials::One(mats.first().copied().unwrap_or(material)),
             None => Materials::One(material),
         };
-        MeshObject { positions, triangles, normals, materials, bvh, bounds, convex: false }
+        MeshObject { positions, triangles, normals, materials, bvh, bounds, convex: false, isosurface: None }
     }
 
     /// Whether every hit's normal is the outward normal of a face of a convex polytope (or
@@ -216,6 +232,7 @@ impl MeshObject {
             bvh_bytes: self.bvh.bytes(),
             bvh_nodes: self.bvh.node_count(),
             bvh_depth: self.bvh.depth(),
+            isosurface: self.isosurface,
         }
     }
 

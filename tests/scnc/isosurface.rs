@@ -153,3 +153,18 @@ proptest! {
         }
     }
 }
+
+/// Lowering measures each isosurface's farthest vertex (`--stats` prints it): for a
+/// unit sphere at cell 0.05 it is the same small fraction of a cell measured above, and
+/// generated meshes have none.
+#[test]
+fn lowering_reports_the_farthest_vertex() {
+    let text = "light ambient(1)\nobject mesh isosurface(sphere(1), cell = 0.05) at [0, 0, 5]\n\
+                object mesh uvsphere(rings = 8) at [3, 0, 5]\n";
+    let (_, world) = crate::support::lower(&scene(text), 16, scnc::world::Mode::Sdf);
+    let meshes = world.memory().meshes;
+    let iso = meshes[0].1.isosurface.expect("the isosurface's accuracy");
+    assert_eq!(iso.cell, 0.05);
+    assert!(iso.farthest > 0.0 && iso.farthest <= 0.05 * iso.cell, "farthest {}", iso.farthest);
+    assert_eq!(meshes[1].1.isosurface, None);
+}
