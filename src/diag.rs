@@ -366,6 +366,8 @@ pub mod codes {
     pub const BEHIND_CAMERA: &str = "W0005";
     /// Parts of a shape too small for its isosurface's cell, left out of the mesh.
     pub const LOST_PARTS: &str = "W0801";
+    /// Isosurface edges left on four triangles where parts are thinner than the cell.
+    pub const PINCHED_EDGES: &str = "W0802";
 }
 
 /// Edit distance for "did you mean" suggestions.

@@ -64,8 +64,18 @@ struct Sheets {
 
 const NO_SHEET: u8 = u8::MAX;
 
+/// An extracted isosurface.
+#[derive(Debug)]
+pub struct Surface {
+    /// The triangles, closed and wound outward.
+    pub mesh: TriMesh,
+    /// Edges left on four triangles: where a part thinner than a cell crosses a cell
+    /// face twice from both sides and the sheets could not be split (0 otherwise).
+    pub pinched: usize,
+}
+
 /// Extracts the zero set of `f` on `grid`.
-pub fn extract(f: &(dyn Fn(Vec3A) -> f32 + Sync), grid: &Grid) -> Result<TriMesh, IsoError> {
+pub fn extract(f: &(dyn Fn(Vec3A) -> f32 + Sync), grid: &Grid) -> Result<Surface, IsoError> {
     let too_many = |cells: f64| IsoError::TooManyCells {
         cells,
         // A surface's cell count goes with the inverse square of the cell.
@@ -108,7 +118,7 @@ pub fn extract(f: &(dyn Fn(Vec3A) -> f32 + Sync), grid: &Grid) -> Result<TriMesh
         cells.par_iter().zip(&values).map(|(&c, v)| sheets::<4>(grid, c, v, &edges, &crossings, 0)).collect();
     // Where a part is thinner than a cell, one sheet can cross an ambiguous face twice,
     // in both cells of the face: the two vertices would then share four quads' edge.
-    split_doubled_faces(grid, &cells, &values, &edges, &crossings, &mut per_cell);
+    let pinched = split_doubled_faces(grid, &cells, &values, &edges, &crossings, &mut per_cell);
     let mut mesh = TriMesh::default();
     let mut sheets_of = Vec::with_capacity(per_cell.len());
     for (mut s, vertices) in per_cell {
@@ -131,7 +141,7 @@ pub fn extract(f: &(dyn Fn(Vec3A) -> f32 + Sync), grid: &Grid) -> Result<TriMesh
         })
         .collect();
     mesh.triangles = quads.into_iter().flatten().collect();
-    Ok(mesh)
+    Ok(Surface { mesh, pinched })
 }
 
 /// Splits sheets that cross a face twice from both sides. Leaving the face's pairing
@@ -144,7 +154,8 @@ pub fn extract(f: &(dyn Fn(Vec3A) -> f32 + Sync), grid: &Grid) -> Result<TriMesh
 /// no check accepts, so along a thin tube of doubled cells about every third face stays
 /// as it was (closed, its edge on four triangles). On the random CSG trees of the
 /// mesher's tests this removes 86–100 % of the four-triangle edges (eight shapes, at a
-/// sixtieth of their bounds).
+/// sixtieth of their bounds). Returns the number of faces still crossed twice from
+/// both sides, each an edge on four triangles.
 fn split_doubled_faces(
     grid: &Grid,
     cells: &[u64],
@@ -152,7 +163,7 @@ fn split_doubled_faces(
     edges: &[EdgeKey],
     crossings: &[Crossing],
     per_cell: &mut [(Sheets, Vec<DVec3>)],
-) {
+) -> usize {
     let doubled = |per_cell: &[(Sheets, Vec<DVec3>)], i: usize, n: u8| per_cell[i].0.doubled & (1 << n) != 0;
     // Each face doubled on both sides, once, from its lower cell.
     let faces: Vec<(usize, u8, usize)> = (0..cells.len())
@@ -178,7 +189,7 @@ fn split_doubled_faces(
     };
     // Per cell: not involved, a partner, or split at the faces of its mask.
     let mut mask: std::collections::HashMap<usize, Option<u8>> = std::collections::HashMap::new();
-    for (i, n, j) in faces {
+    for &(i, n, j) in &faces {
         for (c, face, partner) in [(i, n, j), (j, n ^ 1, i)] {
             let now = match mask.get(&c) {
                 None => 0,
@@ -196,6 +207,13 @@ fn split_doubled_faces(
             }
         }
     }
+    // A face stays pinched while each side has one sheet on all four of its edges (a
+    // split elsewhere in a cell can also part them).
+    let one_sheet = |i: usize, n: u8| {
+        let o = FACES[n as usize].edges.map(|e| per_cell[i].0.of_edge[e]);
+        o.iter().all(|&x| x == o[0])
+    };
+    faces.iter().filter(|&&(i, n, j)| one_sheet(i, n) && one_sheet(j, n ^ 1)).count()
 }
 
 /// The values of `f` at every corner of `cells`, sorted by key.
@@ -524,7 +542,7 @@ mod tests {
     #[test]
     fn sphere_isosurface_is_closed_outward_and_accurate() {
         let f = |p: Vec3A| p.length() - 1.0;
-        let m = extract(&f, &grid(1.0, 0.05)).expect("surface");
+        let m = extract(&f, &grid(1.0, 0.05)).expect("surface").mesh;
         assert_eq!(m.open_edges(), (0, 0), "open edges");
         let v = m.signed_volume();
         assert!((v - 4.0 / 3.0 * std::f64::consts::PI).abs() < 0.01, "volume {v}");
@@ -542,7 +560,7 @@ mod tests {
             let q = p.as_dvec3().abs() - half;
             (q.max(DVec3::ZERO).length() + q.max_element().min(0.0)) as f32
         };
-        let m = extract(&f, &Grid::new(-half, half, 0.07).unwrap()).expect("surface");
+        let m = extract(&f, &Grid::new(-half, half, 0.07).unwrap()).expect("surface").mesh;
         assert_eq!(m.open_edges(), (0, 0), "open edges");
         for p in &m.positions {
             let q = p.abs() - half;
@@ -569,7 +587,7 @@ mod tests {
                 a.min(b)
             };
             let g = Grid::new(DVec3::new(-1.1, -0.6, -0.6), DVec3::new(1.1, 0.6, 0.6), 0.0625).unwrap();
-            let m = extract(&f, &g).expect("surface");
+            let m = extract(&f, &g).expect("surface").mesh;
             assert_eq!(m.open_edges(), (0, 0), "gap {gap}: open or doubled edges");
         }
     }
@@ -604,7 +622,7 @@ mod tests {
             let p = p.as_dvec3();
             (0..125).map(|i| (p - centre(i)).length() - 0.025).fold(f64::INFINITY, f64::min) as f32
         };
-        let m = extract(&f, &Grid::new(DVec3::splat(-0.83), DVec3::splat(0.83), 0.02).unwrap()).expect("surface");
+        let m = extract(&f, &Grid::new(DVec3::splat(-0.83), DVec3::splat(0.83), 0.02).unwrap()).expect("surface").mesh;
         assert_eq!(m.open_edges(), (0, 0), "open or doubled edges");
         assert_eq!(components(&m), 125, "every sphere is its own piece");
         assert!(m.signed_volume() > 0.0, "wound outward");

@@ -364,7 +364,7 @@ fn isosurface_object(
         let for_limit = cell * (cells / isosurface::MAX_CELLS as f64).sqrt();
         too_fine(cells, for_keys.max(for_limit))
     })?;
-    let mesh = isosurface::extract(&*dist, &lattice).map_err(|e| match e {
+    let surface = isosurface::extract(&*dist, &lattice).map_err(|e| match e {
         isosurface::IsoError::TooManyCells { cells, min_cell } => too_fine(cells, min_cell),
         isosurface::IsoError::NoSurface => {
             let d = Diagnostic::error(
@@ -380,6 +380,7 @@ fn isosurface_object(
             }
         }
     })?;
+    let mesh = surface.mesh;
     let per_triangle = mesh
         .triangles
         .iter()
@@ -391,7 +392,10 @@ fn isosurface_object(
     let mut solid = Vec::new();
     parts::solid_parts(shape, grid, &mut solid);
     let lost = parts::lost(&solid, &lattice, &*dist);
-    let warnings = lost_parts(&lost, solid.len(), span, cell, across, from).into_iter().collect();
+    let warnings = lost_parts(&lost, solid.len(), span, cell, across, from)
+        .into_iter()
+        .chain(pinched(surface.pinched, span, cell, across, from))
+        .collect();
     let farthest = mesh.positions.par_iter().map(|p| f64::from(dist(p.as_vec3a()).abs())).reduce(|| 0.0, f64::max);
     Ok(MeshJob {
         mesh,
@@ -432,6 +436,31 @@ fn lost_parts(
         CellFrom::Detail => {
             let rings = (across / (4.0 * needed)).ceil();
             d.with_hint(format!("try `--detail {}` or a `--tolerance` below {}", short(rings), approx(needed / 2.0)))
+        }
+    })
+}
+
+/// The warning for `edges` of an isosurface at `cell` left on four triangles; `None`
+/// when there are none.
+fn pinched(edges: usize, span: Span, cell: f64, across: f64, from: CellFrom) -> Option<Diagnostic> {
+    if edges == 0 {
+        return None;
+    }
+    let plural = if edges == 1 { "edge lies" } else { "edges lie" };
+    let d = Diagnostic::warning(
+        codes::PINCHED_EDGES,
+        span,
+        format!("{edges} isosurface {plural} on four triangles: parts are thinner than the cell"),
+        format!("meshed at cell {}", approx(cell)),
+    )
+    .with_note(
+        "the mesh is closed, but not manifold at those edges; tools that need a manifold (slicers) may refuse it",
+    );
+    Some(match from {
+        CellFrom::Scene => d.with_hint(format!("try `cell = {}` or less", approx(cell / 2.0))),
+        CellFrom::Detail => {
+            let rings = (across / (4.0 * cell / 2.0)).ceil();
+            d.with_hint(format!("try `--detail {}` or more", short(rings)))
         }
     })
 }

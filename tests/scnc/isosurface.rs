@@ -23,7 +23,11 @@ fn meshed(shape: &str, cell: f64) -> (Sdf, Option<TriMesh>) {
     let b = scnc::ir::shape_bounds(shape).expect("bounded");
     let grid = Grid::new(b.min, b.max, cell).expect("grid");
     match extract(&*f, &grid) {
-        Ok(m) => (f, Some(m)),
+        Ok(surface) => {
+            // Every edge off two triangles is one the mesher counted (and warns of).
+            assert_eq!(surface.mesh.open_edges(), (surface.pinched, 2 * surface.pinched), "{shape:?}");
+            (f, Some(surface.mesh))
+        }
         Err(IsoError::NoSurface) => (f, None),
         Err(e) => panic!("{shape:?}: {e:?}"),
     }
