@@ -143,3 +143,28 @@ pub(crate) fn write_png(path: &Path, image: &scnc::render::Image) -> std::io::Re
             .map_err(std::io::Error::other)
     })
 }
+
+/// Encodes a part of a `width × height` image whole or not at all: RGBA at full size,
+/// `image`'s pixels opaque at `region` and every other pixel transparent black, which
+/// is what `scnc merge` assembles (and any viewer shows in place).
+pub(crate) fn write_part_png(
+    path: &Path,
+    width: u32,
+    height: u32,
+    region: scnc::render::Region,
+    image: &scnc::render::Image,
+) -> std::io::Result<()> {
+    use image::ImageEncoder;
+    let mut rgba = vec![0u8; width as usize * height as usize * 4];
+    for (dy, row) in image.pixels.chunks_exact(3 * image.width as usize).enumerate() {
+        let start = ((region.y0 as usize + dy) * width as usize + region.x0 as usize) * 4;
+        for (px, out) in row.chunks_exact(3).zip(rgba[start..].chunks_exact_mut(4)) {
+            out.copy_from_slice(&[px[0], px[1], px[2], 255]);
+        }
+    }
+    write_atomic(path, ".png.tmp", |w| {
+        image::codecs::png::PngEncoder::new(w)
+            .write_image(&rgba, width, height, image::ExtendedColorType::Rgba8)
+            .map_err(std::io::Error::other)
+    })
+}

@@ -10,6 +10,7 @@
 mod export;
 mod files;
 mod fmt;
+mod merge;
 mod render;
 mod stats;
 mod sweep;
@@ -59,6 +60,9 @@ enum Command {
     /// Render, then render again whenever the scene or a file it includes changes;
     /// on errors, print them and keep the last good image. Ctrl-C ends it.
     Watch(RenderArgs),
+    /// Assemble parts rendered with `render --region` or `--tile` into one image; fails,
+    /// writing nothing, on parts of different sizes, overlapping parts or a gap.
+    Merge(merge::MergeArgs),
     /// Write the scene's objects as a mesh file (STL, OBJ, PLY, 3MF or glb), meshed as
     /// `render --geometry mesh` meshes them (written whole or not at all).
     Export(export::ExportArgs),
@@ -156,6 +160,7 @@ fn run(cli: Cli) -> ExitCode {
         Command::Watch(args) => watch::watch_cmd(args),
         Command::Sweep(args) => sweep::sweep_cmd(args),
         Command::Export(args) => export::export_cmd(args),
+        Command::Merge(args) => merge::merge_cmd(args),
         Command::Fmt { files, check } => fmt::fmt_cmd(&files, check),
         Command::Lsp => match scnc::lsp::run_stdio(|why| {
             let _ = writeln!(std::io::stderr(), "scnc lsp: {why}");

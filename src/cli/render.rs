@@ -12,7 +12,9 @@ use scnc::source::FsLoader;
 use scnc::study::tolerance::Tolerance;
 use scnc::Compiled;
 
-use super::files::{check_output, stop_on_interrupt, write_png};
+use scnc::render::Region;
+
+use super::files::{check_output, stop_on_interrupt, write_part_png, write_png};
 use super::{compile, report, usage_error, worker_pool, MessageFormat};
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -84,9 +86,42 @@ pub(crate) struct RenderArgs {
     /// (every effect compiled in; a debugging and benchmarking aid, same image).
     #[arg(long, value_enum, default_value = "derived")]
     effects: EffectsArg,
+    /// Render only the pixels X0..X1 × Y0..Y1 (ends exclusive) and write them as a part:
+    /// a full-size RGBA PNG, transparent outside the region, for `scnc merge`.
+    #[arg(long, value_parser = parse_region, value_name = "X0,Y0,X1,Y1", conflicts_with = "tile")]
+    region: Option<[u32; 4]>,
+    /// Render band I of N equal bands of rows (I from 0) as a part, like `--region`.
+    #[arg(long, value_parser = parse_tile, value_name = "I/N")]
+    tile: Option<(u32, u32)>,
     /// How to print diagnostics.
     #[arg(long, value_enum, default_value = "human")]
     message_format: MessageFormat,
+}
+
+/// `X0,Y0,X1,Y1`: four integers, a non-empty rectangle (checked against the image later).
+fn parse_region(s: &str) -> Result<[u32; 4], String> {
+    let numbers: Vec<u32> = s
+        .split(',')
+        .map(|n| n.trim().parse::<u32>().map_err(|_| format!("`{n}` is not a pixel coordinate")))
+        .collect::<Result<_, _>>()?;
+    let [x0, y0, x1, y1] = numbers[..] else {
+        return Err(format!("expected X0,Y0,X1,Y1 (four numbers), got {}", numbers.len()));
+    };
+    if x0 >= x1 || y0 >= y1 {
+        return Err(format!("the region {x0}..{x1} × {y0}..{y1} is empty (ends are exclusive)"));
+    }
+    Ok([x0, y0, x1, y1])
+}
+
+/// `I/N` with `0 ≤ I < N`.
+fn parse_tile(s: &str) -> Result<(u32, u32), String> {
+    let (i, n) = s.split_once('/').ok_or_else(|| format!("expected I/N, like 0/4, got `{s}`"))?;
+    let i: u32 = i.trim().parse().map_err(|_| format!("`{i}` is not a band number"))?;
+    let n: u32 = n.trim().parse().map_err(|_| format!("`{n}` is not a number of bands"))?;
+    if n == 0 || i >= n {
+        return Err(format!("band {i} of {n}: bands are numbered 0 to N − 1"));
+    }
+    Ok((i, n))
 }
 
 pub(crate) fn parse_detail(s: &str) -> Result<scnc::mesh::Detail, String> {
@@ -161,6 +196,7 @@ impl RenderArgs {
         if s.width as u64 * s.height as u64 > MAX_PIXELS {
             return Err(usage_error(&format!("{}×{} is too large: at most {} pixels", s.width, s.height, MAX_PIXELS)));
         }
+        self.part(s.width, s.height).map_err(|e| usage_error(&e))?;
         let mut detail = self.detail;
         if let Some(tol) = self.tolerance {
             let picked = match self.geometry {
@@ -179,6 +215,22 @@ impl RenderArgs {
             GeometryKind::Sdf => scnc::world::Mode::Sdf,
             GeometryKind::Mesh => scnc::world::Mode::Mesh(detail),
         })
+    }
+
+    /// The region `--region` or `--tile` asks for in a `width × height` image, if any;
+    /// an error when it does not fit.
+    fn part(&self, width: u32, height: u32) -> Result<Option<Region>, String> {
+        if let Some([x0, y0, x1, y1]) = self.region {
+            if x1 > width || y1 > height {
+                return Err(format!("the region {x0}..{x1} × {y0}..{y1} is outside the {width}×{height} image"));
+            }
+            return Ok(Some(Region { x0, y0, x1, y1 }));
+        }
+        match self.tile {
+            Some((_, n)) if n > height => Err(format!("{n} bands of rows in an image {height} rows high")),
+            Some((i, n)) => Ok(Some(Region::band(i, n, width, height))),
+            None => Ok(None),
+        }
     }
 
     /// The worker pool, once the output path is known to be writable and Ctrl-C ends the
@@ -235,22 +287,30 @@ fn render_compiled(args: &RenderArgs, pool: &rayon::ThreadPool, compiled: Compil
         }
     };
     let lowered = started.elapsed();
-    let progress = Progress::new(frame.height);
-    let (image, counters) = pool.install(|| scnc::render::render(&geometry, &frame, &|| progress.row()));
+    let part = args.part(frame.width, frame.height).map_err(|e| usage_error(&e))?;
+    let region = part.unwrap_or(Region::full(frame.width, frame.height));
+    let progress = Progress::new(region.height());
+    let (image, counters) = pool.install(|| scnc::render::render_region(&geometry, &frame, region, &|| progress.row()));
     progress.finish();
     let traced = started.elapsed() - lowered;
-    if let Err(e) = write_png(&args.output, &image) {
+    let written = match part {
+        Some(region) => write_part_png(&args.output, frame.width, frame.height, region, &image),
+        None => write_png(&args.output, &image),
+    };
+    if let Err(e) = written {
         let _ = writeln!(std::io::stderr(), "error: cannot write `{}`: {e}", args.output.display());
         return Err(ExitCode::from(1));
     }
     let secs = traced.as_secs_f64();
     let mut err = std::io::stderr().lock();
+    let size = match part {
+        Some(r) => format!("pixels {}..{} × {}..{} of {}×{}", r.x0, r.x1, r.y0, r.y1, frame.width, frame.height),
+        None => format!("{}×{}", image.width, image.height),
+    };
     let _ = writeln!(
         err,
-        "rendered {}: {}×{} in {:.3} s ({:.2} M rays/s, {} threads)",
+        "rendered {}: {size} in {:.3} s ({:.2} M rays/s, {} threads)",
         args.output.display(),
-        image.width,
-        image.height,
         started.elapsed().as_secs_f64(),
         counters.rays() as f64 / secs.max(1e-9) / 1e6,
         pool.current_num_threads()

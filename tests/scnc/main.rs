@@ -18,4 +18,5 @@ mod render;
 mod skip;
 mod stability;
 mod support;
+mod tiles;
 mod watch;

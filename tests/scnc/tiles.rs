@@ -1,0 +1,119 @@
+//! Parts of an image (`render --tile`, `--region`) and `scnc merge`: merged parts are
+//! the whole render byte for byte, and bad parts or part specifications are refused
+//! without writing anything.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn scnc(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_scnc")).args(args).env("NO_COLOR", "1").output().expect("running scnc")
+}
+
+fn ok(out: &Output) {
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+}
+
+fn path(p: &Path) -> &str {
+    p.to_str().expect("utf-8 path")
+}
+
+/// A size whose rows and columns are not multiples of the 4×4 blocks rays go in.
+const SIZE: [&str; 4] = ["--width", "97", "--height", "61"];
+
+#[test]
+fn merged_tiles_are_the_whole_render_byte_for_byte() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    for (scene, extra) in
+        [("examples/seed/06-many-spheres.scn", &[][..]), ("examples/features/union.scn", &["--geometry", "mesh"][..])]
+    {
+        let full = dir.path().join("full.png");
+        ok(&scnc(&[&["render", scene, "-o", path(&full)][..], &SIZE, extra].concat()));
+        for n in [1u32, 3, 7] {
+            let parts: Vec<String> = (0..n)
+                .map(|i| {
+                    let part = dir.path().join(format!("part-{i}.png"));
+                    let tile = format!("{i}/{n}");
+                    ok(&scnc(&[&["render", scene, "-o", path(&part), "--tile", &tile][..], &SIZE, extra].concat()));
+                    path(&part).to_string()
+                })
+                .collect();
+            let merged = dir.path().join("merged.png");
+            let mut args = vec!["merge"];
+            args.extend(parts.iter().map(String::as_str));
+            args.extend(["-o", path(&merged)]);
+            ok(&scnc(&args));
+            let same = std::fs::read(&full).expect("full") == std::fs::read(&merged).expect("merged");
+            assert!(same, "{scene}: {n} tiles merged differ from the whole render");
+        }
+    }
+}
+
+/// A region cut across the 4×4 blocks has exactly the whole render's pixels there and
+/// is transparent elsewhere.
+#[test]
+fn a_region_is_the_whole_render_cropped() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let scene = "examples/seed/05-mirrors.scn";
+    let (full, part) = (dir.path().join("full.png"), dir.path().join("part.png"));
+    ok(&scnc(&[&["render", scene, "-o", path(&full)][..], &SIZE].concat()));
+    ok(&scnc(&[&["render", scene, "-o", path(&part), "--region", "5,7,33,29"][..], &SIZE].concat()));
+    let full = image::open(&full).expect("full").to_rgb8();
+    let part = image::open(&part).expect("part").to_rgba8();
+    assert_eq!(part.dimensions(), full.dimensions());
+    for (x, y, p) in part.enumerate_pixels() {
+        let inside = (5..33).contains(&x) && (7..29).contains(&y);
+        if inside {
+            assert_eq!(p.0, [full.get_pixel(x, y).0[0], full.get_pixel(x, y).0[1], full.get_pixel(x, y).0[2], 255]);
+        } else {
+            assert_eq!(p.0, [0, 0, 0, 0], "({x}, {y}) outside the region");
+        }
+    }
+}
+
+#[test]
+fn bad_parts_are_refused_and_nothing_is_written() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let scene = "examples/seed/01-sphere.scn";
+    let part = |name: &str, args: &[&str]| {
+        let p = dir.path().join(name);
+        ok(&scnc(&[&["render", scene, "-o", path(&p)][..], args].concat()));
+        path(&p).to_string()
+    };
+    let (a, b) = (
+        part("a.png", &[&SIZE[..], &["--tile", "0/2"]].concat()),
+        part("b.png", &[&SIZE[..], &["--tile", "1/2"]].concat()),
+    );
+    let small = part("small.png", &["--width", "40", "--height", "30", "--tile", "1/2"]);
+    let whole = part("whole.png", &SIZE);
+    let out = dir.path().join("out.png");
+    for (parts, message) in [
+        (vec![&a, &a, &b], "both cover pixel (0, 0)"),
+        (vec![&a], "pixels are in no part, the first at (0, 30)"),
+        (vec![&a, &small], "parts of one image have its size"),
+        (vec![&whole], "is not a part"),
+    ] {
+        let mut args = vec!["merge"];
+        args.extend(parts.iter().map(|p| p.as_str()));
+        args.extend(["-o", path(&out)]);
+        let run = scnc(&args);
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(1), "{err}");
+        assert!(err.contains(message), "expected `{message}` in: {err}");
+        assert!(!out.exists(), "a failed merge wrote {}", out.display());
+    }
+    for (flag, value, message) in [
+        ("--tile", "2/2", "bands are numbered 0 to N − 1"),
+        ("--tile", "0/0", "bands are numbered 0 to N − 1"),
+        ("--tile", "x", "expected I/N"),
+        ("--tile", "0/62", "62 bands of rows in an image 61 rows high"),
+        ("--region", "1,2,3", "four numbers"),
+        ("--region", "5,5,5,9", "is empty"),
+        ("--region", "0,0,98,10", "outside the 97×61 image"),
+    ] {
+        let run = scnc(&[&["render", scene, "-o", path(&out), flag, value][..], &SIZE].concat());
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(2), "{flag} {value}: {err}");
+        assert!(err.contains(message), "{flag} {value}: expected `{message}` in: {err}");
+        assert!(!out.exists());
+    }
+}
