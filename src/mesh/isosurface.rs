@@ -187,22 +187,22 @@ fn split_doubled_faces(
         });
         apart.then_some(s)
     };
-    // Per cell: not involved, a partner, or split at the faces of its mask.
-    let mut mask: std::collections::HashMap<usize, Option<u8>> = std::collections::HashMap::new();
+    // Per cell: absent when not involved, `None` for a partner, the faces it is split at.
+    let mut state: std::collections::HashMap<usize, Option<u8>> = std::collections::HashMap::new();
     for &(i, n, j) in &faces {
         for (c, face, partner) in [(i, n, j), (j, n ^ 1, i)] {
-            let now = match mask.get(&c) {
+            let now = match state.get(&c) {
                 None => 0,
-                Some(Some(m)) => *m,
+                Some(Some(faces)) => *faces,
                 Some(None) => continue,
             };
-            if matches!(mask.get(&partner), Some(Some(_))) {
+            if matches!(state.get(&partner), Some(Some(_))) {
                 continue;
             }
             if let Some(s) = split(c, now | 1 << face) {
                 per_cell[c] = s;
-                mask.insert(c, Some(now | 1 << face));
-                mask.insert(partner, None);
+                state.insert(c, Some(now | 1 << face));
+                state.insert(partner, None);
                 break;
             }
         }

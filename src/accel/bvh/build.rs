@@ -127,7 +127,8 @@ impl Binner {
     /// The bin on every axis: the product clamped to the bins in float (NaN and
     /// products below the lowest centre go to bin 0), then truncated.
     fn bins(&self, c: Vec3A) -> [usize; 3] {
-        truncate(((c - self.min) * self.scale).max(Vec3A::ZERO).min(Vec3A::splat(BINS as f32 - 1.0)))
+        let k = ((c - self.min) * self.scale).max(Vec3A::ZERO).min(Vec3A::splat(BINS as f32 - 1.0));
+        [k.x as usize, k.y as usize, k.z as usize]
     }
 
     /// A test of whether [`bins`](Self::bins) puts a centre in bin `bin` or lower on
@@ -180,15 +181,6 @@ impl Binner {
             bins.merge(c);
         }
     }
-}
-
-/// The integer parts of `v`'s lanes, each in `[0, BINS)`, without casts: a float cast
-/// checks for NaN and overflow lane by lane, which made the casts a third of the
-/// binning loop (callgrind over the million-triangle build). Truncated in SIMD, the
-/// integer `k` plus 2²³ is exact and its mantissa's low bits are `k`.
-fn truncate(v: Vec3A) -> [usize; 3] {
-    let t = v.trunc() + Vec3A::splat(8_388_608.0);
-    [t.x, t.y, t.z].map(|x| (x.to_bits() & 0xff) as usize)
 }
 
 /// A built subtree before layout.
