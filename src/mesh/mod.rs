@@ -164,7 +164,8 @@ impl MeshObject {
             let [a, b, c] = t.map(|k| positions[k as usize]);
             (b - a).cross(c - a).length_squared() > 0.0
         };
-        // Generators make no degenerate triangles; files and isosurfaces rarely do.
+        // Most meshes have no degenerate triangle: one parallel check, and the filtering
+        // pass only for those that do (`degenerate_input_is_an_error_or_defined` has one).
         if !triangles.par_iter().all(area) {
             let keep: Vec<bool> = triangles.par_iter().map(area).collect();
             fn kept<T>(items: Vec<T>, keep: &[bool]) -> Vec<T> {
