@@ -53,6 +53,11 @@ impl Aabb {
     /// The empty box (contains nothing; the identity of `union`).
     pub const EMPTY: Aabb = Aabb { min: Vec3A::splat(f32::INFINITY), max: Vec3A::splat(f32::NEG_INFINITY) };
 
+    /// The box of one point.
+    pub fn point(p: Vec3A) -> Aabb {
+        Aabb { min: p, max: p }
+    }
+
     /// The smallest box containing both.
     pub fn union(self, o: Aabb) -> Aabb {
         Aabb { min: self.min.min(o.min), max: self.max.max(o.max) }

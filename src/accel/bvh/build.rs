@@ -74,7 +74,7 @@ impl Span {
     }
 
     fn add(self, b: Aabb, c: Vec3A) -> Span {
-        Span { bounds: self.bounds.union(b), centres: self.centres.union(Aabb { min: c, max: c }) }
+        Span { bounds: self.bounds.union(b), centres: self.centres.union(Aabb::point(c)) }
     }
 
     fn union(self, o: Span) -> Span {
@@ -267,7 +267,7 @@ fn serial(nodes: &mut Vec<Node>, refs: &mut [Ref], start: usize, span: Span, dep
         return Child { index: start as u32, count: refs.len() as u32 };
     };
     let at = nodes.len();
-    nodes.push(Node::new(Aabb::EMPTY, Aabb::EMPTY, [Child { index: 0, count: 0 }; 2]));
+    nodes.push(Node::PENDING);
     let (lo, hi) = refs.split_at_mut(mid);
     let l = serial(nodes, lo, start, left, depth + 1, leaf_size);
     let r = serial(nodes, hi, start + mid, right, depth + 1, leaf_size);
@@ -293,7 +293,7 @@ fn lay_out(sub: Sub, out: &mut Vec<Node>) -> Child {
         }
         Sub::Fork(halves) => {
             let at = out.len();
-            out.push(Node::new(Aabb::EMPTY, Aabb::EMPTY, [Child { index: 0, count: 0 }; 2]));
+            out.push(Node::PENDING);
             let [(left_box, left), (right_box, right)] = *halves;
             let (l, r) = (lay_out(left, out), lay_out(right, out));
             out[at] = Node::new(left_box, right_box, [l, r]);
@@ -367,7 +367,6 @@ fn split(refs: &mut [Ref], span: Span, depth: usize, leaf_size: usize) -> Option
 /// swapping only misplaced pairs); returns how many satisfy it and the bounds of both
 /// sides' centres.
 fn partition(refs: &mut [Ref], left: impl Fn(Vec3A) -> bool) -> (usize, Aabb, Aabb) {
-    let point = |c: Vec3A| Aabb { min: c, max: c };
     let (mut l, mut r) = (Aabb::EMPTY, Aabb::EMPTY);
     let (mut i, mut j) = (0, refs.len());
     loop {
@@ -376,7 +375,7 @@ fn partition(refs: &mut [Ref], left: impl Fn(Vec3A) -> bool) -> (usize, Aabb, Aa
             if !left(c) {
                 break;
             }
-            l = l.union(point(c));
+            l = l.union(Aabb::point(c));
             i += 1;
         }
         while i < j {
@@ -384,7 +383,7 @@ fn partition(refs: &mut [Ref], left: impl Fn(Vec3A) -> bool) -> (usize, Aabb, Aa
             if left(c) {
                 break;
             }
-            r = r.union(point(c));
+            r = r.union(Aabb::point(c));
             j -= 1;
         }
         if i >= j {

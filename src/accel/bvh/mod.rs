@@ -46,6 +46,10 @@ pub(crate) struct Node {
 }
 
 impl Node {
+    /// A slot taken for a parent before its children are built, filled after.
+    const PENDING: Node =
+        Node { x: Vec4::ZERO, y: Vec4::ZERO, z: Vec4::ZERO, children: [Child { index: 0, count: 0 }; 2] };
+
     fn new(left: Aabb, right: Aabb, children: [Child; 2]) -> Node {
         Node {
             x: Vec4::new(left.min.x, right.min.x, left.max.x, right.max.x),
