@@ -80,12 +80,7 @@ pub fn uvsphere(r: f64, rings: u32, segments: u32) -> TriMesh {
             }
             let q = (k - caps) / 2;
             let (i, j) = (q / segments + 1, q % segments);
-            let (a, b, c, d) = (ring(i, j), ring(i, j + 1), ring(i + 1, j), ring(i + 1, j + 1));
-            if k % 2 == 0 {
-                [a, b, d]
-            } else {
-                [a, d, c]
-            }
+            quad_half([ring(i, j), ring(i, j + 1), ring(i + 1, j + 1), ring(i + 1, j)], k % 2)
         })
         .collect();
     TriMesh { positions, triangles }
@@ -104,8 +99,18 @@ pub fn cuboid(h: DVec3) -> TriMesh {
         .collect();
     // Each face as a quad (a, b, c, d) counter-clockwise seen from outside.
     let quads = [[0, 4, 6, 2], [1, 3, 7, 5], [0, 1, 5, 4], [2, 6, 7, 3], [0, 2, 3, 1], [4, 5, 7, 6]];
-    let triangles = quads.iter().flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
+    let triangles = quads.iter().flat_map(|&q| [quad_half(q, 0), quad_half(q, 1)]).collect();
     TriMesh { positions, triangles }
+}
+
+/// Triangle `half` (0 or 1) of the quad `q`, counter-clockwise seen from outside:
+/// `q0 q1 q2`, then `q0 q2 q3`.
+fn quad_half(q: [u32; 4], half: u32) -> [u32; 3] {
+    if half == 0 {
+        [q[0], q[1], q[2]]
+    } else {
+        [q[0], q[2], q[3]]
+    }
 }
 
 /// Capped cylinder along y with `segments` points per cap circle.
@@ -168,12 +173,7 @@ pub fn torus(major: f64, minor: f64, segments: u32, sides: u32) -> TriMesh {
         .into_par_iter()
         .map(|k| {
             let (i, j) = (k / 2 / s, k / 2 % s);
-            let (a, b, c, d) = (idx(i, j), idx(i + 1, j), idx(i, j + 1), idx(i + 1, j + 1));
-            if k % 2 == 0 {
-                [a, c, d]
-            } else {
-                [a, d, b]
-            }
+            quad_half([idx(i, j), idx(i, j + 1), idx(i + 1, j + 1), idx(i + 1, j)], k % 2)
         })
         .collect();
     TriMesh { positions, triangles }
