@@ -12,7 +12,9 @@
 //! cells sharing it read from one table, so both see the same pairs. Then a mesh edge
 //! between two sheets across a face lies on exactly the two quads of that face's paired
 //! grid edges, and the quads around a sheet's vertex form one fan: every edge has two
-//! triangles and every vertex one disk. A crossed edge's four cells all hold a crossing,
+//! triangles and every vertex one disk — except where one sheet crosses a face twice
+//! from both sides (a part thinner than a cell), which `split_doubled_faces` mends
+//! where it can and counts where it cannot. A crossed edge's four cells all hold a crossing,
 //! so the octree keeps them; should rounding drop one, it is added and the step repeated.
 //! Quads are wound outward (from the inside end of their grid edge).
 
@@ -207,13 +209,9 @@ fn split_doubled_faces(
             }
         }
     }
-    // A face stays pinched while each side has one sheet on all four of its edges (a
-    // split elsewhere in a cell can also part them).
-    let one_sheet = |i: usize, n: u8| {
-        let o = FACES[n as usize].edges.map(|e| per_cell[i].0.of_edge[e]);
-        o.iter().all(|&x| x == o[0])
-    };
-    faces.iter().filter(|&&(i, n, j)| one_sheet(i, n) && one_sheet(j, n ^ 1)).count()
+    // A face stays pinched while it is still doubled on both sides (a split elsewhere
+    // in a cell can also part its segments).
+    faces.iter().filter(|&&(i, n, j)| doubled(per_cell, i, n) && doubled(per_cell, j, n ^ 1)).count()
 }
 
 /// The values of `f` at every corner of `cells`, sorted by key.
@@ -301,10 +299,9 @@ fn local_edge(axis: usize, corner: u64, cell: u64) -> usize {
 /// edge's axis (`None` beyond the grid's low boundary).
 fn around((corner, axis): EdgeKey) -> [Option<u64>; 4] {
     let p = unkey(corner);
-    let (axis, u, w) = (axis as usize, (axis as usize + 1) % 3, (axis as usize + 2) % 3);
+    let (u, w) = ((axis as usize + 1) % 3, (axis as usize + 2) % 3);
     [(0, 0), (1, 0), (1, 1), (0, 1)].map(|(du, dw)| {
         let mut c = p;
-        c[axis] = p[axis];
         c[u] = (p[u] + du).checked_sub(1)?;
         c[w] = (p[w] + dw).checked_sub(1)?;
         Some(key(c))

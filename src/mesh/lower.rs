@@ -98,7 +98,7 @@ pub fn tessellate(
             // An isosurface of the subtree in render space, at a cell size that follows the
             // detail (a 1/(4·rings) fraction of the bounding diameter).
             let bounds = ir::shape_bounds(node).ok_or_else(|| unbounded(node.span))?.transform(&xf);
-            let cell = (bounds.max - bounds.min).length() / (4.0 * detail.rings() as f64);
+            let cell = detail_cell((bounds.max - bounds.min).length(), detail.rings() as f64);
             // Sampled in render space, so the vertices need no further placing.
             let iso =
                 Iso { grid: xf, place: DAffine3::IDENTITY, material, cell, smooth: false, from: CellFrom::Detail };
@@ -253,6 +253,17 @@ impl Budget {
 /// Bytes in MiB, for people.
 fn mib(bytes: u64) -> String {
     format!("{:.0} MiB", bytes as f64 / (1u64 << 20) as f64)
+}
+
+/// The cell of an isosurface made at `rings` of detail: a 1/(4·rings) fraction of the
+/// shape's bounding diameter `across`.
+fn detail_cell(across: f64, rings: f64) -> f64 {
+    across / (4.0 * rings)
+}
+
+/// The lowest detail whose cell ([`detail_cell`]) is at most `cell`.
+fn detail_for(across: f64, cell: f64) -> f64 {
+    (across / (4.0 * cell)).ceil()
 }
 
 /// A positive length to three significant digits, as people read it.
@@ -434,7 +445,7 @@ fn lost_parts(
     Some(match from {
         CellFrom::Scene => d.with_hint(format!("try `cell = {}` or less", approx(needed))),
         CellFrom::Detail => {
-            let rings = (across / (4.0 * needed)).ceil();
+            let rings = detail_for(across, needed);
             d.with_hint(format!("try `--detail {}` or a `--tolerance` below {}", short(rings), approx(needed / 2.0)))
         }
     })
@@ -458,10 +469,7 @@ fn pinched(edges: usize, span: Span, cell: f64, across: f64, from: CellFrom) -> 
     );
     Some(match from {
         CellFrom::Scene => d.with_hint(format!("try `cell = {}` or less", approx(cell / 2.0))),
-        CellFrom::Detail => {
-            let rings = (across / (4.0 * cell / 2.0)).ceil();
-            d.with_hint(format!("try `--detail {}` or more", short(rings)))
-        }
+        CellFrom::Detail => d.with_hint(format!("try `--detail {}` or more", short(detail_for(across, cell / 2.0)))),
     })
 }
 
