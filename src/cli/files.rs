@@ -136,11 +136,20 @@ pub(crate) fn write_text(path: &Path, text: &str) -> std::io::Result<()> {
 
 /// Encodes a PNG whole or not at all.
 pub(crate) fn write_png(path: &Path, image: &scnc::render::Image) -> std::io::Result<()> {
+    encode_png(path, &image.pixels, image.width, image.height, image::ExtendedColorType::Rgb8)
+}
+
+/// Encodes `pixels` of a `width × height` image as a PNG, whole or not at all.
+fn encode_png(
+    path: &Path,
+    pixels: &[u8],
+    width: u32,
+    height: u32,
+    colour: image::ExtendedColorType,
+) -> std::io::Result<()> {
     use image::ImageEncoder;
     write_atomic(path, ".png.tmp", |w| {
-        image::codecs::png::PngEncoder::new(w)
-            .write_image(&image.pixels, image.width, image.height, image::ExtendedColorType::Rgb8)
-            .map_err(std::io::Error::other)
+        image::codecs::png::PngEncoder::new(w).write_image(pixels, width, height, colour).map_err(std::io::Error::other)
     })
 }
 
@@ -154,7 +163,6 @@ pub(crate) fn write_part_png(
     region: scnc::render::Region,
     image: &scnc::render::Image,
 ) -> std::io::Result<()> {
-    use image::ImageEncoder;
     let mut rgba = vec![0u8; width as usize * height as usize * 4];
     for (dy, row) in image.pixels.chunks_exact(3 * image.width as usize).enumerate() {
         let start = ((region.y0 as usize + dy) * width as usize + region.x0 as usize) * 4;
@@ -162,9 +170,5 @@ pub(crate) fn write_part_png(
             out.copy_from_slice(&[px[0], px[1], px[2], 255]);
         }
     }
-    write_atomic(path, ".png.tmp", |w| {
-        image::codecs::png::PngEncoder::new(w)
-            .write_image(&rgba, width, height, image::ExtendedColorType::Rgba8)
-            .map_err(std::io::Error::other)
-    })
+    encode_png(path, &rgba, width, height, image::ExtendedColorType::Rgba8)
 }

@@ -183,8 +183,9 @@ pub(crate) fn render_cmd(args: RenderArgs) -> ExitCode {
 
 impl RenderArgs {
     /// Applies the command line's overrides and `--tolerance` to the scene, and says which
-    /// back-end renders its shapes; an image too large is a usage error.
-    fn apply(&self, scene: &mut scnc::ir::Scene) -> Result<scnc::world::Mode, ExitCode> {
+    /// back-end renders its shapes and which part of the image to render (`None`: all);
+    /// an image too large or a part outside it is a usage error.
+    fn apply(&self, scene: &mut scnc::ir::Scene) -> Result<(scnc::world::Mode, Option<Region>), ExitCode> {
         let s = &mut scene.settings;
         s.width = self.width.unwrap_or(s.width);
         s.height = self.height.unwrap_or(s.height);
@@ -196,7 +197,7 @@ impl RenderArgs {
         if s.width as u64 * s.height as u64 > MAX_PIXELS {
             return Err(usage_error(&format!("{}×{} is too large: at most {} pixels", s.width, s.height, MAX_PIXELS)));
         }
-        self.part(s.width, s.height).map_err(|e| usage_error(&e))?;
+        let part = self.part(s.width, s.height).map_err(|e| usage_error(&e))?;
         let mut detail = self.detail;
         if let Some(tol) = self.tolerance {
             let picked = match self.geometry {
@@ -211,10 +212,11 @@ impl RenderArgs {
             };
             let _ = writeln!(std::io::stderr(), "tolerance {tol}: picked {picked}");
         }
-        Ok(match self.geometry {
+        let mode = match self.geometry {
             GeometryKind::Sdf => scnc::world::Mode::Sdf,
             GeometryKind::Mesh => scnc::world::Mode::Mesh(detail),
-        })
+        };
+        Ok((mode, part))
     }
 
     /// The region `--region` or `--tile` asks for in a `width × height` image, if any;
@@ -268,7 +270,7 @@ fn render_compiled(args: &RenderArgs, pool: &rayon::ThreadPool, compiled: Compil
     let Some(mut scene) = compiled.scene else {
         return Err(ExitCode::from(1));
     };
-    let mode = args.apply(&mut scene)?;
+    let (mode, part) = args.apply(&mut scene)?;
     let started = Instant::now();
     let effects = match args.effects {
         EffectsArg::Derived => scnc::render::effects::derive(&scene),
@@ -287,7 +289,6 @@ fn render_compiled(args: &RenderArgs, pool: &rayon::ThreadPool, compiled: Compil
         }
     };
     let lowered = started.elapsed();
-    let part = args.part(frame.width, frame.height).map_err(|e| usage_error(&e))?;
     let region = part.unwrap_or(Region::full(frame.width, frame.height));
     let progress = Progress::new(region.height());
     let (image, counters) = pool.install(|| scnc::render::render_region(&geometry, &frame, region, &|| progress.row()));

@@ -137,7 +137,12 @@ fn rows<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const AO
                 .into_iter()
                 .enumerate()
                 .filter(|&(dy, _)| (region.y0..region.y1).contains(&(y + dy as u32)))
-                .map(|(_, row)| row[crop.clone()].to_vec())
+                .map(|(_, mut row)| {
+                    // In place: a whole-image render crops nothing.
+                    row.truncate(crop.end);
+                    row.drain(..crop.start);
+                    row
+                })
                 .collect();
             for _ in 0..kept.len() {
                 progress();

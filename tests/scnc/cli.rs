@@ -1,10 +1,6 @@
 //! The binary: exit codes, streams, and output formats.
 
-use std::process::Command;
-
-fn scnc(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_scnc")).args(args).env("NO_COLOR", "1").output().expect("running scnc")
-}
+use crate::support::scnc;
 
 #[test]
 fn check_clean_file_exits_0() {

@@ -3,15 +3,10 @@
 //! body parsed here), golden OBJ/MTL and ASCII STL files, and the errors.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use glam::DVec3;
 
-use super::support::check_golden;
-
-fn scnc(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_scnc")).args(args).env("NO_COLOR", "1").output().expect("running scnc")
-}
+use super::support::{check_golden, scnc};
 
 /// Exports `scene` to `dir/name` with `extra` flags; the file's bytes.
 fn export(scene: &str, dir: &Path, name: &str, extra: &[&str]) -> Vec<u8> {

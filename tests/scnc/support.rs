@@ -5,6 +5,15 @@ use std::path::{Path, PathBuf};
 use scnc::source::FsLoader;
 use scnc::Compiled;
 
+/// Runs the `scnc` binary with `args` (colour off), to completion.
+pub fn scnc(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_scnc"))
+        .args(args)
+        .env("NO_COLOR", "1")
+        .output()
+        .expect("running scnc")
+}
+
 /// The `.scn` files directly inside `dir`, sorted.
 pub fn cases(dir: &str) -> Vec<PathBuf> {
     let mut out: Vec<PathBuf> = std::fs::read_dir(dir)

@@ -3,11 +3,9 @@
 //! without writing anything.
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn scnc(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_scnc")).args(args).env("NO_COLOR", "1").output().expect("running scnc")
-}
+use crate::support::scnc;
 
 fn ok(out: &Output) {
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
