@@ -11,18 +11,8 @@ runs=${1:-5}
 cargo build --release --quiet --bin scnc --example csg_plot
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
-# Median wall time of $runs runs of `scnc ARGS…`.
-median() {
-  local walls=()
-  for _ in $(seq "$runs"); do
-    local start end
-    start=$(date +%s.%N)
-    ./target/release/scnc "$@" 2> "$out/stats"
-    end=$(date +%s.%N)
-    walls+=("$(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.3f", b - a }')")
-  done
-  printf '%s\n' "${walls[@]}" | sort -n | sed -n "$(( (runs + 1) / 2 ))p"
-}
+# shellcheck source=scripts/median.sh
+. scripts/median.sh
 # Median wall time of rendering, then the primitives per ray of the last run.
 measure() {
   local median

@@ -11,22 +11,17 @@ runs=${1:-3}
 cargo build --release --quiet --bin scnc
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
-# Median wall time of $runs runs of `scnc render ARGS…`; the last run's stats stay in $out/stats.
-median() {
-  local walls=()
-  for _ in $(seq "$runs"); do
-    local start end
-    start=$(date +%s.%N)
-    ./target/release/scnc render "$@" -o "$out/img.png" --stats 2> "$out/stats"
-    end=$(date +%s.%N)
-    walls+=("$(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.2f", b - a }')")
-  done
-  printf '%s\n' "${walls[@]}" | sort -n | sed -n "$(( (runs + 1) / 2 ))p"
+digits=2
+# shellcheck source=scripts/median.sh
+. scripts/median.sh
+# Median wall time of a render of ARGS…, its stats in $out/stats.
+render() {
+  median render "$@" -o "$out/img.png" --stats
 }
 # "wall lower triangles bytes farthest" of a mesh render.
 mesh() {
   local wall lower tris bytes far
-  wall=$(median "$@" --geometry mesh)
+  wall=$(render "$@" --geometry mesh)
   lower=$(grep -oE 'lower [0-9.]+ s' "$out/stats" | grep -oE '[0-9.]+')
   tris=$(grep -E '^  meshes' "$out/stats" | grep -oE '[0-9]+ triangles' | grep -oE '[0-9]+' || echo 0)
   bytes=$(grep -E '^  meshes' "$out/stats" | grep -oE '[0-9]+ bytes \(' | grep -oE '[0-9]+' || echo 0)
@@ -38,7 +33,7 @@ echo "|---|---|---|---|---|---|---|---|---|---|"
 for scene in examples/features/*.scn benches/scenes/chain-1000.scn; do
   # lights.scn is the lights the others include, with no object of its own.
   [ "$(basename "$scene")" = lights.scn ] && continue
-  sdf=$(median "$scene")
+  sdf=$(render "$scene")
   read -r hw hl ht hb hf < <(mesh "$scene" --detail high)
   read -r pw pl pt pb pf < <(mesh "$scene" --tolerance pixel)
   echo "| $(basename "$scene" .scn) | $sdf s | $hw s, $hl s | $ht | $hb | $hf | $pw s, $pl s | $pt | $pb | $pf |"
