@@ -270,7 +270,7 @@ fn crossed(v: &[f32; 8], e: usize) -> bool {
 }
 
 /// Whether a value is inside the shape. NaN counts as outside.
-fn inside(v: f32) -> bool {
+pub(super) fn inside(v: f32) -> bool {
     v < 0.0
 }
 

@@ -7,6 +7,7 @@
 use glam::{DAffine3, DVec3, Vec3A};
 use rayon::prelude::*;
 
+use super::isosurface::inside;
 use super::octree::Grid;
 use crate::ir::{self, CsgOp, Shape, ShapeKind};
 use crate::span::Span;
@@ -81,7 +82,7 @@ fn seen(part: &Part, grid: &Grid, f: &(dyn Fn(Vec3A) -> f32 + Sync)) -> bool {
         return false;
     }
     let (a, b) = (first.as_u64vec3(), last.as_u64vec3());
-    (a.x..=b.x).any(|i| (a.y..=b.y).any(|j| (a.z..=b.z).any(|k| f(grid.point([i, j, k]).as_vec3a()) < 0.0)))
+    (a.x..=b.x).any(|i| (a.y..=b.y).any(|j| (a.z..=b.z).any(|k| inside(f(grid.point([i, j, k]).as_vec3a())))))
 }
 
 #[cfg(test)]
