@@ -330,6 +330,8 @@ pub mod codes {
     pub const NOT_AN_OBJECT: &str = "E0501";
     /// `light` of something that is not a light.
     pub const NOT_A_LIGHT: &str = "E0502";
+    /// An animation's frame count, rate or looping differ between its frames.
+    pub const ANIMATION_CHANGES: &str = "E0503";
     /// Included file cannot be read.
     pub const INCLUDE_READ: &str = "E0600";
     /// Include cycle.

@@ -59,6 +59,54 @@ pub struct Compiled {
     pub scene: Option<ir::Scene>,
     /// Errors and warnings, in source order.
     pub diagnostics: Vec<Diagnostic>,
+    /// The root file, when it could be read into `map`.
+    root: Option<source::FileId>,
+    /// The files and parses later evaluations ([`Compiled::at`]) reuse.
+    reuse: check::Reuse,
+}
+
+impl Compiled {
+    /// The scene evaluated again at `time`, a frame of its animation: files are not read
+    /// again nor parsed again (includes a later frame reaches for the first time are), and
+    /// spans point into `map`. Returns the scene, or `None`, and that frame's diagnostics.
+    pub fn at(&mut self, time: check::Time, loader: &dyn Loader) -> (Option<ir::Scene>, Vec<Diagnostic>) {
+        match self.root {
+            Some(root) => check::check_at(&mut self.map, root, loader, time, &mut self.reuse),
+            None => (None, self.diagnostics.clone()),
+        }
+    }
+
+    /// Frame `number` of the animation frame 0 declared (`declared`, its settings): the
+    /// scene at that frame's [`check::Time`], or `None` with an error when it has errors
+    /// or its frame count, rate or looping differ from frame 0's.
+    pub fn frame(
+        &mut self,
+        number: u32,
+        declared: &ir::Settings,
+        loader: &dyn Loader,
+    ) -> (Option<ir::Scene>, Vec<Diagnostic>) {
+        let (mut scene, mut diagnostics) = self.at(check::Time::of(number, declared), loader);
+        if let Some(s) = scene.as_ref().map(|s| &s.settings) {
+            if (s.frames, s.fps, s.cyclic) != (declared.frames, declared.fps, declared.cyclic) {
+                let timing = |s: &ir::Settings| {
+                    let looping = if s.cyclic { ", looping" } else { "" };
+                    format!("{} frames at {} fps{looping}", s.frames, ir::dump_num(s.fps))
+                };
+                diagnostics.push(
+                    Diagnostic::error(
+                        diag::codes::ANIMATION_CHANGES,
+                        s.span.unwrap_or_default(),
+                        "the animation changes from frame to frame",
+                        format!("at frame {number}: {}", timing(s)),
+                    )
+                    .with_note(format!("at frame 0: {}", timing(declared)))
+                    .with_note("`frames`, `fps` and `cyclic` must not depend on `clock` or `frame`"),
+                );
+                scene = None;
+            }
+        }
+        (scene, diagnostics)
+    }
 }
 
 /// Compiles scene text named `name` (whose includes resolve relative to `path`). Text
@@ -78,10 +126,11 @@ pub fn compile_source(name: &str, path: &Path, text: String, loader: &dyn Loader
             format!("the file has {bytes} bytes"),
         )
         .with_note(format!("a source file may have at most {} MiB", source::MAX_FILE_BYTES >> 20));
-        return Compiled { map, scene: None, diagnostics: vec![d] };
+        return Compiled { map, scene: None, diagnostics: vec![d], root: None, reuse: check::Reuse::default() };
     };
-    let (scene, diagnostics) = check::check(&mut map, root, loader);
-    Compiled { map, scene, diagnostics }
+    let mut reuse = check::Reuse::default();
+    let (scene, diagnostics) = check::check_at(&mut map, root, loader, check::Time::STILL, &mut reuse);
+    Compiled { map, scene, diagnostics, root: Some(root), reuse }
 }
 
 /// Runs `f` on a thread with a large stack, so that pathological nesting in user input

@@ -333,70 +333,105 @@ const X: &[Param] = &[p("x", Ty::Num, Req)];
 /// Every builtin function, mesh generator and statement argument list.
 pub static BUILTINS: &[Builtin] = &[
     // Shapes.
-    f("sphere", Ctor::Primitive(Prim::Sphere), &[p("r", Ty::Num, Req)], Ty::Shape, "sphere of radius `r` centred at the origin"),
     f(
-        "box", Ctor::Primitive(Prim::Box),
+        "sphere",
+        Ctor::Primitive(Prim::Sphere),
+        &[p("r", Ty::Num, Req)],
+        Ty::Shape,
+        "sphere of radius `r` centred at the origin",
+    ),
+    f(
+        "box",
+        Ctor::Primitive(Prim::Box),
         &[p("size", Ty::Size, Req)],
         Ty::Shape,
         "box with half-extents `size` (a number for a cube; `box(x, y, z)` also works)",
     ),
-    f("cylinder", Ctor::Primitive(Prim::Cylinder), &[p("r", Ty::Num, Req), p("half_height", Ty::Num, Req)], Ty::Shape, "capped cylinder along y"),
-    f("torus", Ctor::Primitive(Prim::Torus), &[p("major", Ty::Num, Req), p("minor", Ty::Num, Req)], Ty::Shape, "torus in the xz plane"),
     f(
-        "plane", Ctor::Primitive(Prim::Plane),
+        "cylinder",
+        Ctor::Primitive(Prim::Cylinder),
+        &[p("r", Ty::Num, Req), p("half_height", Ty::Num, Req)],
+        Ty::Shape,
+        "capped cylinder along y",
+    ),
+    f(
+        "torus",
+        Ctor::Primitive(Prim::Torus),
+        &[p("major", Ty::Num, Req), p("minor", Ty::Num, Req)],
+        Ty::Shape,
+        "torus in the xz plane",
+    ),
+    f(
+        "plane",
+        Ctor::Primitive(Prim::Plane),
         &[p("normal", Ty::Vec3, V([0.0, 1.0, 0.0])), p("offset", Ty::Num, N(0.0))],
         Ty::Shape,
         "the half-space below `normal·p = offset`",
     ),
     f(
-        "capsule", Ctor::Primitive(Prim::Capsule),
+        "capsule",
+        Ctor::Primitive(Prim::Capsule),
         &[p("r", Ty::Num, Req), p("half_height", Ty::Num, Req)],
         Ty::Shape,
         "capsule along y: a segment of half-length `half_height` thickened by `r`",
     ),
     f(
-        "cone", Ctor::Primitive(Prim::Cone),
+        "cone",
+        Ctor::Primitive(Prim::Cone),
         &[p("r", Ty::Num, Req), p("half_height", Ty::Num, Req)],
         Ty::Shape,
         "capped cone along y with base radius `r`, apex up",
     ),
     // Operators and modifiers.
     variadic(
-        "union", Ctor::Csg(CsgOp::Union),
+        "union",
+        Ctor::Csg(CsgOp::Union),
         Ty::Shape,
         &[p("smooth", Ty::Num, N(0.0))],
         Ty::Shape,
         "everything inside any of the shapes; `smooth` blends the seams",
     ),
     variadic(
-        "intersect", Ctor::Csg(CsgOp::Intersect),
+        "intersect",
+        Ctor::Csg(CsgOp::Intersect),
         Ty::Shape,
         &[p("smooth", Ty::Num, N(0.0))],
         Ty::Shape,
         "only what is inside all of the shapes",
     ),
-    variadic("subtract", Ctor::Csg(CsgOp::Subtract), Ty::Shape, &[p("smooth", Ty::Num, N(0.0))], Ty::Shape, "the first shape minus all the others"),
+    variadic(
+        "subtract",
+        Ctor::Csg(CsgOp::Subtract),
+        Ty::Shape,
+        &[p("smooth", Ty::Num, N(0.0))],
+        Ty::Shape,
+        "the first shape minus all the others",
+    ),
     f(
-        "round", Ctor::Modifier(Modifier::Round),
+        "round",
+        Ctor::Modifier(Modifier::Round),
         &[p("shape", Ty::Shape, Req), p("r", Ty::Num, Req)],
         Ty::Shape,
         "rounds edges by growing the shape by `r`",
     ),
     f(
-        "shell", Ctor::Modifier(Modifier::Shell),
+        "shell",
+        Ctor::Modifier(Modifier::Shell),
         &[p("shape", Ty::Shape, Req), p("thickness", Ty::Num, Req)],
         Ty::Shape,
         "a hollow wall of `thickness` around the surface",
     ),
     f(
-        "repeat", Ctor::Modifier(Modifier::Repeat),
+        "repeat",
+        Ctor::Modifier(Modifier::Repeat),
         &[p("shape", Ty::Shape, Req), p("period", Ty::Size, Req), p("count", Ty::Size, Req)],
         Ty::Shape,
         "`count` copies per axis, `period` apart, centred at the origin",
     ),
     // Materials and colours.
     f(
-        "material", Ctor::Material,
+        "material",
+        Ctor::Material,
         &[
             p("color", Ty::Color, Default::Color([200.0, 200.0, 200.0])),
             p("specular", Ty::Num, N(-1.0)),
@@ -406,21 +441,30 @@ pub static BUILTINS: &[Builtin] = &[
         "surface: colour, Phong exponent (−1 = none), reflectivity in [0, 1]",
     ),
     f(
-        "rgb", Ctor::Rgb,
+        "rgb",
+        Ctor::Rgb,
         &[p("r", Ty::Num, Req), p("g", Ty::Num, Req), p("b", Ty::Num, Req)],
         Ty::Color,
         "a colour from 0–255 channels",
     ),
     // Lights.
-    f("ambient", Ctor::Light(LightFn::Ambient), &[p("intensity", Ty::Num, Req)], Ty::Light, "light reaching every point equally"),
     f(
-        "point", Ctor::Light(LightFn::Point),
+        "ambient",
+        Ctor::Light(LightFn::Ambient),
+        &[p("intensity", Ty::Num, Req)],
+        Ty::Light,
+        "light reaching every point equally",
+    ),
+    f(
+        "point",
+        Ctor::Light(LightFn::Point),
         &[p("intensity", Ty::Num, Req), p("shadows", Ty::Bool, B(true)), p("radius", Ty::Num, N(0.0))],
         Ty::Light,
         "a point light, placed with `at`; `radius` > 0 gives soft shadows",
     ),
     f(
-        "directional", Ctor::Light(LightFn::Directional),
+        "directional",
+        Ctor::Light(LightFn::Directional),
         &[p("intensity", Ty::Num, Req), p("towards", Ty::Vec3, Req), p("shadows", Ty::Bool, B(true))],
         Ty::Light,
         "a light at infinity, shining from direction `towards`",
@@ -435,7 +479,10 @@ pub static BUILTINS: &[Builtin] = &[
     f("ceil", Ctor::Math(MathFn::Ceil), X, Ty::Num, "smallest whole number not below `x`"),
     f("sign", Ctor::Math(MathFn::Sign), X, Ty::Num, "-1, 0 or 1 as `x` is negative, zero or positive"),
     f(
-        "random", Ctor::Math(MathFn::Random), &[p("seed", Ty::Num, Req)], Ty::Num,
+        "random",
+        Ctor::Math(MathFn::Random),
+        &[p("seed", Ty::Num, Req)],
+        Ty::Num,
         "a number in [0, 1) that depends only on `seed` (the same on every machine): `random(i * 7 + 3)`",
     ),
     f("exp", Ctor::Math(MathFn::Exp), X, Ty::Num, "e raised to `x`"),
@@ -447,51 +494,71 @@ pub static BUILTINS: &[Builtin] = &[
     // chooses (see `overload`).
     f("round", Ctor::Math(MathFn::Round), X, Ty::Num, "nearest whole number, halves away from zero"),
     f(
-        "pow", Ctor::Numeric(NumFn::Pow), &[p("x", Ty::Num, Req), p("y", Ty::Num, Req)], Ty::Num,
+        "pow",
+        Ctor::Numeric(NumFn::Pow),
+        &[p("x", Ty::Num, Req), p("y", Ty::Num, Req)],
+        Ty::Num,
         "`x` raised to the power `y` (a whole `y` when `x` is negative)",
     ),
     f(
-        "atan2", Ctor::Numeric(NumFn::Atan2), &[p("y", Ty::Num, Req), p("x", Ty::Num, Req)], Ty::Num,
+        "atan2",
+        Ctor::Numeric(NumFn::Atan2),
+        &[p("y", Ty::Num, Req), p("x", Ty::Num, Req)],
+        Ty::Num,
         "angle in degrees, in (-180, 180], of the point (x, y) from the +x axis",
     ),
     f(
-        "clamp", Ctor::Numeric(NumFn::Clamp),
+        "clamp",
+        Ctor::Numeric(NumFn::Clamp),
         &[p("x", Ty::Num, Req), p("lo", Ty::Num, Req), p("hi", Ty::Num, Req)],
         Ty::Num,
         "`x` limited to [lo, hi]",
     ),
     f(
-        "mix", Ctor::Numeric(NumFn::Mix),
+        "mix",
+        Ctor::Numeric(NumFn::Mix),
         &[p("a", Ty::Linear, Req), p("b", Ty::Linear, Req), p("t", Ty::Num, Req)],
         Ty::Linear,
         "`a + (b - a) * t`: numbers, vectors or colours, `a` and `b` of one type",
     ),
     f(
-        "hsv", Ctor::Numeric(NumFn::Hsv),
+        "hsv",
+        Ctor::Numeric(NumFn::Hsv),
         &[p("h", Ty::Num, Req), p("s", Ty::Num, Req), p("v", Ty::Num, Req)],
         Ty::Color,
         "a colour from hue in degrees (0 red, 120 green, 240 blue), saturation and value in [0, 1]",
     ),
     f(
-        "range", Ctor::Numeric(NumFn::Range),
+        "range",
+        Ctor::Numeric(NumFn::Range),
         &[p("from", Ty::Num, Req), p("to", Ty::Num, Req), p("step", Ty::Num, N(1.0))],
         Ty::List,
         "the list of every `from + i * step` (i = 0, 1, …) before `to`: `range(0, 1, 0.25)` is [0, 0.25, 0.5, 0.75]",
     ),
     f(
-        "sum", Ctor::Numeric(NumFn::Sum), &[p("list", Ty::List, Req)], Ty::Linear,
+        "sum",
+        Ctor::Numeric(NumFn::Sum),
+        &[p("list", Ty::List, Req)],
+        Ty::Linear,
         "sum of a list of numbers, vectors or colours (0 for an empty list)",
     ),
     f("dot", Ctor::Vector(VecFn::Dot), &[p("a", Ty::Vec3, Req), p("b", Ty::Vec3, Req)], Ty::Num, "dot product"),
     f("cross", Ctor::Vector(VecFn::Cross), &[p("a", Ty::Vec3, Req), p("b", Ty::Vec3, Req)], Ty::Vec3, "cross product"),
-    f("normalize", Ctor::Vector(VecFn::Normalize), &[p("v", Ty::Vec3, Req)], Ty::Vec3, "`v` scaled to length 1 (not zero)"),
+    f(
+        "normalize",
+        Ctor::Vector(VecFn::Normalize),
+        &[p("v", Ty::Vec3, Req)],
+        Ty::Vec3,
+        "`v` scaled to length 1 (not zero)",
+    ),
     f("length", Ctor::Vector(VecFn::Length), &[p("v", Ty::Vec3, Req)], Ty::Num, "Euclidean length of a vector"),
     variadic("min", Ctor::Extreme(Extreme::Min), Ty::Num, &[], Ty::Num, "smallest of the numbers"),
     variadic("max", Ctor::Extreme(Extreme::Max), Ty::Num, &[], Ty::Num, "largest of the numbers"),
     f("len", Ctor::Len, &[p("list", Ty::List, Req)], Ty::Int, "number of elements of a list"),
     // Mesh generators (after `mesh`).
     gen(
-        "uvsphere", Gen::UvSphere,
+        "uvsphere",
+        Gen::UvSphere,
         &[
             p("r", Ty::Num, N(1.0)),
             p("rings", Ty::Int, N(14.0)),
@@ -501,17 +568,20 @@ pub static BUILTINS: &[Builtin] = &[
         "UV sphere; `segments` defaults to 2 × `rings`",
     ),
     gen(
-        "icosphere", Gen::IcoSphere,
+        "icosphere",
+        Gen::IcoSphere,
         &[p("r", Ty::Num, N(1.0)), p("subdivisions", Ty::Int, N(2.0)), p("smooth", Ty::Bool, B(false))],
         "subdivided icosahedron",
     ),
     gen(
-        "box", Gen::Box,
+        "box",
+        Gen::Box,
         &[p("size", Ty::Size, N(1.0)), p("smooth", Ty::Bool, B(false))],
         "box of 12 triangles with half-extents `size`",
     ),
     gen(
-        "cylinder", Gen::Cylinder,
+        "cylinder",
+        Gen::Cylinder,
         &[
             p("r", Ty::Num, N(1.0)),
             p("half_height", Ty::Num, N(1.0)),
@@ -521,7 +591,8 @@ pub static BUILTINS: &[Builtin] = &[
         "capped cylinder along y, `segments` points per cap",
     ),
     gen(
-        "torus", Gen::Torus,
+        "torus",
+        Gen::Torus,
         &[
             p("major", Ty::Num, N(1.0)),
             p("minor", Ty::Num, N(0.25)),
@@ -532,17 +603,20 @@ pub static BUILTINS: &[Builtin] = &[
         "torus in the xz plane",
     ),
     gen(
-        "plane", Gen::Plane,
+        "plane",
+        Gen::Plane,
         &[p("size", Ty::Num, N(10.0)), p("smooth", Ty::Bool, B(false))],
         "a square of half-side `size` in the xz plane, facing +y",
     ),
     gen(
-        "isosurface", Gen::Isosurface,
+        "isosurface",
+        Gen::Isosurface,
         &[p("shape", Ty::Shape, Req), p("cell", Ty::Num, N(0.02)), p("smooth", Ty::Bool, B(false))],
         "any shape triangulated on a grid of `cell`-sized cells",
     ),
     gen(
-        "file", Gen::File,
+        "file",
+        Gen::File,
         &[p("path", Ty::Str, Req), p("smooth", Ty::Bool, B(false))],
         "a triangle mesh read from an OBJ file (relative to this file)",
     ),
@@ -573,15 +647,64 @@ pub static BUILTINS: &[Builtin] = &[
             p("max_distance", Ty::Num, N(1000.0)),
             p("samples", Ty::Int, N(1.0)),
             p("ambient_occlusion", Ty::Num, N(0.0)),
+            p("frames", Ty::Int, N(1.0)),
+            p("fps", Ty::Num, N(24.0)),
+            p("cyclic", Ty::Bool, Default::Bool(false)),
         ],
         variadic: None,
         result: Ty::Num,
-        doc: "image size, reflection depth, background, sphere-tracing accuracy, antialiasing and ambient-occlusion reach",
+        doc:
+            "image size, reflection depth, background, sphere-tracing accuracy, antialiasing, ambient-occlusion reach, \
+              and an animation's frame count, frame rate and whether it loops",
     },
 ];
 
-/// Named constants.
-pub const CONSTANTS: &[(&str, f64)] = &[("pi", std::f64::consts::PI)];
+/// A name the language defines as a value: a mathematical constant or the animation's time.
+#[derive(Debug)]
+pub struct Constant {
+    /// The name.
+    pub name: &'static str,
+    /// Its type.
+    pub ty: Ty,
+    /// Where its value comes from.
+    pub value: ConstValue,
+    /// One line for hover and the docs.
+    pub doc: &'static str,
+}
+
+/// Where a [`Constant`]'s value comes from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ConstValue {
+    /// Always this number.
+    Num(f64),
+    /// The frame's `clock` (see [`Time`](super::Time)).
+    Clock,
+    /// The frame's number.
+    Frame,
+}
+
+/// Named constants, and the two names that change from frame to frame.
+pub const CONSTANTS: &[Constant] = &[
+    Constant { name: "pi", ty: Ty::Num, value: ConstValue::Num(std::f64::consts::PI), doc: "π, 3.14159…" },
+    Constant {
+        name: "clock",
+        ty: Ty::Num,
+        value: ConstValue::Clock,
+        doc: "the animation's time: 0 at the first frame, 1 at the last (or one frame before the \
+              first again with `render(cyclic = true)`); 0 in a still",
+    },
+    Constant {
+        name: "frame",
+        ty: Ty::Int,
+        value: ConstValue::Frame,
+        doc: "the number of the frame being rendered, from 0 to `frames` − 1; 0 in a still",
+    },
+];
+
+/// The constant named `name`, if there is one.
+pub fn constant(name: &str) -> Option<&'static Constant> {
+    CONSTANTS.iter().find(|c| c.name == name)
+}
 
 /// The entries of each name, by kind (in [`Kind`]'s order), in table order.
 type Index = HashMap<&'static str, [Vec<&'static Builtin>; Kind::COUNT], FixedState>;

@@ -175,8 +175,15 @@ impl Ctx<'_> {
                 }
             };
         }
-        if let Some((_, x)) = builtins::CONSTANTS.iter().find(|(n, _)| *n == id.name) {
-            return Value::Num(*x);
+        if let Some(c) = builtins::constant(&id.name) {
+            if let Some(ix) = &mut self.index {
+                ix.constants.insert(id.span, c);
+            }
+            return Value::Num(match c.value {
+                builtins::ConstValue::Num(x) => x,
+                builtins::ConstValue::Clock => self.time.clock,
+                builtins::ConstValue::Frame => f64::from(self.time.frame),
+            });
         }
         if let Some(b) = builtins::lookup(&id.name, Kind::Function) {
             let example = if b.params.iter().any(|p| p.default == builtins::Default::Required) || b.variadic.is_some() {
@@ -197,7 +204,7 @@ impl Ctx<'_> {
             return Value::Error;
         }
         let mut candidates = self.names_in_scope(false);
-        candidates.extend(builtins::CONSTANTS.iter().map(|(n, _)| n.to_string()));
+        candidates.extend(builtins::CONSTANTS.iter().map(|c| c.name.to_string()));
         let mut d = Diagnostic::error(
             codes::UNKNOWN_NAME,
             id.span,

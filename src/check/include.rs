@@ -63,6 +63,11 @@ impl Ctx<'_> {
             );
             return;
         }
+        let (known, key) = self.reuse.included(&path);
+        if let Some(id) = known {
+            self.run_file(id);
+            return;
+        }
         let text = match self.loader.read(&path) {
             Ok(text) if text.len() > MAX_FILE_BYTES => {
                 self.report(Diagnostic::error(
@@ -91,17 +96,19 @@ impl Ctx<'_> {
             ));
             return;
         };
+        self.reuse.read(key, id);
         self.run_file(id);
     }
 
     /// Parses the file `id` and runs its statements, with includes relative to it.
     pub(super) fn run_file(&mut self, id: FileId) {
-        let (file, diags) = {
+        let parsed = {
             let f = self.map.file(id);
-            syntax::parse(&f.text, f.base)
+            self.reuse.parse(id, || syntax::parse(&f.text, f.base))
         };
+        let (file, diags) = &*parsed;
         for d in diags {
-            self.report(d);
+            self.report(d.clone());
         }
         let path = self.map.file(id).path.clone();
         let old_dir = std::mem::replace(&mut self.dir, Rc::from(path.parent().unwrap_or(Path::new(""))));

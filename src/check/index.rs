@@ -7,7 +7,7 @@
 
 use std::collections::HashMap;
 
-use super::builtins::{Builtin, Param};
+use super::builtins::{Builtin, Constant, Param};
 use crate::span::Span;
 
 /// What kind of name a definition binds.
@@ -64,6 +64,8 @@ pub struct Index {
     pub types: HashMap<Span, String>,
     /// Builtins named in the source.
     pub builtins: HashMap<Span, BuiltinUse>,
+    /// Constants (`pi`, `clock`, `frame`) named in the source.
+    pub constants: HashMap<Span, &'static Constant>,
 }
 
 impl Index {

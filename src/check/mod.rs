@@ -21,6 +21,7 @@ mod expr;
 mod include;
 pub mod index;
 mod range;
+mod time;
 mod transform;
 mod value;
 
@@ -37,11 +38,12 @@ use crate::source::{FileId, Loader, SourceMap};
 use crate::span::Span;
 use crate::syntax::ast;
 pub use construct::{
-    EPSILON_RULE, MAX_DEPTH, MAX_GENERATED_TRIANGLES, MAX_IMAGE_SIDE, MAX_MESH_RESOLUTION, MAX_PIXELS, MAX_REPEAT,
-    MAX_SAMPLES, MAX_STEPS, MIN_EPSILON,
+    EPSILON_RULE, MAX_DEPTH, MAX_FPS, MAX_FRAMES, MAX_GENERATED_TRIANGLES, MAX_IMAGE_SIDE, MAX_MESH_RESOLUTION,
+    MAX_PIXELS, MAX_REPEAT, MAX_SAMPLES, MAX_STEPS, MIN_EPSILON,
 };
 use env::{Binding, Captured, Env, Found};
 pub use range::{MAX_INTENSITY, MAX_REACH, MIN_SIZE};
+pub use time::{Reuse, Time};
 pub use value::Value;
 
 /// Most loop iterations in one compile, over all loops.
@@ -95,6 +97,10 @@ struct Func {
 struct Ctx<'a> {
     map: &'a mut SourceMap,
     loader: &'a dyn Loader,
+    /// The frame being evaluated: what `clock` and `frame` are.
+    time: Time,
+    /// Files read and parsed by earlier evaluations of the same scene.
+    reuse: &'a mut Reuse,
     diags: Vec<Diagnostic>,
     /// Each diagnostic reported so far, by code, span and message: its index in `diags`.
     reported: HashMap<(&'static str, Span, String), usize>,
@@ -600,18 +606,28 @@ fn behind_camera(obj: &ir::Object, camera: &Camera) -> Option<f64> {
     (depth + radius < 0.0).then_some(-(depth + radius))
 }
 
+/// What one evaluation of a scene reads and where it is in time.
+struct Input<'a> {
+    map: &'a mut SourceMap,
+    root: FileId,
+    loader: &'a dyn Loader,
+    time: Time,
+    reuse: &'a mut Reuse,
+}
+
 #[allow(clippy::type_complexity, reason = "the three results of one compile")]
 fn run(
-    map: &mut SourceMap,
-    root: FileId,
-    loader: &dyn Loader,
+    input: Input<'_>,
     indexed: bool,
     cancel: &dyn Fn() -> bool,
 ) -> Option<(Option<Scene>, Vec<Diagnostic>, Option<index::Index>)> {
+    let Input { map, root, loader, time, reuse } = input;
     let dir: Rc<Path> = Rc::from(map.file(root).path.parent().unwrap_or(Path::new("")));
     let mut ctx = Ctx {
         map,
         loader,
+        time,
+        reuse,
         diags: Vec::new(),
         reported: HashMap::new(),
         repeats: Vec::new(),
@@ -645,6 +661,7 @@ fn run(
         block_end: u32::MAX,
         export: None,
     };
+    ctx.reuse.start();
     ctx.run_file(root);
     if ctx.cancelled {
         return None;
@@ -656,9 +673,23 @@ fn run(
 
 /// Checks and evaluates the file `root` of `map` (already added), loading includes
 /// through `loader`. Returns the scene when there are no errors, and every diagnostic.
+/// The scene is a still, or the first frame of its animation (`clock` and `frame` are 0).
 pub fn check(map: &mut SourceMap, root: FileId, loader: &dyn Loader) -> (Option<Scene>, Vec<Diagnostic>) {
+    check_at(map, root, loader, Time::STILL, &mut Reuse::default())
+}
+
+/// [`check`] at `time`, reusing the files and parses of earlier evaluations of the same
+/// scene in `map` that `reuse` remembers (and remembering this one's).
+pub fn check_at(
+    map: &mut SourceMap,
+    root: FileId,
+    loader: &dyn Loader,
+    time: Time,
+    reuse: &mut Reuse,
+) -> (Option<Scene>, Vec<Diagnostic>) {
+    let input = Input { map, root, loader, time, reuse };
     // Nothing cancels this compile, so there is always a result.
-    run(map, root, loader, false, &|| false).map(|(scene, diags, _)| (scene, diags)).unwrap_or_default()
+    run(input, false, &|| false).map(|(scene, diags, _)| (scene, diags)).unwrap_or_default()
 }
 
 /// [`check`], also returning the [`index::Index`] of names and types for editor tooling.
@@ -670,7 +701,8 @@ pub fn check_indexed(
     loader: &dyn Loader,
     cancel: &dyn Fn() -> bool,
 ) -> Option<(Option<Scene>, Vec<Diagnostic>, index::Index)> {
-    let (scene, diags, index) = run(map, root, loader, true, cancel)?;
+    let input = Input { map, root, loader, time: Time::STILL, reuse: &mut Reuse::default() };
+    let (scene, diags, index) = run(input, true, cancel)?;
     Some((scene, diags, index.unwrap_or_default()))
 }
 

@@ -13,7 +13,6 @@ use scnc::export::report::MeshReport;
 use scnc::export::{Frame, Up};
 use scnc::source::FsLoader;
 use scnc::study::tolerance::Tolerance;
-use scnc::Compiled;
 
 use super::files::{check_output_as, write_atomic};
 use super::render::{parse_bytes, parse_detail};
@@ -200,8 +199,7 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
             e
         }
         Err(d) => {
-            let c = Compiled { map: compiled.map, scene: None, diagnostics: vec![d] };
-            report(&c, args.message_format);
+            super::report_in(&compiled.map, &[d], args.message_format);
             return ExitCode::from(1);
         }
     };

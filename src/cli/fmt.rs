@@ -5,10 +5,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use scnc::source::{FsLoader, Loader};
-use scnc::Compiled;
 
 use super::files::write_text;
-use super::{report, MessageFormat};
+use super::{report_in, MessageFormat};
 
 /// Formats each file in place, or with `check` lists those that would change.
 pub(crate) fn fmt_cmd(files: &[PathBuf], check: bool) -> ExitCode {
@@ -29,7 +28,7 @@ pub(crate) fn fmt_cmd(files: &[PathBuf], check: bool) -> ExitCode {
             Err(diagnostics) => {
                 let mut map = scnc::source::SourceMap::new();
                 let _ = map.add(&name, path, text);
-                report(&Compiled { map, scene: None, diagnostics }, MessageFormat::Human);
+                report_in(&map, &diagnostics, MessageFormat::Human);
                 let _ = writeln!(std::io::stderr(), "error: `{name}` was not formatted: it has syntax errors");
                 failed = true;
                 continue;

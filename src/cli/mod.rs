@@ -10,6 +10,7 @@
 mod export;
 mod files;
 mod fmt;
+mod frames;
 mod merge;
 mod render;
 mod stats;

@@ -1,13 +1,17 @@
 //! `scnc render`: one scene compiled, lowered and rendered to a PNG.
 
+use std::collections::HashSet;
 use std::io::{IsTerminal, Write};
-use std::path::PathBuf;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
 use clap::ValueEnum;
 
-use scnc::check::{EPSILON_RULE, MAX_DEPTH, MAX_IMAGE_SIDE, MAX_PIXELS, MAX_SAMPLES, MAX_STEPS, MIN_EPSILON};
+use scnc::check::{
+    Time, EPSILON_RULE, MAX_DEPTH, MAX_FRAMES, MAX_IMAGE_SIDE, MAX_PIXELS, MAX_SAMPLES, MAX_STEPS, MIN_EPSILON,
+};
 use scnc::source::FsLoader;
 use scnc::study::tolerance::Tolerance;
 use scnc::Compiled;
@@ -15,6 +19,7 @@ use scnc::Compiled;
 use scnc::render::Region;
 
 use super::files::{check_output, stop_on_interrupt, write_part_png, write_png};
+use super::frames::{frame_path, is_pattern, parse_frames, FrameChoice};
 use super::{compile, report, usage_error, worker_pool, MessageFormat};
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -93,6 +98,23 @@ pub(crate) struct RenderArgs {
     /// Render band I of N equal bands of rows (I from 0) as a part, like `--region`.
     #[arg(long, value_parser = parse_tile, value_name = "I/N")]
     tile: Option<(u32, u32)>,
+    /// Frames of the scene's animation to render, `A..B` (end exclusive) or `N`; every
+    /// frame it declares by default. More than one needs `#` in the output name.
+    #[arg(long, value_parser = parse_frames, value_name = "A..B")]
+    frames: Option<Range<u32>>,
+    /// Leave frames whose output file already exists (outputs are written whole or not
+    /// at all, so one that exists is complete).
+    #[arg(long)]
+    skip_existing: bool,
+    /// Render the chunk of frames picked by the task index in this environment variable
+    /// (`SLURM_ARRAY_TASK_ID`, `JOB_COMPLETION_INDEX`, …): task I renders frames I·K to
+    /// I·K + K − 1 of the selection, K being `--chunk`.
+    #[arg(long, value_name = "VAR")]
+    frame_index_from: Option<String>,
+    /// Frames per task with `--frame-index-from`.
+    #[arg(long, value_name = "K", default_value = "1", requires = "frame_index_from",
+          value_parser = clap::value_parser!(u32).range(1..=MAX_FRAMES as i64))]
+    chunk: u32,
     /// How to print diagnostics.
     #[arg(long, value_enum, default_value = "human")]
     message_format: MessageFormat,
@@ -263,28 +285,95 @@ pub(crate) fn render_once(args: &RenderArgs, pool: &rayon::ThreadPool) -> Attemp
     Attempt { files, result }
 }
 
-fn render_compiled(args: &RenderArgs, pool: &rayon::ThreadPool, compiled: Compiled) -> Result<(), ExitCode> {
+fn render_compiled(args: &RenderArgs, pool: &rayon::ThreadPool, mut compiled: Compiled) -> Result<(), ExitCode> {
     if report(&compiled, args.message_format) {
         return Err(ExitCode::from(1));
     }
-    let Some(mut scene) = compiled.scene else {
+    let Some(first) = compiled.scene.take() else {
         return Err(ExitCode::from(1));
     };
+    let declared = first.settings.clone();
+    let choice =
+        FrameChoice { frames: args.frames.clone(), index_from: args.frame_index_from.as_deref(), chunk: args.chunk };
+    let frames = choice.select(declared.frames, &|var| std::env::var(var).ok()).map_err(|e| usage_error(&e))?;
+    if frames.len() > 1 && !is_pattern(&args.output) {
+        return Err(usage_error(&format!(
+            "{} frames cannot all be written to `{}`: put `#` in the file name for the frame number, \
+             like `frame-####.png`",
+            frames.len(),
+            args.output.display()
+        )));
+    }
+    // Later frames report only what frame 0 did not.
+    let mut seen: HashSet<String> = compiled.diagnostics.iter().map(diagnostic_key).collect();
+    let mut first = Some(first);
+    let mut cache = scnc::world::FrameCache::default();
+    for number in frames {
+        let output = frame_path(&args.output, number);
+        if args.skip_existing && output.exists() {
+            let _ = writeln!(std::io::stderr(), "skipped {}: it exists", output.display());
+            continue;
+        }
+        let scene = match first.take().filter(|_| number == 0) {
+            Some(scene) => scene,
+            None => evaluate_frame(&mut compiled, number, &declared, &mut seen, args.message_format)?,
+        };
+        render_scene(args, pool, &compiled.map, scene, &output, &mut cache)?;
+    }
+    Ok(())
+}
+
+/// What makes a diagnostic the same one at another frame.
+fn diagnostic_key(d: &scnc::diag::Diagnostic) -> String {
+    format!("{} {:?} {}", d.code, d.span(), d.message)
+}
+
+/// Frame `number` of the animation `declared` (frame 0's settings) evaluated, its new
+/// diagnostics printed with the frame named; the exit code when it has errors.
+fn evaluate_frame(
+    compiled: &mut Compiled,
+    number: u32,
+    declared: &scnc::ir::Settings,
+    seen: &mut HashSet<String>,
+    format: MessageFormat,
+) -> Result<scnc::ir::Scene, ExitCode> {
+    let (scene, diagnostics) = scnc::with_big_stack(|| compiled.frame(number, declared, &FsLoader));
+    let clock = Time::of(number, declared).clock;
+    let fresh: Vec<_> = diagnostics
+        .into_iter()
+        .filter(|d| seen.insert(diagnostic_key(d)))
+        .map(|d| d.with_note(format!("at frame {number} (clock = {clock})")))
+        .collect();
+    if super::report_in(&compiled.map, &fresh, format) {
+        return Err(ExitCode::from(1));
+    }
+    scene.ok_or(ExitCode::from(1))
+}
+
+/// Lowers and renders one evaluated scene (a still or one frame) to `output`.
+fn render_scene(
+    args: &RenderArgs,
+    pool: &rayon::ThreadPool,
+    map: &scnc::source::SourceMap,
+    mut scene: scnc::ir::Scene,
+    output: &Path,
+    cache: &mut scnc::world::FrameCache,
+) -> Result<(), ExitCode> {
     let (mode, part) = args.apply(&mut scene)?;
     let started = Instant::now();
     let effects = match args.effects {
         EffectsArg::Derived => scnc::render::effects::derive(&scene),
         EffectsArg::All => scnc::render::effects::Effects::all(&scene),
     };
-    let lowered = pool.install(|| scnc::world::prepare_within(&scene, effects, mode, &FsLoader, args.memory_limit));
+    let lowered =
+        pool.install(|| scnc::world::prepare_reusing(&scene, effects, mode, &FsLoader, args.memory_limit, cache));
     let (frame, geometry) = match lowered {
         Ok(g) => {
-            super::report_in(&compiled.map, &g.1.warnings, args.message_format);
+            super::report_in(map, &g.1.warnings, args.message_format);
             g
         }
         Err(d) => {
-            let c = Compiled { map: compiled.map, scene: None, diagnostics: vec![d] };
-            report(&c, args.message_format);
+            super::report_in(map, &[d], args.message_format);
             return Err(ExitCode::from(1));
         }
     };
@@ -295,11 +384,11 @@ fn render_compiled(args: &RenderArgs, pool: &rayon::ThreadPool, compiled: Compil
     progress.finish();
     let traced = started.elapsed() - lowered;
     let written = match part {
-        Some(region) => write_part_png(&args.output, frame.width, frame.height, region, &image),
-        None => write_png(&args.output, &image),
+        Some(region) => write_part_png(output, frame.width, frame.height, region, &image),
+        None => write_png(output, &image),
     };
     if let Err(e) = written {
-        let _ = writeln!(std::io::stderr(), "error: cannot write `{}`: {e}", args.output.display());
+        let _ = writeln!(std::io::stderr(), "error: cannot write `{}`: {e}", output.display());
         return Err(ExitCode::from(1));
     }
     let secs = traced.as_secs_f64();
@@ -311,18 +400,22 @@ fn render_compiled(args: &RenderArgs, pool: &rayon::ThreadPool, compiled: Compil
     let _ = writeln!(
         err,
         "rendered {}: {size} in {:.3} s ({:.2} M rays/s, {} threads)",
-        args.output.display(),
+        output.display(),
         started.elapsed().as_secs_f64(),
         counters.rays() as f64 / secs.max(1e-9) / 1e6,
         pool.current_num_threads()
     );
     if args.stats {
         let _ = writeln!(err, "{}", frame.effects);
-        let _ = write!(
-            err,
-            "{}",
-            super::stats::stats_text(&counters, &geometry, &compiled.map, lowered.as_secs_f64(), secs)
-        );
+        let _ = write!(err, "{}", super::stats::stats_text(&counters, &geometry, map, lowered.as_secs_f64(), secs));
+        if scene.settings.frames > 1 {
+            let _ = writeln!(
+                err,
+                "  animation       {} of {} objects reused from the previous frame (not lowered again)",
+                cache.reused,
+                geometry.len()
+            );
+        }
     }
     Ok(())
 }

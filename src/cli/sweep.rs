@@ -8,7 +8,6 @@ use scnc::source::FsLoader;
 use scnc::study::sweep::{Options, PeakMemory, Setting};
 use scnc::study::tolerance::Tolerance;
 use scnc::study::{chart, report as table, sweep};
-use scnc::Compiled;
 
 use super::files::{write_png, write_text};
 use super::{compile, report, usage_error, MessageFormat};
@@ -73,8 +72,7 @@ pub(crate) fn sweep_cmd(args: SweepArgs) -> ExitCode {
     let rows = match sweep::run(&scene, &ladder, &opts) {
         Ok(rows) => rows,
         Err(d) => {
-            let c = Compiled { map: compiled.map, scene: None, diagnostics: vec![d] };
-            report(&c, args.message_format);
+            super::report_in(&compiled.map, &[d], args.message_format);
             return ExitCode::from(1);
         }
     };

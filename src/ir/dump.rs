@@ -148,7 +148,7 @@ pub fn dump(scene: &Scene, map: &SourceMap) -> String {
     d.line(
         0,
         &format!(
-            "render {}x{} depth {} background {} epsilon {} max_steps {} max_distance {} samples {}{}",
+            "render {}x{} depth {} background {} epsilon {} max_steps {} max_distance {} samples {}{}{}",
             s.width,
             s.height,
             s.depth,
@@ -159,6 +159,11 @@ pub fn dump(scene: &Scene, map: &SourceMap) -> String {
             s.samples,
             if s.ambient_occlusion > 0.0 {
                 format!(" ambient_occlusion {}", num(s.ambient_occlusion))
+            } else {
+                String::new()
+            },
+            if s.frames > 1 {
+                format!(" frames {} fps {}{}", s.frames, num(s.fps), if s.cyclic { " cyclic" } else { "" })
             } else {
                 String::new()
             }

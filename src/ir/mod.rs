@@ -84,6 +84,13 @@ pub struct Settings {
     pub samples: u32,
     /// Reach of ambient occlusion in world units (0 = off).
     pub ambient_occlusion: f64,
+    /// Frames of the animation (1: a still).
+    pub frames: u32,
+    /// Frames per second, for encoding an animation.
+    pub fps: f64,
+    /// Whether the animation loops: then `clock` stops one frame short of 1, so the frame
+    /// after the last would be the first again.
+    pub cyclic: bool,
     /// The `render` statement, if any.
     pub span: Option<Span>,
 }
@@ -100,6 +107,9 @@ impl Default for Settings {
             max_distance: 1000.0,
             samples: 1,
             ambient_occlusion: 0.0,
+            frames: 1,
+            fps: 24.0,
+            cyclic: false,
             span: None,
         }
     }
@@ -158,7 +168,7 @@ pub struct Light {
 }
 
 /// One `object` statement.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Object {
     /// Its geometry.
     pub geometry: Geometry,
@@ -167,7 +177,7 @@ pub struct Object {
 }
 
 /// Either an SDF-able shape tree or an explicit mesh.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum Geometry {
     /// A shape: sphere traced by the SDF back-end, tessellated by the mesh back-end.
     Shape(Arc<Shape>),
@@ -176,7 +186,7 @@ pub enum Geometry {
 }
 
 /// A node of a shape tree.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Shape {
     /// What it is.
     pub kind: ShapeKind,
@@ -220,7 +230,7 @@ impl CsgOp {
 }
 
 /// Shape nodes: a primitive leaf, a CSG operator, a modifier, a transform or a material.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum ShapeKind {
     /// A primitive solid (every per-primitive fact is stated there).
     Primitive(Primitive),
@@ -335,7 +345,7 @@ impl Mesh {
 }
 
 /// An explicit triangle mesh.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Mesh {
     /// How the triangles are made.
     pub source: MeshSource,
@@ -350,7 +360,7 @@ pub struct Mesh {
 }
 
 /// Mesh generators.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum MeshSource {
     /// UV sphere.
     UvSphere {

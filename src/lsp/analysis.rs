@@ -153,6 +153,9 @@ impl Analysis {
                 };
                 return Some((span, text));
             }
+            if let Some(c) = self.index.constants.get(&span) {
+                return Some((span, format!("```scn\n{}: {}\n```\n{}", c.name, c.ty, c.doc)));
+            }
             if let Some(def) = self.index.refs.get(&span).and_then(|d| self.index.def(*d)) {
                 return Some((span, describe_def(def)));
             }
@@ -217,11 +220,11 @@ impl Analysis {
             });
         }
         out.extend(builtins::BUILTINS.iter().filter(|b| b.kind() == Kind::Function).map(builtin_candidate));
-        out.extend(builtins::CONSTANTS.iter().map(|(name, value)| Candidate {
-            label: name.to_string(),
+        out.extend(builtins::CONSTANTS.iter().map(|c| Candidate {
+            label: c.name.to_string(),
             kind: CandidateKind::Constant,
-            detail: "num".into(),
-            doc: Some(format!("{value}")),
+            detail: c.ty.to_string(),
+            doc: Some(c.doc.to_string()),
         }));
         let depth: i32 = before.iter().map(|(t, _)| bracket_delta(t)).sum();
         if call.is_none() && depth == 0 {

@@ -209,6 +209,11 @@ impl Budget {
         .with_hint("try a lower `--detail`, coarser meshes, or a lower `--memory-limit`"))
     }
 
+    /// Triangles the scene's meshes may still have.
+    pub fn triangles_left(&self) -> u64 {
+        self.triangles
+    }
+
     /// Takes `triangles` from what is left, or reports the object that would exceed the
     /// triangle count or the memory limit, before anything is allocated.
     pub fn spend(&mut self, triangles: u64, span: Span) -> Result<(), Diagnostic> {

@@ -40,6 +40,7 @@ pub fn take_leaf_evals() -> u64 {
 }
 
 /// One shape object ready for marching, in render space.
+#[derive(Clone)]
 pub struct SdfObject {
     /// Distance bound, for marching.
     pub dist: Sdf,

@@ -195,6 +195,7 @@ impl Fold {
 /// parts in force equals the full one. That field is 1-Lipschitz, so a step by it never
 /// crosses one of its zeros, and therefore never crosses the surface; a step never runs
 /// past the next part's entry either, where the parts in force change.
+#[derive(Clone)]
 pub struct RayParts {
     /// The parts' frame from render space (identity for unions built in render space).
     pub inv: glam::Affine3A,

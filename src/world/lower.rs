@@ -1,7 +1,9 @@
 //! Lowering: each object to its back-end, in scene order (materials and the triangle
 //! budget are spent deterministically), then meshes built in parallel.
 
-use glam::{DAffine3, Vec3A};
+use std::sync::Arc;
+
+use glam::{DAffine3, DVec3, Vec3A};
 use rayon::prelude::*;
 
 use super::{Mode, Object, ObjectKind, World};
@@ -9,14 +11,16 @@ use crate::accel::{padded_sphere, Aabb, Bvh};
 use crate::diag::Diagnostic;
 use crate::ir;
 use crate::mesh;
-use crate::render::Frame;
+use crate::render::{Frame, ShadeMaterial};
 use crate::sdf::{self, MarchParams, SdfObject};
 use crate::source::Loader;
 
-/// An object between lowering and building: an SDF object with its bounds, or a mesh to build.
+/// An object between lowering and building: an SDF object with its bounds, a mesh to
+/// build, or an object an earlier frame lowered.
 enum Lowered {
     Sdf(SdfObject, Option<Aabb>, Option<(Vec3A, f32)>),
     Mesh(mesh::MeshJob),
+    Kept(Object),
 }
 
 /// Builds the frame for `effects` and lowers the scene into a world, with the scene's
@@ -40,10 +44,25 @@ pub fn prepare_within(
     loader: &dyn Loader,
     memory_limit: u64,
 ) -> Result<(Frame, World), Diagnostic> {
+    prepare_reusing(scene, effects, mode, loader, memory_limit, &mut FrameCache::default())
+}
+
+/// [`prepare_within`] for one frame of an animation: objects equal to the previous
+/// frame's, seen from the same place, are taken from `reuse` instead of lowered again
+/// (their meshes are shared, not rebuilt), and this frame's objects are kept there for
+/// the next. The world is the one [`prepare_within`] would make, bit for bit.
+pub fn prepare_reusing(
+    scene: &ir::Scene,
+    effects: crate::render::effects::Effects,
+    mode: Mode,
+    loader: &dyn Loader,
+    memory_limit: u64,
+    reuse: &mut FrameCache,
+) -> Result<(Frame, World), Diagnostic> {
     let mut frame = Frame::with_effects(scene, effects);
     let params = MarchParams { epsilon: scene.settings.epsilon as f32, max_steps: scene.settings.max_steps };
     let budget = mesh::lower::Budget::new(memory_limit);
-    let world = lower(scene, &mut frame, mode, params, loader, budget)?;
+    let world = lower_reusing(scene, &mut frame, mode, params, loader, budget, reuse)?;
     Ok((frame, world))
 }
 
@@ -55,63 +74,162 @@ pub fn lower(
     mode: Mode,
     params: MarchParams,
     loader: &dyn Loader,
+    budget: mesh::lower::Budget,
+) -> Result<World, Diagnostic> {
+    lower_reusing(scene, frame, mode, params, loader, budget, &mut FrameCache::default())
+}
+
+/// Objects one frame lowered, for the next frame to reuse.
+///
+/// Why a kept object is exactly what lowering would make again: lowering an object is a
+/// function of the object, the render-space origin, the back-end and its detail, and the
+/// material table it starts from (it interns its materials, and their ids depend on
+/// what is in the table). The first three are compared whole; for the table, a kept
+/// object remembers how long it was before and after the object, and is reused only when
+/// this frame's table so far equals the last frame's up to that length, then takes the
+/// entries the object added. Mesh files are read again each frame, as a changed file
+/// should show (an object naming one is never kept).
+#[derive(Default)]
+pub struct FrameCache {
+    /// Where render space was, how far rays reach (planes are meshed to there), and
+    /// which back-end.
+    origin: DVec3,
+    max_distance: f32,
+    mode: Option<Mode>,
+    /// By object index; `None` for an object that is lowered afresh every frame.
+    kept: Vec<Option<Kept>>,
+    /// The material table the kept objects were lowered into, at its end.
+    table: Vec<ShadeMaterial>,
+    /// Objects reused by the last lowering, for `--stats`.
+    pub reused: usize,
+}
+
+/// One object kept for the next frame.
+struct Kept {
+    source: ir::Object,
+    object: Object,
+    /// The material table's length before and after the object.
+    table: (usize, usize),
+    closure_bytes: usize,
+    triangles: u64,
+    warnings: Vec<Diagnostic>,
+}
+
+/// Whether lowering `obj` reads a file (which may change between frames).
+fn reads_files(obj: &ir::Object) -> bool {
+    matches!(&obj.geometry, ir::Geometry::Mesh(m) if matches!(m.source, ir::MeshSource::File { .. }))
+}
+
+fn lower_reusing(
+    scene: &ir::Scene,
+    frame: &mut Frame,
+    mode: Mode,
+    params: MarchParams,
+    loader: &dyn Loader,
     mut budget: mesh::lower::Budget,
+    reuse: &mut FrameCache,
 ) -> Result<World, Diagnostic> {
     // Render space: world translated so the camera is at the origin, composed in f64.
     let to_render = DAffine3::from_translation(-frame.origin);
     let max_distance = frame.max_distance as f64;
+    if (reuse.origin, reuse.max_distance, reuse.mode) != (frame.origin, frame.max_distance, Some(mode)) {
+        reuse.kept.clear();
+    }
     let mut builder = sdf::Builder::new(&mut frame.materials);
+    // How much of this frame's material table equals the last frame's so far.
+    let mut agree = 0;
+    let mut reused = 0;
     // In scene order: materials are interned and the triangle budget spent as objects
     // come, so ids and errors do not depend on timing. Meshes are built afterwards.
     let mut lowered = Vec::with_capacity(scene.objects.len());
-    for obj in &scene.objects {
-        let part = match (&obj.geometry, mode) {
-            (ir::Geometry::Shape(shape), Mode::Sdf) => {
-                let bounds = ir::shape_bounds(shape).map(|b| Aabb::padded(b.transform(&to_render)));
-                let sphere = ir::shape_sphere(shape).map(|(c, r)| padded_sphere(to_render.transform_point3(c), r));
-                Lowered::Sdf(SdfObject::new(shape, to_render, &mut builder), bounds, sphere)
+    let mut kept = Vec::with_capacity(scene.objects.len());
+    for (i, obj) in scene.objects.iter().enumerate() {
+        let table = &mut builder.materials.materials;
+        while agree < table.len().min(reuse.table.len()) && table[agree] == reuse.table[agree] {
+            agree += 1;
+        }
+        let before = (table.len(), builder.bytes, budget.triangles_left());
+        let old = reuse.kept.get(i).and_then(Option::as_ref);
+        let old = old.filter(|k| k.source == *obj && k.table.0 == before.0 && agree >= before.0);
+        let part = match old {
+            Some(k) => {
+                table.extend_from_slice(&reuse.table[k.table.0..k.table.1]);
+                builder.bytes += k.closure_bytes;
+                if k.triangles > 0 {
+                    budget.spend(k.triangles, obj.span)?;
+                }
+                reused += 1;
+                Lowered::Kept(k.object.clone())
             }
-            (ir::Geometry::Shape(shape), Mode::Mesh(detail)) => Lowered::Mesh(mesh::lower::tessellate(
-                shape,
-                to_render,
-                detail,
-                max_distance,
-                &mut budget,
-                builder.materials,
-            )?),
-            (ir::Geometry::Mesh(m), _) => {
-                Lowered::Mesh(mesh::lower::explicit(m, to_render, &mut budget, builder.materials, loader)?)
-            }
+            None => match (&obj.geometry, mode) {
+                (ir::Geometry::Shape(shape), Mode::Sdf) => {
+                    let bounds = ir::shape_bounds(shape).map(|b| Aabb::padded(b.transform(&to_render)));
+                    let sphere = ir::shape_sphere(shape).map(|(c, r)| padded_sphere(to_render.transform_point3(c), r));
+                    Lowered::Sdf(SdfObject::new(shape, to_render, &mut builder), bounds, sphere)
+                }
+                (ir::Geometry::Shape(shape), Mode::Mesh(detail)) => Lowered::Mesh(mesh::lower::tessellate(
+                    shape,
+                    to_render,
+                    detail,
+                    max_distance,
+                    &mut budget,
+                    builder.materials,
+                )?),
+                (ir::Geometry::Mesh(m), _) => {
+                    Lowered::Mesh(mesh::lower::explicit(m, to_render, &mut budget, builder.materials, loader)?)
+                }
+            },
         };
-        lowered.push((part, obj.span));
+        let after = (builder.materials.materials.len(), builder.bytes, budget.triangles_left());
+        let warnings = match (&part, old) {
+            (Lowered::Mesh(job), _) => job.warnings.clone(),
+            (_, Some(k)) => k.warnings.clone(),
+            _ => Vec::new(),
+        };
+        let (closure_bytes, triangles) = (after.1 - before.1, before.2 - after.2);
+        kept.push((obj, (before.0, after.0), closure_bytes, triangles, warnings.clone()));
+        lowered.push((part, warnings, obj.span));
     }
     budget.confirm()?;
-    let warnings = lowered
-        .iter_mut()
-        .flat_map(|(part, _)| match part {
-            Lowered::Mesh(job) => std::mem::take(&mut job.warnings),
-            Lowered::Sdf(..) => Vec::new(),
-        })
-        .collect();
+    let warnings: Vec<Diagnostic> = lowered.iter().flat_map(|(_, w, _)| w.iter().cloned()).collect();
     // Building the meshes (vertices to render space, BVHs) is most of the lowering time
     // of a scene of many meshes; they are independent, so they are built in parallel.
     let objects: Vec<Object> = lowered
         .into_par_iter()
-        .map(|(part, span)| match part {
+        .map(|(part, _, span)| match part {
             Lowered::Sdf(s, bounds, sphere) => Object { kind: ObjectKind::Sdf(s), bounds, sphere, span },
             Lowered::Mesh(job) => {
                 let m = job.build();
-                Object { bounds: Some(m.bounds()), sphere: m.sphere(), kind: ObjectKind::Mesh(m), span }
+                Object { bounds: Some(m.bounds()), sphere: m.sphere(), kind: ObjectKind::Mesh(Arc::new(m)), span }
             }
+            Lowered::Kept(object) => object,
         })
         .collect();
+    let closure_bytes = builder.bytes;
+    reuse.kept = kept
+        .into_iter()
+        .zip(&objects)
+        .map(|((obj, table, closure_bytes, triangles, warnings), object)| {
+            let source = (!reads_files(obj)).then(|| obj.clone())?;
+            Some(Kept { source, object: object.clone(), table, closure_bytes, triangles, warnings })
+        })
+        .collect();
+    reuse.origin = frame.origin;
+    reuse.max_distance = frame.max_distance;
+    reuse.mode = Some(mode);
+    reuse.table = frame.materials.materials.clone();
+    reuse.reused = reused;
+    Ok(world_of(objects, params, closure_bytes, warnings))
+}
+
+/// The world of lowered objects: the top-level BVH over the bounded ones.
+fn world_of(objects: Vec<Object>, params: MarchParams, closure_bytes: usize, warnings: Vec<Diagnostic>) -> World {
     // The checker's renderable range (check::range) keeps camera-relative f32 finite.
     debug_assert!(
         objects.iter().all(|o| o.bounds.is_none_or(|b| b.min.is_finite() && b.max.is_finite())
             && o.sphere.is_none_or(|(c, r)| c.is_finite() && r.is_finite())),
         "lowering made a non-finite bound"
     );
-    let closure_bytes = builder.bytes;
     let bounded: Vec<u32> = (0..objects.len() as u32)
         .filter(|&i| objects[i as usize].bounds.is_some_and(|b| b.min.cmple(b.max).all()))
         .collect();
@@ -121,5 +239,5 @@ pub fn lower(
     debug_assert!(bvh.validate(&boxes).is_ok());
     let has_meshes = objects.iter().any(|o| matches!(o.kind, ObjectKind::Mesh(_)));
     let share_walks = has_meshes || bvh.node_count() > 1;
-    Ok(World { objects, bvh, bounded, unbounded, params, closure_bytes, has_meshes, share_walks, warnings })
+    World { objects, bvh, bounded, unbounded, params, closure_bytes, has_meshes, share_walks, warnings }
 }

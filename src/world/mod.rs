@@ -17,7 +17,7 @@ mod query;
 
 use glam::Vec3A;
 
-pub use lower::{lower, prepare, prepare_within};
+pub use lower::{lower, prepare, prepare_reusing, prepare_within, FrameCache};
 
 use crate::accel::{Aabb, Bvh};
 use crate::mesh::{Detail, MeshMemory, MeshObject};
@@ -34,13 +34,15 @@ pub enum Mode {
 }
 
 /// One object of the world.
+#[derive(Clone)]
 pub enum ObjectKind {
     /// Sphere traced.
     Sdf(SdfObject),
-    /// Triangles.
-    Mesh(MeshObject),
+    /// Triangles, shared with the frames that reuse them.
+    Mesh(std::sync::Arc<MeshObject>),
 }
 
+#[derive(Clone)]
 pub(crate) struct Object {
     kind: ObjectKind,
     bounds: Option<Aabb>,

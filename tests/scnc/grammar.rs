@@ -74,7 +74,7 @@ fn grammar_knows_exactly_the_compilers_words() {
     assert_eq!(keywords, set(&mut Token::KEYWORDS.iter().copied()), "keywords");
     assert_eq!(words(&all, "support.function.builtin"), set(&mut builtins::names(Kind::Function)), "builtins");
     assert_eq!(words(&all, "support.function.mesh"), set(&mut builtins::names(Kind::MeshGenerator)), "mesh generators");
-    let constants = set(&mut builtins::CONSTANTS.iter().map(|(n, _)| *n));
+    let constants = set(&mut builtins::CONSTANTS.iter().map(|c| c.name));
     assert_eq!(words(&all, "constant.language.scn"), constants, "constants");
 }
 

@@ -38,6 +38,10 @@ pub const MAX_STEPS: u32 = 1_000_000;
 pub const MIN_EPSILON: f64 = 1e-6;
 /// How a bad `epsilon` is explained, in the scene and on the command line.
 pub const EPSILON_RULE: &str = "at least 1e-6 (f32 cannot resolve less) and less than 1";
+/// Most frames of an animation: an hour at 24 frames a second is 86,400.
+pub const MAX_FRAMES: u32 = 1_000_000;
+/// Highest frame rate.
+pub const MAX_FPS: f64 = 1000.0;
 /// Most copies per axis of `repeat`.
 pub const MAX_REPEAT: u32 = 1_000;
 /// Most nodes of one shape, shared parts counted each time they are used.
@@ -284,8 +288,10 @@ impl Ctx<'_> {
         let ok_dist = self.check_num(&a, b, 6, |d| d > 0.0 && d <= super::MAX_REACH, "greater than 0 and at most 1e15");
         let samples = self.check_int(&a, b, 7, 1, MAX_SAMPLES);
         let ok_ao = self.check_num(&a, b, 8, |d| d >= 0.0, "at least 0 (0 turns it off)");
-        let (Some(width), Some(height), Some(depth), true, Some(max_steps), true, Some(samples)) =
-            (width, height, depth, ok_eps && ok_ao, steps, ok_dist, samples)
+        let frames = self.check_int(&a, b, 9, 1, MAX_FRAMES);
+        let ok_fps = self.check_num(&a, b, 10, |f| f > 0.0 && f <= MAX_FPS, "greater than 0 and at most 1000");
+        let (Some(width), Some(height), Some(depth), true, Some(max_steps), true, Some(samples), Some(frames)) =
+            (width, height, depth, ok_eps && ok_ao && ok_fps, steps, ok_dist, samples, frames)
         else {
             return None;
         };
@@ -314,6 +320,9 @@ impl Ctx<'_> {
             max_distance: a.num(b, 6),
             samples,
             ambient_occlusion: a.num(b, 8),
+            frames,
+            fps: a.num(b, 10),
+            cyclic: a.flag(b, 11),
             span: Some(span),
         })
     }
