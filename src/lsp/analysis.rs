@@ -130,13 +130,15 @@ impl Analysis {
         &self.map.file(FileId(0)).text
     }
 
-    /// The smallest name span at `at` that the index knows (a use, a definition or a builtin).
+    /// The smallest name span at `at` that the index knows (a use, a definition, a
+    /// builtin or a constant).
     fn name_at(&self, at: u32) -> Option<Span> {
         let hit = |s: &Span| s.start <= at && at <= s.end;
         self.index
             .refs
             .keys()
             .chain(self.index.builtins.keys())
+            .chain(self.index.constants.keys())
             .filter(|s| hit(s))
             .min_by_key(|s| (s.end - s.start, s.start))
             .copied()

@@ -448,3 +448,25 @@ if n > 2 {
     assert_eq!(inner, ["object union(…)", "object sphere(…)"]);
     c.stop();
 }
+
+/// `clock` and `frame` are known to hover and completion, with what they mean.
+#[test]
+fn the_animation_names_in_the_editor() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let doc = uri(&dir.path().join("scene.scn"));
+    let text = "render(frames = 24)\nlight ambient(0.2)\nobject sphere(0.5 + clock) at [frame, 0, 5]\n";
+    let mut c = Client::start();
+    c.open(&doc, text);
+    let h = c.at("textDocument/hover", &doc, 2, 22);
+    let h = h["contents"]["value"].as_str().unwrap_or_default().to_string();
+    assert!(h.contains("clock: num") && h.contains("0 at the first frame"), "{h}");
+    let h = c.at("textDocument/hover", &doc, 2, 32);
+    let h = h["contents"]["value"].as_str().unwrap_or_default().to_string();
+    assert!(h.contains("frame: int") && h.contains("frame being rendered"), "{h}");
+    let h = c.at("textDocument/hover", &doc, 0, 9);
+    let h = h["contents"]["value"].as_str().unwrap_or_default().to_string();
+    assert!(h.contains("frames: int = 1"), "{h}");
+    let items = c.at("textDocument/completion", &doc, 2, 20);
+    let labels: Vec<&str> = items.as_array().expect("items").iter().filter_map(|i| i["label"].as_str()).collect();
+    assert!(labels.contains(&"clock") && labels.contains(&"frame"), "{labels:?}");
+}

@@ -1,5 +1,6 @@
 //! The single integration-test binary: every test module links into it.
 
+mod animation;
 mod budget;
 mod cli;
 mod conformance;

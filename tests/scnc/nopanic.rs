@@ -18,7 +18,7 @@ impl Loader for Examples {
 
 fn sources() -> Vec<(String, String)> {
     let mut out = Vec::new();
-    for dir in ["examples/seed", "examples/features"] {
+    for dir in ["examples/seed", "examples/features", "examples/animation"] {
         for path in crate::support::cases(dir) {
             let text = std::fs::read_to_string(&path).expect("example");
             out.push((path.display().to_string(), text));

@@ -1,0 +1,180 @@
+//! Animation: `clock` and `frame` evaluated at frames (goldens), and the command-line
+//! contract a job system relies on: frames named by `####`, exactly the frames asked
+//! for, `--skip-existing`, the task index from the environment, a frame rendered alone
+//! equal to the same frame rendered in a sequence, and `scnc encode`.
+
+use std::path::Path;
+use std::process::Output;
+
+use scnc::source::FsLoader;
+
+use crate::support::{cases, check_golden, compile, finish, scnc};
+
+fn ok(out: &Output) {
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+}
+
+fn path(p: &Path) -> &str {
+    p.to_str().expect("utf-8 path")
+}
+
+/// The PNG files in `dir`, sorted by name.
+fn pngs(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .expect("reading the output directory")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".png"))
+        .collect();
+    names.sort();
+    names
+}
+
+/// Every case dumped at its first, middle and last frame matches `NAME.ir`.
+#[test]
+fn clock_and_frame_evaluate_per_frame() {
+    let mut failures = Vec::new();
+    for path in cases("tests/data/time") {
+        let mut c = compile(&path);
+        let Some(first) = c.scene.take() else {
+            failures.push(format!("{}: did not compile", path.display()));
+            continue;
+        };
+        let declared = first.settings.clone();
+        let last = declared.frames - 1;
+        let mut frames = vec![0, last / 2, last];
+        frames.dedup();
+        let mut actual = String::new();
+        for k in frames {
+            let time = scnc::check::Time::of(k, &declared);
+            let (scene, diags) = scnc::with_big_stack(|| c.frame(k, &declared, &FsLoader));
+            let scene = scene.unwrap_or_else(|| panic!("{}: frame {k}:\n{diags:?}", path.display()));
+            actual.push_str(&format!("== frame {k}, clock {}\n", time.clock));
+            actual.push_str(&scnc::ir::dump(&scene, &c.map));
+        }
+        failures.extend(check_golden(&path.with_extension("ir"), &actual));
+    }
+    finish(failures);
+}
+
+#[test]
+fn the_clock_runs_to_one_or_one_frame_short_of_it_when_cyclic() {
+    let mut s = scnc::ir::Settings { frames: 5, ..Default::default() };
+    let clock = |k, s: &scnc::ir::Settings| scnc::check::Time::of(k, s).clock;
+    assert_eq!([0, 1, 4].map(|k| clock(k, &s)), [0.0, 0.25, 1.0]);
+    s.cyclic = true;
+    assert_eq!([0, 1, 4].map(|k| clock(k, &s)), [0.0, 0.2, 0.8]);
+    s.frames = 1;
+    assert_eq!(clock(0, &s), 0.0);
+    s.cyclic = false;
+    assert_eq!(clock(0, &s), 0.0);
+}
+
+const SCENE: &str = "tests/data/animation/bounce.scn";
+
+#[test]
+fn frames_a_to_b_write_exactly_those_files() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let pattern = dir.path().join("f-####.png");
+    ok(&scnc(&["render", SCENE, "-o", path(&pattern), "--frames", "2..5"]));
+    assert_eq!(pngs(dir.path()), ["f-0002.png", "f-0003.png", "f-0004.png"]);
+    // A single frame by number.
+    ok(&scnc(&["render", SCENE, "-o", path(&pattern), "--frames", "7"]));
+    assert_eq!(pngs(dir.path()).len(), 4);
+}
+
+#[test]
+fn an_animation_without_hashes_or_past_its_end_is_refused_before_any_work() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let one = dir.path().join("one.png");
+    let out = scnc(&["render", SCENE, "-o", path(&one)]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("put `#` in the file name"));
+    let pattern = dir.path().join("f-##.png");
+    let out = scnc(&["render", SCENE, "-o", path(&pattern), "--frames", "6..9"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("frames 0..8"), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = scnc(&["render", "examples/seed/01-sphere.scn", "-o", path(&pattern), "--frames", "0..2"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("the scene is a still"));
+    assert!(pngs(dir.path()).is_empty(), "nothing may be written");
+}
+
+#[test]
+fn skip_existing_renders_nothing_the_second_time() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let pattern = dir.path().join("f-##.png");
+    let args = ["render", SCENE, "-o", path(&pattern), "--frames", "0..3", "--skip-existing"];
+    ok(&scnc(&args));
+    let before: Vec<_> = pngs(dir.path()).iter().map(|n| std::fs::read(dir.path().join(n)).expect("read")).collect();
+    // One frame lost (a task killed before it wrote) is rendered again; the rest are not.
+    std::fs::remove_file(dir.path().join("f-01.png")).expect("remove");
+    let out = scnc(&args);
+    ok(&out);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.matches("skipped").count(), 2, "{err}");
+    assert_eq!(err.matches("rendered").count(), 1, "{err}");
+    let out = scnc(&args);
+    assert_eq!(String::from_utf8_lossy(&out.stderr).matches("rendered").count(), 0);
+    let after: Vec<_> = pngs(dir.path()).iter().map(|n| std::fs::read(dir.path().join(n)).expect("read")).collect();
+    assert_eq!(before, after);
+}
+
+/// A job system's task index picks a chunk; a frame rendered by its own task (lowered
+/// afresh) equals the same frame rendered in a sequence (its unchanged objects reused
+/// from the frame before), byte for byte.
+#[test]
+fn tasks_render_their_chunk_and_frames_do_not_depend_on_how_they_were_grouped() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let (seq, farm) = (dir.path().join("seq"), dir.path().join("farm"));
+    std::fs::create_dir_all(&seq).expect("mkdir");
+    std::fs::create_dir_all(&farm).expect("mkdir");
+    for mode in ["sdf", "mesh"] {
+        ok(&scnc(&["render", SCENE, "-o", path(&seq.join("f-##.png")), "--geometry", mode]));
+        for task in 0..3 {
+            let out = std::process::Command::new(env!("CARGO_BIN_EXE_scnc"))
+                .args(["render", SCENE, "-o", path(&farm.join("f-##.png")), "--geometry", mode])
+                .args(["--frame-index-from", "SCNC_TEST_TASK", "--chunk", "3"])
+                .env("SCNC_TEST_TASK", task.to_string())
+                .output()
+                .expect("running scnc");
+            ok(&out);
+        }
+        assert_eq!(pngs(&farm).len(), 8, "tasks 0-2 of 3 frames cover 8 frames");
+        for name in pngs(&seq) {
+            let same = std::fs::read(seq.join(&name)).expect("seq") == std::fs::read(farm.join(&name)).expect("farm");
+            assert!(same, "{mode}: {name} differs between the sequence and its task");
+        }
+    }
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_scnc"))
+        .args(["render", SCENE, "-o", path(&farm.join("f-##.png")), "--frame-index-from", "SCNC_TEST_TASK"])
+        .args(["--chunk", "3"])
+        .env("SCNC_TEST_TASK", "3")
+        .output()
+        .expect("running scnc");
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("tasks 0 to 2"));
+    let out = scnc(&["render", SCENE, "-o", path(&farm.join("f-##.png")), "--frame-index-from", "SCNC_NOT_SET_X"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("is not set"));
+}
+
+/// An error only some frames reach is reported at that frame, naming it; a frame count
+/// that changes with the clock is E0503.
+#[test]
+fn errors_of_later_frames_name_the_frame() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let scene = dir.path().join("shrink.scn");
+    std::fs::write(&scene, "render(width = 16, height = 16, frames = 3)\nobject sphere(1 - clock) at [0, 0, 5]\n")
+        .expect("write");
+    let out = scnc(&["render", path(&scene), "-o", path(&dir.path().join("f-#.png"))]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("at frame 2 (clock = 1)") && err.contains("E0400"), "{err}");
+    assert_eq!(pngs(dir.path()), ["f-0.png", "f-1.png"], "frames before the error are written");
+    std::fs::write(&scene, "render(width = 16, height = 16, frames = 3 + frame)\nobject sphere(1) at [0, 0, 5]\n")
+        .expect("write");
+    let out = scnc(&["render", path(&scene), "-o", path(&dir.path().join("g-#.png"))]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("E0503") && err.contains("at frame 0: 3 frames"), "{err}");
+}
