@@ -7,6 +7,7 @@
 //! - `fmt`: `scnc fmt`.
 //! - `export`: the scene as a mesh file.
 
+mod encode;
 mod export;
 mod files;
 mod fmt;
@@ -64,6 +65,9 @@ enum Command {
     /// Assemble parts rendered with `render --region` or `--tile` into one image; fails,
     /// writing nothing, on parts of different sizes, overlapping parts or a gap.
     Merge(merge::MergeArgs),
+    /// Encode rendered frames (`out/frame-####.png`) as one animation: GIF, APNG
+    /// (`.png`) or MP4 (through `ffmpeg`, when it is on PATH); written whole or not at all.
+    Encode(encode::EncodeArgs),
     /// Write the scene's objects as a mesh file (STL, OBJ, PLY, 3MF or glb), meshed as
     /// `render --geometry mesh` meshes them (written whole or not at all).
     Export(export::ExportArgs),
@@ -162,6 +166,7 @@ fn run(cli: Cli) -> ExitCode {
         Command::Sweep(args) => sweep::sweep_cmd(args),
         Command::Export(args) => export::export_cmd(args),
         Command::Merge(args) => merge::merge_cmd(args),
+        Command::Encode(args) => encode::encode_cmd(args),
         Command::Fmt { files, check } => fmt::fmt_cmd(&files, check),
         Command::Lsp => match scnc::lsp::run_stdio(|why| {
             let _ = writeln!(std::io::stderr(), "scnc lsp: {why}");

@@ -178,3 +178,51 @@ fn errors_of_later_frames_name_the_frame() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("E0503") && err.contains("at frame 0: 3 frames"), "{err}");
 }
+
+/// Frames encoded as a GIF and an APNG decode to as many frames of the same size; a gap
+/// in the sequence, a single file and MP4 without `ffmpeg` are refused, writing nothing.
+#[test]
+fn encode_round_trips_frame_count_and_size() {
+    use image::AnimationDecoder;
+    let dir = tempfile::tempdir().expect("tempdir");
+    let pattern = dir.path().join("f-###.png");
+    ok(&scnc(&["render", SCENE, "-o", path(&pattern), "--frames", "0..5"]));
+    let gif = dir.path().join("a.gif");
+    ok(&scnc(&["encode", path(&pattern), "-o", path(&gif), "--fps", "10"]));
+    let reader = std::io::BufReader::new(std::fs::File::open(&gif).expect("gif"));
+    let frames = image::codecs::gif::GifDecoder::new(reader).expect("decoding").into_frames().collect_frames();
+    let frames = frames.expect("frames");
+    assert_eq!(frames.len(), 5);
+    assert!(frames.iter().all(|f| f.buffer().dimensions() == (48, 36)));
+    assert_eq!(frames[0].delay().numer_denom_ms(), (100, 1));
+
+    let apng = dir.path().join("a.png");
+    ok(&scnc(&["encode", path(&pattern), "-o", path(&apng), "--fps", "8"]));
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&apng).expect("apng")));
+    let reader = decoder.read_info().expect("png header");
+    let info = reader.info();
+    assert_eq!((info.width, info.height), (48, 36));
+    assert_eq!(info.animation_control.map(|a| a.num_frames), Some(5));
+    assert_eq!(info.frame_control.map(|f| (f.delay_num, f.delay_den)), Some((1, 8)));
+
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_scnc"))
+        .args(["encode", path(&pattern), "-o", path(&dir.path().join("b.mp4"))])
+        .env("PATH", dir.path())
+        .output()
+        .expect("running scnc");
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("`ffmpeg`, which is not on PATH"));
+
+    std::fs::remove_file(dir.path().join("f-002.png")).expect("remove");
+    let out = scnc(&["encode", path(&pattern), "-o", path(&dir.path().join("b.gif"))]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("frame 2 is missing"));
+    let out = scnc(&["encode", path(&dir.path().join("f-000.png")), "-o", path(&dir.path().join("b.gif"))]);
+    assert_eq!(out.status.code(), Some(2));
+    let names: Vec<String> = std::fs::read_dir(dir.path())
+        .expect("read dir")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with('b') || n.starts_with(".scnc"))
+        .collect();
+    assert!(names.is_empty(), "nothing half-written: {names:?}");
+}
