@@ -4,6 +4,7 @@ mod animation;
 mod budget;
 mod cli;
 mod conformance;
+mod deploy;
 mod effects;
 mod export;
 mod fmt;
