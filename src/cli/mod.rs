@@ -89,6 +89,9 @@ enum Command {
     Ir {
         /// The scene file.
         file: PathBuf,
+        /// The frame of the scene's animation to evaluate (default 0).
+        #[arg(long, default_value = "0")]
+        frame: u32,
         /// How to print diagnostics.
         #[arg(long, value_enum, default_value = "human")]
         message_format: MessageFormat,
@@ -188,10 +191,26 @@ fn run(cli: Cli) -> ExitCode {
                 ExitCode::SUCCESS
             }
         }
-        Command::Ir { file, message_format } => {
-            let Some(compiled) = compile(&file, message_format) else { return ExitCode::from(1) };
-            if report(&compiled, message_format) {
+        Command::Ir { file, frame, message_format } => {
+            let Some(mut compiled) = compile(&file, message_format) else { return ExitCode::from(1) };
+            // Frame 0's diagnostics, unless another frame is asked for and frame 0 has no
+            // errors: then that frame's own (its warnings include frame 0's that still hold).
+            let later = compiled.scene.as_ref().map(|s| s.settings.clone()).filter(|_| frame > 0);
+            if later.is_none() && report(&compiled, message_format) {
                 return ExitCode::from(1);
+            }
+            if let Some(declared) = later {
+                if frame >= declared.frames {
+                    return usage_error(&format!(
+                        "--frame {frame}: the scene's animation has frames 0..{}",
+                        declared.frames
+                    ));
+                }
+                let (scene, diagnostics) = scnc::with_big_stack(|| compiled.frame(frame, &declared, &FsLoader));
+                if report_in(&compiled.map, &diagnostics, message_format) {
+                    return ExitCode::from(1);
+                }
+                compiled.scene = scene;
             }
             if let Some(scene) = &compiled.scene {
                 let text =

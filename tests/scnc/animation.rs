@@ -226,3 +226,14 @@ fn encode_round_trips_frame_count_and_size() {
         .collect();
     assert!(names.is_empty(), "nothing half-written: {names:?}");
 }
+
+/// `scnc ir --frame K` prints the scene at frame K; a frame past the end is a usage error.
+#[test]
+fn ir_prints_any_frame() {
+    let out = scnc(&["ir", "tests/data/time/cyclic.scn", "--frame", "2"]);
+    ok(&out);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("transform at [-2, 0, 6]"));
+    let out = scnc(&["ir", "tests/data/time/cyclic.scn", "--frame", "4"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("frames 0..4"));
+}
