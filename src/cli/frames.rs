@@ -12,7 +12,7 @@ pub(crate) fn parse_frames(s: &str) -> Result<Range<u32>, String> {
         Some((a, b)) => number(a)?..number(b)?,
         None => {
             let n = number(s)?;
-            n..n.saturating_add(1)
+            n..n.checked_add(1).ok_or_else(|| format!("frame {n} is past the last frame an animation may have"))?
         }
     };
     if range.is_empty() {

@@ -304,10 +304,11 @@ fn render_compiled(args: &RenderArgs, pool: &rayon::ThreadPool, mut compiled: Co
             args.output.display()
         )));
     }
-    // Later frames report only what frame 0 did not.
-    let mut seen: HashSet<String> = compiled.diagnostics.iter().map(diagnostic_key).collect();
     let mut first = Some(first);
-    let mut cache = scnc::world::FrameCache::default();
+    let mut sequence = Sequence {
+        cache: scnc::world::FrameCache::default(),
+        shown: compiled.diagnostics.iter().map(diagnostic_key).collect(),
+    };
     for number in frames {
         let output = frame_path(&args.output, number);
         if args.skip_existing && output.exists() {
@@ -316,11 +317,19 @@ fn render_compiled(args: &RenderArgs, pool: &rayon::ThreadPool, mut compiled: Co
         }
         let scene = match first.take().filter(|_| number == 0) {
             Some(scene) => scene,
-            None => evaluate_frame(&mut compiled, number, &declared, &mut seen, args.message_format)?,
+            None => evaluate_frame(&mut compiled, number, &declared, &mut sequence.shown, args.message_format)?,
         };
-        render_scene(args, pool, &compiled.map, scene, &output, &mut cache)?;
+        render_scene(args, pool, &compiled.map, scene, &output, &mut sequence)?;
     }
     Ok(())
+}
+
+/// What the frames of one render share.
+struct Sequence {
+    /// Each frame's lowered objects, for the next to reuse.
+    cache: scnc::world::FrameCache,
+    /// The diagnostics shown so far ([`diagnostic_key`]): a later frame shows only new ones.
+    shown: HashSet<String>,
 }
 
 /// What makes a diagnostic the same one at another frame.
@@ -357,7 +366,7 @@ fn render_scene(
     map: &scnc::source::SourceMap,
     mut scene: scnc::ir::Scene,
     output: &Path,
-    cache: &mut scnc::world::FrameCache,
+    sequence: &mut Sequence,
 ) -> Result<(), ExitCode> {
     let (mode, part) = args.apply(&mut scene)?;
     let started = Instant::now();
@@ -365,11 +374,14 @@ fn render_scene(
         EffectsArg::Derived => scnc::render::effects::derive(&scene),
         EffectsArg::All => scnc::render::effects::Effects::all(&scene),
     };
-    let lowered =
-        pool.install(|| scnc::world::prepare_reusing(&scene, effects, mode, &FsLoader, args.memory_limit, cache));
+    let lowered = pool.install(|| {
+        scnc::world::prepare_reusing(&scene, effects, mode, &FsLoader, args.memory_limit, &mut sequence.cache)
+    });
     let (frame, geometry) = match lowered {
         Ok(g) => {
-            super::report_in(map, &g.1.warnings, args.message_format);
+            let fresh: Vec<_> =
+                g.1.warnings.iter().filter(|d| sequence.shown.insert(diagnostic_key(d))).cloned().collect();
+            super::report_in(map, &fresh, args.message_format);
             g
         }
         Err(d) => {
@@ -412,7 +424,7 @@ fn render_scene(
             let _ = writeln!(
                 err,
                 "  animation       {} of {} objects reused from the previous frame (not lowered again)",
-                cache.reused,
+                sequence.cache.reused,
                 geometry.len()
             );
         }

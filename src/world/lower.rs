@@ -135,6 +135,14 @@ fn lower_reusing(
     if (reuse.origin, reuse.max_distance, reuse.mode) != (frame.origin, frame.max_distance, Some(mode)) {
         reuse.kept.clear();
     }
+    // What changed is let go before anything is built, so a mesh that changes every frame
+    // is not held twice.
+    reuse.kept.truncate(scene.objects.len());
+    for (kept, obj) in reuse.kept.iter_mut().zip(&scene.objects) {
+        if kept.as_ref().is_some_and(|k| k.source != *obj) {
+            *kept = None;
+        }
+    }
     let mut builder = sdf::Builder::new(&mut frame.materials);
     // How much of this frame's material table equals the last frame's so far.
     let mut agree = 0;
@@ -150,7 +158,7 @@ fn lower_reusing(
         }
         let before = (table.len(), builder.bytes, budget.triangles_left());
         let old = reuse.kept.get(i).and_then(Option::as_ref);
-        let old = old.filter(|k| k.source == *obj && k.table.0 == before.0 && agree >= before.0);
+        let old = old.filter(|k| k.table.0 == before.0 && agree >= before.0);
         let part = match old {
             Some(k) => {
                 table.extend_from_slice(&reuse.table[k.table.0..k.table.1]);

@@ -237,3 +237,22 @@ fn ir_prints_any_frame() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("frames 0..4"));
 }
+
+/// A warning that holds at every frame is shown once, not once per frame.
+#[test]
+fn warnings_are_shown_once_per_render() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let scene = dir.path().join("warn.scn");
+    // The small spheres fit between the points of the 0.2 grid (W0801), the mesh never
+    // moves (so later frames reuse it), the ball does.
+    let text = "render(width = 16, height = 16, frames = 3)\nlight ambient(1)\nlet unused = 1\n\
+                object mesh isosurface(union(sphere(1), [for i in 0..8 => sphere(0.04) at [i * 0.25 - 1, 1.6, 0]]), \
+                cell = 0.2) at [0, 0, 5]\nobject sphere(0.2) at [2, clock, 5]\n";
+    std::fs::write(&scene, text).expect("write");
+    let out = scnc(&["render", path(&scene), "-o", path(&dir.path().join("f-#.png"))]);
+    ok(&out);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.matches("W0001").count(), 1, "{err}");
+    assert_eq!(err.matches("W0801").count(), 1, "{err}");
+    assert_eq!(err.matches("rendered").count(), 3, "{err}");
+}
