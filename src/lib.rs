@@ -25,6 +25,10 @@
 //! - [`source`], [`span`] and [`diag`]: input text, positions and diagnostics; [`fmt`] and
 //!   [`lsp`]: the formatter and the language server.
 //!
+//! An animation is checked once: [`compile_source`] evaluates frame 0, and
+//! [`Compiled::frame`] evaluates any other frame from the files already read and parsed;
+//! [`world::prepare_reusing`] then lowers only the objects that changed.
+//!
 //! Every stage reports problems as [`diag::Diagnostic`] values; only the binary prints.
 
 pub mod accel;

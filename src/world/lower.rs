@@ -1,5 +1,6 @@
 //! Lowering: each object to its back-end, in scene order (materials and the triangle
-//! budget are spent deterministically), then meshes built in parallel.
+//! budget are spent deterministically), then meshes built in parallel. In an animation,
+//! objects that did not change since the previous frame are taken from it ([`FrameCache`]).
 
 use std::sync::Arc;
 
