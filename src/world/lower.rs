@@ -190,10 +190,10 @@ fn lower_reusing(
             },
         };
         let after = (builder.materials.materials.len(), builder.bytes, budget.triangles_left());
-        let warnings = match (&part, old) {
-            (Lowered::Mesh(job), _) => job.warnings.clone(),
-            (_, Some(k)) => k.warnings.clone(),
-            _ => Vec::new(),
+        let warnings = match &part {
+            Lowered::Mesh(job) => job.warnings.clone(),
+            Lowered::Kept(_) => old.map_or_else(Vec::new, |k| k.warnings.clone()),
+            Lowered::Sdf(..) => Vec::new(),
         };
         let (closure_bytes, triangles) = (after.1 - before.1, before.2 - after.2);
         kept.push((obj, (before.0, after.0), closure_bytes, triangles, warnings.clone()));
