@@ -1,0 +1,365 @@
+//! The builtins: every function, shape, mesh generator, light and statement argument
+//! list, with parameter names, types, defaults and a one-line doc, in one table
+//! (`table`, with the named constants); here are its types and the lookups into it. The
+//! checker, the docs and the editor tooling read this one table.
+
+use std::collections::HashMap;
+use std::fmt;
+use std::sync::OnceLock;
+
+use foldhash::fast::FixedState;
+
+use crate::ir::CsgOp;
+
+mod table;
+pub use table::{constant, ConstValue, Constant, BUILTINS, CONSTANTS};
+
+/// The types of the language.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Ty {
+    /// A number.
+    Num,
+    /// A whole number.
+    Int,
+    /// `true` or `false`.
+    Bool,
+    /// A string.
+    Str,
+    /// `[x, y, z]`.
+    Vec3,
+    /// A number or a `vec3` (a number `k` means `[k, k, k]`).
+    Size,
+    /// `rgb(r, g, b)` or `#rrggbb`.
+    Color,
+    /// `material(…)`.
+    Material,
+    /// An SDF-able solid.
+    Shape,
+    /// A triangle mesh.
+    Mesh,
+    /// A light.
+    Light,
+    /// A list.
+    List,
+    /// A number, a `vec3` or a colour: what can be scaled and added (`mix`, `sum`).
+    Linear,
+}
+
+impl fmt::Display for Ty {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let s = match self {
+            Ty::Num => "num",
+            Ty::Int => "int",
+            Ty::Bool => "bool",
+            Ty::Str => "string",
+            Ty::Vec3 => "vec3",
+            Ty::Size => "num or vec3",
+            Ty::Color => "color",
+            Ty::Material => "material",
+            Ty::Shape => "shape",
+            Ty::Mesh => "mesh",
+            Ty::Light => "light",
+            Ty::List => "list",
+            Ty::Linear => "num, vec3 or color",
+        };
+        f.write_str(s)
+    }
+}
+
+/// A parameter's default.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Default {
+    /// Must be given.
+    Required,
+    /// A number.
+    Num(f64),
+    /// A vector.
+    Vec3([f64; 3]),
+    /// A boolean.
+    Bool(bool),
+    /// A colour, 0–255.
+    Color([f64; 3]),
+    /// Absent means "derived from the other arguments" (documented per builtin).
+    Derived,
+}
+
+/// One parameter.
+#[derive(Clone, Copy, Debug)]
+pub struct Param {
+    /// Its name, for named arguments.
+    pub name: &'static str,
+    /// Its type.
+    pub ty: Ty,
+    /// Its default.
+    pub default: Default,
+}
+
+/// Where a builtin may be used (follows from its [`Ctor`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// A function callable in expressions.
+    Function,
+    /// A generator after `mesh`.
+    MeshGenerator,
+    /// The argument list of the `camera` statement.
+    Camera,
+    /// The argument list of the `render` statement.
+    Render,
+}
+
+impl Kind {
+    /// How many kinds there are (`Render` is the last).
+    const COUNT: usize = Kind::Render as usize + 1;
+}
+
+/// What a builtin makes: the checker's constructors match on it exhaustively, so an
+/// entry of [`BUILTINS`] cannot lack a constructor, nor a constructor its entry.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Ctor {
+    /// A primitive shape.
+    Primitive(Prim),
+    /// A CSG operator.
+    Csg(CsgOp),
+    /// A shape modifier.
+    Modifier(Modifier),
+    /// `material(…)`.
+    Material,
+    /// `rgb(…)`.
+    Rgb,
+    /// A light.
+    Light(LightFn),
+    /// A function of one number.
+    Math(MathFn),
+    /// Another function of numbers (several, or giving a list or colour).
+    Numeric(NumFn),
+    /// A function of vectors.
+    Vector(VecFn),
+    /// `min` or `max` of numbers.
+    Extreme(Extreme),
+    /// `len(list)`.
+    Len,
+    /// A mesh generator.
+    Generator(Gen),
+    /// The `camera` statement's arguments.
+    Camera,
+    /// The `render` statement's arguments.
+    Render,
+}
+
+/// The primitive shape builtins.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(missing_docs, reason = "each variant is the builtin of the same name, documented in BUILTINS")]
+pub enum Prim {
+    Sphere,
+    Box,
+    Cylinder,
+    Torus,
+    Plane,
+    Capsule,
+    Cone,
+}
+
+/// The shape modifiers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(missing_docs, reason = "each variant is the builtin of the same name, documented in BUILTINS")]
+pub enum Modifier {
+    Round,
+    Shell,
+    Repeat,
+}
+
+/// The lights.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(missing_docs, reason = "each variant is the builtin of the same name, documented in BUILTINS")]
+pub enum LightFn {
+    Ambient,
+    Point,
+    Directional,
+}
+
+/// Functions of one number.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(missing_docs, reason = "each variant is the builtin of the same name, documented in BUILTINS")]
+pub enum MathFn {
+    Sin,
+    Cos,
+    Tan,
+    Sqrt,
+    Abs,
+    Floor,
+    Ceil,
+    Sign,
+    Random,
+    Exp,
+    Log,
+    Asin,
+    Acos,
+    Atan,
+    Round,
+}
+
+/// Functions of several numbers, or giving a list or a colour.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(missing_docs, reason = "each variant is the builtin of the same name, documented in BUILTINS")]
+pub enum NumFn {
+    Pow,
+    Atan2,
+    Clamp,
+    Mix,
+    Hsv,
+    Range,
+    Sum,
+}
+
+/// Functions of vectors.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(missing_docs, reason = "each variant is the builtin of the same name, documented in BUILTINS")]
+pub enum VecFn {
+    Dot,
+    Cross,
+    Normalize,
+    Length,
+}
+
+/// `min` and `max`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(missing_docs, reason = "each variant is the builtin of the same name, documented in BUILTINS")]
+pub enum Extreme {
+    Min,
+    Max,
+}
+
+/// The mesh generators, one variant per entry of [`BUILTINS`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(missing_docs, reason = "each variant is the generator of the same name, documented in BUILTINS")]
+pub enum Gen {
+    UvSphere,
+    IcoSphere,
+    Box,
+    Cylinder,
+    Torus,
+    Plane,
+    Isosurface,
+    File,
+}
+
+/// A builtin.
+#[derive(Clone, Copy, Debug)]
+pub struct Builtin {
+    /// Its name.
+    pub name: &'static str,
+    /// What it makes, and so where it may be used.
+    pub ctor: Ctor,
+    /// Its parameters, in positional order.
+    pub params: &'static [Param],
+    /// For variadic builtins: the type of the extra positional arguments (before `params`).
+    pub variadic: Option<Ty>,
+    /// What it returns.
+    pub result: Ty,
+    /// One line for hover and docs.
+    pub doc: &'static str,
+}
+
+impl Builtin {
+    /// Where it may be used.
+    pub fn kind(&self) -> Kind {
+        match self.ctor {
+            Ctor::Primitive(_)
+            | Ctor::Csg(_)
+            | Ctor::Modifier(_)
+            | Ctor::Material
+            | Ctor::Rgb
+            | Ctor::Light(_)
+            | Ctor::Math(_)
+            | Ctor::Numeric(_)
+            | Ctor::Vector(_)
+            | Ctor::Extreme(_)
+            | Ctor::Len => Kind::Function,
+            Ctor::Generator(_) => Kind::MeshGenerator,
+            Ctor::Camera => Kind::Camera,
+            Ctor::Render => Kind::Render,
+        }
+    }
+
+    /// The signature as users read it, such as `sphere(r: num)` or `min(num…)`.
+    pub fn signature(&self) -> String {
+        let mut parts = Vec::new();
+        if let Some(ty) = self.variadic {
+            parts.push(format!("{ty}…"));
+        }
+        parts.extend(self.params.iter().map(Param::describe));
+        format!("{}({})", self.name, parts.join(", "))
+    }
+}
+
+impl Param {
+    /// `name: type = default`, as in a signature.
+    pub fn describe(&self) -> String {
+        let default = match self.default {
+            Default::Required => String::new(),
+            Default::Num(x) => format!(" = {}", crate::ir::dump_num(x)),
+            Default::Vec3(v) => format!(" = {}", crate::ir::dump_vec(v.into())),
+            Default::Bool(b) => format!(" = {b}"),
+            Default::Color(c) => format!(" = rgb({}, {}, {})", c[0], c[1], c[2]),
+            Default::Derived => " = …".into(),
+        };
+        format!("{}: {}{default}", self.name, self.ty)
+    }
+}
+
+/// The entries of each name, by kind (in [`Kind`]'s order), in table order.
+type Index = HashMap<&'static str, [Vec<&'static Builtin>; Kind::COUNT], FixedState>;
+
+/// Builtins by name and kind, built once: a generated scene calls builtins for every
+/// part it makes, and scanning the table by name for each call (and again for its
+/// overloads) was the largest single cost of evaluating
+/// `benches/scenes/union-10000.scn` (`perf record scnc check …`).
+fn index() -> &'static Index {
+    static INDEX: OnceLock<Index> = OnceLock::new();
+    INDEX.get_or_init(|| {
+        let mut index = Index::default();
+        for b in BUILTINS {
+            index.entry(b.name).or_default()[b.kind() as usize].push(b);
+        }
+        index
+    })
+}
+
+/// Looks a builtin up by name and kind (the first entry of that name and kind).
+pub fn lookup(name: &str, kind: Kind) -> Option<&'static Builtin> {
+    overloads(name, kind).first().copied()
+}
+
+/// Every entry of a name and kind, in table order: overloads told apart by the type of
+/// their first parameter, such as `round(x)` and `round(shape, r)`. Empty when there
+/// is none.
+pub fn overloads(name: &str, kind: Kind) -> &'static [&'static Builtin] {
+    index().get(name).map_or(&[], |kinds| kinds[kind as usize].as_slice())
+}
+
+/// Names of builtins of one kind (for suggestions).
+pub fn names(kind: Kind) -> impl Iterator<Item = &'static str> {
+    BUILTINS.iter().filter(move |b| b.kind() == kind).map(|b| b.name)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each constructor belongs to one entry, and a name to one entry of each kind, or
+    /// to overloads whose first parameters no value fits both of.
+    #[test]
+    fn constructors_and_names_are_unique() {
+        for (i, a) in BUILTINS.iter().enumerate() {
+            for b in &BUILTINS[i + 1..] {
+                assert_ne!(a.ctor, b.ctor, "`{}` and `{}` share a constructor", a.name, b.name);
+                if a.name == b.name && a.kind() == b.kind() {
+                    let (x, y) = (a.params[0].ty, b.params[0].ty);
+                    let distinct =
+                        [x, y].contains(&Ty::Shape) && x != y && a.variadic.is_none() && b.variadic.is_none();
+                    assert!(distinct, "`{}` is listed twice and its overloads cannot be told apart", a.name);
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,171 @@
+//! The scene an evaluation assembles: each `object` statement's geometry, within the
+//! scene's limits on objects and shape nodes, and at the end the scene-wide warnings
+//! (unused names, no objects or lights, useless lights, objects behind the camera).
+
+use super::{Ctx, Value, MAX_OBJECTS, MAX_SCENE_NODES};
+use crate::diag::{codes, Diagnostic};
+use crate::ir::{self, Camera, Scene};
+use crate::span::Span;
+
+impl Ctx<'_> {
+    /// Adds the value of an `object` statement to the scene.
+    pub(super) fn object(&mut self, v: Value, expr_span: Span, stmt_span: Span) {
+        let geometry = match v {
+            Value::Shape(s) => ir::Geometry::Shape(s),
+            Value::Mesh(m) => ir::Geometry::Mesh(m),
+            Value::Error => return,
+            other => {
+                let mut d = Diagnostic::error(
+                    codes::NOT_AN_OBJECT,
+                    expr_span,
+                    format!("expected a shape or a mesh, found `{}`", other.ty_name()),
+                    other.this_is(),
+                );
+                if matches!(other, Value::Light(_)) {
+                    d = d.with_hint("lights are added with `light …`, not `object …`");
+                }
+                self.report(d);
+                return;
+            }
+        };
+        if self.dry > 0 {
+            return;
+        }
+        if self.objects.len() >= MAX_OBJECTS {
+            if !self.too_many_objects {
+                self.too_many_objects = true;
+                self.report(
+                    Diagnostic::error(
+                        codes::TOO_MANY_OBJECTS,
+                        stmt_span,
+                        "too many objects",
+                        format!("object number {} is one too many", MAX_OBJECTS + 1),
+                    )
+                    .with_note(format!(
+                        "a scene may have at most {MAX_OBJECTS} objects; `repeat(…)` draws many copies as one object"
+                    )),
+                );
+            }
+            return;
+        }
+        let nodes = match &geometry {
+            ir::Geometry::Shape(s) => s.nodes,
+            ir::Geometry::Mesh(m) => match &m.source {
+                ir::MeshSource::Isosurface { shape, .. } => shape.nodes,
+                ir::MeshSource::UvSphere { .. }
+                | ir::MeshSource::IcoSphere { .. }
+                | ir::MeshSource::Box { .. }
+                | ir::MeshSource::Cylinder { .. }
+                | ir::MeshSource::Torus { .. }
+                | ir::MeshSource::Plane { .. }
+                | ir::MeshSource::File { .. } => 0,
+            },
+        };
+        self.scene_nodes = self.scene_nodes.saturating_add(nodes);
+        if self.scene_nodes > MAX_SCENE_NODES {
+            self.too_many_objects = true;
+            self.report(
+                Diagnostic::error(
+                    codes::SHAPE_TOO_LARGE,
+                    stmt_span,
+                    "the scene's shapes are too large in total",
+                    format!("with this object they have {} nodes", self.scene_nodes),
+                )
+                .with_note(format!(
+                    "a scene's shapes may have at most {MAX_SCENE_NODES} nodes in all, counting a shared part each time it is used"
+                )),
+            );
+            return;
+        }
+        self.objects.push(ir::Object { geometry, span: stmt_span });
+    }
+
+    /// The scene and every diagnostic, with the scene-wide warnings added.
+    pub(super) fn finish(mut self) -> (Option<Scene>, Vec<Diagnostic>) {
+        let mut unused: Vec<(Span, String)> = self
+            .lets
+            .iter()
+            .filter(|(_, (name, used))| !used && !name.starts_with('_'))
+            .map(|(s, (n, _))| (*s, n.clone()))
+            .collect();
+        unused.sort();
+        for (span, name) in unused {
+            self.report(
+                Diagnostic::warning(codes::UNUSED, span, format!("`{name}` is never used"), "defined here")
+                    .with_hint(format!("if this is intentional, try naming it `_{name}`")),
+            );
+        }
+        let end = self.map.files().next().map_or(Span::default(), |(_, f)| Span::new(f.base as usize, f.base as usize));
+        let has_errors = self.diags.iter().any(Diagnostic::is_error);
+        if has_errors {
+            // Objects and lights were dropped with their errors; do not warn about their absence.
+        } else if self.objects.is_empty() {
+            self.report(
+                Diagnostic::warning(
+                    codes::NO_OBJECTS,
+                    end,
+                    "the scene has no objects",
+                    "the image will show only the background",
+                )
+                .with_hint("try `object sphere(1) at [0, 0, 5]`"),
+            );
+        } else if self.lights.is_empty() {
+            self.report(
+                Diagnostic::warning(codes::NO_LIGHTS, end, "the scene has no lights", "every object will be black")
+                    .with_hint("try `light ambient(0.2)` and `light point(0.6) at [2, 1, 0]`"),
+            );
+        }
+        for light in &self.lights.clone() {
+            if light.intensity == 0.0 {
+                self.report(
+                    Diagnostic::warning(
+                        codes::USELESS_LIGHT,
+                        light.span,
+                        "this light has intensity 0",
+                        "it lights nothing",
+                    )
+                    .with_hint("try removing it, or giving it an intensity above 0"),
+                );
+            }
+        }
+        let camera = self.camera.clone().unwrap_or_default();
+        self.check_range(&camera);
+        for obj in &self.objects.clone() {
+            if let Some(dist) = behind_camera(obj, &camera) {
+                self.report(
+                    Diagnostic::warning(
+                        codes::BEHIND_CAMERA,
+                        obj.span,
+                        "this object is behind the camera",
+                        format!("its bounds end {} units behind the eye", ir::dump_num(dist)),
+                    )
+                    .with_note("it can still show in reflections"),
+                );
+            }
+        }
+        let mut diags: Vec<Diagnostic> = self
+            .diags
+            .into_iter()
+            .zip(self.repeats)
+            .map(|(d, more)| match more {
+                0 => d,
+                n => d.with_note(format!("and {n} more {} here", if n == 1 { "time" } else { "times" })),
+            })
+            .collect();
+        diags.sort_by_key(|d| (d.span().start, d.severity));
+        if diags.iter().any(Diagnostic::is_error) {
+            return (None, diags);
+        }
+        let scene =
+            Scene { camera, settings: self.settings.unwrap_or_default(), lights: self.lights, objects: self.objects };
+        (Some(scene), diags)
+    }
+}
+
+/// How far behind the camera plane an object's bounding sphere lies, if entirely behind it.
+fn behind_camera(obj: &ir::Object, camera: &Camera) -> Option<f64> {
+    let (centre, radius) = ir::bounding_sphere(&obj.geometry)?;
+    let forward = (camera.look_at - camera.position).normalize();
+    let depth = (centre - camera.position).dot(forward);
+    (depth + radius < 0.0).then_some(-(depth + radius))
+}
