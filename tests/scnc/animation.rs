@@ -8,10 +8,17 @@ use std::process::Output;
 
 use scnc::source::FsLoader;
 
-use crate::support::{cases, check_golden, compile, finish, scnc};
+use crate::support::{cases, check_golden, compile, finish, scnc, scnc_env};
 
 fn ok(out: &Output) {
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+}
+
+/// The run failed with `code`, saying `says`.
+fn refused(out: &Output, code: i32, says: &str) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(code), "{err}");
+    assert!(err.contains(says), "expected `{says}` in:\n{err}");
 }
 
 fn path(p: &Path) -> &str {
@@ -87,15 +94,12 @@ fn an_animation_without_hashes_or_past_its_end_is_refused_before_any_work() {
     let dir = tempfile::tempdir().expect("tempdir");
     let one = dir.path().join("one.png");
     let out = scnc(&["render", SCENE, "-o", path(&one)]);
-    assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("put `#` in the file name"));
+    refused(&out, 2, "put `#` in the file name");
     let pattern = dir.path().join("f-##.png");
     let out = scnc(&["render", SCENE, "-o", path(&pattern), "--frames", "6..9"]);
-    assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("frames 0..8"), "{}", String::from_utf8_lossy(&out.stderr));
+    refused(&out, 2, "frames 0..8");
     let out = scnc(&["render", "examples/seed/01-sphere.scn", "-o", path(&pattern), "--frames", "0..2"]);
-    assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("the scene is a still"));
+    refused(&out, 2, "the scene is a still");
     assert!(pngs(dir.path()).is_empty(), "nothing may be written");
 }
 
@@ -105,7 +109,10 @@ fn skip_existing_renders_nothing_the_second_time() {
     let pattern = dir.path().join("f-##.png");
     let args = ["render", SCENE, "-o", path(&pattern), "--frames", "0..3", "--skip-existing"];
     ok(&scnc(&args));
-    let before: Vec<_> = pngs(dir.path()).iter().map(|n| std::fs::read(dir.path().join(n)).expect("read")).collect();
+    let contents = || -> Vec<Vec<u8>> {
+        pngs(dir.path()).iter().map(|n| std::fs::read(dir.path().join(n)).expect("read")).collect()
+    };
+    let before = contents();
     // One frame lost (a task killed before it wrote) is rendered again; the rest are not.
     std::fs::remove_file(dir.path().join("f-01.png")).expect("remove");
     let out = scnc(&args);
@@ -115,8 +122,7 @@ fn skip_existing_renders_nothing_the_second_time() {
     assert_eq!(err.matches("rendered").count(), 1, "{err}");
     let out = scnc(&args);
     assert_eq!(String::from_utf8_lossy(&out.stderr).matches("rendered").count(), 0);
-    let after: Vec<_> = pngs(dir.path()).iter().map(|n| std::fs::read(dir.path().join(n)).expect("read")).collect();
-    assert_eq!(before, after);
+    assert_eq!(before, contents());
 }
 
 /// A job system's task index picks a chunk; a frame rendered by its own task (lowered
@@ -128,16 +134,16 @@ fn tasks_render_their_chunk_and_frames_do_not_depend_on_how_they_were_grouped() 
     let (seq, farm) = (dir.path().join("seq"), dir.path().join("farm"));
     std::fs::create_dir_all(&seq).expect("mkdir");
     std::fs::create_dir_all(&farm).expect("mkdir");
+    let farm_frames = farm.join("f-##.png");
+    let task = |mode: &str, index: &str| {
+        let args =
+            ["render", SCENE, "-o", path(&farm_frames), "--geometry", mode, "--frame-index-from", "SCNC_TEST_TASK"];
+        scnc_env(&[&args[..], &["--chunk", "3"]].concat(), &[("SCNC_TEST_TASK", index)])
+    };
     for mode in ["sdf", "mesh"] {
         ok(&scnc(&["render", SCENE, "-o", path(&seq.join("f-##.png")), "--geometry", mode]));
-        for task in 0..3 {
-            let out = std::process::Command::new(env!("CARGO_BIN_EXE_scnc"))
-                .args(["render", SCENE, "-o", path(&farm.join("f-##.png")), "--geometry", mode])
-                .args(["--frame-index-from", "SCNC_TEST_TASK", "--chunk", "3"])
-                .env("SCNC_TEST_TASK", task.to_string())
-                .output()
-                .expect("running scnc");
-            ok(&out);
+        for index in 0..3 {
+            ok(&task(mode, &index.to_string()));
         }
         assert_eq!(pngs(&farm).len(), 8, "tasks 0-2 of 3 frames cover 8 frames");
         for name in pngs(&seq) {
@@ -145,17 +151,10 @@ fn tasks_render_their_chunk_and_frames_do_not_depend_on_how_they_were_grouped() 
             assert!(same, "{mode}: {name} differs between the sequence and its task");
         }
     }
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_scnc"))
-        .args(["render", SCENE, "-o", path(&farm.join("f-##.png")), "--frame-index-from", "SCNC_TEST_TASK"])
-        .args(["--chunk", "3"])
-        .env("SCNC_TEST_TASK", "3")
-        .output()
-        .expect("running scnc");
-    assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("tasks 0 to 2"));
-    let out = scnc(&["render", SCENE, "-o", path(&farm.join("f-##.png")), "--frame-index-from", "SCNC_NOT_SET_X"]);
-    assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("is not set"));
+    let out = task("sdf", "3");
+    refused(&out, 2, "tasks 0 to 2");
+    let out = scnc(&["render", SCENE, "-o", path(&farm_frames), "--frame-index-from", "SCNC_NOT_SET_X"]);
+    refused(&out, 2, "is not set");
 }
 
 /// An error only some frames reach is reported at that frame, naming it; a frame count
@@ -205,18 +204,13 @@ fn encode_round_trips_frame_count_and_size() {
     assert_eq!(info.animation_control.map(|a| a.num_frames), Some(5));
     assert_eq!(info.frame_control.map(|f| (f.delay_num, f.delay_den)), Some((1, 8)));
 
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_scnc"))
-        .args(["encode", path(&pattern), "-o", path(&dir.path().join("b.mp4"))])
-        .env("PATH", dir.path())
-        .output()
-        .expect("running scnc");
-    assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("`ffmpeg`, which is not on PATH"));
+    let out =
+        scnc_env(&["encode", path(&pattern), "-o", path(&dir.path().join("b.mp4"))], &[("PATH", path(dir.path()))]);
+    refused(&out, 1, "`ffmpeg`, which is not on PATH");
 
     std::fs::remove_file(dir.path().join("f-002.png")).expect("remove");
     let out = scnc(&["encode", path(&pattern), "-o", path(&dir.path().join("b.gif"))]);
-    assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("frame 2 is missing"));
+    refused(&out, 2, "frame 2 is missing");
     let out = scnc(&["encode", path(&dir.path().join("f-000.png")), "-o", path(&dir.path().join("b.gif"))]);
     assert_eq!(out.status.code(), Some(2));
     let names: Vec<String> = std::fs::read_dir(dir.path())
@@ -234,8 +228,7 @@ fn ir_prints_any_frame() {
     ok(&out);
     assert!(String::from_utf8_lossy(&out.stdout).contains("transform at [-2, 0, 6]"));
     let out = scnc(&["ir", "tests/data/time/cyclic.scn", "--frame", "4"]);
-    assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("frames 0..4"));
+    refused(&out, 2, "frames 0..4");
 }
 
 /// A warning that holds at every frame is shown once, not once per frame.

@@ -134,6 +134,12 @@ impl Client {
         self.request(method, params)
     }
 
+    /// The hover text at a position (empty when there is none).
+    fn hover(&mut self, uri: &str, line: u32, character: u32) -> String {
+        let h = self.at("textDocument/hover", uri, line, character);
+        h["contents"]["value"].as_str().unwrap_or_default().to_string()
+    }
+
     fn stop(mut self) {
         self.request("shutdown", Value::Null);
         self.notify("exit", Value::Null);
@@ -228,8 +234,7 @@ object sphere(
     c.open(&doc, text);
 
     // Hover: a builtin's signature and doc, a name's type, an expression's type, a parameter.
-    let h = c.at("textDocument/hover", &doc, 2, 12);
-    let h = h["contents"]["value"].as_str().unwrap_or_default().to_string();
+    let h = c.hover(&doc, 2, 12);
     assert!(h.contains("sphere(r: num)") && h.contains("radius"), "{h}");
     let h = c.at("textDocument/hover", &doc, 6, 8);
     assert!(h["contents"]["value"].as_str().is_some_and(|v| v.contains("let ball: shape")), "{h}");
@@ -414,19 +419,15 @@ if n > 2 {
 ";
     let mut c = Client::start();
     c.open(&doc, text);
-    let hover = |c: &mut Client, line, col| {
-        let h = c.at("textDocument/hover", &doc, line, col);
-        h["contents"]["value"].as_str().unwrap_or_default().to_string()
-    };
     // The comprehension's variables, its type, an `if` expression's type, the overload.
-    assert!(hover(&mut c, 2, 68).contains("for i: num"));
-    assert!(hover(&mut c, 2, 41).contains("for i: num"), "in the filter");
-    assert!(hover(&mut c, 2, 13).contains("list<shape>"));
-    assert!(hover(&mut c, 3, 8).contains("num"), "the `if` expression's type");
-    assert!(hover(&mut c, 3, 22).contains("round(x: num)"), "the overload the number chose");
-    assert!(hover(&mut c, 5, 10).contains("union(shape…"), "inside the branch that ran");
-    assert!(hover(&mut c, 7, 10).contains("sphere(r: num)"), "inside the branch that did not run");
-    assert!(hover(&mut c, 7, 16).contains("let r: num"), "a use inside the branch that did not run");
+    assert!(c.hover(&doc, 2, 68).contains("for i: num"));
+    assert!(c.hover(&doc, 2, 41).contains("for i: num"), "in the filter");
+    assert!(c.hover(&doc, 2, 13).contains("list<shape>"));
+    assert!(c.hover(&doc, 3, 8).contains("num"), "the `if` expression's type");
+    assert!(c.hover(&doc, 3, 22).contains("round(x: num)"), "the overload the number chose");
+    assert!(c.hover(&doc, 5, 10).contains("union(shape…"), "inside the branch that ran");
+    assert!(c.hover(&doc, 7, 10).contains("sphere(r: num)"), "inside the branch that did not run");
+    assert!(c.hover(&doc, 7, 16).contains("let r: num"), "a use inside the branch that did not run");
     let d = c.at("textDocument/definition", &doc, 2, 68);
     assert_eq!(d, json!({ "uri": doc, "range": range(2, 17, 18) }));
 
@@ -457,14 +458,11 @@ fn the_animation_names_in_the_editor() {
     let text = "render(frames = 24)\nlight ambient(0.2)\nobject sphere(0.5 + clock) at [frame, 0, 5]\n";
     let mut c = Client::start();
     c.open(&doc, text);
-    let h = c.at("textDocument/hover", &doc, 2, 22);
-    let h = h["contents"]["value"].as_str().unwrap_or_default().to_string();
+    let h = c.hover(&doc, 2, 22);
     assert!(h.contains("clock: num") && h.contains("0 at the first frame"), "{h}");
-    let h = c.at("textDocument/hover", &doc, 2, 32);
-    let h = h["contents"]["value"].as_str().unwrap_or_default().to_string();
+    let h = c.hover(&doc, 2, 32);
     assert!(h.contains("frame: int") && h.contains("frame being rendered"), "{h}");
-    let h = c.at("textDocument/hover", &doc, 0, 9);
-    let h = h["contents"]["value"].as_str().unwrap_or_default().to_string();
+    let h = c.hover(&doc, 0, 9);
     assert!(h.contains("frames: int = 1"), "{h}");
     let items = c.at("textDocument/completion", &doc, 2, 20);
     let labels: Vec<&str> = items.as_array().expect("items").iter().filter_map(|i| i["label"].as_str()).collect();

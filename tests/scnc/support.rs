@@ -7,9 +7,15 @@ use scnc::Compiled;
 
 /// Runs the `scnc` binary with `args` (colour off), to completion.
 pub fn scnc(args: &[&str]) -> std::process::Output {
+    scnc_env(args, &[])
+}
+
+/// [`scnc`] with these environment variables set as well.
+pub fn scnc_env(args: &[&str], env: &[(&str, &str)]) -> std::process::Output {
     std::process::Command::new(env!("CARGO_BIN_EXE_scnc"))
         .args(args)
         .env("NO_COLOR", "1")
+        .envs(env.iter().copied())
         .output()
         .expect("running scnc")
 }
