@@ -5,8 +5,8 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use super::files::{check_output_as, write_atomic};
-use super::frames::frame_path;
+use super::files::{check_output_as, stop_on_interrupt, write_atomic, Pending};
+use super::frames::{frame_path, Pattern};
 use super::usage_error;
 
 #[derive(clap::Args)]
@@ -34,26 +34,15 @@ enum Format {
 /// Frames must run without a gap: an animation missing a frame (a task that failed) is
 /// refused rather than encoded with a jump.
 fn find_frames(pattern: &Path) -> Result<Vec<u32>, String> {
-    let name = pattern.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let end = name.rfind('#').map(|i| i + 1).ok_or_else(|| {
+    let names = Pattern::of(pattern).ok_or_else(|| {
         format!("`{}` names one file: give the frames' pattern, like `out/frame-####.png`", pattern.display())
     })?;
-    let start = name[..end].trim_end_matches('#').len();
-    let (prefix, suffix, width) = (&name[..start], &name[end..], end - start);
     let dir = match pattern.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
     let entries = std::fs::read_dir(dir).map_err(|e| format!("cannot read the directory `{}`: {e}", dir.display()))?;
-    let mut numbers: Vec<u32> = entries
-        .filter_map(|e| e.ok()?.file_name().into_string().ok())
-        .filter_map(|n| {
-            let digits = n.strip_prefix(prefix)?.strip_suffix(suffix)?;
-            let n: u32 = digits.bytes().all(|b| b.is_ascii_digit()).then(|| digits.parse().ok())??;
-            // Only the names `render` writes: `007` is not frame 7 of a one-`#` pattern.
-            (digits == format!("{n:0width$}")).then_some(n)
-        })
-        .collect();
+    let mut numbers: Vec<u32> = entries.filter_map(|e| names.frame_of(e.ok()?.file_name().to_str()?)).collect();
     numbers.sort_unstable();
     let (Some(&first), Some(&last)) = (numbers.first(), numbers.last()) else {
         return Err(format!("no frames match `{}`", pattern.display()));
@@ -109,6 +98,10 @@ pub(crate) fn encode_cmd(args: EncodeArgs) -> ExitCode {
     };
     if let Err(e) = check_output_as(&args.output, "a file name ending in `.gif`, `.png` or `.mp4`") {
         return usage_error(&e);
+    }
+    // Interrupted, nothing is left behind: the shell's 128 + SIGINT.
+    if let Err(e) = stop_on_interrupt(130) {
+        let _ = writeln!(std::io::stderr(), "warning: {e}");
     }
     let numbers = match find_frames(&args.frames) {
         Ok(n) => n,
@@ -177,17 +170,15 @@ fn apng(out: &mut dyn Write, frames: &[Vec<u8>], w: u32, h: u32, fps: u16) -> st
 /// MP4 (H.264, yuv420p for players' sake) by `ffmpeg`, into a temporary file renamed
 /// over the output when it succeeds.
 fn mp4(args: &EncodeArgs, numbers: &[u32]) -> Result<(), String> {
-    let name = args.frames.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let end = name.rfind('#').map_or(0, |i| i + 1);
-    let start = name[..end].trim_end_matches('#').len();
+    let p = Pattern::of(&args.frames).ok_or("the frames are not a pattern")?;
     // ffmpeg's image2 pattern: `%04d` for `####` (a literal `%` doubled).
     let escaped = |s: &str| s.replace('%', "%%");
-    let input =
-        args.frames.with_file_name(format!("{}%0{}d{}", escaped(&name[..start]), end - start, escaped(&name[end..])));
+    let input = args.frames.with_file_name(format!("{}%0{}d{}", escaped(&p.prefix), p.width, escaped(&p.suffix)));
     let tmp = args.output.with_file_name(format!(
         ".scnc-{}.tmp.mp4",
         args.output.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
     ));
+    let _pending = Pending::new(&tmp);
     let status = std::process::Command::new("ffmpeg")
         .args(["-loglevel", "error", "-y", "-framerate", &args.fps.to_string()])
         .args(["-start_number", &numbers[0].to_string(), "-i"])

@@ -25,10 +25,11 @@ pub(crate) fn stop_on_interrupt(code: i32) -> Result<(), String> {
 }
 
 /// Registers a temporary file for removal on interrupt while it lives.
-struct Pending(PathBuf);
+pub(crate) struct Pending(PathBuf);
 
 impl Pending {
-    fn new(path: &Path) -> Pending {
+    /// Registers `path` (a file another program may be writing, too).
+    pub(crate) fn new(path: &Path) -> Pending {
         if let Ok(mut p) = PENDING.lock() {
             p.push(path.to_path_buf());
         }

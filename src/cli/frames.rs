@@ -71,23 +71,49 @@ impl FrameChoice<'_> {
     }
 }
 
-/// Whether the file name of `path` has a run of `#` for the frame number.
-pub(crate) fn is_pattern(path: &Path) -> bool {
-    path.file_name().is_some_and(|n| n.to_string_lossy().contains('#'))
+/// A file name with a run of `#` standing for the frame number: what comes before the
+/// last run, the run's length, and what comes after.
+pub(crate) struct Pattern {
+    /// Before the run.
+    pub(crate) prefix: String,
+    /// The run's length: frame numbers are zero-padded to it.
+    pub(crate) width: usize,
+    /// After the run.
+    pub(crate) suffix: String,
 }
 
-/// `path` with the last run of `#` in its file name replaced by `frame`, zero-padded to
-/// the run's length (more digits when the number needs them), as Blender names frames.
+impl Pattern {
+    /// The pattern in `path`'s file name, if it has a `#`.
+    pub(crate) fn of(path: &Path) -> Option<Pattern> {
+        let name = path.file_name()?.to_string_lossy();
+        let end = name.rfind('#')? + 1;
+        let start = name[..end].trim_end_matches('#').len();
+        Some(Pattern { prefix: name[..start].into(), width: end - start, suffix: name[end..].into() })
+    }
+
+    /// The file name of frame `n`: zero-padded to the run's length, more digits when the
+    /// number needs them, as Blender names frames.
+    pub(crate) fn name(&self, n: u32) -> String {
+        format!("{}{n:0width$}{}", self.prefix, self.suffix, width = self.width)
+    }
+
+    /// The frame a file name is, when it is exactly what [`name`](Self::name) writes
+    /// (`007` is not frame 7 of a one-`#` pattern).
+    pub(crate) fn frame_of(&self, file: &str) -> Option<u32> {
+        let digits = file.strip_prefix(&self.prefix)?.strip_suffix(&self.suffix)?;
+        let n: u32 = digits.bytes().all(|b| b.is_ascii_digit()).then(|| digits.parse().ok())??;
+        (self.name(n) == file).then_some(n)
+    }
+}
+
+/// Whether the file name of `path` has a run of `#` for the frame number.
+pub(crate) fn is_pattern(path: &Path) -> bool {
+    Pattern::of(path).is_some()
+}
+
+/// `path` with the last run of `#` in its file name replaced by `frame` ([`Pattern::name`]).
 pub(crate) fn frame_path(path: &Path, frame: u32) -> PathBuf {
-    let Some(name) = path.file_name().map(|n| n.to_string_lossy().into_owned()) else {
-        return path.to_path_buf();
-    };
-    let Some(end) = name.rfind('#').map(|i| i + 1) else {
-        return path.to_path_buf();
-    };
-    let start = name[..end].trim_end_matches('#').len();
-    let named = format!("{}{frame:0width$}{}", &name[..start], &name[end..], width = end - start);
-    path.with_file_name(named)
+    Pattern::of(path).map_or_else(|| path.to_path_buf(), |p| path.with_file_name(p.name(frame)))
 }
 
 #[cfg(test)]
