@@ -329,12 +329,15 @@ struct Sequence {
     /// Each frame's lowered objects, for the next to reuse.
     cache: scnc::world::FrameCache,
     /// The diagnostics shown so far ([`diagnostic_key`]): a later frame shows only new ones.
-    shown: HashSet<String>,
+    shown: HashSet<DiagnosticKey>,
 }
 
-/// What makes a diagnostic the same one at another frame.
-fn diagnostic_key(d: &scnc::diag::Diagnostic) -> String {
-    format!("{} {:?} {}", d.code, d.span(), d.message)
+/// What makes a diagnostic the same one at another frame: code, place and message, as
+/// the checker tells repeats apart.
+type DiagnosticKey = (&'static str, scnc::span::Span, String);
+
+fn diagnostic_key(d: &scnc::diag::Diagnostic) -> DiagnosticKey {
+    (d.code, d.span(), d.message.clone())
 }
 
 /// Frame `number` of the animation `declared` (frame 0's settings) evaluated, its new
@@ -343,7 +346,7 @@ fn evaluate_frame(
     compiled: &mut Compiled,
     number: u32,
     declared: &scnc::ir::Settings,
-    seen: &mut HashSet<String>,
+    seen: &mut HashSet<DiagnosticKey>,
     format: MessageFormat,
 ) -> Result<scnc::ir::Scene, ExitCode> {
     let (scene, diagnostics) = scnc::with_big_stack(|| compiled.frame(number, declared, &FsLoader));
