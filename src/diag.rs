@@ -350,7 +350,7 @@ pub mod codes {
     pub const TOO_LARGE: &str = "E0705";
     /// Evaluation ran out of fuel.
     pub const OUT_OF_FUEL: &str = "E0706";
-    /// A shape that expands to too many nodes.
+    /// A shape that expands to too many nodes, or a pattern holding too many patterns.
     pub const SHAPE_TOO_LARGE: &str = "E0707";
     /// Too many errors: evaluation stopped.
     pub const TOO_MANY_ERRORS: &str = "E0708";
@@ -366,6 +366,8 @@ pub mod codes {
     pub const NO_OBJECTS: &str = "W0004";
     /// Object entirely behind the camera.
     pub const BEHIND_CAMERA: &str = "W0005";
+    /// A material argument that does nothing (`ior` or `absorption` without `transparency`).
+    pub const NO_EFFECT: &str = "W0006";
     /// Parts of a shape too small for its isosurface's cell, left out of the mesh.
     pub const LOST_PARTS: &str = "W0801";
     /// Isosurface edges left on four triangles where parts are thinner than the cell.

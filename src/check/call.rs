@@ -400,7 +400,7 @@ impl Ctx<'_> {
         )
         .with_note(format!("{} is a `{ty}`", what()));
         match (ty, v) {
-            (Ty::Color, Value::Vec3(c)) => {
+            (Ty::Color | Ty::Paint, Value::Vec3(c)) => {
                 d = d.with_hint(format!("try `rgb({}, {}, {})`", dump_num(c.x), dump_num(c.y), dump_num(c.z)))
             }
             (Ty::Shape, Value::Mesh(_)) => {
@@ -496,6 +496,8 @@ fn admits(ty: Ty, v: &Value) -> bool {
         Ty::Str => matches!(v, Value::Str(_)),
         Ty::Color => matches!(v, Value::Color(_)),
         Ty::Material => matches!(v, Value::Material(_)),
+        Ty::Pattern => matches!(v, Value::Pattern(_)),
+        Ty::Paint => matches!(v, Value::Color(_) | Value::Pattern(_)),
         Ty::Shape => matches!(v, Value::Shape(_)),
         Ty::Mesh => matches!(v, Value::Mesh(_)),
         Ty::Light => matches!(v, Value::Light(_)),

@@ -24,6 +24,8 @@ pub enum Value {
     Color(DVec3),
     /// A material.
     Material(Arc<ir::Material>),
+    /// A pattern.
+    Pattern(Arc<ir::Pattern>),
     /// A shape tree.
     Shape(Arc<ir::Shape>),
     /// A mesh.
@@ -47,6 +49,7 @@ impl Value {
             Value::Vec3(_) => Ty::Vec3,
             Value::Color(_) => Ty::Color,
             Value::Material(_) => Ty::Material,
+            Value::Pattern(_) => Ty::Pattern,
             Value::Shape(_) => Ty::Shape,
             Value::Mesh(_) => Ty::Mesh,
             Value::Light(_) => Ty::Light,

@@ -136,8 +136,14 @@ pub(crate) fn write_text(path: &Path, text: &str) -> std::io::Result<()> {
 }
 
 /// Encodes a PNG whole or not at all.
+use scnc::render::BitDepth;
+
 pub(crate) fn write_png(path: &Path, image: &scnc::render::Image) -> std::io::Result<()> {
-    encode_png(path, &image.pixels, image.width, image.height, image::ExtendedColorType::Rgb8)
+    let colour = match image.depth {
+        BitDepth::Eight => image::ExtendedColorType::Rgb8,
+        BitDepth::Sixteen => image::ExtendedColorType::Rgb16,
+    };
+    encode_png(path, &image.pixels, image.width, image.height, colour)
 }
 
 /// Encodes `pixels` of a `width × height` image as a PNG, whole or not at all.
@@ -164,12 +170,19 @@ pub(crate) fn write_part_png(
     region: scnc::render::Region,
     image: &scnc::render::Image,
 ) -> std::io::Result<()> {
-    let mut rgba = vec![0u8; width as usize * height as usize * 4];
-    for (dy, row) in image.pixels.chunks_exact(3 * image.width as usize).enumerate() {
-        let start = ((region.y0 as usize + dy) * width as usize + region.x0 as usize) * 4;
-        for (px, out) in row.chunks_exact(3).zip(rgba[start..].chunks_exact_mut(4)) {
-            out.copy_from_slice(&[px[0], px[1], px[2], 255]);
+    // One sample is one byte, or two in the machine's order.
+    let (sample, colour) = match image.depth {
+        BitDepth::Eight => (1, image::ExtendedColorType::Rgba8),
+        BitDepth::Sixteen => (2, image::ExtendedColorType::Rgba16),
+    };
+    let mut rgba = vec![0u8; width as usize * height as usize * 4 * sample];
+    for (dy, row) in image.pixels.chunks_exact(3 * sample * image.width as usize).enumerate() {
+        let start = ((region.y0 as usize + dy) * width as usize + region.x0 as usize) * 4 * sample;
+        for (px, out) in row.chunks_exact(3 * sample).zip(rgba[start..].chunks_exact_mut(4 * sample)) {
+            out[..3 * sample].copy_from_slice(px);
+            // Opaque: the largest sample, all bits set at either depth.
+            out[3 * sample..].fill(255);
         }
     }
-    encode_png(path, &rgba, width, height, image::ExtendedColorType::Rgba8)
+    encode_png(path, &rgba, width, height, colour)
 }

@@ -4,6 +4,8 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+use scnc::render::BitDepth;
+
 use super::files::{check_output, write_png};
 
 #[derive(clap::Args)]
@@ -16,14 +18,38 @@ pub(crate) struct MergeArgs {
     output: PathBuf,
 }
 
-/// Reads a part: its size and RGBA pixels.
-fn read_part(path: &Path) -> Result<(u32, u32, Vec<u8>), String> {
+/// A part read: its size, bit depth, and RGBA samples (16-bit ones in the machine's order).
+struct Part {
+    width: u32,
+    height: u32,
+    depth: BitDepth,
+    rgba: Vec<u8>,
+}
+
+/// Reads a part.
+fn read_part(path: &Path) -> Result<Part, String> {
     let image = image::open(path).map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
-    let rgba = match image {
-        image::DynamicImage::ImageRgba8(rgba) => rgba,
-        _ => return Err(format!("`{}` is not a part (8-bit RGBA, as `scnc render --tile` writes)", path.display())),
+    let (width, height) = (image.width(), image.height());
+    let (depth, rgba) = match image {
+        image::DynamicImage::ImageRgba8(rgba) => (BitDepth::Eight, rgba.into_raw()),
+        image::DynamicImage::ImageRgba16(rgba) => {
+            (BitDepth::Sixteen, rgba.into_raw().into_iter().flat_map(u16::to_ne_bytes).collect())
+        }
+        _ => {
+            return Err(format!(
+                "`{}` is not a part (8- or 16-bit RGBA, as `scnc render --tile` writes)",
+                path.display()
+            ))
+        }
     };
-    Ok((rgba.width(), rgba.height(), rgba.into_raw()))
+    Ok(Part { width, height, depth, rgba })
+}
+
+fn bits(depth: BitDepth) -> u32 {
+    match depth {
+        BitDepth::Eight => 8,
+        BitDepth::Sixteen => 16,
+    }
 }
 
 /// The full image from its parts: every pixel opaque in exactly one part.
@@ -33,33 +59,47 @@ fn merge(parts: &[PathBuf]) -> Result<scnc::render::Image, String> {
     // Which part covers each pixel, by index + 1 (0: none yet).
     let mut owner: Vec<u32> = Vec::new();
     for (k, path) in parts.iter().enumerate() {
-        let (w, h, rgba) = read_part(path)?;
+        let Part { width: w, height: h, depth, rgba } = read_part(path)?;
         match size {
             None => {
-                size = Some((w, h, path));
-                pixels = vec![0u8; w as usize * h as usize * 3];
+                size = Some((w, h, depth, path));
+                pixels = vec![0u8; w as usize * h as usize * depth.pixel_bytes()];
                 owner = vec![0; w as usize * h as usize];
             }
-            Some((sw, sh, first)) if (sw, sh) != (w, h) => {
+            Some((sw, sh, _, first)) if (sw, sh) != (w, h) => {
                 return Err(format!(
                     "`{}` is {w}×{h} but `{}` is {sw}×{sh}: parts of one image have its size",
                     path.display(),
                     first.display()
                 ));
             }
+            Some((_, _, sd, first)) if sd != depth => {
+                return Err(format!(
+                    "`{}` has {} bits per channel but `{}` has {}: parts of one image have its bit depth",
+                    path.display(),
+                    bits(depth),
+                    first.display(),
+                    bits(sd)
+                ));
+            }
             Some(_) => {}
         }
-        for (i, px) in rgba.chunks_exact(4).enumerate() {
-            match px[3] {
-                0 => continue,
-                255 => {}
-                a => {
+        let px_bytes = depth.pixel_bytes();
+        let sample = px_bytes / 3;
+        for (i, px) in rgba.chunks_exact(4 * sample).enumerate() {
+            // Parts are wholly opaque (every alpha bit set) or wholly transparent.
+            let alpha = &px[3 * sample..];
+            match alpha.iter().all(|&b| b == alpha[0]).then_some(alpha[0]) {
+                Some(0) => continue,
+                Some(255) => {}
+                _ => {
+                    let a = if sample == 1 { u16::from(alpha[0]) } else { u16::from_ne_bytes([alpha[0], alpha[1]]) };
                     return Err(format!(
                         "`{}` has a pixel of alpha {a} at ({}, {}): parts are opaque or transparent",
                         path.display(),
                         i as u32 % w,
                         i as u32 / w
-                    ))
+                    ));
                 }
             }
             if owner[i] != 0 {
@@ -72,10 +112,10 @@ fn merge(parts: &[PathBuf]) -> Result<scnc::render::Image, String> {
                 ));
             }
             owner[i] = k as u32 + 1;
-            pixels[3 * i..3 * i + 3].copy_from_slice(&px[..3]);
+            pixels[px_bytes * i..px_bytes * (i + 1)].copy_from_slice(&px[..px_bytes]);
         }
     }
-    let Some((width, height, _)) = size else { return Err("no parts".into()) };
+    let Some((width, height, depth, _)) = size else { return Err("no parts".into()) };
     let gaps = owner.iter().filter(|&&o| o == 0).count();
     if let Some(first) = owner.iter().position(|&o| o == 0) {
         return Err(format!(
@@ -84,7 +124,7 @@ fn merge(parts: &[PathBuf]) -> Result<scnc::render::Image, String> {
             first as u32 / width
         ));
     }
-    Ok(scnc::render::Image { width, height, pixels })
+    Ok(scnc::render::Image { width, height, depth, pixels })
 }
 
 pub(crate) fn merge_cmd(args: MergeArgs) -> ExitCode {

@@ -16,7 +16,7 @@ use scnc::source::FsLoader;
 use scnc::study::tolerance::Tolerance;
 use scnc::Compiled;
 
-use scnc::render::Region;
+use scnc::render::{BitDepth, Region};
 
 use super::files::{check_output, stop_on_interrupt, write_part_png, write_png};
 use super::frames::{frame_path, is_pattern, parse_frames, FrameChoice};
@@ -84,6 +84,10 @@ pub(crate) struct RenderArgs {
     /// K, M or G suffix (binary); a mesh that would need more is refused before it is made.
     #[arg(long, value_parser = parse_bytes, default_value = "4G")]
     memory_limit: u64,
+    /// Bits per channel of the PNG: 8, or 16 (finer steps for grading, as shading is
+    /// done in f32 before it is quantised).
+    #[arg(long, value_parser = parse_bit_depth, value_name = "8|16", default_value = "8")]
+    bit_depth: BitDepth,
     /// Print the effect set, ray counts, work per ray and memory.
     #[arg(long)]
     stats: bool,
@@ -118,6 +122,15 @@ pub(crate) struct RenderArgs {
     /// How to print diagnostics.
     #[arg(long, value_enum, default_value = "human")]
     message_format: MessageFormat,
+}
+
+/// `8` or `16`.
+fn parse_bit_depth(s: &str) -> Result<BitDepth, String> {
+    match s.trim() {
+        "8" => Ok(BitDepth::Eight),
+        "16" => Ok(BitDepth::Sixteen),
+        other => Err(format!("`{other}` bits per channel: a PNG here has 8 or 16")),
+    }
 }
 
 /// `X0,Y0,X1,Y1`: four integers, a non-empty rectangle (checked against the image later).
@@ -380,7 +393,7 @@ fn render_scene(
     let lowered = pool.install(|| {
         scnc::world::prepare_reusing(&scene, effects, mode, &FsLoader, args.memory_limit, &mut sequence.cache)
     });
-    let (frame, geometry) = match lowered {
+    let (mut frame, geometry) = match lowered {
         Ok(g) => {
             let fresh: Vec<_> =
                 g.1.warnings.iter().filter(|d| sequence.shown.insert(diagnostic_key(d))).cloned().collect();
@@ -392,6 +405,7 @@ fn render_scene(
             return Err(ExitCode::from(1));
         }
     };
+    frame.bit_depth = args.bit_depth;
     let lowered = started.elapsed();
     let region = part.unwrap_or(Region::full(frame.width, frame.height));
     let progress = Progress::new(region.height());

@@ -11,7 +11,7 @@ pub(crate) fn stats_text(c: &Counters, g: &World, map: &SourceMap, lower_s: f64,
     let mut out = format!(
         "stats:
   time            lower {:.3} s (tessellation and BVH builds), trace {:.3} s
-  rays            {} primary, {} shadow, {} reflection, {} occlusion ({} total, {:.2} M/s)
+  rays            {} primary, {} shadow, {} reflection, {} refraction, {} occlusion ({} total, {:.2} M/s)
   sdf evaluations {} marching ({:.1} per ray, max {} on one ray), {} for normals and materials
   primitives      {} evaluations ({:.1} per ray), inside those
   step budget     {} marches ran out of steps (counted as misses)
@@ -23,6 +23,7 @@ pub(crate) fn stats_text(c: &Counters, g: &World, map: &SourceMap, lower_s: f64,
         c.primary_rays,
         c.shadow_rays,
         c.reflection_rays,
+        c.refraction_rays,
         c.occlusion_rays,
         c.rays(),
         c.rays() as f64 / trace_s.max(1e-9) / 1e6,

@@ -4,7 +4,9 @@ use std::fmt::Write as _;
 
 use glam::{DAffine3, DVec3};
 
-use super::{Geometry, LightKind, Material, Mesh, MeshSource, Primitive, Scene, Shape, ShapeKind};
+use super::{
+    ColorSpace, Geometry, LightKind, Material, Mesh, MeshSource, Paint, PatternKind, Primitive, Scene, Shape, ShapeKind,
+};
 use crate::source::SourceMap;
 use crate::span::Span;
 
@@ -26,6 +28,22 @@ pub(crate) fn vec(v: DVec3) -> String {
 
 fn color(c: DVec3) -> String {
     format!("rgb({}, {}, {})", num(c.x), num(c.y), num(c.z))
+}
+
+/// A colour or a pattern, patterns written as calls with their paints last.
+fn paint(p: &Paint) -> String {
+    match p {
+        Paint::Solid(c) => color(*c),
+        Paint::Pattern(pat) => {
+            let args = match &pat.kind {
+                PatternKind::Checker { size } => format!("size {}", num(*size)),
+                PatternKind::Stripes { width, axis } => format!("width {} axis {}", num(*width), vec(*axis)),
+                PatternKind::Gradient { from, to } => format!("from {} to {}", vec(*from), vec(*to)),
+                PatternKind::Noise { size, seed } => format!("size {} seed {seed}", num(*size)),
+            };
+            format!("{}({args}, {}, {})", pat.kind.name(), paint(&pat.a), paint(&pat.b))
+        }
+    }
 }
 
 struct Dumper<'a> {
@@ -50,7 +68,13 @@ impl Dumper<'_> {
 
     fn material(m: &Material) -> String {
         let spec = m.specular.map_or("none".to_string(), num);
-        format!("{} specular {} reflective {}", color(m.color), spec, num(m.reflective))
+        let mut s = format!("{} specular {} reflective {}", paint(&m.color), spec, num(m.reflective));
+        // Only transparent materials show the medium, so opaque scenes dump as before.
+        if m.is_transparent() {
+            let _ =
+                write!(s, " transparency {} ior {} absorption {}", num(m.transparency), num(m.ior), vec(m.absorption));
+        }
+        s
     }
 
     fn xf(xf: &DAffine3) -> String {
@@ -148,7 +172,7 @@ pub fn dump(scene: &Scene, map: &SourceMap) -> String {
     d.line(
         0,
         &format!(
-            "render {}x{} depth {} background {} epsilon {} max_steps {} max_distance {} samples {}{}{}",
+            "render {}x{} depth {} background {} epsilon {} max_steps {} max_distance {} samples {}{}{}{}",
             s.width,
             s.height,
             s.depth,
@@ -162,6 +186,7 @@ pub fn dump(scene: &Scene, map: &SourceMap) -> String {
             } else {
                 String::new()
             },
+            if s.color == ColorSpace::Linear { String::new() } else { format!(" color {}", s.color.name()) },
             if s.frames > 1 {
                 format!(" frames {} fps {}{}", s.frames, num(s.fps), if s.cyclic { " cyclic" } else { "" })
             } else {

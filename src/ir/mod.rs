@@ -10,6 +10,7 @@
 
 mod bounds;
 mod dump;
+mod paint;
 mod primitive;
 
 use std::path::PathBuf;
@@ -22,6 +23,7 @@ pub use bounds::{
 };
 pub use dump::dump;
 pub(crate) use dump::{num as dump_num, vec as dump_vec};
+pub use paint::{Paint, Pattern, PatternKind};
 pub use primitive::{Facets, Primitive};
 
 use crate::span::Span;
@@ -84,6 +86,8 @@ pub struct Settings {
     pub samples: u32,
     /// Reach of ambient occlusion in world units (0 = off).
     pub ambient_occlusion: f64,
+    /// How colours are read and pixels written.
+    pub color: ColorSpace,
     /// Frames of the animation (1: a still).
     pub frames: u32,
     /// Frames per second, for encoding an animation.
@@ -107,6 +111,7 @@ impl Default for Settings {
             max_distance: 1000.0,
             samples: 1,
             ambient_occlusion: 0.0,
+            color: ColorSpace::Linear,
             frames: 1,
             fps: 24.0,
             cyclic: false,
@@ -115,15 +120,42 @@ impl Default for Settings {
     }
 }
 
-/// A surface material, as in the study.
+/// How colours are read and pixels written (`render(color = …)`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ColorSpace {
+    /// The study's: colours are shaded as written and pixels are those numbers, 0–255.
+    Linear,
+    /// Colours are sRGB-encoded (as colour pickers give them): decoded to linear light
+    /// for shading, and pixels are encoded back to sRGB.
+    Srgb,
+}
+
+impl ColorSpace {
+    /// The name `render(color = …)` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            ColorSpace::Linear => "linear",
+            ColorSpace::Srgb => "srgb",
+        }
+    }
+}
+
+/// A surface material: the study's Phong terms, and a transparent medium behind the
+/// surface when `transparency` > 0.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
-    /// Colour, 0–255 per channel.
-    pub color: DVec3,
+    /// Colour, 0–255 per channel, or a pattern.
+    pub color: Paint,
     /// Phong exponent; `None` for no highlight (the study's −1).
     pub specular: Option<f64>,
     /// Reflectivity in [0, 1].
     pub reflective: f64,
+    /// The share of light passing into the surface, in [0, 1] (0 = opaque).
+    pub transparency: f64,
+    /// Index of refraction of the medium inside, in [1, 10] (1 = air: no bending).
+    pub ior: f64,
+    /// Beer–Lambert absorption inside, per unit of distance, per channel, ≥ 0.
+    pub absorption: DVec3,
     /// The `material(…)` call.
     pub span: Span,
 }
@@ -131,7 +163,20 @@ pub struct Material {
 impl Material {
     /// The colour of an object with no material anywhere above it: light grey, matte.
     pub fn default_grey() -> Material {
-        Material { color: DVec3::splat(200.0), specular: None, reflective: 0.0, span: Span::default() }
+        Material {
+            color: Paint::Solid(DVec3::splat(200.0)),
+            specular: None,
+            reflective: 0.0,
+            transparency: 0.0,
+            ior: 1.0,
+            absorption: DVec3::ZERO,
+            span: Span::default(),
+        }
+    }
+
+    /// Whether light passes through the surface (refraction rays are traced).
+    pub fn is_transparent(&self) -> bool {
+        self.transparency > 0.0
     }
 }
 

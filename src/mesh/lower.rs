@@ -34,7 +34,7 @@ pub fn tessellate(
                 node = child;
             }
             ShapeKind::Paint { child, material: m } => {
-                material = materials.intern(m);
+                material = materials.intern(m, xf);
                 node = child;
             }
             ShapeKind::Primitive(_)
@@ -487,7 +487,7 @@ pub fn explicit(
     loader: &dyn Loader,
 ) -> Result<MeshJob, Diagnostic> {
     let xf = to_render * m.xf;
-    let material = m.material.as_ref().map_or(0, |mat| materials.intern(mat));
+    let material = m.material.as_ref().map_or(0, |mat| materials.intern(mat, xf));
     // Generators are charged before anything is allocated; isosurfaces and files once
     // made (their grid-cell and file-size limits bound them until then).
     let expected = match &m.source {

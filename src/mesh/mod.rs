@@ -306,8 +306,9 @@ impl MeshObject {
     /// The surface at a hit found by [`closest`](Self::closest): point, normal (interpolated
     /// when smooth, else the face's), material and error, numbered `object`. Done once per
     /// ray, for the winner.
-    pub fn surface(&self, i: u32, hit: triangle::TriHit, object: u32) -> Hit {
+    pub fn surface(&self, i: u32, hit: triangle::TriHit, object: u32, dir: Vec3A) -> Hit {
         let (a, b, cc) = self.tri(i);
+        let geometric = (b - a).cross(cc - a);
         let point = a * hit.bary[0] + b * hit.bary[1] + cc * hit.bary[2];
         let normal = match &self.normals {
             Some(n) => {
@@ -317,19 +318,20 @@ impl MeshObject {
             }
             None => None,
         }
-        .unwrap_or_else(|| (b - a).cross(cc - a).normalize());
+        .unwrap_or_else(|| geometric.normalize());
         let material = match &self.materials {
             Materials::One(m) => *m,
             Materials::PerTriangle(m) => m[i as usize],
         };
         // The interpolated point lies within a few ulps of the true plane.
         let error = point.abs().max_element() * 8.0 * f32::EPSILON;
-        Hit { t: hit.t, point, normal, material, error, object, convex: self.is_convex() }
+        let from_inside = geometric.dot(dir) > 0.0;
+        Hit { t: hit.t, point, normal, material, error, object, convex: self.is_convex(), from_inside }
     }
 
     /// The closest hit within `(ray.t_min, t_max)`, with its surface.
     pub fn intersect(&self, ray: &Ray, shear: &triangle::Shear, t_max: f32, c: &mut Counters) -> Option<Hit> {
-        self.closest(ray, shear, t_max, c).map(|(i, hit)| self.surface(i, hit, NO_OBJECT))
+        self.closest(ray, shear, t_max, c).map(|(i, hit)| self.surface(i, hit, NO_OBJECT, ray.dir))
     }
 
     /// Whether any triangle lies along the ray within `(ray.t_min, t_max)`.

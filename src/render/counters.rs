@@ -7,8 +7,10 @@ pub struct Counters {
     pub primary_rays: u64,
     /// Shadow (occlusion) rays.
     pub shadow_rays: u64,
-    /// Reflection rays.
+    /// Reflection rays (mirrors, and the Fresnel reflection of transparent surfaces).
     pub reflection_rays: u64,
+    /// Refraction rays (transmitted through transparent surfaces).
+    pub refraction_rays: u64,
     /// Ambient-occlusion rays (mesh scenes; SDF scenes estimate without rays).
     pub occlusion_rays: u64,
     /// SDF evaluations during marching (SDF back-end).
@@ -39,6 +41,7 @@ impl Counters {
         self.primary_rays += o.primary_rays;
         self.shadow_rays += o.shadow_rays;
         self.reflection_rays += o.reflection_rays;
+        self.refraction_rays += o.refraction_rays;
         self.occlusion_rays += o.occlusion_rays;
         self.sdf_evals += o.sdf_evals;
         self.sdf_shading_evals += o.sdf_shading_evals;
@@ -52,6 +55,6 @@ impl Counters {
 
     /// All rays cast.
     pub fn rays(&self) -> u64 {
-        self.primary_rays + self.shadow_rays + self.reflection_rays + self.occlusion_rays
+        self.primary_rays + self.shadow_rays + self.reflection_rays + self.refraction_rays + self.occlusion_rays
     }
 }

@@ -2,9 +2,10 @@
 //! IR alone, so the tracer is built with those and no others.
 //!
 //! Derived facts: whether any light casts shadows (`shadows = false` opts a light out;
-//! ambient light never casts), whether any material reflects (and how deep recursion
-//! can matter), whether any material has a specular highlight, the total ambient
-//! intensity, and the optional extras the scene asked for (`render(samples = n)`).
+//! ambient light never casts), whether any material reflects or lets light through (and
+//! how deep recursion can matter), whether any material has a specular highlight or a
+//! pattern, the total ambient intensity, and the optional extras the scene asked for
+//! (`render(samples = n)`).
 
 use std::fmt;
 
@@ -21,8 +22,14 @@ pub struct Effects {
     pub ambient: f64,
     /// Some material reflects and the depth allows a bounce.
     pub reflections: bool,
+    /// Some material is transparent and the depth allows a bounce: refraction rays, the
+    /// Fresnel reflections that go with them, and shadow rays through glass.
+    pub refraction: bool,
     /// The deepest recursion that can change a pixel (≤ the scene's `depth`).
     pub useful_depth: u32,
+    /// Some material is painted with a pattern (evaluated per shaded point of those
+    /// materials only).
+    pub patterns: bool,
     /// Some material has a Phong highlight.
     pub specular: bool,
     /// Samples per pixel (1 = no antialiasing).
@@ -38,6 +45,7 @@ impl Effects {
     pub fn all(scene: &Scene) -> Effects {
         let mut e = derive(scene);
         e.reflections = scene.settings.depth > 0;
+        e.refraction = scene.settings.depth > 0;
         e.useful_depth = scene.settings.depth;
         e.specular = true;
         e
@@ -105,9 +113,13 @@ pub fn derive(scene: &Scene) -> Effects {
     let per_object: Vec<Vec<ir::Material>> = scene.objects.iter().map(|o| materials_of(&o.geometry)).collect();
     let reflective_objects = per_object.iter().filter(|ms| ms.iter().any(|m| m.reflective > 0.0)).count();
     let reflections = reflective_objects > 0 && scene.settings.depth > 0;
+    let refraction = per_object.iter().flatten().any(ir::Material::is_transparent) && scene.settings.depth > 0;
     // A single convex object sees nothing but the background in its reflection, so one
-    // bounce is all that can show; otherwise every allowed bounce may matter.
-    let useful_depth = if !reflections {
+    // bounce is all that can show; otherwise every allowed bounce may matter. Light
+    // through glass bounces inside it, so refraction keeps the whole depth.
+    let useful_depth = if refraction {
+        scene.settings.depth
+    } else if !reflections {
         0
     } else if scene.objects.len() == 1 && scene.objects[0].geometry.is_convex() {
         1
@@ -121,7 +133,9 @@ pub fn derive(scene: &Scene) -> Effects {
         unshadowed_lights,
         ambient,
         reflections,
+        refraction,
         useful_depth,
+        patterns: per_object.iter().flatten().any(|m| m.color.is_pattern()),
         specular,
         samples: scene.settings.samples,
         soft_lights,
@@ -142,13 +156,15 @@ impl fmt::Display for Effects {
         };
         write!(
             f,
-            "effects: ambient {}, shadow rays from {}, unshadowed lights {}, soft shadows from {}, specular {}, reflections {}, antialiasing {}, ambient occlusion {}",
+            "effects: ambient {}, shadow rays from {}, unshadowed lights {}, soft shadows from {}, specular {}, reflections {}, refraction {}, patterns {}, antialiasing {}, ambient occlusion {}",
             ir::dump_num(self.ambient),
             list(&self.shadow_lights),
             list(&self.unshadowed_lights),
             list(&self.soft_lights),
             if self.specular { "on" } else { "off" },
             if self.reflections { format!("up to depth {}", self.useful_depth) } else { "off".to_string() },
+            if self.refraction { format!("up to depth {}", self.useful_depth) } else { "off".to_string() },
+            if self.patterns { "on" } else { "off" },
             if self.samples > 1 { format!("{} samples", self.samples) } else { "off".to_string() },
             self.ambient_occlusion.map_or("off".to_string(), |d| format!("within {}", ir::dump_num(d))),
         )

@@ -1,19 +1,42 @@
 //! The back-end-independent part of a lowered scene: camera, lights, materials, settings.
 
-use glam::{DVec3, Vec3A};
+use std::sync::Arc;
 
-use crate::ir;
+use glam::{DAffine3, DVec3, Vec3A};
+
+use super::pattern::{self, ShadePattern};
+use crate::ir::{self, ColorSpace};
 use crate::render::effects::Effects;
 
 /// A material ready for shading.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ShadeMaterial {
-    /// Colour, 0–255 per channel.
+    /// Colour, linear, 0–255 per channel (a pattern's average where there is one).
     pub color: Vec3A,
+    /// The pattern that paints it instead of `color`, with its object's space.
+    pub pattern: Option<Arc<ShadePattern>>,
     /// Phong exponent, `None` for no highlight.
     pub specular: Option<f32>,
     /// Reflectivity in [0, 1].
     pub reflective: f32,
+    /// The share of light passing into the surface, in [0, 1].
+    pub transparency: f32,
+    /// Index of refraction inside.
+    pub ior: f32,
+    /// Absorption inside, per unit of distance, per channel.
+    pub absorption: Vec3A,
+}
+
+impl ShadeMaterial {
+    /// The colour at a render-space point of the surface (just inside it, so a face lying
+    /// on a pattern's cell boundary takes one side's colour, not both in speckles).
+    #[inline]
+    pub fn color_at(&self, inside: Vec3A) -> Vec3A {
+        match &self.pattern {
+            None => self.color,
+            Some(p) => p.color_at(inside),
+        }
+    }
 }
 
 /// Materials by index; index 0 is the default light grey.
@@ -21,23 +44,37 @@ pub struct ShadeMaterial {
 pub struct MaterialTable {
     /// The materials.
     pub materials: Vec<ShadeMaterial>,
+    /// How the scene's colours are read.
+    space: ColorSpace,
 }
 
 impl Default for MaterialTable {
     fn default() -> MaterialTable {
-        let mut t = MaterialTable { materials: Vec::new() };
-        t.intern(&ir::Material::default_grey());
-        t
+        MaterialTable::new(ColorSpace::Linear)
     }
 }
 
 impl MaterialTable {
-    /// The index of this material, adding it if new.
-    pub fn intern(&mut self, m: &ir::Material) -> u32 {
+    /// An empty table but for the default grey, reading colours in `space`.
+    pub fn new(space: ColorSpace) -> MaterialTable {
+        let mut t = MaterialTable { materials: Vec::new(), space };
+        t.intern(&ir::Material::default_grey(), DAffine3::IDENTITY);
+        t
+    }
+
+    /// The index of this material painting an object whose space is `render_from_local`
+    /// of render space, adding it if new. Only a patterned material depends on where it
+    /// is; plain ones are shared by every object.
+    pub fn intern(&mut self, m: &ir::Material, render_from_local: DAffine3) -> u32 {
+        let pattern = pattern::of_material(m, render_from_local, self.space).map(Arc::new);
         let sm = ShadeMaterial {
-            color: m.color.as_vec3a(),
+            color: pattern::linear(m.color.mean().as_vec3a(), self.space),
+            pattern,
             specular: m.specular.map(|s| s as f32),
             reflective: m.reflective as f32,
+            transparency: m.transparency as f32,
+            ior: m.ior as f32,
+            absorption: m.absorption.as_vec3a(),
         };
         match self.materials.iter().position(|x| *x == sm) {
             Some(i) => i as u32,
@@ -95,7 +132,7 @@ pub struct Frame {
     pub effects: Effects,
     /// Materials.
     pub materials: MaterialTable,
-    /// Background colour, 0–255.
+    /// Background colour, linear, 0–255.
     pub background: Vec3A,
     /// Reflection recursion depth actually traced (the effect set's useful depth).
     pub depth: u32,
@@ -105,6 +142,10 @@ pub struct Frame {
     pub max_distance: f32,
     /// The world position of the render-space origin (the camera), in f64.
     pub origin: DVec3,
+    /// How pixels are encoded (`render(color = …)`).
+    pub color: ColorSpace,
+    /// Bits per channel of the image (`--bit-depth`).
+    pub bit_depth: super::BitDepth,
 }
 
 impl Frame {
@@ -151,12 +192,14 @@ impl Frame {
             casting,
             soft,
             plain,
-            materials: MaterialTable::default(),
-            background: s.background.as_vec3a(),
+            materials: MaterialTable::new(s.color),
+            background: pattern::linear(s.background.as_vec3a(), s.color),
             depth: effects.useful_depth,
             samples: s.samples,
             max_distance: s.max_distance as f32,
             origin,
+            color: s.color,
+            bit_depth: super::BitDepth::Eight,
             effects,
         }
     }

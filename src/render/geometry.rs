@@ -24,6 +24,9 @@ pub struct Hit {
     /// (a convex solid with its geometric normal, or a flat surface), so a ray leaving the
     /// front of that plane cannot meet it again.
     pub convex: bool,
+    /// Whether the ray met the surface from the object's inside (the side its normal
+    /// points away from: the geometric side for a mesh, whatever its shading normal).
+    pub from_inside: bool,
 }
 
 /// What a geometry back-end provides to the tracer.

@@ -13,25 +13,73 @@ mod counters;
 pub mod effects;
 mod frame;
 mod geometry;
+pub mod pattern;
 mod ray;
 mod shade;
+mod transmit;
 
+use glam::Vec3A;
 use rayon::prelude::*;
+use shade::fx;
+
+use crate::ir::ColorSpace;
 
 pub use counters::Counters;
 pub use frame::{Frame, MaterialTable, ShadeLight, ShadeMaterial};
 pub use geometry::{intersect_each, Geometry, Hit};
 pub use ray::{lanes, spawn_offset, Packet, Ray, NO_OBJECT};
 
-/// A rendered image: RGB, 8 bits per channel, rows top to bottom.
+/// A rendered image: RGB, rows top to bottom.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Image {
     /// Width in pixels.
     pub width: u32,
     /// Height in pixels.
     pub height: u32,
-    /// `width × height × 3` bytes.
+    /// Bits per channel.
+    pub depth: BitDepth,
+    /// `width × height × 3` samples of `depth` bits, a 16-bit one as two bytes in the
+    /// machine's order (as `image`'s encoders take them).
     pub pixels: Vec<u8>,
+}
+
+/// Bits per channel of an image.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BitDepth {
+    /// 8 bits, 0–255: the study's.
+    #[default]
+    Eight,
+    /// 16 bits, 0–65535.
+    Sixteen,
+}
+
+impl BitDepth {
+    /// Bytes of one pixel (three channels).
+    pub fn pixel_bytes(self) -> usize {
+        match self {
+            BitDepth::Eight => 3,
+            BitDepth::Sixteen => 6,
+        }
+    }
+}
+
+/// Writes a pixel's colour (linear, 0–255, clamped) as `frame` asks: encoded to sRGB or
+/// not, at its bit depth. The study's 8-bit linear pixels round the value to nearest.
+#[inline]
+fn encode(colour: Vec3A, frame: &Frame, out: &mut Vec<u8>) {
+    let v = match frame.color {
+        ColorSpace::Linear => colour,
+        ColorSpace::Srgb => Vec3A::from_array(colour.to_array().map(|x| pattern::linear_to_srgb(x / 255.0) * 255.0)),
+    };
+    match frame.bit_depth {
+        // Values are in [0, 255], so adding one half and truncating rounds to nearest.
+        BitDepth::Eight => out.extend((v + 0.5).to_array().map(|x| x as u8)),
+        BitDepth::Sixteen => {
+            for x in (v * (65535.0 / 255.0) + 0.5).to_array() {
+                out.extend((x as u16).to_ne_bytes());
+            }
+        }
+    }
 }
 
 /// A rectangle of the image's pixels, `x0..x1` by `y0..y1` (ends exclusive).
@@ -88,23 +136,27 @@ pub fn render_region(
     progress: &(dyn Fn() + Sync),
 ) -> (Image, Counters) {
     let e = &frame.effects;
+    let flag = |on: bool, bit: u8| if on { bit } else { 0 };
+    let wanted = flag(e.shadows(), fx::SHADOWS)
+        | flag(e.reflections, fx::REFLECT)
+        | flag(e.specular, fx::SPECULAR)
+        | flag(e.ambient_occlusion.is_some(), fx::AO)
+        | flag(e.refraction, fx::REFRACT);
     // Pick the tracer built for this effect set, once, before the first ray.
     macro_rules! pick {
-        ($($s:literal $r:literal $p:literal $a:literal),*) => {
-            match (e.shadows(), e.reflections, e.specular, e.ambient_occlusion.is_some()) {
-                $(($s, $r, $p, $a) => rows::<$s, $r, $p, $a>(geometry, frame, region, progress),)*
+        ($($n:literal)*) => {
+            match wanted {
+                $($n => rows::<$n>(geometry, frame, region, progress),)*
+                // Every set of the five flags is listed above; the tracer with every
+                // effect would render any scene correctly.
+                _ => rows::<31>(geometry, frame, region, progress),
             }
         };
     }
-    pick!(
-        false false false false, false false false true, false false true false, false false true true,
-        false true false false, false true false true, false true true false, false true true true,
-        true false false false, true false false true, true false true false, true false true true,
-        true true false false, true true false true, true true true false, true true true true
-    )
+    pick!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31)
 }
 
-fn rows<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const AO: bool>(
+fn rows<const FX: u8>(
     geometry: &dyn Geometry,
     frame: &Frame,
     region: Region,
@@ -113,7 +165,8 @@ fn rows<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const AO
     let (w, h) = (frame.width, frame.height);
     // The blocks' first column, and where the region starts in a strip's rows.
     let bx = region.x0 / 4 * 4;
-    let crop = 3 * (region.x0 - bx) as usize..3 * (region.x1 - bx) as usize;
+    let bytes = frame.bit_depth.pixel_bytes();
+    let crop = bytes * (region.x0 - bx) as usize..bytes * (region.x1 - bx) as usize;
     // Rows go in fours, so camera rays can be cast in 4×4 blocks.
     let rows: Vec<(Vec<u8>, Counters)> = (region.y0 / 4..region.y1.div_ceil(4))
         .into_par_iter()
@@ -123,13 +176,14 @@ fn rows<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const AO
             // Leaves are counted per thread; a strip runs on one thread from start to end.
             let _ = crate::sdf::take_leaf_evals();
             let mut rows: Vec<Vec<u8>> =
-                (0..rows_here).map(|_| Vec::with_capacity((region.x1 - bx) as usize * 3)).collect();
+                (0..rows_here).map(|_| Vec::with_capacity((region.x1 - bx) as usize * bytes)).collect();
             for x in (bx..region.x1).step_by(4) {
                 let cols = (w - x).min(4);
-                let px =
-                    shade::block::<SHADOWS, REFLECT, SPECULAR, AO>(geometry, frame, (x, y), (cols, rows_here), &mut c);
+                let px = shade::block::<FX>(geometry, frame, (x, y), (cols, rows_here), &mut c);
                 for (dy, row) in rows.iter_mut().enumerate() {
-                    row.extend(px[4 * dy..4 * dy + cols as usize].iter().flatten());
+                    for &colour in &px[4 * dy..4 * dy + cols as usize] {
+                        encode(colour, frame, row);
+                    }
                 }
             }
             c.leaf_evals += crate::sdf::take_leaf_evals();
@@ -153,10 +207,10 @@ fn rows<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const AO
         })
         .collect();
     let mut counters = Counters::default();
-    let mut pixels = Vec::with_capacity(region.width() as usize * region.height() as usize * 3);
+    let mut pixels = Vec::with_capacity(region.width() as usize * region.height() as usize * bytes);
     for (row, c) in rows {
         pixels.extend_from_slice(&row);
         counters.add(&c);
     }
-    (Image { width: region.width(), height: region.height(), pixels }, counters)
+    (Image { width: region.width(), height: region.height(), depth: frame.bit_depth, pixels }, counters)
 }

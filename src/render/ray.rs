@@ -20,6 +20,10 @@ pub struct Ray {
     /// An object the ray cannot meet, which a back-end may leave out ([`NO_OBJECT`] for none):
     /// the convex object a secondary ray leaves (see [`Ray::leaving`]).
     pub skip: u32,
+    /// The object the ray starts inside ([`NO_OBJECT`] for none): a ray refracted into
+    /// a transparent object, whose back-end must then find the surface from within
+    /// (an SDF marches `−f`).
+    pub inside: u32,
 }
 
 /// No object: the [`Ray::skip`] of a ray that may meet anything.
@@ -29,7 +33,7 @@ impl Ray {
     /// A ray from `origin` along the unit vector `dir`, accepting hits in `[0, t_max]`.
     pub fn new(origin: Vec3A, dir: Vec3A, t_max: f32) -> Ray {
         debug_assert!(origin.is_finite() && dir.is_finite(), "non-finite ray");
-        Ray { origin, dir, inv_dir: dir.recip(), t_min: 0.0, t_max, skip: NO_OBJECT }
+        Ray { origin, dir, inv_dir: dir.recip(), t_min: 0.0, t_max, skip: NO_OBJECT, inside: NO_OBJECT }
     }
 
     /// A secondary ray from `origin`, just off `hit`'s surface, along `dir`. When the hit

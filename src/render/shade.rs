@@ -2,28 +2,48 @@
 //! Phong `(R·V/|R||V|)^s`), hard shadows, reflections blended `(1 − r)·local + r·reflected`,
 //! colour clamped once at the end.
 //!
+//! Transparent materials add refraction: `(1 − t)·surface + t·(F·reflected + (1 − F)·refracted)`
+//! for transparency `t` and Fresnel reflectance `F` ([`transmit`](super::transmit)),
+//! which is the study's model exactly when `t` = 0.
+//!
 //! The tracer is built for the scene's effect set: `block`, `trace` and `shade` are
-//! generic over four const flags (shadow rays, reflection rays, specular highlights,
-//! ambient occlusion), and [`render`](super::render) picks the one of sixteen
-//! monomorphised variants that the effect set calls for before the first ray. Lights
-//! arrive pre-split into an ambient sum, casting and non-casting lists, so no per-ray
-//! code tests for an effect or a light kind the scene does not have.
+//! generic over a const set of flags ([`fx`]: shadow rays, reflection rays, specular
+//! highlights, ambient occlusion, refraction), and [`render`](super::render) picks the
+//! one of thirty-two monomorphised variants that the effect set calls for before the
+//! first ray. Lights arrive pre-split into an ambient sum, casting and non-casting
+//! lists, so no per-ray code tests for an effect or a light kind the scene does not have.
 
 use glam::Vec3A;
 
+use super::transmit::{self, Media};
 use super::{lanes, spawn_offset, Counters, Frame, Geometry, Hit, Packet, Ray, ShadeLight};
 
-/// The 8-bit colours of a block of up to 4×4 pixels from `(x, y)`, `w` wide and `h` high,
-/// each averaging `frame.samples` deterministic samples. Each sample's camera rays go
+/// The effect flags a tracer variant is built with (bits of its `FX` parameter).
+pub(super) mod fx {
+    /// Shadow rays.
+    pub const SHADOWS: u8 = 1;
+    /// Reflection rays for reflective materials.
+    pub const REFLECT: u8 = 2;
+    /// Phong highlights.
+    pub const SPECULAR: u8 = 4;
+    /// Ambient occlusion.
+    pub const AO: u8 = 8;
+    /// Transparent materials: refraction and Fresnel rays, shadows through glass.
+    pub const REFRACT: u8 = 16;
+}
+use fx::{AO, REFLECT, REFRACT, SHADOWS, SPECULAR};
+
+/// The colours (linear, clamped to 0–255) of a block of up to 4×4 pixels from `(x, y)`,
+/// `w` wide and `h` high, each averaging `frame.samples` deterministic samples. Each sample's camera rays go
 /// to the back-end together, as four 2×2 packets; each pixel is then shaded on its own
 /// (secondary rays go one by one). Pixel `(dx, dy)` of the block is entry `4·dy + dx`.
-pub(super) fn block<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const AO: bool>(
+pub(super) fn block<const FX: u8>(
     g: &dyn Geometry,
     frame: &Frame,
     (x, y): (u32, u32),
     (w, h): (u32, u32),
     c: &mut Counters,
-) -> [[u8; 3]; 16] {
+) -> [Vec3A; 16] {
     let n = frame.samples.max(1);
     // Lane `l` of packet `q` is pixel `(dx, dy)` of the block; outside `w × h` it traces
     // the nearest pixel inside, unwanted.
@@ -51,7 +71,7 @@ pub(super) fn block<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bo
         for (q, quad) in quads.iter().enumerate() {
             for l in lanes(quad.mask) {
                 let ray = &quad.rays[l];
-                let mut colour = shade::<SHADOWS, REFLECT, SPECULAR, AO>(g, frame, ray, hits[q][l], frame.depth, c);
+                let mut colour = shade::<FX>(g, frame, ray, hits[q][l], frame.depth, Media::AIR, c);
                 if !colour.is_finite() {
                     c.nonfinite_samples += 1;
                     colour = Vec3A::ZERO;
@@ -61,12 +81,13 @@ pub(super) fn block<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bo
             }
         }
     }
-    sums.map(|sum| {
-        let avg = if n == 1 { sum } else { sum * (1.0 / n as f32) };
-        // Values are in [0, 255], so adding one half and truncating rounds to nearest.
-        let q = avg + 0.5;
-        [q.x as u8, q.y as u8, q.z as u8]
-    })
+    if n > 1 {
+        let inv = 1.0 / n as f32;
+        for sum in &mut sums {
+            *sum *= inv;
+        }
+    }
+    sums
 }
 
 /// Sample positions inside the pixel: its centre for one sample, else the R2
@@ -84,7 +105,7 @@ fn sample_offset(s: u32, n: u32) -> (f32, f32) {
 /// The light a point receives from one direct light, before shadowing: `None` when the
 /// light adds nothing there (behind the surface, no highlight), so no shadow ray is needed.
 #[inline(always)]
-fn direct<const SPECULAR: bool>(
+fn direct<const FX: u8>(
     light: &ShadeLight,
     point: Vec3A,
     normal: Vec3A,
@@ -106,7 +127,7 @@ fn direct<const SPECULAR: bool>(
     let n_dot_l = normal.dot(l_unit);
     let diffuse = n_dot_l.max(0.0);
     let mut spec = 0.0;
-    if SPECULAR {
+    if FX & SPECULAR != 0 {
         if let Some(s) = specular {
             let r = normal * (2.0 * n_dot_l) - l_unit;
             let r_dot_v = r.dot(view) / r.length().max(f32::MIN_POSITIVE);
@@ -121,30 +142,38 @@ fn direct<const SPECULAR: bool>(
 /// Shadow rays per soft light when the back-end cannot estimate a penumbra.
 const SOFT_SAMPLES: u32 = 16;
 
-/// The visible fraction of a round light of `radius` at distance `t_max` along `dir`:
-/// the back-end's one-query penumbra estimate if it has one (SDF scenes), else the
-/// fraction of [`SOFT_SAMPLES`] shadow rays to points spread over the light's disk.
-fn soft_visibility(
+/// The light let through from a round light of `radius` at distance `t_max` along
+/// `dir`, per channel: the back-end's one-query penumbra estimate if it has one (SDF
+/// scenes without transparent materials), else the average over [`SOFT_SAMPLES`] shadow
+/// rays to points spread over the light's disk.
+#[allow(clippy::too_many_arguments, reason = "the shading state a shadow ray starts from")]
+fn soft_visibility<const FX: u8>(
     g: &dyn Geometry,
+    frame: &Frame,
     hit: &Hit,
     origin: Vec3A,
     dir: Vec3A,
     t_max: f32,
     radius: f32,
+    media: Media,
     c: &mut Counters,
-) -> f32 {
+) -> Vec3A {
     let cone = radius / t_max.max(f32::MIN_POSITIVE);
-    c.shadow_rays += 1;
-    // The cone, unlike a ray leaving the surface, may graze the object it starts on (its
-    // own horizon hides part of the light near the terminator), so it skips nothing.
-    if let Some(v) = g.soft_visibility(&Ray::new(origin, dir, t_max), cone, c) {
-        return v;
+    // The cone estimate cannot see through glass; with transparent materials every
+    // sample is a ray that can.
+    if FX & REFRACT == 0 {
+        c.shadow_rays += 1;
+        // The cone, unlike a ray leaving the surface, may graze the object it starts on (its
+        // own horizon hides part of the light near the terminator), so it skips nothing.
+        if let Some(v) = g.soft_visibility(&Ray::new(origin, dir, t_max), cone, c) {
+            return Vec3A::splat(v);
+        }
+        c.shadow_rays -= 1;
     }
-    c.shadow_rays -= 1;
     let centre = origin + dir * t_max;
     let u = dir.any_orthonormal_vector();
     let w = dir.cross(u);
-    let mut visible = 0;
+    let mut visible = Vec3A::ZERO;
     for s in 0..SOFT_SAMPLES {
         // Deterministic, evenly spread points on the disk (Vogel's sunflower spiral).
         let r = radius * ((s as f32 + 0.5) / SOFT_SAMPLES as f32).sqrt();
@@ -152,12 +181,11 @@ fn soft_visibility(
         let target = centre + u * (r * a.cos()) + w * (r * a.sin());
         let to = target - origin;
         let len = to.length();
-        c.shadow_rays += 1;
-        if !g.occluded(&Ray::leaving(hit, origin, to / len, len), c) {
-            visible += 1;
-        }
+        let mut ray = Ray::leaving(hit, origin, to / len, len);
+        ray.inside = media.object();
+        visible += shadow::<FX>(g, frame, &ray, media, c);
     }
-    visible as f32 / SOFT_SAMPLES as f32
+    visible / SOFT_SAMPLES as f32
 }
 
 /// Occlusion rays per hit when the back-end cannot estimate occlusion.
@@ -187,25 +215,53 @@ fn occlusion(g: &dyn Geometry, hit: &Hit, origin: Vec3A, normal: Vec3A, reach: f
     open as f32 / AO_SAMPLES as f32
 }
 
-/// The colour seen along `ray`, 0–255 per channel but not yet clamped.
-fn trace<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const AO: bool>(
+/// The colour seen along `ray` travelling in `media`, 0–255 per channel but not yet clamped.
+fn trace<const FX: u8>(
     g: &dyn Geometry,
     frame: &Frame,
     ray: &Ray,
     depth: u32,
+    media: Media,
     c: &mut Counters,
 ) -> Vec3A {
     let hit = g.intersect(ray, c);
-    shade::<SHADOWS, REFLECT, SPECULAR, AO>(g, frame, ray, hit, depth, c)
+    let colour = shade::<FX>(g, frame, ray, hit, depth, media, c);
+    if FX & REFRACT == 0 {
+        return colour;
+    }
+    // Beer–Lambert: the medium the ray crossed to get here absorbs along the way.
+    match media.absorb(frame, hit.map_or(ray.t_max, |h| h.t)) {
+        Some(left) => colour * left,
+        None => colour,
+    }
 }
 
-/// The colour seen along `ray` given what it hit (`None`: the background).
-fn shade<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const AO: bool>(
+/// The light arriving from one direct light over a shadow ray, per channel: all or
+/// nothing, or, through transparent objects, what they let pass.
+#[inline(always)]
+fn shadow<const FX: u8>(g: &dyn Geometry, frame: &Frame, ray: &Ray, media: Media, c: &mut Counters) -> Vec3A {
+    c.shadow_rays += 1;
+    if ray.t_max <= 0.0 {
+        return Vec3A::ONE;
+    }
+    if FX & REFRACT != 0 {
+        return transmit::light_through(g, frame, ray, media, c);
+    }
+    if g.occluded(ray, c) {
+        Vec3A::ZERO
+    } else {
+        Vec3A::ONE
+    }
+}
+
+/// The colour seen along `ray` (travelling in `media`) given what it hit (`None`: the background).
+fn shade<const FX: u8>(
     g: &dyn Geometry,
     frame: &Frame,
     ray: &Ray,
     hit: Option<Hit>,
     depth: u32,
+    media: Media,
     c: &mut Counters,
 ) -> Vec3A {
     let Some(hit) = hit else {
@@ -214,61 +270,78 @@ fn shade<const SHADOWS: bool, const REFLECT: bool, const SPECULAR: bool, const A
     let view = -ray.dir;
     // Seen from behind (inside a solid or a one-sided surface): shade the side we see.
     let normal = if hit.normal.dot(view) < 0.0 { -hit.normal } else { hit.normal };
-    let material = frame.materials.materials[hit.material as usize];
+    let material = &frame.materials.materials[hit.material as usize];
     let offset = spawn_offset(hit.point, hit.error);
     let origin = hit.point + normal * offset;
+    let transparency = if FX & REFRACT != 0 { material.transparency } else { 0.0 };
 
-    let mut intensity = frame.ambient;
-    if AO {
-        intensity *= occlusion(g, &hit, origin, normal, frame.ao_reach, c);
-    }
-    if SHADOWS {
-        for light in &frame.casting {
-            let Some((l_unit, dist, amount)) = direct::<SPECULAR>(light, hit.point, normal, view, material.specular)
-            else {
-                continue;
-            };
-            c.shadow_rays += 1;
-            let shadow = Ray::leaving(&hit, origin, l_unit, (dist - offset).min(frame.max_distance));
-            if shadow.t_max > 0.0 && g.occluded(&shadow, c) {
-                continue;
+    // The surface's own light: skipped where it has no weight (clear glass).
+    let mut local = Vec3A::ZERO;
+    if transparency < 1.0 {
+        let mut light = Vec3A::splat(frame.ambient);
+        if FX & AO != 0 {
+            light *= occlusion(g, &hit, origin, normal, frame.ao_reach, c);
+        }
+        if FX & SHADOWS != 0 {
+            for l in &frame.casting {
+                let Some((l_unit, dist, amount)) = direct::<FX>(l, hit.point, normal, view, material.specular) else {
+                    continue;
+                };
+                let mut ray = Ray::leaving(&hit, origin, l_unit, (dist - offset).min(frame.max_distance));
+                ray.inside = media.object();
+                light += amount * shadow::<FX>(g, frame, &ray, media, c);
             }
-            intensity += amount;
-        }
-        for (light, radius) in &frame.soft {
-            let Some((l_unit, dist, amount)) = direct::<SPECULAR>(light, hit.point, normal, view, material.specular)
-            else {
-                continue;
-            };
-            let t_max = (dist - offset).min(frame.max_distance);
-            if t_max <= 0.0 {
-                intensity += amount;
-                continue;
+            for (l, radius) in &frame.soft {
+                let Some((l_unit, dist, amount)) = direct::<FX>(l, hit.point, normal, view, material.specular) else {
+                    continue;
+                };
+                let t_max = (dist - offset).min(frame.max_distance);
+                if t_max <= 0.0 {
+                    light += Vec3A::splat(amount);
+                    continue;
+                }
+                light += amount * soft_visibility::<FX>(g, frame, &hit, origin, l_unit, t_max, *radius, media, c);
             }
-            intensity += amount * soft_visibility(g, &hit, origin, l_unit, t_max, *radius, c);
         }
-    }
-    for light in &frame.plain {
-        if let Some((_, _, amount)) = direct::<SPECULAR>(light, hit.point, normal, view, material.specular) {
-            intensity += amount;
+        for l in &frame.plain {
+            if let Some((_, _, amount)) = direct::<FX>(l, hit.point, normal, view, material.specular) {
+                light += Vec3A::splat(amount);
+            }
         }
+        // Patterns are read just inside the surface (see `ShadeMaterial::color_at`).
+        local = material.color_at(hit.point - normal * offset) * light;
     }
-    let local = material.color * intensity;
-    if !REFLECT {
+    if FX & (REFLECT | REFRACT) == 0 {
         return local;
     }
-    let r = material.reflective;
-    if depth == 0 || r <= 0.0 {
-        return local;
+    let r = if FX & REFLECT != 0 { material.reflective } else { 0.0 };
+    let surface = if depth > 0 && r > 0.0 { local * (1.0 - r) } else { local };
+    if depth == 0 || (r <= 0.0 && transparency <= 0.0) {
+        return surface;
     }
-    let reflected_dir = (normal * (2.0 * normal.dot(view)) - view).normalize();
-    c.reflection_rays += 1;
-    let reflected = trace::<SHADOWS, REFLECT, SPECULAR, AO>(
-        g,
-        frame,
-        &Ray::leaving(&hit, origin, reflected_dir, frame.max_distance),
-        depth - 1,
-        c,
-    );
-    local * (1.0 - r) + reflected * r
+    // How much of the mirror direction and of the transmitted direction shows.
+    let (mut mirror, mut through, mut bent) = (r * (1.0 - transparency), 0.0, None);
+    if transparency > 0.0 {
+        let (n1, n2) = transmit::indices(frame, &hit, &media);
+        let split = transmit::split(view, normal, n1, n2);
+        mirror += transparency * split.reflectance;
+        through = transparency * (1.0 - split.reflectance);
+        bent = split.refracted;
+    }
+    let mut colour = surface * (1.0 - transparency);
+    if mirror > 0.0 {
+        let reflected_dir = (normal * (2.0 * normal.dot(view)) - view).normalize();
+        c.reflection_rays += 1;
+        let mut ray = Ray::leaving(&hit, origin, reflected_dir, frame.max_distance);
+        ray.inside = media.object();
+        colour += trace::<FX>(g, frame, &ray, depth - 1, media, c) * mirror;
+    }
+    if let (Some(dir), true) = (bent, through > 0.0) {
+        c.refraction_rays += 1;
+        let beyond = media.crossing(&hit);
+        let mut ray = Ray::leaving(&hit, hit.point - normal * offset, dir, frame.max_distance);
+        ray.inside = beyond.object();
+        colour += trace::<FX>(g, frame, &ray, depth - 1, beyond, c) * through;
+    }
+    colour
 }

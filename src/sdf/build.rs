@@ -30,6 +30,10 @@ pub struct Builder<'a> {
     /// The union built last through a hierarchy (its node's address, hierarchy, parts
     /// and blend radius), for [`build_root`](Self::build_root).
     last_union: Option<LastUnion>,
+    /// Render space from the frame the node being built is in: operators that work in
+    /// their own units restart `xf` at the identity, and a pattern still needs the
+    /// whole map to its object's space.
+    frame: DAffine3,
 }
 
 /// A union built through a hierarchy: its node's address, the hierarchy, its parts'
@@ -48,7 +52,7 @@ const ARC_HEADER: usize = 16;
 impl<'a> Builder<'a> {
     /// A builder interning materials into `materials`.
     pub fn new(materials: &'a mut MaterialTable) -> Builder<'a> {
-        Builder { materials, bytes: 0, prune: true, last_union: None }
+        Builder { materials, bytes: 0, prune: true, last_union: None, frame: DAffine3::IDENTITY }
     }
 
     /// [`build`](Self::build), and when the shape is a union of bounded parts (under
@@ -103,7 +107,7 @@ impl<'a> Builder<'a> {
         match &shape.kind {
             ShapeKind::Transform { child, xf: inner } => self.build(child, xf * *inner, mat),
             ShapeKind::Paint { child, material } => {
-                let id = self.materials.intern(material);
+                let id = self.materials.intern(material, self.frame * xf);
                 self.build(child, xf, id)
             }
             ShapeKind::Csg { op: CsgOp::Union, children, smooth } if *smooth == 0.0 && children.len() >= MANY => {
@@ -130,7 +134,10 @@ impl<'a> Builder<'a> {
             ShapeKind::Primitive(p) => self.primitive(p, xf, mat),
             ShapeKind::Csg { .. } | ShapeKind::Round { .. } | ShapeKind::Shell { .. } | ShapeKind::Repeat { .. } => {
                 // Smooth operators and modifiers work in their own units: build locally, then wrap.
+                let outer = self.frame;
+                self.frame = outer * xf;
                 let (d, m) = self.local(shape, mat);
+                self.frame = outer;
                 self.wrap(d, m, xf)
             }
         }

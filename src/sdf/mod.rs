@@ -75,6 +75,22 @@ impl SdfObject {
         }
     }
 
+    /// [`closest`](Self::closest) for a ray that starts inside the solid: it marches `−f`,
+    /// the distance bound of the solid's complement, whose surface is the same, so the
+    /// hit is where the ray leaves the solid (or meets a cavity in it). The whole tree is
+    /// evaluated: a union's parts are pruned for rays outside them.
+    pub fn closest_from_inside(
+        &self,
+        ray: &Ray,
+        (t0, t1): (f32, f32),
+        params: MarchParams,
+        c: &mut Counters,
+        evals: &mut u64,
+    ) -> Option<(f32, f32)> {
+        let dist = &*self.dist;
+        march::march(&|p| -dist(p), ray, t0, t1, params, c, evals)
+    }
+
     /// The surface at a hit found by [`closest`](Self::closest): normal from the gradient
     /// and material from the material closure, numbered `object`. Done once per ray, for the winner.
     // Kept out of line: inlined into `World::intersect` it bloated the march loop's caller
@@ -95,7 +111,8 @@ impl SdfObject {
         // The gradient of a convex solid's field is its outward normal, but only on the
         // surface: a ray starting inside the solid "hits" where it starts, below it.
         let convex = self.convex && d > -error;
-        Hit { t, point, normal, material, error, object, convex }
+        let from_inside = normal.dot(ray.dir) > 0.0;
+        Hit { t, point, normal, material, error, object, convex, from_inside }
     }
 
     /// The unblocked fraction of a cone of slope `cone` around the ray over `[t0, t1]`: the

@@ -79,7 +79,7 @@ mod tests {
     use super::*;
 
     fn image(pixels: Vec<u8>) -> Image {
-        Image { width: (pixels.len() / 3) as u32, height: 1, pixels }
+        Image { width: (pixels.len() / 3) as u32, height: 1, depth: crate::render::BitDepth::Eight, pixels }
     }
 
     #[test]

@@ -139,5 +139,5 @@ pub fn loglog(
             .map_err(|e| e.to_string())?;
         root.present().map_err(|e| e.to_string())?;
     }
-    Ok(Image { width: w, height: h, pixels })
+    Ok(Image { width: w, height: h, depth: crate::render::BitDepth::Eight, pixels })
 }

@@ -34,6 +34,9 @@ impl World {
         }
         let o = &self.objects[i as usize];
         match &o.kind {
+            ObjectKind::Sdf(s) if i == q.ray.inside => s
+                .closest_from_inside(q.ray, self.interval(o, q.ray, t_max)?, self.params, c, &mut q.evals)
+                .map(|(t, error)| Found::Sdf { object: i, sdf: s, t, error }),
             ObjectKind::Sdf(s) => s
                 .closest(q.ray, self.interval(o, q.ray, t_max)?, self.params, c, &mut q.evals)
                 .map(|(t, error)| Found::Sdf { object: i, sdf: s, t, error }),
@@ -71,6 +74,9 @@ impl World {
         }
         let o = &self.objects[i as usize];
         match &o.kind {
+            ObjectKind::Sdf(s) if i == q.ray.inside => self
+                .interval(o, q.ray, t_max)
+                .is_some_and(|interval| s.closest_from_inside(q.ray, interval, self.params, c, &mut q.evals).is_some()),
             ObjectKind::Sdf(s) => self
                 .interval(o, q.ray, t_max)
                 .is_some_and(|interval| s.closest(q.ray, interval, self.params, c, &mut q.evals).is_some()),
@@ -102,7 +108,7 @@ impl Found<'_> {
     pub(super) fn surface(self, ray: &Ray, c: &mut Counters) -> Hit {
         match self {
             Found::Sdf { object, sdf, t, error } => sdf.surface(ray, t, error, object, c),
-            Found::Mesh { object, mesh, tri, hit } => mesh.surface(tri, hit, object),
+            Found::Mesh { object, mesh, tri, hit } => mesh.surface(tri, hit, object, ray.dir),
         }
     }
 }

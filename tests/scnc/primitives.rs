@@ -19,6 +19,8 @@ fn argument(ty: Ty) -> &'static str {
         Ty::Size => "1",
         Ty::Color => "rgb(200, 100, 50)",
         Ty::Material => "material()",
+        Ty::Pattern => "checker(rgb(10, 20, 30), rgb(200, 100, 50), 0.25)",
+        Ty::Paint => "stripes(rgb(10, 20, 30), rgb(200, 100, 50), 0.25)",
         Ty::Shape => "sphere(0.5)",
         Ty::Mesh => "mesh box(0.5)",
         Ty::Light => "ambient(1)",

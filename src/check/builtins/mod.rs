@@ -33,6 +33,10 @@ pub enum Ty {
     Color,
     /// `material(…)`.
     Material,
+    /// `checker(…)`, `stripes(…)`, `gradient(…)` or `noise(…)`.
+    Pattern,
+    /// A colour or a pattern: what a material's colour can be.
+    Paint,
     /// An SDF-able solid.
     Shape,
     /// A triangle mesh.
@@ -56,6 +60,8 @@ impl fmt::Display for Ty {
             Ty::Size => "num or vec3",
             Ty::Color => "color",
             Ty::Material => "material",
+            Ty::Pattern => "pattern",
+            Ty::Paint => "color or pattern",
             Ty::Shape => "shape",
             Ty::Mesh => "mesh",
             Ty::Light => "light",
@@ -79,6 +85,8 @@ pub enum Default {
     Bool(bool),
     /// A colour, 0–255.
     Color([f64; 3]),
+    /// A string.
+    Str(&'static str),
     /// Absent means "derived from the other arguments" (documented per builtin).
     Derived,
 }
@@ -126,6 +134,8 @@ pub enum Ctor {
     Material,
     /// `rgb(…)`.
     Rgb,
+    /// A pattern.
+    Pattern(PatternFn),
     /// A light.
     Light(LightFn),
     /// A function of one number.
@@ -166,6 +176,16 @@ pub enum Modifier {
     Round,
     Shell,
     Repeat,
+}
+
+/// The patterns.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(missing_docs, reason = "each variant is the builtin of the same name, documented in BUILTINS")]
+pub enum PatternFn {
+    Checker,
+    Stripes,
+    Gradient,
+    Noise,
 }
 
 /// The lights.
@@ -269,6 +289,7 @@ impl Builtin {
             | Ctor::Modifier(_)
             | Ctor::Material
             | Ctor::Rgb
+            | Ctor::Pattern(_)
             | Ctor::Light(_)
             | Ctor::Math(_)
             | Ctor::Numeric(_)
@@ -301,6 +322,7 @@ impl Param {
             Default::Vec3(v) => format!(" = {}", crate::ir::dump_vec(v.into())),
             Default::Bool(b) => format!(" = {b}"),
             Default::Color(c) => format!(" = rgb({}, {}, {})", c[0], c[1], c[2]),
+            Default::Str(s) => format!(" = \"{s}\""),
             Default::Derived => " = …".into(),
         };
         format!("{}: {}{default}", self.name, self.ty)

@@ -1,6 +1,8 @@
 //! The table itself: every builtin's entry, and the named constants.
 
-use super::{Builtin, Ctor, Default, Extreme, Gen, LightFn, MathFn, Modifier, NumFn, Param, Prim, Ty, VecFn};
+use super::{
+    Builtin, Ctor, Default, Extreme, Gen, LightFn, MathFn, Modifier, NumFn, Param, PatternFn, Prim, Ty, VecFn,
+};
 use crate::ir::CsgOp;
 
 const fn p(name: &'static str, ty: Ty, default: Default) -> Param {
@@ -133,12 +135,54 @@ pub static BUILTINS: &[Builtin] = &[
         "material",
         Ctor::Material,
         &[
-            p("color", Ty::Color, Default::Color([200.0, 200.0, 200.0])),
+            p("color", Ty::Paint, Default::Color([200.0, 200.0, 200.0])),
             p("specular", Ty::Num, N(-1.0)),
             p("reflective", Ty::Num, N(0.0)),
+            p("transparency", Ty::Num, N(0.0)),
+            p("ior", Ty::Num, N(1.0)),
+            p("absorption", Ty::Vec3, V([0.0, 0.0, 0.0])),
         ],
         Ty::Material,
-        "surface: colour, Phong exponent (−1 = none), reflectivity in [0, 1]",
+        "surface: colour or pattern, Phong exponent (−1 = none), reflectivity in [0, 1]; light passing in \
+         (`transparency` in [0, 1]), the medium's index of refraction and its absorption per unit length",
+    ),
+    f(
+        "checker",
+        Ctor::Pattern(PatternFn::Checker),
+        &[p("a", Ty::Paint, Req), p("b", Ty::Paint, Req), p("size", Ty::Num, N(1.0))],
+        Ty::Pattern,
+        "cubes of edge `size` alternating `a` and `b`, in the painted object's space",
+    ),
+    f(
+        "stripes",
+        Ctor::Pattern(PatternFn::Stripes),
+        &[
+            p("a", Ty::Paint, Req),
+            p("b", Ty::Paint, Req),
+            p("width", Ty::Num, N(1.0)),
+            p("axis", Ty::Vec3, V([1.0, 0.0, 0.0])),
+        ],
+        Ty::Pattern,
+        "slabs `width` thick alternating `a` and `b` along `axis`, in the painted object's space",
+    ),
+    f(
+        "gradient",
+        Ctor::Pattern(PatternFn::Gradient),
+        &[
+            p("a", Ty::Paint, Req),
+            p("b", Ty::Paint, Req),
+            p("from", Ty::Vec3, V([0.0, 0.0, 0.0])),
+            p("to", Ty::Vec3, V([0.0, 1.0, 0.0])),
+        ],
+        Ty::Pattern,
+        "`a` at `from` blending linearly to `b` at `to`, in the painted object's space",
+    ),
+    f(
+        "noise",
+        Ctor::Pattern(PatternFn::Noise),
+        &[p("a", Ty::Paint, Req), p("b", Ty::Paint, Req), p("size", Ty::Num, N(1.0)), p("seed", Ty::Int, N(0.0))],
+        Ty::Pattern,
+        "`a` and `b` mixed by Perlin gradient noise of feature size `size`, the same on every machine",
     ),
     f(
         "rgb",
@@ -350,12 +394,14 @@ pub static BUILTINS: &[Builtin] = &[
             p("frames", Ty::Int, N(1.0)),
             p("fps", Ty::Num, N(24.0)),
             p("cyclic", Ty::Bool, Default::Bool(false)),
+            p("color", Ty::Str, Default::Str("linear")),
         ],
         variadic: None,
         result: Ty::Num,
         doc:
             "image size, reflection depth, background, sphere-tracing accuracy, antialiasing, ambient-occlusion reach, \
-              and an animation's frame count, frame rate and whether it loops",
+              an animation's frame count, frame rate and whether it loops, and how colours are read and written \
+              (`\"linear\"`, the study's, or `\"srgb\"`)",
     },
 ];
 

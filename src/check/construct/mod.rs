@@ -63,6 +63,7 @@ impl BoundArgs {
                 builtins::Default::Vec3(v) => Value::Vec3(DVec3::from(v)),
                 builtins::Default::Bool(x) => Value::Bool(x),
                 builtins::Default::Color(c) => Value::Color(DVec3::from(c)),
+                builtins::Default::Str(s) => Value::Str(s.into()),
                 builtins::Default::Required | builtins::Default::Derived => Value::Error,
             },
         }
@@ -182,6 +183,7 @@ impl Ctx<'_> {
             }
             Ctor::Material => self.material(b, &a),
             Ctor::Rgb => self.rgb(b, &a),
+            Ctor::Pattern(f) => self.pattern(b, f, &a),
             Ctor::Light(l) => self.light(b, l, &a),
             Ctor::Math(f) => self.math(b, f, &a),
             Ctor::Numeric(f) => self.numeric(b, f, &a),
@@ -310,6 +312,23 @@ impl Ctx<'_> {
         let Value::Color(background) = a.value(b, 3) else {
             return None;
         };
+        let color = match a.value(b, 12) {
+            Value::Str(s) if &*s == "linear" => ir::ColorSpace::Linear,
+            Value::Str(s) if &*s == "srgb" => ir::ColorSpace::Srgb,
+            Value::Str(s) => {
+                self.report(
+                    Diagnostic::error(
+                        codes::OUT_OF_RANGE,
+                        a.span(12),
+                        "`color` must be \"linear\" or \"srgb\"",
+                        format!("this is {:?}", &*s),
+                    )
+                    .with_note("\"linear\" shades colours as written (the study's); \"srgb\" reads them as sRGB and shades in linear light"),
+                );
+                return None;
+            }
+            _ => return None,
+        };
         Some(Settings {
             width,
             height,
@@ -323,6 +342,7 @@ impl Ctx<'_> {
             frames,
             fps: a.num(b, 10),
             cyclic: a.flag(b, 11),
+            color,
             span: Some(span),
         })
     }

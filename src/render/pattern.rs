@@ -1,0 +1,219 @@
+//! Patterns ready for shading: the IR's pattern trees in f32, each with the map from
+//! render space into the space of the object it paints, and the gradient noise.
+
+use std::sync::Arc;
+
+use glam::{Affine3A, DAffine3, Vec3A};
+
+use crate::ir::{self, ColorSpace, Paint, PatternKind};
+
+/// A pattern as one material shows it: where render-space points go, then the tree.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShadePattern {
+    /// Render space to the painted object's space.
+    pub to_local: Affine3A,
+    /// The pattern.
+    pub texture: Texture,
+}
+
+impl ShadePattern {
+    /// The colour at the render-space point `p` (linear, 0–255).
+    pub fn color_at(&self, p: Vec3A) -> Vec3A {
+        self.texture.at(self.to_local.transform_point3a(p))
+    }
+}
+
+/// A paint in f32, colours already in linear light.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Texture {
+    /// One colour.
+    Solid(Vec3A),
+    /// Two paints laid out by a pattern.
+    Pattern(Arc<(TextureKind, Texture, Texture)>),
+}
+
+/// [`PatternKind`] with the divisions done once.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TextureKind {
+    /// `1 / size`.
+    Checker(f32),
+    /// The axis, unit, divided by the width.
+    Stripes(Vec3A),
+    /// `from`, and `(to − from) / |to − from|²`.
+    Gradient(Vec3A, Vec3A),
+    /// `1 / size` and the seed.
+    Noise(f32, u32),
+}
+
+impl Texture {
+    /// The texture of a paint, its colours read in `space`.
+    pub fn new(paint: &Paint, space: ColorSpace) -> Texture {
+        match paint {
+            Paint::Solid(c) => Texture::Solid(linear(c.as_vec3a(), space)),
+            Paint::Pattern(p) => {
+                let kind = match p.kind {
+                    PatternKind::Checker { size } => TextureKind::Checker((1.0 / size) as f32),
+                    PatternKind::Stripes { width, axis } => TextureKind::Stripes((axis.normalize() / width).as_vec3a()),
+                    PatternKind::Gradient { from, to } => {
+                        let d = to - from;
+                        TextureKind::Gradient(from.as_vec3a(), (d / d.length_squared()).as_vec3a())
+                    }
+                    PatternKind::Noise { size, seed } => TextureKind::Noise((1.0 / size) as f32, seed),
+                };
+                Texture::Pattern(Arc::new((kind, Texture::new(&p.a, space), Texture::new(&p.b, space))))
+            }
+        }
+    }
+
+    /// The colour at `p` in the painted object's space.
+    pub fn at(&self, p: Vec3A) -> Vec3A {
+        let (kind, a, b) = match self {
+            Texture::Solid(c) => return *c,
+            Texture::Pattern(node) => &**node,
+        };
+        let pick = |second: bool| if second { b.at(p) } else { a.at(p) };
+        match *kind {
+            TextureKind::Checker(inv) => {
+                let c = (p * inv).floor();
+                // Saturating casts: a point beyond i32's cells stays in one cell, not UB.
+                pick((c.x as i32).wrapping_add(c.y as i32).wrapping_add(c.z as i32) & 1 != 0)
+            }
+            TextureKind::Stripes(axis) => pick((p.dot(axis).floor() as i32) & 1 != 0),
+            TextureKind::Gradient(from, d) => {
+                let t = (p - from).dot(d).clamp(0.0, 1.0);
+                a.at(p) * (1.0 - t) + b.at(p) * t
+            }
+            TextureKind::Noise(inv, seed) => {
+                let t = (0.5 + 0.5 * noise(p * inv, seed)).clamp(0.0, 1.0);
+                a.at(p) * (1.0 - t) + b.at(p) * t
+            }
+        }
+    }
+}
+
+/// A colour as written, 0–255, in linear light for shading.
+pub fn linear(c: Vec3A, space: ColorSpace) -> Vec3A {
+    match space {
+        ColorSpace::Linear => c,
+        ColorSpace::Srgb => Vec3A::from_array(c.to_array().map(|x| srgb_to_linear(x / 255.0) * 255.0)),
+    }
+}
+
+/// The sRGB transfer function's inverse (IEC 61966-2-1), on [0, 1].
+pub fn srgb_to_linear(x: f32) -> f32 {
+    if x <= 0.04045 {
+        x / 12.92
+    } else {
+        ((x + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// The sRGB transfer function (IEC 61966-2-1), on [0, 1].
+pub fn linear_to_srgb(x: f32) -> f32 {
+    if x <= 0.003_130_8 {
+        x * 12.92
+    } else {
+        1.055 * x.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// Perlin's improved gradient noise (Perlin 2002): at integer lattice points the value
+/// is 0 and the gradient one of the twelve cube-edge directions, chosen by hashing the
+/// point with `seed` (integer arithmetic, so every machine gives the same field);
+/// between them the quintic fade blends the eight corners. Values lie in about [−1, 1].
+pub fn noise(p: Vec3A, seed: u32) -> f32 {
+    let cell = p.floor();
+    let f = p - cell;
+    // Saturating casts keep far points finite; the field simply repeats there.
+    let (x, y, z) = (cell.x as i32, cell.y as i32, cell.z as i32);
+    let fade = |t: f32| t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
+    let (u, v, w) = (fade(f.x), fade(f.y), fade(f.z));
+    let corner = |dx: i32, dy: i32, dz: i32| {
+        let h = hash(x.wrapping_add(dx), y.wrapping_add(dy), z.wrapping_add(dz), seed);
+        grad(h, f.x - dx as f32, f.y - dy as f32, f.z - dz as f32)
+    };
+    let lerp = |t: f32, a: f32, b: f32| a + t * (b - a);
+    lerp(
+        w,
+        lerp(v, lerp(u, corner(0, 0, 0), corner(1, 0, 0)), lerp(u, corner(0, 1, 0), corner(1, 1, 0))),
+        lerp(v, lerp(u, corner(0, 0, 1), corner(1, 0, 1)), lerp(u, corner(0, 1, 1), corner(1, 1, 1))),
+    )
+}
+
+/// A well-mixed 32-bit hash of a lattice point and a seed (the `lowbias32` finaliser
+/// over a combination of the coordinates).
+fn hash(x: i32, y: i32, z: i32, seed: u32) -> u32 {
+    let mut h = (x as u32).wrapping_mul(0x8da6_b343)
+        ^ (y as u32).wrapping_mul(0xd816_3841)
+        ^ (z as u32).wrapping_mul(0xcb1a_b31f)
+        ^ seed.wrapping_mul(0x9e37_79b9);
+    h ^= h >> 16;
+    h = h.wrapping_mul(0x7feb_352d);
+    h ^= h >> 15;
+    h = h.wrapping_mul(0x846c_a68b);
+    h ^ (h >> 16)
+}
+
+/// The dot product of `(x, y, z)` with the cube-edge gradient `h` picks (Perlin's
+/// sixteen-entry table: the twelve edges, four of them twice).
+fn grad(h: u32, x: f32, y: f32, z: f32) -> f32 {
+    let h = h >> 28;
+    let u = if h < 8 { x } else { y };
+    let v = if h < 4 {
+        y
+    } else if h == 12 || h == 14 {
+        x
+    } else {
+        z
+    };
+    (if h & 1 == 0 { u } else { -u }) + (if h & 2 == 0 { v } else { -v })
+}
+
+/// The map from render space into a space that is `render_from_local` of it, in f32.
+pub fn to_local(render_from_local: DAffine3) -> Affine3A {
+    let inv = render_from_local.inverse();
+    Affine3A::from_mat3_translation(inv.matrix3.as_mat3(), inv.translation.as_vec3())
+}
+
+/// The texture of a material and where it sits, if it has a pattern.
+pub fn of_material(m: &ir::Material, render_from_local: DAffine3, space: ColorSpace) -> Option<ShadePattern> {
+    m.color
+        .is_pattern()
+        .then(|| ShadePattern { to_local: to_local(render_from_local), texture: Texture::new(&m.color, space) })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn noise_is_zero_on_the_lattice_and_bounded_between() {
+        let mut most = 0.0f32;
+        for i in 0..2000 {
+            let p = Vec3A::new(i as f32 * 0.137, i as f32 * 0.071 - 40.0, (i % 17) as f32 * 0.29);
+            let n = noise(p, 7);
+            assert!(n.is_finite());
+            most = most.max(n.abs());
+            assert_eq!(noise(p.floor(), 7), 0.0);
+        }
+        // Improved noise stays within about ±1, and this many points reach well inside it.
+        assert!(most <= 1.05 && most > 0.3, "{most}");
+    }
+
+    #[test]
+    fn noise_is_continuous_and_depends_on_the_seed() {
+        let p = Vec3A::new(3.3, -1.7, 0.45);
+        let step = Vec3A::splat(1e-4);
+        assert!((noise(p, 1) - noise(p + step, 1)).abs() < 1e-3);
+        assert_ne!(noise(p, 1), noise(p, 2));
+    }
+
+    #[test]
+    fn srgb_round_trips() {
+        for i in 0..=255 {
+            let x = i as f32 / 255.0;
+            assert!((linear_to_srgb(srgb_to_linear(x)) - x).abs() < 1e-5, "{i}");
+        }
+        assert!((srgb_to_linear(0.5) - 0.214).abs() < 1e-3);
+    }
+}
