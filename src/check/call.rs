@@ -403,6 +403,9 @@ impl Ctx<'_> {
             (Ty::Color | Ty::Paint, Value::Vec3(c)) => {
                 d = d.with_hint(format!("try `rgb({}, {}, {})`", dump_num(c.x), dump_num(c.y), dump_num(c.z)))
             }
+            (Ty::Color, Value::Pattern(_)) => {
+                d = d.with_note("a pattern paints the surface of the object its material is on; this needs one colour")
+            }
             (Ty::Shape, Value::Mesh(_)) => {
                 d = d.with_note("meshes cannot take part in CSG; shapes can be meshed with `mesh isosurface(…)`")
             }

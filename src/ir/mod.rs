@@ -328,6 +328,22 @@ pub enum ShapeKind {
 }
 
 impl Shape {
+    /// The transforms that place this shape: the composition of the chain of
+    /// [`ShapeKind::Transform`] nodes at its top (identity for none). A pattern painting the
+    /// shape is laid in the space below them, so it moves with the shape however the
+    /// transforms and the material are ordered (`sphere(1) at p with m` = `sphere(1) with m at p`).
+    pub fn placement(&self) -> DAffine3 {
+        match &self.kind {
+            ShapeKind::Transform { child, xf } => *xf * child.placement(),
+            ShapeKind::Primitive(_)
+            | ShapeKind::Csg { .. }
+            | ShapeKind::Round { .. }
+            | ShapeKind::Shell { .. }
+            | ShapeKind::Repeat { .. }
+            | ShapeKind::Paint { .. } => DAffine3::IDENTITY,
+        }
+    }
+
     /// Whether the solid is convex, so a ray leaving its surface outward never meets it
     /// again. Conservative: `false` unless it follows from the shape's form (primitives
     /// other than the torus, a half-space, sharp intersections of convex solids, and

@@ -34,7 +34,7 @@ pub fn tessellate(
                 node = child;
             }
             ShapeKind::Paint { child, material: m } => {
-                material = materials.intern(m, xf);
+                material = materials.intern(m, xf * child.placement());
                 node = child;
             }
             ShapeKind::Primitive(_)

@@ -1,9 +1,14 @@
-//! Patterns ready for shading: the IR's pattern trees in f32, each with the map from
-//! render space into the space of the object it paints, and the gradient noise.
+//! Patterns ready for shading: the IR's pattern trees, each with the map from render
+//! space into the space of the object it paints, and the gradient noise.
+//!
+//! Patterns are evaluated in f64. An object's space can be world-sized (a floor is
+//! painted in world coordinates), and there f32 keeps too few digits: 1e4 from the
+//! origin its step is 1e-3, and a floor lying on a checker boundary would take either
+//! side's colour by the last bit of the point read just inside it.
 
 use std::sync::Arc;
 
-use glam::{Affine3A, DAffine3, Vec3A};
+use glam::{DAffine3, DVec3, Vec3A};
 
 use crate::ir::{self, ColorSpace, Paint, PatternKind};
 
@@ -11,7 +16,7 @@ use crate::ir::{self, ColorSpace, Paint, PatternKind};
 #[derive(Clone, Debug, PartialEq)]
 pub struct ShadePattern {
     /// Render space to the painted object's space.
-    pub to_local: Affine3A,
+    pub to_local: DAffine3,
     /// The pattern.
     pub texture: Texture,
 }
@@ -19,15 +24,15 @@ pub struct ShadePattern {
 impl ShadePattern {
     /// The colour at the render-space point `p` (linear, 0–255).
     pub fn color_at(&self, p: Vec3A) -> Vec3A {
-        self.texture.at(self.to_local.transform_point3a(p))
+        self.texture.at(self.to_local.transform_point3(p.as_dvec3())).as_vec3a()
     }
 }
 
-/// A paint in f32, colours already in linear light.
+/// A paint ready to evaluate, colours already in linear light (0–255).
 #[derive(Clone, Debug, PartialEq)]
 pub enum Texture {
     /// One colour.
-    Solid(Vec3A),
+    Solid(DVec3),
     /// Two paints laid out by a pattern.
     Pattern(Arc<(TextureKind, Texture, Texture)>),
 }
@@ -36,29 +41,29 @@ pub enum Texture {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum TextureKind {
     /// `1 / size`.
-    Checker(f32),
+    Checker(f64),
     /// The axis, unit, divided by the width.
-    Stripes(Vec3A),
+    Stripes(DVec3),
     /// `from`, and `(to − from) / |to − from|²`.
-    Gradient(Vec3A, Vec3A),
+    Gradient(DVec3, DVec3),
     /// `1 / size` and the seed.
-    Noise(f32, u32),
+    Noise(f64, u32),
 }
 
 impl Texture {
     /// The texture of a paint, its colours read in `space`.
     pub fn new(paint: &Paint, space: ColorSpace) -> Texture {
         match paint {
-            Paint::Solid(c) => Texture::Solid(linear(c.as_vec3a(), space)),
+            Paint::Solid(c) => Texture::Solid(linear(c.as_vec3a(), space).as_dvec3()),
             Paint::Pattern(p) => {
                 let kind = match p.kind {
-                    PatternKind::Checker { size } => TextureKind::Checker((1.0 / size) as f32),
-                    PatternKind::Stripes { width, axis } => TextureKind::Stripes((axis.normalize() / width).as_vec3a()),
+                    PatternKind::Checker { size } => TextureKind::Checker(1.0 / size),
+                    PatternKind::Stripes { width, axis } => TextureKind::Stripes(axis.normalize() / width),
                     PatternKind::Gradient { from, to } => {
                         let d = to - from;
-                        TextureKind::Gradient(from.as_vec3a(), (d / d.length_squared()).as_vec3a())
+                        TextureKind::Gradient(from, d / d.length_squared())
                     }
-                    PatternKind::Noise { size, seed } => TextureKind::Noise((1.0 / size) as f32, seed),
+                    PatternKind::Noise { size, seed } => TextureKind::Noise(1.0 / size, seed),
                 };
                 Texture::Pattern(Arc::new((kind, Texture::new(&p.a, space), Texture::new(&p.b, space))))
             }
@@ -66,7 +71,7 @@ impl Texture {
     }
 
     /// The colour at `p` in the painted object's space.
-    pub fn at(&self, p: Vec3A) -> Vec3A {
+    pub fn at(&self, p: DVec3) -> DVec3 {
         let (kind, a, b) = match self {
             Texture::Solid(c) => return *c,
             Texture::Pattern(node) => &**node,
@@ -75,10 +80,10 @@ impl Texture {
         match *kind {
             TextureKind::Checker(inv) => {
                 let c = (p * inv).floor();
-                // Saturating casts: a point beyond i32's cells stays in one cell, not UB.
-                pick((c.x as i32).wrapping_add(c.y as i32).wrapping_add(c.z as i32) & 1 != 0)
+                // Saturating casts: a point beyond i64's cells stays in one cell, not UB.
+                pick((c.x as i64).wrapping_add(c.y as i64).wrapping_add(c.z as i64) & 1 != 0)
             }
-            TextureKind::Stripes(axis) => pick((p.dot(axis).floor() as i32) & 1 != 0),
+            TextureKind::Stripes(axis) => pick((p.dot(axis).floor() as i64) & 1 != 0),
             TextureKind::Gradient(from, d) => {
                 let t = (p - from).dot(d).clamp(0.0, 1.0);
                 a.at(p) * (1.0 - t) + b.at(p) * t
@@ -121,18 +126,19 @@ pub fn linear_to_srgb(x: f32) -> f32 {
 /// is 0 and the gradient one of the twelve cube-edge directions, chosen by hashing the
 /// point with `seed` (integer arithmetic, so every machine gives the same field);
 /// between them the quintic fade blends the eight corners. Values lie in about [−1, 1].
-pub fn noise(p: Vec3A, seed: u32) -> f32 {
+pub fn noise(p: DVec3, seed: u32) -> f64 {
     let cell = p.floor();
     let f = p - cell;
-    // Saturating casts keep far points finite; the field simply repeats there.
+    // Lattice points wrap at i32 (saturating casts, then wrapping sums): far points stay
+    // defined, and the field repeats there.
     let (x, y, z) = (cell.x as i32, cell.y as i32, cell.z as i32);
-    let fade = |t: f32| t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
+    let fade = |t: f64| t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
     let (u, v, w) = (fade(f.x), fade(f.y), fade(f.z));
     let corner = |dx: i32, dy: i32, dz: i32| {
         let h = hash(x.wrapping_add(dx), y.wrapping_add(dy), z.wrapping_add(dz), seed);
-        grad(h, f.x - dx as f32, f.y - dy as f32, f.z - dz as f32)
+        grad(h, f.x - dx as f64, f.y - dy as f64, f.z - dz as f64)
     };
-    let lerp = |t: f32, a: f32, b: f32| a + t * (b - a);
+    let lerp = |t: f64, a: f64, b: f64| a + t * (b - a);
     lerp(
         w,
         lerp(v, lerp(u, corner(0, 0, 0), corner(1, 0, 0)), lerp(u, corner(0, 1, 0), corner(1, 1, 0))),
@@ -156,7 +162,7 @@ fn hash(x: i32, y: i32, z: i32, seed: u32) -> u32 {
 
 /// The dot product of `(x, y, z)` with the cube-edge gradient `h` picks (Perlin's
 /// sixteen-entry table: the twelve edges, four of them twice).
-fn grad(h: u32, x: f32, y: f32, z: f32) -> f32 {
+fn grad(h: u32, x: f64, y: f64, z: f64) -> f64 {
     let h = h >> 28;
     let u = if h < 8 { x } else { y };
     let v = if h < 4 {
@@ -169,17 +175,11 @@ fn grad(h: u32, x: f32, y: f32, z: f32) -> f32 {
     (if h & 1 == 0 { u } else { -u }) + (if h & 2 == 0 { v } else { -v })
 }
 
-/// The map from render space into a space that is `render_from_local` of it, in f32.
-pub fn to_local(render_from_local: DAffine3) -> Affine3A {
-    let inv = render_from_local.inverse();
-    Affine3A::from_mat3_translation(inv.matrix3.as_mat3(), inv.translation.as_vec3())
-}
-
 /// The texture of a material and where it sits, if it has a pattern.
 pub fn of_material(m: &ir::Material, render_from_local: DAffine3, space: ColorSpace) -> Option<ShadePattern> {
     m.color
         .is_pattern()
-        .then(|| ShadePattern { to_local: to_local(render_from_local), texture: Texture::new(&m.color, space) })
+        .then(|| ShadePattern { to_local: render_from_local.inverse(), texture: Texture::new(&m.color, space) })
 }
 
 #[cfg(test)]
@@ -188,9 +188,9 @@ mod tests {
 
     #[test]
     fn noise_is_zero_on_the_lattice_and_bounded_between() {
-        let mut most = 0.0f32;
+        let mut most = 0.0f64;
         for i in 0..2000 {
-            let p = Vec3A::new(i as f32 * 0.137, i as f32 * 0.071 - 40.0, (i % 17) as f32 * 0.29);
+            let p = DVec3::new(i as f64 * 0.137, i as f64 * 0.071 - 40.0, (i % 17) as f64 * 0.29);
             let n = noise(p, 7);
             assert!(n.is_finite());
             most = most.max(n.abs());
@@ -202,8 +202,8 @@ mod tests {
 
     #[test]
     fn noise_is_continuous_and_depends_on_the_seed() {
-        let p = Vec3A::new(3.3, -1.7, 0.45);
-        let step = Vec3A::splat(1e-4);
+        let p = DVec3::new(3.3, -1.7, 0.45);
+        let step = DVec3::splat(1e-4);
         assert!((noise(p, 1) - noise(p + step, 1)).abs() < 1e-3);
         assert_ne!(noise(p, 1), noise(p, 2));
     }

@@ -102,8 +102,10 @@ fn sample_offset(s: u32, n: u32) -> (f32, f32) {
     (((0.5 + a1 * i) % 1.0) as f32, ((0.5 + a2 * i) % 1.0) as f32)
 }
 
-/// The light a point receives from one direct light, before shadowing: `None` when the
-/// light adds nothing there (behind the surface, no highlight), so no shadow ray is needed.
+/// The light a point receives from one direct light, before shadowing: the unit vector
+/// and distance to the light, the diffuse and highlight light together, and the
+/// highlight alone; `None` when the light adds nothing there (behind the surface, no
+/// highlight), so no shadow ray is needed.
 #[inline(always)]
 fn direct<const FX: u8>(
     light: &ShadeLight,
@@ -111,7 +113,7 @@ fn direct<const FX: u8>(
     normal: Vec3A,
     view: Vec3A,
     specular: Option<f32>,
-) -> Option<(Vec3A, f32, f32)> {
+) -> Option<(Vec3A, f32, f32, f32)> {
     let (to_light, dist, power) = match *light {
         ShadeLight::Point { position, intensity } => {
             let l = position - point;
@@ -136,7 +138,7 @@ fn direct<const FX: u8>(
             }
         }
     }
-    (diffuse > 0.0 || spec > 0.0).then_some((l_unit, dist, power * (diffuse + spec)))
+    (diffuse > 0.0 || spec > 0.0).then_some((l_unit, dist, power * (diffuse + spec), power * spec))
 }
 
 /// Shadow rays per soft light when the back-end cannot estimate a penumbra.
@@ -275,49 +277,73 @@ fn shade<const FX: u8>(
     let origin = hit.point + normal * offset;
     let transparency = if FX & REFRACT != 0 { material.transparency } else { 0.0 };
 
-    // The surface's own light: skipped where it has no weight (clear glass).
+    // The surface's own light, and its highlights alone: a transparent surface shows
+    // its diffuse light in proportion to its opacity, but its highlights whole (they
+    // are the lights' reflections). Skipped where neither shows (clear glass, matte).
     let mut local = Vec3A::ZERO;
-    if transparency < 1.0 {
+    let mut shine = Vec3A::ZERO;
+    let highlights = FX & SPECULAR != 0 && material.specular.is_some();
+    if transparency < 1.0 || highlights {
         let mut light = Vec3A::splat(frame.ambient);
         if FX & AO != 0 {
             light *= occlusion(g, &hit, origin, normal, frame.ao_reach, c);
         }
         if FX & SHADOWS != 0 {
             for l in &frame.casting {
-                let Some((l_unit, dist, amount)) = direct::<FX>(l, hit.point, normal, view, material.specular) else {
+                let Some((l_unit, dist, amount, spec)) = direct::<FX>(l, hit.point, normal, view, material.specular)
+                else {
                     continue;
                 };
                 let mut ray = Ray::leaving(&hit, origin, l_unit, (dist - offset).min(frame.max_distance));
                 ray.inside = media.object();
-                light += amount * shadow::<FX>(g, frame, &ray, media, c);
+                let passed = shadow::<FX>(g, frame, &ray, media, c);
+                light += amount * passed;
+                if FX & REFRACT != 0 {
+                    shine += spec * passed;
+                }
             }
             for (l, radius) in &frame.soft {
-                let Some((l_unit, dist, amount)) = direct::<FX>(l, hit.point, normal, view, material.specular) else {
+                let Some((l_unit, dist, amount, spec)) = direct::<FX>(l, hit.point, normal, view, material.specular)
+                else {
                     continue;
                 };
                 let t_max = (dist - offset).min(frame.max_distance);
-                if t_max <= 0.0 {
-                    light += Vec3A::splat(amount);
-                    continue;
+                let passed = if t_max <= 0.0 {
+                    Vec3A::ONE
+                } else {
+                    soft_visibility::<FX>(g, frame, &hit, origin, l_unit, t_max, *radius, media, c)
+                };
+                light += amount * passed;
+                if FX & REFRACT != 0 {
+                    shine += spec * passed;
                 }
-                light += amount * soft_visibility::<FX>(g, frame, &hit, origin, l_unit, t_max, *radius, media, c);
             }
         }
         for l in &frame.plain {
-            if let Some((_, _, amount)) = direct::<FX>(l, hit.point, normal, view, material.specular) {
+            if let Some((_, _, amount, spec)) = direct::<FX>(l, hit.point, normal, view, material.specular) {
                 light += Vec3A::splat(amount);
+                if FX & REFRACT != 0 {
+                    shine += Vec3A::splat(spec);
+                }
             }
         }
         // Patterns are read just inside the surface (see `ShadeMaterial::color_at`).
-        local = material.color_at(hit.point - normal * offset) * light;
+        let paint = material.color_at(hit.point - normal * offset);
+        local = paint * light;
+        shine *= paint;
     }
     if FX & (REFLECT | REFRACT) == 0 {
         return local;
     }
     let r = if FX & REFLECT != 0 { material.reflective } else { 0.0 };
     let surface = if depth > 0 && r > 0.0 { local * (1.0 - r) } else { local };
-    if depth == 0 || (r <= 0.0 && transparency <= 0.0) {
+    if transparency <= 0.0 && (depth == 0 || r <= 0.0) {
         return surface;
+    }
+    // Highlights over the transmitted light, which the surface's weight leaves out.
+    let highlight = shine * transparency;
+    if depth == 0 {
+        return surface * (1.0 - transparency) + highlight;
     }
     // How much of the mirror direction and of the transmitted direction shows.
     let (mut mirror, mut through, mut bent) = (r * (1.0 - transparency), 0.0, None);
@@ -328,7 +354,7 @@ fn shade<const FX: u8>(
         through = transparency * (1.0 - split.reflectance);
         bent = split.refracted;
     }
-    let mut colour = surface * (1.0 - transparency);
+    let mut colour = surface * (1.0 - transparency) + highlight;
     if mirror > 0.0 {
         let reflected_dir = (normal * (2.0 * normal.dot(view)) - view).normalize();
         c.reflection_rays += 1;

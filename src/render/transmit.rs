@@ -126,16 +126,89 @@ pub(super) fn light_through(g: &dyn Geometry, frame: &Frame, ray: &Ray, media: M
         }
         through *= m.transparency * media.absorb(frame, hit.t).unwrap_or(Vec3A::ONE);
         media = media.crossing(&hit);
-        // On along the same line, from just past the surface.
+        // On in the same direction from just past the surface: off it along the normal,
+        // which a grazing ray would not get far enough from by moving along itself.
         let offset = spawn_offset(hit.point, hit.error);
         let rest = ray.t_max - hit.t - offset;
         if rest <= 0.0 {
             return through;
         }
-        let mut next = Ray::new(hit.point + ray.dir * offset, ray.dir, rest);
+        let beyond = if hit.from_inside { hit.normal } else { -hit.normal };
+        let mut next = Ray::new(hit.point + beyond * offset, ray.dir, rest);
         next.inside = media.object();
         ray = next;
         c.shadow_rays += 1;
     }
     Vec3A::ZERO
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A unit view vector at `degrees` from the normal +z, in the xz plane.
+    fn view_at(degrees: f32) -> Vec3A {
+        let a = degrees.to_radians();
+        Vec3A::new(a.sin(), 0.0, a.cos())
+    }
+
+    #[test]
+    fn snell_bends_by_the_ratio_of_sines() {
+        for angle in [0.0f32, 10.0, 30.0, 45.0, 60.0, 80.0, 89.0] {
+            let s = split(view_at(angle), Vec3A::Z, 1.0, 1.5);
+            let t = s.refracted.expect("air to glass always refracts");
+            assert!((t.length() - 1.0).abs() < 1e-6);
+            assert!(t.z < 0.0, "the refracted ray goes through the surface");
+            // sin θt = sin θi / 1.5, and the ray stays in the plane of incidence, on the far side.
+            let sin_t = t.x.abs();
+            assert!((sin_t - angle.to_radians().sin() / 1.5).abs() < 1e-5, "{angle}°: sin θt = {sin_t}");
+            assert!(t.y.abs() < 1e-6 && t.x <= 0.0);
+        }
+    }
+
+    #[test]
+    fn fresnel_has_its_known_values() {
+        // Normal incidence: ((n1 − n2) / (n1 + n2))², 0.04 for glass from air.
+        assert!((split(view_at(0.0), Vec3A::Z, 1.0, 1.5).reflectance - 0.04).abs() < 1e-6);
+        assert!((split(view_at(0.0), Vec3A::Z, 1.5, 1.0).reflectance - 0.04).abs() < 1e-6);
+        // Brewster's angle, atan(1.5): the p-polarised half vanishes, so F = Rs / 2.
+        let brewster = 1.5f32.atan().to_degrees();
+        let rs = {
+            let (ci, ct) = (brewster.to_radians().cos(), (90.0 - brewster).to_radians().cos());
+            ((ci - 1.5 * ct) / (ci + 1.5 * ct)).powi(2)
+        };
+        assert!((split(view_at(brewster), Vec3A::Z, 1.0, 1.5).reflectance - rs / 2.0).abs() < 1e-5);
+        // Grazing light is all reflected.
+        assert!(split(view_at(90.0), Vec3A::Z, 1.0, 1.5).reflectance > 0.999);
+        // Reflectance grows with the angle from air into glass.
+        let mut last = 0.0;
+        for angle in (0..90).step_by(5) {
+            let f = split(view_at(angle as f32), Vec3A::Z, 1.0, 1.5).reflectance;
+            assert!(f >= last - 1e-6 && (0.0..=1.0).contains(&f));
+            last = f;
+        }
+    }
+
+    #[test]
+    fn total_internal_reflection_starts_at_the_critical_angle() {
+        let critical = (1.0f32 / 1.5).asin().to_degrees();
+        let below = split(view_at(critical - 0.05), Vec3A::Z, 1.5, 1.0);
+        assert!(below.refracted.is_some() && below.reflectance < 1.0);
+        // Just below it the refracted ray already grazes the surface.
+        assert!(below.refracted.is_some_and(|t| t.z.abs() < 0.05));
+        let above = split(view_at(critical + 0.05), Vec3A::Z, 1.5, 1.0);
+        assert!(above.refracted.is_none());
+        assert_eq!(above.reflectance, 1.0);
+    }
+
+    #[test]
+    fn equal_indices_reflect_nothing_and_bend_nothing() {
+        for angle in [0.0f32, 20.0, 45.0, 70.0, 89.5] {
+            let v = view_at(angle);
+            let s = split(v, Vec3A::Z, 1.33, 1.33);
+            assert!(s.reflectance < 1e-6, "{angle}°: {}", s.reflectance);
+            let t = s.refracted.expect("no interface, no reflection");
+            assert!((t + v).length() < 1e-5, "{angle}°: {t} is not straight on");
+        }
+    }
 }

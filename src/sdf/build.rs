@@ -107,7 +107,7 @@ impl<'a> Builder<'a> {
         match &shape.kind {
             ShapeKind::Transform { child, xf: inner } => self.build(child, xf * *inner, mat),
             ShapeKind::Paint { child, material } => {
-                let id = self.materials.intern(material, self.frame * xf);
+                let id = self.materials.intern(material, self.frame * xf * child.placement());
                 self.build(child, xf, id)
             }
             ShapeKind::Csg { op: CsgOp::Union, children, smooth } if *smooth == 0.0 && children.len() >= MANY => {

@@ -51,6 +51,42 @@ pub fn march(
     None
 }
 
+/// Marches out of the solid `f < 0` from a ray that starts inside it (a refracted ray),
+/// for `t` in `[t0, t1]`: steps by `−f`, the distance to the nearest face from within.
+/// A wall thinner than the hit threshold must still be crossed, not found where the ray
+/// came in, so no hit is taken before the ray has moved, a step is at least the
+/// threshold, and a ray found outside the solid (at the start, or after a step that
+/// crossed a face closer than the threshold) has left it there. Returns the hit distance
+/// and the threshold used there.
+#[inline]
+pub fn march_out(
+    f: &dyn Fn(Vec3A) -> f32,
+    ray: &Ray,
+    t0: f32,
+    t1: f32,
+    params: MarchParams,
+    c: &mut Counters,
+    evals: &mut u64,
+) -> Option<(f32, f32)> {
+    let (origin, dir) = (ray.origin, ray.dir);
+    let base = origin.length();
+    let mut t = t0;
+    for _ in 0..params.max_steps {
+        let d = f(origin + dir * t);
+        *evals += 1;
+        let threshold = params.epsilon * (base + t);
+        if d >= 0.0 || (-d < threshold && t > t0) {
+            return Some((t, threshold));
+        }
+        t += (-d).max(threshold);
+        if t > t1 {
+            return None;
+        }
+    }
+    c.budget_misses += 1;
+    None
+}
+
 /// The unit gradient of `f` at `p` by the four-tap tetrahedral difference, step `h`.
 #[inline]
 pub fn normal(f: &dyn Fn(Vec3A) -> f32, p: Vec3A, h: f32) -> Vec3A {

@@ -75,10 +75,10 @@ impl SdfObject {
         }
     }
 
-    /// [`closest`](Self::closest) for a ray that starts inside the solid: it marches `−f`,
-    /// the distance bound of the solid's complement, whose surface is the same, so the
-    /// hit is where the ray leaves the solid (or meets a cavity in it). The whole tree is
-    /// evaluated: a union's parts are pruned for rays outside them.
+    /// [`closest`](Self::closest) for a ray that starts inside the solid (refracted into
+    /// it): the hit is where it leaves the solid or meets a cavity in it, found by
+    /// [`march::march_out`] over the whole tree (a union's parts are pruned only for rays
+    /// outside them).
     pub fn closest_from_inside(
         &self,
         ray: &Ray,
@@ -87,8 +87,7 @@ impl SdfObject {
         c: &mut Counters,
         evals: &mut u64,
     ) -> Option<(f32, f32)> {
-        let dist = &*self.dist;
-        march::march(&|p| -dist(p), ray, t0, t1, params, c, evals)
+        march::march_out(&*self.dist, ray, t0, t1, params, c, evals)
     }
 
     /// The surface at a hit found by [`closest`](Self::closest): normal from the gradient
@@ -97,7 +96,11 @@ impl SdfObject {
     // and cost a one-object SDF scene ~10% of its primary-ray throughput (bench
     // `primary rays/intersect sdf/01-sphere`).
     #[inline(never)]
-    pub fn surface(&self, ray: &Ray, t: f32, error: f32, object: u32, c: &mut Counters) -> Hit {
+    /// `leaving` says the hit was found by [`closest_from_inside`](Self::closest_from_inside):
+    /// the ray is leaving the solid there whatever the gradient says (at grazing, or in a
+    /// wall thinner than the threshold, it can point either way), so the normal is turned
+    /// to agree.
+    pub fn surface(&self, ray: &Ray, t: f32, error: f32, object: u32, leaving: bool, c: &mut Counters) -> Hit {
         let point = ray.at(t);
         let h = error.max(point.abs().max_element() * 8.0 * f32::EPSILON);
         let (normal, d, material) = match &self.parts {
@@ -111,7 +114,8 @@ impl SdfObject {
         // The gradient of a convex solid's field is its outward normal, but only on the
         // surface: a ray starting inside the solid "hits" where it starts, below it.
         let convex = self.convex && d > -error;
-        let from_inside = normal.dot(ray.dir) > 0.0;
+        let from_inside = leaving || normal.dot(ray.dir) > 0.0;
+        let normal = if leaving && normal.dot(ray.dir) < 0.0 { -normal } else { normal };
         Hit { t, point, normal, material, error, object, convex, from_inside }
     }
 

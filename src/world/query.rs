@@ -36,10 +36,10 @@ impl World {
         match &o.kind {
             ObjectKind::Sdf(s) if i == q.ray.inside => s
                 .closest_from_inside(q.ray, self.interval(o, q.ray, t_max)?, self.params, c, &mut q.evals)
-                .map(|(t, error)| Found::Sdf { object: i, sdf: s, t, error }),
+                .map(|(t, error)| Found::Sdf { object: i, sdf: s, t, error, leaving: true }),
             ObjectKind::Sdf(s) => s
                 .closest(q.ray, self.interval(o, q.ray, t_max)?, self.params, c, &mut q.evals)
-                .map(|(t, error)| Found::Sdf { object: i, sdf: s, t, error }),
+                .map(|(t, error)| Found::Sdf { object: i, sdf: s, t, error, leaving: false }),
             // Triangles are tested exactly; the sphere only decides whether to look.
             ObjectKind::Mesh(m) if self.may_reach_mesh(o, q.ray, t_max) => {
                 m.closest(q.ray, q.shear(), t_max, c).map(|(tri, hit)| Found::Mesh { object: i, mesh: m, tri, hit })
@@ -89,8 +89,9 @@ impl World {
 /// on (numbered, and lowered by its back-end) and where.
 #[derive(Clone, Copy)]
 pub(super) enum Found<'w> {
-    /// An SDF hit: distance and the threshold there.
-    Sdf { object: u32, sdf: &'w SdfObject, t: f32, error: f32 },
+    /// An SDF hit: distance and the threshold there, and whether the ray was marched
+    /// out of the object (it started inside).
+    Sdf { object: u32, sdf: &'w SdfObject, t: f32, error: f32, leaving: bool },
     /// A triangle hit.
     Mesh { object: u32, mesh: &'w MeshObject, tri: u32, hit: mesh::triangle::TriHit },
 }
@@ -107,7 +108,7 @@ impl Found<'_> {
     /// Normal, material and error of the winning surface, computed once per ray.
     pub(super) fn surface(self, ray: &Ray, c: &mut Counters) -> Hit {
         match self {
-            Found::Sdf { object, sdf, t, error } => sdf.surface(ray, t, error, object, c),
+            Found::Sdf { object, sdf, t, error, leaving } => sdf.surface(ray, t, error, object, leaving, c),
             Found::Mesh { object, mesh, tri, hit } => mesh.surface(tri, hit, object, ray.dir),
         }
     }

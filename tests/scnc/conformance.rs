@@ -34,6 +34,8 @@ conformance! {
     packets_agree_with_single_rays => crate::mesh::packets_agree_with_single_rays,
     image_is_identical_for_any_thread_count => crate::render::image_is_identical_for_any_thread_count,
     every_primitive_hit_is_outside_in_and_finite => primitive_hits_are_outside_in_and_finite,
+    glass_far_from_the_origin_renders_the_same => crate::glass::glass_far_from_the_origin_renders_the_same,
+    thin_glass_walls_are_crossed_cleanly => crate::glass::thin_glass_walls_are_crossed_cleanly,
 }
 
 /// Every object of `tests/data/primitives.scn` is hit by some ray aimed inside its

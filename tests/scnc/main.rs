@@ -8,6 +8,7 @@ mod deploy;
 mod effects;
 mod export;
 mod fmt;
+mod glass;
 mod golden;
 mod grammar;
 mod isosurface;

@@ -166,7 +166,7 @@ fn unions_marched_part_by_part_hit_where_the_whole_field_does() {
                 (Some((a, ea)), Some((r, _))) => {
                     hits += 1;
                     assert!(a <= r + 2.0 * ea, "case {case}: part by part {a}, first crossing {r}\n{text}");
-                    let hit = object.surface(&ray, a, ea, 0, &mut c);
+                    let hit = object.surface(&ray, a, ea, 0, false, &mut c);
                     let h = ea.max(hit.point.abs().max_element() * 8.0 * f32::EPSILON);
                     let whole = march::normal(&*object.dist, hit.point, h);
                     let (_, material) = (object.mat)(hit.point);
