@@ -3,7 +3,7 @@
 //! colour clamped once at the end.
 //!
 //! Transparent materials add refraction: `(1 − t)·surface + t·(F·reflected + (1 − F)·refracted)`
-//! for transparency `t` and Fresnel reflectance `F` ([`transmit`](super::transmit)),
+//! for transparency `t` and Fresnel reflectance `F` ([`transmit`]),
 //! which is the study's model exactly when `t` = 0.
 //!
 //! The tracer is built for the scene's effect set: `block`, `trace` and `shade` are

@@ -48,7 +48,7 @@ fn diagnostics() {
 #[test]
 fn examples_check_clean() {
     let mut failures = Vec::new();
-    for dir in ["examples/seed", "examples/features", "examples/animation"] {
+    for dir in ["examples/seed", "examples/features", "examples/animation", "examples/povray"] {
         for path in cases(dir) {
             if path.file_name().is_some_and(|n| n == "lights.scn") {
                 continue;

@@ -115,3 +115,44 @@ fn bad_parts_are_refused_and_nothing_is_written() {
         assert!(!out.exists());
     }
 }
+
+/// `--bit-depth 16` writes a 16-bit PNG, its parts merge into the same 16-bit image byte
+/// for byte, and parts of different depths, or a depth PNG has not, are refused.
+#[test]
+fn sixteen_bit_renders_and_parts() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let scene = "examples/features/patterns.scn";
+    let full = dir.path().join("full.png");
+    ok(&scnc(&[&["render", scene, "-o", path(&full), "--bit-depth", "16"][..], &SIZE].concat()));
+    let decoded = image::open(&full).expect("a PNG");
+    assert!(matches!(decoded, image::DynamicImage::ImageRgb16(_)), "{:?}", decoded.color());
+    let parts: Vec<String> = (0..2)
+        .map(|i| {
+            let part = dir.path().join(format!("part-{i}.png"));
+            let tile = format!("{i}/2");
+            ok(&scnc(
+                &[&["render", scene, "-o", path(&part), "--tile", &tile, "--bit-depth", "16"][..], &SIZE].concat(),
+            ));
+            path(&part).to_string()
+        })
+        .collect();
+    let merged = dir.path().join("merged.png");
+    ok(&scnc(&["merge", &parts[0], &parts[1], "-o", path(&merged)]));
+    let (a, b) = (image::open(&full).expect("full"), image::open(&merged).expect("merged"));
+    assert!(a.as_bytes() == b.as_bytes() && a.color() == b.color(), "merged 16-bit parts differ from the render");
+    // An 8-bit part beside a 16-bit one.
+    let eight = dir.path().join("eight.png");
+    ok(&scnc(&[&["render", scene, "-o", path(&eight), "--tile", "1/2"][..], &SIZE].concat()));
+    let mixed = dir.path().join("mixed.png");
+    let out = scnc(&["merge", &parts[0], path(&eight), "-o", path(&mixed)]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("bits per channel"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(!mixed.exists());
+    let out = scnc(&["render", scene, "-o", path(&dir.path().join("x.png")), "--bit-depth", "12"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("8 or 16"));
+}
