@@ -201,6 +201,26 @@ mod tests {
         assert_eq!(above.reflectance, 1.0);
     }
 
+    fn crossing(object: u32, material: u32, from_inside: bool) -> Hit {
+        Hit { t: 1.0, point: Vec3A::ZERO, normal: Vec3A::Z, material, error: 0.0, object, convex: false, from_inside }
+    }
+
+    #[test]
+    fn media_nest_and_unnest_by_object() {
+        // Into water (object 1), into an air bubble in it (object 2), out of the bubble.
+        let water = Media::AIR.crossing(&crossing(1, 5, false));
+        let bubble = water.crossing(&crossing(2, 6, false));
+        assert_eq!((water.object(), bubble.object()), (1, 2));
+        assert_eq!(bubble.crossing(&crossing(2, 6, true)).object(), 1);
+        // Leaving the water while still in the bubble (objects that overlap) keeps the bubble.
+        assert_eq!(bubble.crossing(&crossing(1, 5, true)).object(), 2);
+        // Leaving what the ray never entered (a camera inside glass) changes nothing.
+        assert_eq!(Media::AIR.crossing(&crossing(3, 7, true)).object(), NO_OBJECT);
+        // Past the deepest nesting, entering is ignored and leaving still finds its entry.
+        let deep = (0..MAX_NESTING as u32 + 2).fold(Media::AIR, |m, o| m.crossing(&crossing(o, 0, false)));
+        assert_eq!(deep.object(), MAX_NESTING as u32 - 1);
+    }
+
     #[test]
     fn equal_indices_reflect_nothing_and_bend_nothing() {
         for angle in [0.0f32, 20.0, 45.0, 70.0, 89.5] {
