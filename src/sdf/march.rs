@@ -32,23 +32,8 @@ pub fn march(
     c: &mut Counters,
     evals: &mut u64,
 ) -> Option<(f32, f32)> {
-    let (origin, dir) = (ray.origin, ray.dir);
-    let base = origin.length();
-    let mut t = t0;
-    for _ in 0..params.max_steps {
-        let d = f(origin + dir * t);
-        *evals += 1;
-        let threshold = params.epsilon * (base + t);
-        if d < threshold {
-            return Some((t, threshold));
-        }
-        t += d;
-        if t > t1 {
-            return None;
-        }
-    }
-    c.budget_misses += 1;
-    None
+    // Written so that a NaN distance steps (and runs out of budget) rather than hits.
+    walk(f, ray, (t0, t1), params, c, evals, |d, threshold, _| if d < threshold { None } else { Some(d) })
 }
 
 /// Marches out of the solid `f < 0` from a ray that starts inside it (a refracted ray),
@@ -68,6 +53,27 @@ pub fn march_out(
     c: &mut Counters,
     evals: &mut u64,
 ) -> Option<(f32, f32)> {
+    walk(f, ray, (t0, t1), params, c, evals, |d, threshold, t| {
+        if d >= 0.0 || (-d < threshold && t > t0) {
+            None
+        } else {
+            Some((-d).max(threshold))
+        }
+    })
+}
+
+/// The loop both marches share: evaluate `f` at `t`, ask `step(f, threshold, t)` how far
+/// to go (`None`: a hit here), until the ray passes `t1` or the step budget runs out.
+#[inline(always)]
+fn walk(
+    f: &dyn Fn(Vec3A) -> f32,
+    ray: &Ray,
+    (t0, t1): (f32, f32),
+    params: MarchParams,
+    c: &mut Counters,
+    evals: &mut u64,
+    step: impl Fn(f32, f32, f32) -> Option<f32>,
+) -> Option<(f32, f32)> {
     let (origin, dir) = (ray.origin, ray.dir);
     let base = origin.length();
     let mut t = t0;
@@ -75,10 +81,10 @@ pub fn march_out(
         let d = f(origin + dir * t);
         *evals += 1;
         let threshold = params.epsilon * (base + t);
-        if d >= 0.0 || (-d < threshold && t > t0) {
+        let Some(dt) = step(d, threshold, t) else {
             return Some((t, threshold));
-        }
-        t += (-d).max(threshold);
+        };
+        t += dt;
         if t > t1 {
             return None;
         }

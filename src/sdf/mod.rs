@@ -60,46 +60,37 @@ impl SdfObject {
     }
 
     /// Marches the ray over `[t0, t1]`; on a hit, its distance and the threshold there
-    /// (the hit point's error bound).
+    /// (the hit point's error bound). A ray `inside` the solid (refracted into it) is
+    /// marched out of it by [`march::march_out`] over the whole tree, and its hit is where
+    /// it leaves the solid or meets a cavity (a union's parts are pruned only for rays
+    /// outside them).
     pub fn closest(
         &self,
         ray: &Ray,
         (t0, t1): (f32, f32),
+        inside: bool,
         params: MarchParams,
         c: &mut Counters,
         evals: &mut u64,
     ) -> Option<(f32, f32)> {
+        if inside {
+            return march::march_out(&*self.dist, ray, t0, t1, params, c, evals);
+        }
         match &self.parts {
             Some(parts) => parts.march(ray, (t0, t1), params, c, evals),
             None => march::march(&*self.dist, ray, t0, t1, params, c, evals),
         }
     }
 
-    /// [`closest`](Self::closest) for a ray that starts inside the solid (refracted into
-    /// it): the hit is where it leaves the solid or meets a cavity in it, found by
-    /// [`march::march_out`] over the whole tree (a union's parts are pruned only for rays
-    /// outside them).
-    pub fn closest_from_inside(
-        &self,
-        ray: &Ray,
-        (t0, t1): (f32, f32),
-        params: MarchParams,
-        c: &mut Counters,
-        evals: &mut u64,
-    ) -> Option<(f32, f32)> {
-        march::march_out(&*self.dist, ray, t0, t1, params, c, evals)
-    }
-
     /// The surface at a hit found by [`closest`](Self::closest): normal from the gradient
     /// and material from the material closure, numbered `object`. Done once per ray, for the winner.
+    /// `leaving` says the hit was found marching from inside: the ray is leaving the solid
+    /// there whatever the gradient says (at grazing, or in a wall thinner than the
+    /// threshold, it can point either way), so the normal is turned to agree.
     // Kept out of line: inlined into `World::intersect` it bloated the march loop's caller
     // and cost a one-object SDF scene ~10% of its primary-ray throughput (bench
     // `primary rays/intersect sdf/01-sphere`).
     #[inline(never)]
-    /// `leaving` says the hit was found by [`closest_from_inside`](Self::closest_from_inside):
-    /// the ray is leaving the solid there whatever the gradient says (at grazing, or in a
-    /// wall thinner than the threshold, it can point either way), so the normal is turned
-    /// to agree.
     pub fn surface(&self, ray: &Ray, t: f32, error: f32, object: u32, leaving: bool, c: &mut Counters) -> Hit {
         let point = ray.at(t);
         let h = error.max(point.abs().max_element() * 8.0 * f32::EPSILON);

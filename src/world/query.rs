@@ -34,12 +34,11 @@ impl World {
         }
         let o = &self.objects[i as usize];
         match &o.kind {
-            ObjectKind::Sdf(s) if i == q.ray.inside => s
-                .closest_from_inside(q.ray, self.interval(o, q.ray, t_max)?, self.params, c, &mut q.evals)
-                .map(|(t, error)| Found::Sdf { object: i, sdf: s, t, error, leaving: true }),
-            ObjectKind::Sdf(s) => s
-                .closest(q.ray, self.interval(o, q.ray, t_max)?, self.params, c, &mut q.evals)
-                .map(|(t, error)| Found::Sdf { object: i, sdf: s, t, error, leaving: false }),
+            ObjectKind::Sdf(s) => {
+                let leaving = i == q.ray.inside;
+                s.closest(q.ray, self.interval(o, q.ray, t_max)?, leaving, self.params, c, &mut q.evals)
+                    .map(|(t, error)| Found::Sdf { object: i, sdf: s, t, error, leaving })
+            }
             // Triangles are tested exactly; the sphere only decides whether to look.
             ObjectKind::Mesh(m) if self.may_reach_mesh(o, q.ray, t_max) => {
                 m.closest(q.ray, q.shear(), t_max, c).map(|(tri, hit)| Found::Mesh { object: i, mesh: m, tri, hit })
@@ -74,12 +73,9 @@ impl World {
         }
         let o = &self.objects[i as usize];
         match &o.kind {
-            ObjectKind::Sdf(s) if i == q.ray.inside => self
-                .interval(o, q.ray, t_max)
-                .is_some_and(|interval| s.closest_from_inside(q.ray, interval, self.params, c, &mut q.evals).is_some()),
-            ObjectKind::Sdf(s) => self
-                .interval(o, q.ray, t_max)
-                .is_some_and(|interval| s.closest(q.ray, interval, self.params, c, &mut q.evals).is_some()),
+            ObjectKind::Sdf(s) => self.interval(o, q.ray, t_max).is_some_and(|interval| {
+                s.closest(q.ray, interval, i == q.ray.inside, self.params, c, &mut q.evals).is_some()
+            }),
             ObjectKind::Mesh(m) => self.may_reach_mesh(o, q.ray, t_max) && m.occluded(q.ray, q.shear(), t_max, c),
         }
     }

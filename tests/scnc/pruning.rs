@@ -156,7 +156,7 @@ fn unions_marched_part_by_part_hit_where_the_whole_field_does() {
             let target = Vec3A::new(rng.f32() * 5.0 - 2.5, rng.f32() * 5.0 - 2.5, 8.0 + rng.f32() * 5.0 - 2.5);
             let ray = Ray::new(Vec3A::ZERO, target.normalize(), 100.0);
             let mut evals = 0;
-            let by_parts = object.closest(&ray, (0.0, 100.0), params, &mut c, &mut evals);
+            let by_parts = object.closest(&ray, (0.0, 100.0), false, params, &mut c, &mut evals);
             // The first crossing, found by marching the whole field with a tight threshold.
             let reference = march::march(&*object.dist, &ray, 0.0, 100.0, tight, &mut c, &mut evals);
             rays += 1;
