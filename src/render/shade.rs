@@ -183,8 +183,7 @@ fn soft_visibility<const FX: u8>(
         let target = centre + u * (r * a.cos()) + w * (r * a.sin());
         let to = target - origin;
         let len = to.length();
-        let mut ray = Ray::leaving(hit, origin, to / len, len);
-        ray.inside = media.object();
+        let ray = spawn::<FX>(hit, origin, to / len, len, &media);
         visible += shadow::<FX>(g, frame, &ray, media, c);
     }
     visible / SOFT_SAMPLES as f32
@@ -256,6 +255,17 @@ fn shadow<const FX: u8>(g: &dyn Geometry, frame: &Frame, ray: &Ray, media: Media
     }
 }
 
+/// A secondary ray from `origin`, just off `hit`, travelling in `media` (which only a
+/// tracer with refraction tracks; without it every ray is in air).
+#[inline(always)]
+fn spawn<const FX: u8>(hit: &Hit, origin: Vec3A, dir: Vec3A, t_max: f32, media: &Media) -> Ray {
+    let mut ray = Ray::leaving(hit, origin, dir, t_max);
+    if FX & REFRACT != 0 {
+        ray.inside = media.object();
+    }
+    ray
+}
+
 /// The colour seen along `ray` (travelling in `media`) given what it hit (`None`: the background).
 fn shade<const FX: u8>(
     g: &dyn Geometry,
@@ -288,19 +298,22 @@ fn shade<const FX: u8>(
         if FX & AO != 0 {
             light *= occlusion(g, &hit, origin, normal, frame.ao_reach, c);
         }
+        // A light's diffuse and highlight light together, and (for the transmitted
+        // share) its highlight alone, each as much as reached the point.
+        let mut gather = |amount: f32, spec: f32, passed: Vec3A| {
+            light += amount * passed;
+            if FX & REFRACT != 0 {
+                shine += spec * passed;
+            }
+        };
         if FX & SHADOWS != 0 {
             for l in &frame.casting {
                 let Some((l_unit, dist, amount, spec)) = direct::<FX>(l, hit.point, normal, view, material.specular)
                 else {
                     continue;
                 };
-                let mut ray = Ray::leaving(&hit, origin, l_unit, (dist - offset).min(frame.max_distance));
-                ray.inside = media.object();
-                let passed = shadow::<FX>(g, frame, &ray, media, c);
-                light += amount * passed;
-                if FX & REFRACT != 0 {
-                    shine += spec * passed;
-                }
+                let ray = spawn::<FX>(&hit, origin, l_unit, (dist - offset).min(frame.max_distance), &media);
+                gather(amount, spec, shadow::<FX>(g, frame, &ray, media, c));
             }
             for (l, radius) in &frame.soft {
                 let Some((l_unit, dist, amount, spec)) = direct::<FX>(l, hit.point, normal, view, material.specular)
@@ -313,18 +326,12 @@ fn shade<const FX: u8>(
                 } else {
                     soft_visibility::<FX>(g, frame, &hit, origin, l_unit, t_max, *radius, media, c)
                 };
-                light += amount * passed;
-                if FX & REFRACT != 0 {
-                    shine += spec * passed;
-                }
+                gather(amount, spec, passed);
             }
         }
         for l in &frame.plain {
             if let Some((_, _, amount, spec)) = direct::<FX>(l, hit.point, normal, view, material.specular) {
-                light += Vec3A::splat(amount);
-                if FX & REFRACT != 0 {
-                    shine += Vec3A::splat(spec);
-                }
+                gather(amount, spec, Vec3A::ONE);
             }
         }
         // Patterns are read just inside the surface (see `ShadeMaterial::color_at`).
@@ -345,28 +352,28 @@ fn shade<const FX: u8>(
     if depth == 0 {
         return surface * (1.0 - transparency) + highlight;
     }
-    // How much of the mirror direction and of the transmitted direction shows.
-    let (mut mirror, mut through, mut bent) = (r * (1.0 - transparency), 0.0, None);
+    // How much of the mirror direction shows, and the transmitted direction with the
+    // media beyond the surface and its share.
+    let mut mirror = r * (1.0 - transparency);
+    let mut transmitted = None;
     if transparency > 0.0 {
-        let (n1, n2) = transmit::indices(frame, &hit, &media);
+        let beyond = media.crossing(&hit);
+        let (n1, n2) = transmit::indices(frame, &hit, &media, &beyond);
         let split = transmit::split(view, normal, n1, n2);
         mirror += transparency * split.reflectance;
-        through = transparency * (1.0 - split.reflectance);
-        bent = split.refracted;
+        let through = transparency * (1.0 - split.reflectance);
+        transmitted = split.refracted.filter(|_| through > 0.0).map(|dir| (dir, beyond, through));
     }
     let mut colour = surface * (1.0 - transparency) + highlight;
     if mirror > 0.0 {
         let reflected_dir = (normal * (2.0 * normal.dot(view)) - view).normalize();
         c.reflection_rays += 1;
-        let mut ray = Ray::leaving(&hit, origin, reflected_dir, frame.max_distance);
-        ray.inside = media.object();
+        let ray = spawn::<FX>(&hit, origin, reflected_dir, frame.max_distance, &media);
         colour += trace::<FX>(g, frame, &ray, depth - 1, media, c) * mirror;
     }
-    if let (Some(dir), true) = (bent, through > 0.0) {
+    if let Some((dir, beyond, through)) = transmitted {
         c.refraction_rays += 1;
-        let beyond = media.crossing(&hit);
-        let mut ray = Ray::leaving(&hit, hit.point - normal * offset, dir, frame.max_distance);
-        ray.inside = beyond.object();
+        let ray = spawn::<FX>(&hit, hit.point - normal * offset, dir, frame.max_distance, &beyond);
         colour += trace::<FX>(g, frame, &ray, depth - 1, beyond, c) * through;
     }
     colour

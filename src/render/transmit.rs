@@ -93,12 +93,13 @@ pub(super) fn split(view: Vec3A, n: Vec3A, n1: f32, n2: f32) -> Split {
     Split { reflectance: reflectance.clamp(0.0, 1.0), refracted: (refracted != Vec3A::ZERO).then_some(refracted) }
 }
 
-/// The indices of refraction on either side of `hit`'s surface for a ray in `media`:
-/// the medium it comes from and the one it would pass into.
-pub(super) fn indices(frame: &Frame, hit: &Hit, media: &Media) -> (f32, f32) {
+/// The indices of refraction on either side of `hit`'s surface for a ray in `media`
+/// that would be in `beyond` past it: the medium it comes from and the one it would
+/// pass into.
+pub(super) fn indices(frame: &Frame, hit: &Hit, media: &Media, beyond: &Media) -> (f32, f32) {
     let own = frame.materials.materials[hit.material as usize].ior;
     if hit.from_inside {
-        (own, media.crossing(hit).ior(frame))
+        (own, beyond.ior(frame))
     } else {
         (media.ior(frame), own)
     }
