@@ -171,9 +171,10 @@ pub(crate) fn write_part_png(
     image: &scnc::render::Image,
 ) -> std::io::Result<()> {
     // One sample is one byte, or two in the machine's order.
-    let (sample, colour) = match image.depth {
-        BitDepth::Eight => (1, image::ExtendedColorType::Rgba8),
-        BitDepth::Sixteen => (2, image::ExtendedColorType::Rgba16),
+    let sample = image.depth.sample_bytes();
+    let colour = match image.depth {
+        BitDepth::Eight => image::ExtendedColorType::Rgba8,
+        BitDepth::Sixteen => image::ExtendedColorType::Rgba16,
     };
     let mut rgba = vec![0u8; width as usize * height as usize * 4 * sample];
     for (dy, row) in image.pixels.chunks_exact(3 * sample * image.width as usize).enumerate() {

@@ -45,13 +45,6 @@ fn read_part(path: &Path) -> Result<Part, String> {
     Ok(Part { width, height, depth, rgba })
 }
 
-fn bits(depth: BitDepth) -> u32 {
-    match depth {
-        BitDepth::Eight => 8,
-        BitDepth::Sixteen => 16,
-    }
-}
-
 /// The full image from its parts: every pixel opaque in exactly one part.
 fn merge(parts: &[PathBuf]) -> Result<scnc::render::Image, String> {
     let mut size = None;
@@ -77,15 +70,14 @@ fn merge(parts: &[PathBuf]) -> Result<scnc::render::Image, String> {
                 return Err(format!(
                     "`{}` has {} bits per channel but `{}` has {}: parts of one image have its bit depth",
                     path.display(),
-                    bits(depth),
+                    depth.bits(),
                     first.display(),
-                    bits(sd)
+                    sd.bits()
                 ));
             }
             Some(_) => {}
         }
-        let px_bytes = depth.pixel_bytes();
-        let sample = px_bytes / 3;
+        let (px_bytes, sample) = (depth.pixel_bytes(), depth.sample_bytes());
         for (i, px) in rgba.chunks_exact(4 * sample).enumerate() {
             // Parts are wholly opaque (every alpha bit set) or wholly transparent.
             let alpha = &px[3 * sample..];

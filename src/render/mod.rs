@@ -22,8 +22,6 @@ use glam::Vec3A;
 use rayon::prelude::*;
 use shade::fx;
 
-use crate::ir::ColorSpace;
-
 pub use counters::Counters;
 pub use frame::{Frame, MaterialTable, ShadeLight, ShadeMaterial};
 pub use geometry::{intersect_each, Geometry, Hit};
@@ -54,12 +52,22 @@ pub enum BitDepth {
 }
 
 impl BitDepth {
+    /// Bits of one sample.
+    pub fn bits(self) -> u32 {
+        match self {
+            BitDepth::Eight => 8,
+            BitDepth::Sixteen => 16,
+        }
+    }
+
+    /// Bytes of one sample.
+    pub fn sample_bytes(self) -> usize {
+        self.bits() as usize / 8
+    }
+
     /// Bytes of one pixel (three channels).
     pub fn pixel_bytes(self) -> usize {
-        match self {
-            BitDepth::Eight => 3,
-            BitDepth::Sixteen => 6,
-        }
+        3 * self.sample_bytes()
     }
 }
 
@@ -67,10 +75,7 @@ impl BitDepth {
 /// not, at its bit depth. The study's 8-bit linear pixels round the value to nearest.
 #[inline]
 fn encode(colour: Vec3A, frame: &Frame, out: &mut Vec<u8>) {
-    let v = match frame.color {
-        ColorSpace::Linear => colour,
-        ColorSpace::Srgb => Vec3A::from_array(colour.to_array().map(|x| pattern::linear_to_srgb(x / 255.0) * 255.0)),
-    };
+    let v = pattern::encoded(colour, frame.color);
     match frame.bit_depth {
         // Values are in [0, 255], so adding one half and truncating rounds to nearest.
         BitDepth::Eight => out.extend((v + 0.5).to_array().map(|x| x as u8)),

@@ -104,6 +104,14 @@ pub fn linear(c: Vec3A, space: ColorSpace) -> Vec3A {
     }
 }
 
+/// A linear colour, 0–255, as pixels in `space` hold it.
+pub fn encoded(c: Vec3A, space: ColorSpace) -> Vec3A {
+    match space {
+        ColorSpace::Linear => c,
+        ColorSpace::Srgb => Vec3A::from_array(c.to_array().map(|x| linear_to_srgb(x / 255.0) * 255.0)),
+    }
+}
+
 /// The sRGB transfer function's inverse (IEC 61966-2-1), on [0, 1].
 pub fn srgb_to_linear(x: f32) -> f32 {
     if x <= 0.04045 {
