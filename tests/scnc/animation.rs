@@ -4,26 +4,10 @@
 //! equal to the same frame rendered in a sequence, and `scnc encode`.
 
 use std::path::Path;
-use std::process::Output;
 
 use scnc::source::FsLoader;
 
-use crate::support::{cases, check_golden, compile, finish, scnc, scnc_env};
-
-fn ok(out: &Output) {
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
-}
-
-/// The run failed with `code`, saying `says`.
-fn refused(out: &Output, code: i32, says: &str) {
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(code), "{err}");
-    assert!(err.contains(says), "expected `{says}` in:\n{err}");
-}
-
-fn path(p: &Path) -> &str {
-    p.to_str().expect("utf-8 path")
-}
+use crate::support::{cases, check_golden, compile, finish, ok, path, refused, scnc, scnc_env};
 
 /// The PNG files in `dir`, sorted by name.
 fn pngs(dir: &Path) -> Vec<String> {
@@ -166,16 +150,14 @@ fn errors_of_later_frames_name_the_frame() {
     std::fs::write(&scene, "render(width = 16, height = 16, frames = 3)\nobject sphere(1 - clock) at [0, 0, 5]\n")
         .expect("write");
     let out = scnc(&["render", path(&scene), "-o", path(&dir.path().join("f-#.png"))]);
-    assert_eq!(out.status.code(), Some(1));
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("at frame 2 (clock = 1)") && err.contains("E0400"), "{err}");
+    refused(&out, 1, "at frame 2 (clock = 1)");
+    refused(&out, 1, "E0400");
     assert_eq!(pngs(dir.path()), ["f-0.png", "f-1.png"], "frames before the error are written");
     std::fs::write(&scene, "render(width = 16, height = 16, frames = 3 + frame)\nobject sphere(1) at [0, 0, 5]\n")
         .expect("write");
     let out = scnc(&["render", path(&scene), "-o", path(&dir.path().join("g-#.png"))]);
-    assert_eq!(out.status.code(), Some(1));
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("E0503") && err.contains("at frame 0: 3 frames"), "{err}");
+    refused(&out, 1, "E0503");
+    refused(&out, 1, "at frame 0: 3 frames");
 }
 
 /// Frames encoded as a GIF and an APNG decode to as many frames of the same size; a gap

@@ -10,6 +10,23 @@ pub fn scnc(args: &[&str]) -> std::process::Output {
     scnc_env(args, &[])
 }
 
+/// The run succeeded.
+pub fn ok(out: &std::process::Output) {
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+}
+
+/// The run failed with `code`, saying `says`.
+pub fn refused(out: &std::process::Output, code: i32, says: &str) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(code), "{err}");
+    assert!(err.contains(says), "expected `{says}` in:\n{err}");
+}
+
+/// A path as a command-line argument.
+pub fn path(p: &Path) -> &str {
+    p.to_str().expect("utf-8 path")
+}
+
 /// [`scnc`] with these environment variables set as well.
 pub fn scnc_env(args: &[&str], env: &[(&str, &str)]) -> std::process::Output {
     std::process::Command::new(env!("CARGO_BIN_EXE_scnc"))

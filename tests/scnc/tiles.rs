@@ -2,18 +2,7 @@
 //! the whole render byte for byte, and bad parts or part specifications are refused
 //! without writing anything.
 
-use std::path::Path;
-use std::process::Output;
-
-use crate::support::scnc;
-
-fn ok(out: &Output) {
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
-}
-
-fn path(p: &Path) -> &str {
-    p.to_str().expect("utf-8 path")
-}
+use crate::support::{ok, path, refused, scnc};
 
 /// A size whose rows and columns are not multiples of the 4×4 blocks rays go in.
 const SIZE: [&str; 4] = ["--width", "97", "--height", "61"];
@@ -144,15 +133,7 @@ fn sixteen_bit_renders_and_parts() {
     let eight = dir.path().join("eight.png");
     ok(&scnc(&[&["render", scene, "-o", path(&eight), "--tile", "1/2"][..], &SIZE].concat()));
     let mixed = dir.path().join("mixed.png");
-    let out = scnc(&["merge", &parts[0], path(&eight), "-o", path(&mixed)]);
-    assert_eq!(out.status.code(), Some(1));
-    assert!(
-        String::from_utf8_lossy(&out.stderr).contains("bits per channel"),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    refused(&scnc(&["merge", &parts[0], path(&eight), "-o", path(&mixed)]), 1, "bits per channel");
     assert!(!mixed.exists());
-    let out = scnc(&["render", scene, "-o", path(&dir.path().join("x.png")), "--bit-depth", "12"]);
-    assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("8 or 16"));
+    refused(&scnc(&["render", scene, "-o", path(&dir.path().join("x.png")), "--bit-depth", "12"]), 2, "8 or 16");
 }
