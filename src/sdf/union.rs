@@ -79,20 +79,21 @@ impl PartTree {
     /// The union's value and material at `p` from the parts' distance-and-material
     /// closures `mats`, blend radius `k`: ties go to the part written first, whatever
     /// order the walk takes. Every part within `extra` beyond the union's own pruning
-    /// reach (best value + `k`) is also walked, and each part walked is passed to `seen`.
+    /// reach (best value + `k`) is also walked, and each part walked is passed to `seen`
+    /// with its value.
     pub fn material(
         &self,
         mats: &[super::MatSdf],
         k: f32,
         p: Vec3A,
         extra: f32,
-        mut seen: impl FnMut(usize),
+        mut seen: impl FnMut(usize, f32),
     ) -> (f32, u32) {
         let (mut fold, mut first, mut id) = (Fold::new(k), usize::MAX, 0);
         self.visit(p, f32::INFINITY, |i, bound| {
-            seen(i);
             let (v, material) = mats[i](p);
             let v = clamp(v, bound);
+            seen(i, v);
             if v < fold.best() || (v == fold.best() && i < first) {
                 (first, id) = (i, material);
             }
@@ -103,11 +104,20 @@ impl PartTree {
 
     /// Walks the parts nearest first, calling `part(i, bound)` (see [`bound`](Self::bound))
     /// for each part not skipped. `part` returns the threshold from then on: a node is
-    /// skipped when `p` is outside it by at least the threshold (`start` at first). A
+    /// skipped when `p` is outside it by at least the threshold (`start` at first), and
+    /// so is a part whose bound is positive and above it (its value, at least the bound,
+    /// can change nothing: a leaf holds two parts, and the second is often far). A
     /// union's threshold is its best value plus `k`; a subtraction's, minus its value.
     #[inline]
     pub fn visit(&self, p: Vec3A, start: f32, mut part: impl FnMut(usize, f32) -> f32) {
-        self.bvh.nearest_first(p, start, self.prune, |i| part(i as usize, self.bound(i as usize, p)));
+        let mut threshold = start;
+        self.bvh.nearest_first(p, start, self.prune, |i| {
+            let bound = self.bound(i as usize, p);
+            if !(self.prune && bound > 0.0 && bound > threshold) {
+                threshold = part(i as usize, bound);
+            }
+            threshold
+        });
     }
 }
 
@@ -220,7 +230,7 @@ thread_local! {
     static SCRATCH: std::cell::RefCell<Scratch> =
         const { std::cell::RefCell::new((Vec::new(), Vec::new(), Vec::new())) };
     /// The parts gathered around a hit for its normal and material.
-    static NEAR: std::cell::RefCell<Vec<u32>> = const { std::cell::RefCell::new(Vec::new()) };
+    static NEAR: std::cell::RefCell<Vec<(u32, f32)>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 impl RayParts {
@@ -228,17 +238,22 @@ impl RayParts {
     /// at render-space `p`, from one walk of the hierarchy instead of one per tap.
     ///
     /// Why this is exact: the taps lie within `r = h·√3` of `p`. The walk gathers every
-    /// part whose bound at `p` is below the best value there plus `k + 2r`; a part
-    /// left out has, at any tap, a value at least its bound at `p` minus `r`, so at
-    /// least the best value at that tap plus `k`, and blends by exactly nothing there.
+    /// part whose bound at `p` is below the best value there plus `k + 2r`, and the taps
+    /// use those whose value is; a part left out has, at any tap, a value at least its
+    /// bound (or value) at `p` minus `r`, so at least the best value at that tap plus
+    /// `k`, and blends by exactly nothing there.
     pub fn surface(&self, p: Vec3A, h: f32) -> (Vec3A, f32, u32) {
         NEAR.with(|near| {
             let near = &mut *near.borrow_mut();
             near.clear();
             let q = self.inv.transform_point3a(p);
             let extra = 2.0 * h * 3f32.sqrt() / self.scale;
-            let (value, id) = self.tree.material(&self.mats, self.k, q, extra, |i| near.push(i as u32));
-            let at = |x: Vec3A| self.value(x, near.iter().copied());
+            let (value, id) = self.tree.material(&self.mats, self.k, q, extra, |i, v| near.push((i as u32, v)));
+            // The walk kept every part within reach of the best value found so far; now
+            // that the best is known, the taps need only those within reach of it.
+            let best = near.iter().fold(f32::INFINITY, |m, &(_, v)| m.min(v));
+            near.retain(|&(_, v)| v < best + self.k + extra);
+            let at = |x: Vec3A| self.value(x, near.iter().map(|&(i, _)| i));
             (super::march::normal(&at, p, h), value * self.scale, id)
         })
     }
@@ -256,7 +271,7 @@ impl RayParts {
 
     /// Sphere traces the ray over `[t0, t1]` with the parts in force at each step (see
     /// [`march`](super::march::march) for the threshold); the hit distance and the
-    /// threshold there.
+    /// threshold there. A sharp union takes [`march_sharp`](Self::march_sharp).
     pub fn march(
         &self,
         ray: &crate::render::Ray,
@@ -265,11 +280,14 @@ impl RayParts {
         c: &mut crate::render::Counters,
         evals: &mut u64,
     ) -> Option<(f32, f32)> {
+        let frame = FrameRay::new(self.inv.transform_point3a(ray.origin), self.inv.transform_vector3a(ray.dir));
+        if self.k == 0.0 {
+            return self.march_sharp(ray, &frame, (t0, t1), params, c, evals);
+        }
         SCRATCH.with(|s| {
             let (closed, active, waiting) = &mut *s.borrow_mut();
             active.clear();
             waiting.clear();
-            let frame = FrameRay::new(self.inv.transform_point3a(ray.origin), self.inv.transform_vector3a(ray.dir));
             let walk = self.tree.bvh.ray_walk(frame.origin, frame.inv_dir, (t0, t1), self.k, closed);
             let base = ray.origin.length();
             let mut t = t0;
@@ -323,6 +341,49 @@ impl RayParts {
         })
     }
 
+    /// [`march`](Self::march) for a sharp union: its first hit is the nearest of its
+    /// parts' first hits (from outside, the minimum first reaches zero where one of its
+    /// terms does), so each part is marched alone inside its span, and the hierarchy is
+    /// walked front to back as separate objects are, skipping every part that begins
+    /// beyond the nearest hit so far. A part's own value steps at least as far as the
+    /// union's would, and no span list is kept: on `benches/scenes/union-10000.scn` this
+    /// walk traced in three quarters of the time of the resumable one (`scnc render …
+    /// --stats`, medians of 15 alternating runs).
+    fn march_sharp(
+        &self,
+        ray: &crate::render::Ray,
+        frame: &FrameRay,
+        (t0, t1): (f32, f32),
+        params: super::MarchParams,
+        c: &mut crate::render::Counters,
+        evals: &mut u64,
+    ) -> Option<(f32, f32)> {
+        let base = ray.origin.length();
+        let (mut visits, mut misses) = (0, 0);
+        let hit = self.tree.bvh.closest(frame.origin, frame.inv_dir, t0, t1, &mut visits, |i, t_max| {
+            let i = i as usize;
+            let (a, z) = self.span(i as u32, frame, (t0, t_max))?;
+            let mut t = a;
+            for _ in 0..params.max_steps {
+                let q = frame.origin + frame.dir * t;
+                let d = clamp(self.parts[i](q), self.tree.bound(i, q)) * self.scale;
+                *evals += 1;
+                if d < params.epsilon * (base + t) {
+                    return Some(t);
+                }
+                t += d;
+                if t > z {
+                    return None;
+                }
+            }
+            misses += 1;
+            None
+        });
+        c.node_visits += visits;
+        c.budget_misses += misses;
+        hit.map(|(_, t)| (t, params.epsilon * (base + t)))
+    }
+
     /// The union's value at render-space `p` from the parts listed (the others being
     /// known to blend by nothing there).
     #[inline]
@@ -342,6 +403,7 @@ impl RayParts {
 /// (spheres, whose distances are divided back by the length).
 struct FrameRay {
     origin: Vec3A,
+    dir: Vec3A,
     inv_dir: Vec3A,
     unit: Vec3A,
     len: f32,
@@ -350,6 +412,6 @@ struct FrameRay {
 impl FrameRay {
     fn new(origin: Vec3A, dir: Vec3A) -> FrameRay {
         let len = dir.length();
-        FrameRay { origin, inv_dir: dir.recip(), unit: dir / len, len }
+        FrameRay { origin, dir, inv_dir: dir.recip(), unit: dir / len, len }
     }
 }
