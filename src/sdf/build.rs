@@ -324,7 +324,7 @@ impl<'a> Builder<'a> {
             t.visit(p, f32::INFINITY, |i, bound| fold.push(union::clamp(ds[i](p), bound)));
             fold.finish()
         });
-        let m = self.mat(move |p| tree.material(&ms, k, p, 0.0, |_, _| {}));
+        let m = self.mat(move |p| tree.material(&ms, (k, 0.0), p, f32::INFINITY, |_, _| {}));
         (d, m)
     }
 

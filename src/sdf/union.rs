@@ -80,17 +80,19 @@ impl PartTree {
     /// closures `mats`, blend radius `k`: ties go to the part written first, whatever
     /// order the walk takes. Every part within `extra` beyond the union's own pruning
     /// reach (best value + `k`) is also walked, and each part walked is passed to `seen`
-    /// with its value.
+    /// with its value. Nothing `start` or more from `p` is walked until a part is found
+    /// (infinity: the whole reach; a smaller start is the caller's guess of the reach,
+    /// to be checked against the best value found).
     pub fn material(
         &self,
         mats: &[super::MatSdf],
-        k: f32,
+        (k, extra): (f32, f32),
         p: Vec3A,
-        extra: f32,
+        start: f32,
         mut seen: impl FnMut(usize, f32),
     ) -> (f32, u32) {
         let (mut fold, mut first, mut id) = (Fold::new(k), usize::MAX, 0);
-        self.visit(p, f32::INFINITY, |i, bound| {
+        self.visit(p, start, |i, bound| {
             let (v, material) = mats[i](p);
             let v = clamp(v, bound);
             seen(i, v);
@@ -248,10 +250,24 @@ impl RayParts {
             near.clear();
             let q = self.inv.transform_point3a(p);
             let extra = 2.0 * h * 3f32.sqrt() / self.scale;
-            let (value, id) = self.tree.material(&self.mats, self.k, q, extra, |i, v| near.push((i as u32, v)));
+            let best = |near: &Vec<(u32, f32)>| near.iter().fold(f32::INFINITY, |m, &(_, v)| m.min(v));
+            // At a hit the union's value is below the threshold, at most `h`, so the
+            // reach is at most `h + k + extra`: a walk that starts there skips the whole
+            // tree but the parts around `p`. Checked, and walked again from infinity
+            // when `p` is further out than that (a point that is not a march's hit).
+            let guess = h / self.scale + self.k + extra;
+            let walk = |start: f32, near: &mut Vec<(u32, f32)>| {
+                near.clear();
+                self.tree.material(&self.mats, (self.k, extra), q, start, |i, v| near.push((i as u32, v)))
+            };
+            let mut found = walk(guess, near);
+            if near.is_empty() || best(near) + self.k + extra > guess {
+                found = walk(f32::INFINITY, near);
+            }
+            let (value, id) = found;
             // The walk kept every part within reach of the best value found so far; now
             // that the best is known, the taps need only those within reach of it.
-            let best = near.iter().fold(f32::INFINITY, |m, &(_, v)| m.min(v));
+            let best = best(near);
             near.retain(|&(_, v)| v < best + self.k + extra);
             let at = |x: Vec3A| self.value(x, near.iter().map(|&(i, _)| i));
             (super::march::normal(&at, p, h), value * self.scale, id)
@@ -389,10 +405,14 @@ impl RayParts {
     #[inline]
     fn value(&self, p: Vec3A, parts: impl Iterator<Item = u32>) -> f32 {
         let q = self.inv.transform_point3a(p);
+        let part = |i: u32| clamp(self.parts[i as usize](q), self.tree.bound(i as usize, q));
+        if self.k == 0.0 {
+            // The minimum, without a fold's buffer to set up at every tap of a normal.
+            return parts.map(part).fold(f32::INFINITY, f32::min) * self.scale;
+        }
         let mut fold = Fold::new(self.k);
         for i in parts {
-            let i = i as usize;
-            fold.push(clamp(self.parts[i](q), self.tree.bound(i, q)));
+            fold.push(part(i));
         }
         fold.finish() * self.scale
     }
