@@ -287,7 +287,7 @@ impl RayParts {
 
     /// Sphere traces the ray over `[t0, t1]` with the parts in force at each step (see
     /// [`march`](super::march::march) for the threshold); the hit distance and the
-    /// threshold there. A sharp union takes [`march_sharp`](Self::march_sharp).
+    /// threshold there. A sharp union is marched part by part, front to back.
     pub fn march(
         &self,
         ray: &crate::render::Ray,
