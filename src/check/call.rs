@@ -3,7 +3,7 @@
 
 use glam::DVec3;
 
-use super::builtins::{self, Builtin, Kind, Ty};
+use super::builtins::{self, Builtin, Ctor, Kind, Ty};
 use super::expr::{ArgVal, BoundArgs, SYNONYMS};
 use super::{Bound, Ctx, Env, Func, Value, MAX_CALL_DEPTH};
 use crate::diag::{codes, suggest, Diagnostic};
@@ -133,7 +133,20 @@ impl Ctx<'_> {
     /// Evaluates the arguments, picks the overload of `all` they fit, binds them and
     /// builds the builtin's value; `name` is the callee's span, for the editor's index.
     fn apply_builtin(&mut self, all: &'static [&'static Builtin], name: Span, args: &[ast::Arg], span: Span) -> Value {
-        let args = self.eval_args(args);
+        // `floor(x)`, `random(i)`: a number in, a number out. The inner loop of generated
+        // scenes, so a number argument skips binding and its allocations (what binding
+        // would check of it holds: one positional argument, of the one type taken).
+        let args = match (all, args) {
+            ([b @ Builtin { ctor: Ctor::Math(f), .. }], [ast::Arg { name: None, value }]) if b.params.len() == 1 => {
+                let x = self.expr(value);
+                if let Value::Num(x) = x {
+                    self.note_builtin(name, b);
+                    return self.math(b, *f, x, value.span, span);
+                }
+                vec![ArgVal { name: None, value: x, span: value.span }]
+            }
+            _ => self.eval_args(args),
+        };
         let Some(builtin) = self.overload(all, &args) else {
             return Value::Error;
         };

@@ -193,7 +193,21 @@ impl Ctx<'_> {
 
     /// Spends `steps` of fuel on the work at `span`; `false` once it has run out (or
     /// evaluation stopped), after reporting where, and what used it, once.
+    #[inline]
     fn burn(&mut self, steps: u64, span: Span) -> bool {
+        // Every expression node burns: the common case stays inline, the rest is
+        // `burn_slow`, which decides exactly as if it were alone.
+        if !self.halted && self.until_poll >= steps && self.fuel >= steps {
+            self.until_poll -= steps;
+            self.fuel -= steps;
+            return true;
+        }
+        self.burn_slow(steps, span)
+    }
+
+    /// [`burn`](Self::burn) when evaluation has stopped, a poll is due or fuel runs out.
+    #[cold]
+    fn burn_slow(&mut self, steps: u64, span: Span) -> bool {
         if self.halted {
             return false;
         }

@@ -11,14 +11,14 @@ use crate::check::expr::BoundArgs;
 use crate::check::{direction, Ctx, Value, MAX_LIST};
 use crate::diag::{codes, Diagnostic};
 use crate::ir::{dump_num, dump_vec};
+use crate::span::Span;
 
 /// The rule of `asin` and `acos`.
 const UNIT: &str = "between -1 and 1";
 
 impl Ctx<'_> {
-    /// A function of one number.
-    pub(super) fn math(&mut self, b: &Builtin, f: MathFn, a: &BoundArgs) -> Value {
-        let x = a.num(b, 0);
+    /// A function of one number, `x` given at `arg` in the call at `call`.
+    pub(in crate::check) fn math(&mut self, b: &Builtin, f: MathFn, x: f64, arg: Span, call: Span) -> Value {
         let r = x.to_radians();
         let domain = match f {
             MathFn::Sqrt => Some((x >= 0.0, NONNEG)),
@@ -27,7 +27,7 @@ impl Ctx<'_> {
             _ => None,
         };
         if let Some((false, rule)) = domain {
-            self.range_error(a.span(0), Range { name: b.params[0].name, rule }, dump_num(x));
+            self.range_error(arg, Range { name: b.params[0].name, rule }, dump_num(x));
             return Value::Error;
         }
         let y = match f {
@@ -53,7 +53,7 @@ impl Ctx<'_> {
             MathFn::Acos => x.acos().to_degrees(),
             MathFn::Atan => x.atan().to_degrees(),
         };
-        self.finite(Value::Num(y), a.call, || format!("`{}` overflowed", b.name))
+        self.finite(Value::Num(y), call, || format!("`{}` overflowed", b.name))
     }
 
     /// A function of several numbers, or one giving a list or a colour.

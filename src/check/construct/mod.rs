@@ -185,7 +185,7 @@ impl Ctx<'_> {
             Ctor::Rgb => self.rgb(b, &a),
             Ctor::Pattern(f) => self.pattern(b, f, &a),
             Ctor::Light(l) => self.light(b, l, &a),
-            Ctor::Math(f) => self.math(b, f, &a),
+            Ctor::Math(f) => self.math(b, f, a.num(b, 0), a.span(0), a.call),
             Ctor::Numeric(f) => self.numeric(b, f, &a),
             Ctor::Vector(f) => self.vector(b, f, &a),
             Ctor::Extreme(e) => self.extreme(b, e, &a),
