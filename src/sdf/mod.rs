@@ -20,7 +20,7 @@ pub use build::{Builder, MatSdf, Sdf};
 pub use march::MarchParams;
 
 use crate::ir;
-use crate::render::{Counters, Hit, Ray};
+use crate::render::{Counters, Hit, Packet, Ray};
 
 thread_local! {
     /// Primitive evaluations on this thread, for `--stats`: how much a tree costs,
@@ -80,6 +80,36 @@ impl SdfObject {
             Some(parts) => parts.march(ray, (t0, t1), params, c, evals),
             None => march::march(&*self.dist, ray, t0, t1, params, c, evals),
         }
+    }
+
+    /// Whether packets of camera rays share one walk of this object's parts: a sharp
+    /// union's ([`closest_packet`](Self::closest_packet)).
+    pub fn walks_packets(&self) -> bool {
+        self.parts.as_ref().is_some_and(|p| p.k == 0.0)
+    }
+
+    /// [`closest`](Self::closest) for the lanes `mask` of `N` packets of rays starting
+    /// outside the solid, lane `l` of packet `g` over `spans[g][l]`, with `evals` per lane:
+    /// a sharp union's lanes share one walk of its parts, any other object marches each
+    /// lane alone.
+    pub fn closest_packet<const N: usize>(
+        &self,
+        quads: &[Packet; N],
+        mask: u32,
+        spans: &[[(f32, f32); 4]; N],
+        params: MarchParams,
+        c: &mut Counters,
+        evals: &mut [[u64; 4]; N],
+    ) -> [[Option<(f32, f32)>; 4]; N] {
+        if let Some(parts) = self.parts.as_ref().filter(|p| p.k == 0.0) {
+            return parts.march_packet(quads, mask, spans, params, c, evals);
+        }
+        let mut hits = [[None; 4]; N];
+        for lane in crate::render::lanes(mask) {
+            let (g, l) = (lane / 4, lane % 4);
+            hits[g][l] = self.closest(&quads[g].rays[l], spans[g][l], false, params, c, &mut evals[g][l]);
+        }
+        hits
     }
 
     /// The surface at a hit found by [`closest`](Self::closest): normal from the gradient

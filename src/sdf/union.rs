@@ -20,10 +20,10 @@
 //! 2025), per point instead of per cell: no pruned tree is built, the hierarchy is the
 //! cache.
 
-use glam::Vec3A;
+use glam::{Vec3A, Vec4};
 
 use super::prim;
-use crate::accel::{sphere_interval, Aabb, Bvh, Child, ROBUST};
+use crate::accel::{sphere_interval, Aabb, Bvh, Child, Rays4, ROBUST};
 
 /// Parts per leaf of the hierarchy.
 const LEAF: usize = 2;
@@ -377,27 +377,96 @@ impl RayParts {
         let base = ray.origin.length();
         let (mut visits, mut misses) = (0, 0);
         let hit = self.tree.bvh.closest(frame.origin, frame.inv_dir, t0, t1, &mut visits, |i, t_max| {
-            let i = i as usize;
-            let (a, z) = self.span(i as u32, frame, (t0, t_max))?;
-            let mut t = a;
-            for _ in 0..params.max_steps {
-                let q = frame.origin + frame.dir * t;
-                let d = clamp(self.parts[i](q), self.tree.bound(i, q)) * self.scale;
-                *evals += 1;
-                if d < params.epsilon * (base + t) {
-                    return Some(t);
-                }
-                t += d;
-                if t > z {
-                    return None;
-                }
-            }
-            misses += 1;
-            None
+            self.march_part(i, frame, (t0, t_max), base, params, evals, &mut misses)
         });
         c.node_visits += visits;
         c.budget_misses += misses;
         hit.map(|(_, t)| (t, params.epsilon * (base + t)))
+    }
+
+    /// [`march`](Self::march) of a sharp union for the lanes `mask` of `N` packets of
+    /// camera rays, lane `l` of packet `g` over `spans[g][l]`: one walk of the hierarchy
+    /// for all of them ([`Bvh::each_packet`]), each part met marched for each lane alone
+    /// as the single ray's walk would. A lane's hit is the nearest of its parts' first
+    /// hits whichever order they come in, so it is the single ray's. Per lane, the hit
+    /// distance and the threshold there.
+    pub fn march_packet<const N: usize>(
+        &self,
+        quads: &[crate::render::Packet; N],
+        mask: u32,
+        spans: &[[(f32, f32); 4]; N],
+        params: super::MarchParams,
+        c: &mut crate::render::Counters,
+        evals: &mut [[u64; 4]; N],
+    ) -> [[Option<(f32, f32)>; 4]; N] {
+        debug_assert!(self.k == 0.0, "only a sharp union's first hit is the nearest of its parts'");
+        let frames: [[FrameRay; 4]; N] = std::array::from_fn(|g| {
+            std::array::from_fn(|l| {
+                let ray = &quads[g].rays[l];
+                FrameRay::new(self.inv.transform_point3a(ray.origin), self.inv.transform_vector3a(ray.dir))
+            })
+        });
+        let across = |g: usize, f: fn(&FrameRay) -> Vec3A| {
+            let v = frames[g].each_ref().map(f);
+            [Vec4::from_array(v.map(|v| v.x)), Vec4::from_array(v.map(|v| v.y)), Vec4::from_array(v.map(|v| v.z))]
+        };
+        let rays: [Rays4; N] = std::array::from_fn(|g| Rays4 {
+            origin: across(g, |f| f.origin),
+            inv_dir: across(g, |f| f.inv_dir),
+            t_min: Vec4::from_array(spans[g].map(|s| s.0)),
+        });
+        let mut t_max: [Vec4; N] = std::array::from_fn(|g| Vec4::from_array(spans[g].map(|s| s.1)));
+        let base: [[f32; 4]; N] = std::array::from_fn(|g| quads[g].rays.each_ref().map(|r| r.origin.length()));
+        let mut hits = [[None; 4]; N];
+        let (mut visits, mut misses) = (0, 0);
+        self.tree.bvh.each_packet(&rays, mask, &mut t_max, &mut visits, |i, lanes, t_max| {
+            for lane in crate::render::lanes(lanes) {
+                let (g, l) = (lane / 4, lane % 4);
+                let span = (spans[g][l].0, t_max[g][l]);
+                if let Some(t) =
+                    self.march_part(i, &frames[g][l], span, base[g][l], params, &mut evals[g][l], &mut misses)
+                {
+                    t_max[g][l] = t;
+                    hits[g][l] = Some((t, params.epsilon * (base[g][l] + t)));
+                }
+            }
+        });
+        c.node_visits += visits;
+        c.budget_misses += misses;
+        hits
+    }
+
+    /// Part `i` alone marched along `frame` over its span within `(t0, t1)`: its first
+    /// hit there. A part's own value steps at least as far as the union's would.
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    fn march_part(
+        &self,
+        i: u32,
+        frame: &FrameRay,
+        (t0, t1): (f32, f32),
+        base: f32,
+        params: super::MarchParams,
+        evals: &mut u64,
+        misses: &mut u64,
+    ) -> Option<f32> {
+        let (a, z) = self.span(i, frame, (t0, t1))?;
+        let i = i as usize;
+        let mut t = a;
+        for _ in 0..params.max_steps {
+            let q = frame.origin + frame.dir * t;
+            let d = clamp(self.parts[i](q), self.tree.bound(i, q)) * self.scale;
+            *evals += 1;
+            if d < params.epsilon * (base + t) {
+                return Some(t);
+            }
+            t += d;
+            if t > z {
+                return None;
+            }
+        }
+        *misses += 1;
+        None
     }
 
     /// The union's value at render-space `p` from the parts listed (the others being

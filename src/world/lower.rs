@@ -247,6 +247,7 @@ fn world_of(objects: Vec<Object>, params: MarchParams, closure_bytes: usize, war
     let bvh = Bvh::build(&boxes, 2);
     debug_assert!(bvh.validate(&boxes).is_ok());
     let has_meshes = objects.iter().any(|o| matches!(o.kind, ObjectKind::Mesh(_)));
-    let share_walks = has_meshes || bvh.node_count() > 1;
+    let packs = |o: &Object| matches!(&o.kind, ObjectKind::Sdf(s) if s.walks_packets());
+    let share_walks = has_meshes || bvh.node_count() > 1 || objects.iter().any(packs);
     World { objects, bvh, bounded, unbounded, params, closure_bytes, has_meshes, share_walks, warnings }
 }

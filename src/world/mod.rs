@@ -61,9 +61,10 @@ pub struct World {
     /// Whether any object is a mesh: then soft shadows and occlusion need rays, not estimates.
     has_meshes: bool,
     /// Whether packets walk the BVHs together: only when there is a walk to share (a mesh,
-    /// or a top-level tree with interior nodes). Sphere tracing is per ray anyway, and on
-    /// a lone SDF object the packet set-up measured 10–20% slower than single rays (bench
-    /// `primary rays/packets sdf/01-sphere` against `intersect sdf/01-sphere`).
+    /// a sharp union's parts, or a top-level tree with interior nodes). Sphere tracing is
+    /// per ray anyway, and on a lone SDF object the packet set-up measured 10–20% slower
+    /// than single rays (bench `primary rays/packets sdf/01-sphere` against
+    /// `intersect sdf/01-sphere`).
     share_walks: bool,
     /// What lowering found wrong but survivable, in scene order (parts an isosurface lost).
     pub warnings: Vec<crate::diag::Diagnostic>,

@@ -9,6 +9,7 @@ use crate::accel::bvh::splat3;
 use crate::accel::Rays4;
 use crate::mesh::triangle::PacketShear;
 use crate::render::{intersect_each, lanes, Counters, Hit, Packet, NO_OBJECT};
+use crate::sdf::SdfObject;
 
 impl World {
     /// [`Geometry::intersect4`](crate::render::Geometry::intersect4) for `N` packets of four traced together: one walk of the
@@ -64,7 +65,12 @@ impl World {
                 });
                 return;
             }
-            self.find_each(i, quads, lanes, t_max, &mut best, &mut evals, c);
+            match &o.kind {
+                ObjectKind::Sdf(s) if s.walks_packets() => {
+                    self.find_packed(i, s, quads, lanes, t_max, &mut best, &mut evals, c);
+                }
+                _ => self.find_each(i, quads, lanes, t_max, &mut best, &mut evals, c),
+            }
         });
         c.node_visits += visits;
         // A loop, not `array::from_fn` (see `intersect_each`).
@@ -115,6 +121,49 @@ impl World {
                 best[g][l] = Some(found);
             }
             evals[g][l] = q.evals;
+        }
+    }
+
+    /// SDF object `i` (whose parts packets walk together) tested for the lanes of
+    /// `lanes`: each lane's interval as [`World::find`] takes it, then one walk of the
+    /// parts for all of them. Out of line for the reason [`World::find_each`] is.
+    #[inline(never)]
+    #[allow(clippy::too_many_arguments)]
+    fn find_packed<'w, const N: usize>(
+        &'w self,
+        i: u32,
+        sdf: &'w SdfObject,
+        quads: &[Packet; N],
+        lanes: u32,
+        t_max: &mut [Vec4; N],
+        best: &mut [[Option<Found<'w>>; 4]; N],
+        evals: &mut [[u64; 4]; N],
+        c: &mut Counters,
+    ) {
+        // A ray inside the object is marched out of it over the whole tree, alone.
+        if crate::render::lanes(lanes).any(|lane| quads[lane / 4].rays[lane % 4].inside == i) {
+            return self.find_each(i, quads, lanes, t_max, best, evals, c);
+        }
+        let o = &self.objects[i as usize];
+        let mut spans = [[(0.0, 0.0); 4]; N];
+        let mut reach = 0;
+        for lane in crate::render::lanes(lanes) {
+            let (g, l) = (lane / 4, lane % 4);
+            if let Some(span) = self.interval(o, &quads[g].rays[l], t_max[g][l]) {
+                spans[g][l] = span;
+                reach |= 1 << lane;
+            }
+        }
+        if reach == 0 {
+            return;
+        }
+        let found = sdf.closest_packet(quads, reach, &spans, self.params, c, evals);
+        for lane in crate::render::lanes(reach) {
+            let (g, l) = (lane / 4, lane % 4);
+            if let Some((t, error)) = found[g][l] {
+                t_max[g][l] = t;
+                best[g][l] = Some(Found::Sdf { object: i, sdf, t, error, leaving: false });
+            }
         }
     }
 }

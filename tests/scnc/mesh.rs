@@ -185,7 +185,8 @@ fn mesh_at_pixel_tolerance_covers_what_sdf_covers() {
 }
 
 /// Each lane of a camera-ray packet finds what its ray finds traced alone, for every seed
-/// scene (in every mode, by `conformance.rs`), for 2×2 packets and 4×4 blocks of four,
+/// scene and `tests/data/packets` (unions whose parts a packet walks together; in every
+/// mode, by `conformance.rs`), for 2×2 packets and 4×4 blocks of four,
 /// full and partial: hit or miss exactly, the distance up to rounding, and the same
 /// surface except where a ray meets an edge and two faces tie within rounding (then
 /// either face is correct; the walks visit leaves in different orders). Packets spread
@@ -193,7 +194,7 @@ fn mesh_at_pixel_tolerance_covers_what_sdf_covers() {
 pub fn packets_agree_with_single_rays(mode: Mode) {
     const SIZE: u32 = 128;
     let mut rng = Rng(0x9ac4_e7a1);
-    for path in crate::support::cases("examples/seed") {
+    for path in crate::support::cases("examples/seed").into_iter().chain(crate::support::cases("tests/data/packets")) {
         if path.file_name().is_some_and(|n| n == "lights.scn") {
             continue;
         }
