@@ -90,8 +90,10 @@ pub fn loglog(
         let all = || series.iter().flat_map(|s| s.points.iter());
         let range = |v: &mut dyn Iterator<Item = f64>| {
             let (lo, hi) = v.fold((f64::INFINITY, 0.0f64), |(lo, hi), x| (lo.min(x), hi.max(x)));
+            // Whole decades: plotters' log mesh crowds its fine ticks into a band when
+            // an end falls just past a power of ten.
             if lo.is_finite() && lo > 0.0 {
-                (lo / 1.6, hi * 1.6)
+                (10f64.powf(lo.log10().floor()), 10f64.powf(hi.log10().ceil().max(lo.log10().floor() + 1.0)))
             } else {
                 (1e-9, 1.0)
             }
@@ -110,6 +112,8 @@ pub fn loglog(
             .x_desc(x_desc)
             .y_desc(y_desc)
             .label_style(("sans-serif", 14))
+            .x_label_formatter(&|v| tick(*v))
+            .y_label_formatter(&|v| tick(*v))
             .draw()
             .map_err(|e| e.to_string())?;
         for s in series.iter().filter(|s| !s.points.is_empty()) {
@@ -140,4 +144,14 @@ pub fn loglog(
         root.present().map_err(|e| e.to_string())?;
     }
     Ok(Image { width: w, height: h, depth: crate::render::BitDepth::Eight, pixels })
+}
+
+/// An axis tick as a person writes it: `10`, `0.5`, `2e-7`, not `10.0` or `0.00000020`.
+fn tick(v: f64) -> String {
+    if v != 0.0 && !(1e-3..1e6).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        let s = format!("{v:.3}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    }
 }
