@@ -140,8 +140,13 @@ impl World {
         evals: &mut [[u64; 4]; N],
         c: &mut Counters,
     ) {
-        // A ray inside the object is marched out of it over the whole tree, alone.
-        if crate::render::lanes(lanes).any(|lane| quads[lane / 4].rays[lane % 4].inside == i) {
+        // A ray inside the object is marched out of it over the whole tree, alone; one
+        // that skips it is left to `find`, which knows why.
+        let alone = |lane: usize| {
+            let ray = &quads[lane / 4].rays[lane % 4];
+            ray.inside == i || ray.skip == i
+        };
+        if crate::render::lanes(lanes).any(alone) {
             return self.find_each(i, quads, lanes, t_max, best, evals, c);
         }
         let o = &self.objects[i as usize];
