@@ -159,6 +159,44 @@ fn sphere_within(shape: &Shape, g: f64) -> Option<(DVec3, f64)> {
     }
 }
 
+/// A half-space `(n, offset)`, `n` unit, holding an unbounded shape tree: the set of
+/// points `p` with `n·p ≤ offset`; `None` when the tree has no such bound that is
+/// cheap to find (a union of half-spaces, a repeat) or is bounded.
+pub fn shape_half_space(shape: &Shape) -> Option<(DVec3, f64)> {
+    half_space_within(shape, 0.0)
+}
+
+/// A half-space holding where the shape's field is at most `g` (see [`bounds_within`]).
+fn half_space_within(shape: &Shape, g: f64) -> Option<(DVec3, f64)> {
+    match &shape.kind {
+        ShapeKind::Primitive(p) => p.half_space().map(|(n, o)| (n, o + g)),
+        // Any operand's half-space holds an intersection, and the first operand's holds
+        // a subtraction; a smooth one reaches `smooth` further (as for boxes).
+        ShapeKind::Csg { op: CsgOp::Intersect, children, smooth } => {
+            children.iter().find_map(|c| half_space_within(c, g + smooth))
+        }
+        ShapeKind::Csg { op: CsgOp::Subtract, children, smooth } => half_space_within(children.first()?, g + smooth),
+        ShapeKind::Csg { op: CsgOp::Union, .. } | ShapeKind::Repeat { .. } => None,
+        ShapeKind::Round { child, radius } => half_space_within(child, g + radius),
+        ShapeKind::Shell { child, thickness } => half_space_within(child, g + thickness * 0.5),
+        ShapeKind::Transform { child, xf } => {
+            let (n, o) = half_space_within(child, within_child(g, xf))?;
+            transform_half_space((n, o), xf)
+        }
+        ShapeKind::Paint { child, .. } => half_space_within(child, g),
+    }
+}
+
+/// The image of the half-space `n·p ≤ offset` under an invertible affine map, which is
+/// exactly a half-space: its normal is `M⁻ᵀ n`, through the image of a point on the
+/// plane. `None` if the map is too degenerate to say.
+pub fn transform_half_space((n, offset): (DVec3, f64), xf: &DAffine3) -> Option<(DVec3, f64)> {
+    let normal = (xf.matrix3.inverse().transpose() * n).try_normalize()?;
+    let on_plane = xf.transform_point3(n * offset);
+    let offset = normal.dot(on_plane);
+    (normal.is_finite() && offset.is_finite()).then_some((normal, offset))
+}
+
 /// An upper bound of the largest singular value (how far the map can stretch a
 /// vector): the largest column-norm sum bound, exact for rotations and scales.
 pub fn max_stretch(m: glam::DMat3) -> f64 {
@@ -225,5 +263,27 @@ mod tests {
             let v = glam::DVec3::new(a.cos(), a.sin(), 0.0);
             assert!((shear * v).length() >= k - 1e-12);
         }
+    }
+
+    /// A mapped half-space holds exactly the mapped points of the original: points on
+    /// its plane map onto the new plane, and points either side stay on their side.
+    #[test]
+    fn transformed_half_spaces_hold_the_mapped_points() {
+        let n = glam::DVec3::new(0.3, -0.8, 0.5).normalize();
+        let xf = DAffine3::from_translation(glam::DVec3::new(1.0, -2.0, 3.0))
+            * DAffine3::from_mat3(DMat3::from_cols_array(&[2.0, 0.0, 0.0, 0.7, 0.5, 0.0, 0.0, 0.3, 1.5]))
+            * DAffine3::from_rotation_y(0.9);
+        let (m, o) = transform_half_space((n, 0.4), &xf).expect("an invertible map");
+        assert!((m.length() - 1.0).abs() < 1e-12);
+        for i in 0..1000 {
+            let f = i as f64;
+            let p = glam::DVec3::new((f * 0.37).sin(), (f * 0.71).cos(), (f * 0.13).sin()) * 3.0;
+            let before = n.dot(p) - 0.4;
+            let after = m.dot(xf.transform_point3(p)) - o;
+            assert_eq!(before > 1e-9, after > 1e-9, "{p}: {before} before, {after} after");
+            let on = p - n * before;
+            assert!((m.dot(xf.transform_point3(on)) - o).abs() < 1e-12, "{on} left the plane");
+        }
+        assert!(transform_half_space((n, 0.4), &DAffine3::from_mat3(DMat3::ZERO)).is_none());
     }
 }

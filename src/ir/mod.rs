@@ -19,7 +19,8 @@ use std::sync::Arc;
 use glam::{DAffine3, DVec3};
 
 pub use bounds::{
-    bounding_sphere, max_stretch, mesh_bounds, min_singular_value, shape_bounds, shape_sphere, similarity, Aabb,
+    bounding_sphere, max_stretch, mesh_bounds, min_singular_value, shape_bounds, shape_half_space, shape_sphere,
+    similarity, transform_half_space, Aabb,
 };
 pub use dump::dump;
 pub(crate) use dump::{num as dump_num, vec as dump_vec};

@@ -115,6 +115,21 @@ impl Primitive {
         }
     }
 
+    /// A half-space `n·p ≤ offset` (unit `n`) holding an unbounded solid, which a ray
+    /// outside it can only meet once it has entered; `None` when bounded (its box and
+    /// sphere say more).
+    pub fn half_space(&self) -> Option<(DVec3, f64)> {
+        match *self {
+            Primitive::Plane { normal, offset } => Some((normal, offset)),
+            Primitive::Sphere { .. }
+            | Primitive::Box { .. }
+            | Primitive::Cylinder { .. }
+            | Primitive::Capsule { .. }
+            | Primitive::Cone { .. }
+            | Primitive::Torus { .. } => None,
+        }
+    }
+
     /// Whether the solid is convex (a half-space is).
     pub fn is_convex(&self) -> bool {
         match self {

@@ -167,10 +167,11 @@ impl<'a> Builder<'a> {
             Primitive::Cylinder { radius, half_height } => self.leaf2(prim::cylinder, radius, half_height),
             Primitive::Torus { major, minor } => self.leaf2(prim::torus, major, minor),
             Primitive::Plane { normal, offset } => {
-                // Transform the plane itself (exact for any invertible map), in f64.
-                let n_world = (xf.matrix3.inverse().transpose() * normal).normalize();
-                let point = xf.transform_point3(normal * offset);
-                let (n, o) = (n_world.as_vec3a(), n_world.dot(point) as f32);
+                // Transform the plane itself (exact for any invertible map), in f64; the
+                // checker refuses maps degenerate enough to fail (E0403).
+                let (n_world, o_world) =
+                    crate::ir::transform_half_space((normal, offset), &xf).unwrap_or((normal, offset));
+                let (n, o) = (n_world.as_vec3a(), o_world as f32);
                 let d = self.leaf(move |p| prim::plane(p, n, o));
                 let m = self.mat(move |p| {
                     super::count_leaf();

@@ -19,9 +19,31 @@ use crate::source::Loader;
 /// An object between lowering and building: an SDF object with its bounds, a mesh to
 /// build, or an object an earlier frame lowered.
 enum Lowered {
-    Sdf(SdfObject, Option<Aabb>, Option<(Vec3A, f32)>),
+    Sdf(SdfObject, Reach),
     Mesh(mesh::MeshJob),
     Kept(Object),
+}
+
+/// Where an SDF object's surface can be, in render space: its box and sphere when
+/// bounded, a half-space holding it when not (a floor plane, a plane cut by others).
+struct Reach {
+    bounds: Option<Aabb>,
+    sphere: Option<(Vec3A, f32)>,
+    half_space: Option<(Vec3A, f32)>,
+}
+
+impl Reach {
+    fn of(shape: &ir::Shape, to_render: &DAffine3) -> Reach {
+        let bounds = ir::shape_bounds(shape).map(|b| Aabb::padded(b.transform(to_render)));
+        let sphere = ir::shape_sphere(shape).map(|(c, r)| padded_sphere(to_render.transform_point3(c), r));
+        let half_space = match bounds {
+            Some(_) => None,
+            None => ir::shape_half_space(shape)
+                .and_then(|h| ir::transform_half_space(h, to_render))
+                .map(|(n, o)| (n.as_vec3a(), o as f32)),
+        };
+        Reach { bounds, sphere, half_space }
+    }
 }
 
 /// Builds the frame for `effects` and lowers the scene into a world, with the scene's
@@ -172,9 +194,8 @@ fn lower_reusing(
             }
             None => match (&obj.geometry, mode) {
                 (ir::Geometry::Shape(shape), Mode::Sdf) => {
-                    let bounds = ir::shape_bounds(shape).map(|b| Aabb::padded(b.transform(&to_render)));
-                    let sphere = ir::shape_sphere(shape).map(|(c, r)| padded_sphere(to_render.transform_point3(c), r));
-                    Lowered::Sdf(SdfObject::new(shape, to_render, &mut builder), bounds, sphere)
+                    let reach = Reach::of(shape, &to_render);
+                    Lowered::Sdf(SdfObject::new(shape, to_render, &mut builder), reach)
                 }
                 (ir::Geometry::Shape(shape), Mode::Mesh(detail)) => Lowered::Mesh(mesh::lower::tessellate(
                     shape,
@@ -206,10 +227,13 @@ fn lower_reusing(
     let objects: Vec<Object> = lowered
         .into_par_iter()
         .map(|(part, _, span)| match part {
-            Lowered::Sdf(s, bounds, sphere) => Object { kind: ObjectKind::Sdf(s), bounds, sphere, span },
+            Lowered::Sdf(s, Reach { bounds, sphere, half_space }) => {
+                Object { kind: ObjectKind::Sdf(s), bounds, sphere, half_space, span }
+            }
             Lowered::Mesh(job) => {
                 let m = job.build();
-                Object { bounds: Some(m.bounds()), sphere: m.sphere(), kind: ObjectKind::Mesh(Arc::new(m)), span }
+                let (bounds, sphere) = (Some(m.bounds()), m.sphere());
+                Object { bounds, sphere, half_space: None, kind: ObjectKind::Mesh(Arc::new(m)), span }
             }
             Lowered::Kept(object) => object,
         })

@@ -47,6 +47,10 @@ pub(crate) struct Object {
     kind: ObjectKind,
     bounds: Option<Aabb>,
     sphere: Option<(Vec3A, f32)>,
+    /// For an unbounded SDF object, a half-space `n·p ≤ offset` holding it, in render
+    /// space: a ray from outside starts marching where it enters, which a grazing ray
+    /// along a floor would otherwise spend its whole step budget reaching.
+    half_space: Option<(Vec3A, f32)>,
     span: Span,
 }
 

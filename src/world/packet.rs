@@ -149,12 +149,11 @@ impl World {
         if crate::render::lanes(lanes).any(alone) {
             return self.find_each(i, quads, lanes, t_max, best, evals, c);
         }
-        let o = &self.objects[i as usize];
         let mut spans = [[(0.0, 0.0); 4]; N];
         let mut reach = 0;
         for lane in crate::render::lanes(lanes) {
             let (g, l) = (lane / 4, lane % 4);
-            if let Some(span) = self.interval(o, &quads[g].rays[l], t_max[g][l]) {
+            if let Some(span) = self.interval(i, &quads[g].rays[l], t_max[g][l]) {
                 spans[g][l] = span;
                 reach |= 1 << lane;
             }

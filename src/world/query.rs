@@ -12,12 +12,18 @@ use crate::sdf::SdfObject;
 impl World {
     /// The interval of the ray inside object `i`'s bounds, clipped to `[ray.t_min, t_max]`.
     #[inline]
-    pub(super) fn interval(&self, o: &Object, ray: &Ray, t_max: f32) -> Option<(f32, f32)> {
+    pub(super) fn interval(&self, i: u32, ray: &Ray, t_max: f32) -> Option<(f32, f32)> {
+        let o = &self.objects[i as usize];
         let (t0, t1) = match o.bounds {
             Some(b) => b.slab(ray.origin, ray.inv_dir, ray.t_min, t_max)?,
             None => (ray.t_min, t_max),
         };
-        clip_to_sphere(o, ray, (t0, t1))
+        let (t0, t1) = clip_to_sphere(o, ray, (t0, t1))?;
+        match o.half_space {
+            // A ray marching out of the solid needs its whole interval.
+            Some(h) if ray.inside != i => clip_to_half_space(h, ray, (t0, t1)),
+            _ => Some((t0, t1)),
+        }
     }
 
     /// Whether the ray can reach mesh object `o` before `t_max`. Only its sphere is
@@ -36,7 +42,7 @@ impl World {
         match &o.kind {
             ObjectKind::Sdf(s) => {
                 let leaving = i == q.ray.inside;
-                s.closest(q.ray, self.interval(o, q.ray, t_max)?, leaving, self.params, c, &mut q.evals)
+                s.closest(q.ray, self.interval(i, q.ray, t_max)?, leaving, self.params, c, &mut q.evals)
                     .map(|(t, error)| Found::Sdf { object: i, sdf: s, t, error, leaving })
             }
             // Triangles are tested exactly; the sphere only decides whether to look.
@@ -73,7 +79,7 @@ impl World {
         }
         let o = &self.objects[i as usize];
         match &o.kind {
-            ObjectKind::Sdf(s) => self.interval(o, q.ray, t_max).is_some_and(|interval| {
+            ObjectKind::Sdf(s) => self.interval(i, q.ray, t_max).is_some_and(|interval| {
                 s.closest(q.ray, interval, i == q.ray.inside, self.params, c, &mut q.evals).is_some()
             }),
             ObjectKind::Mesh(m) => self.may_reach_mesh(o, q.ray, t_max) && m.occluded(q.ray, q.shear(), t_max, c),
@@ -154,6 +160,28 @@ pub(super) fn clip_to_sphere(o: &Object, ray: &Ray, (t0, t1): (f32, f32)) -> Opt
         }
         None => (t0, t1),
     };
+    (t0 <= t1).then_some((t0, t1))
+}
+
+/// `(t0, t1)` from where the ray enters the half-space `n·p ≤ offset`, or `None` if it
+/// stays outside; a ray starting inside keeps its interval. The entry is moved back by
+/// a millionth of its distance, more than the f32 rounding of `t` (a few 1e-7 of it), so
+/// a surface on the plane is never passed; a march starting there is within the hit
+/// threshold (`epsilon ≥ 1e-6` of the distance) at once. Without it, a ray grazing a
+/// floor steps geometrically towards it, by the floor's height times `1 − sin θ` each
+/// step, and runs out of steps before the horizon (`stability::grazing_rays_match_analytic_coverage`).
+#[inline]
+fn clip_to_half_space((n, offset): (Vec3A, f32), ray: &Ray, (t0, t1): (f32, f32)) -> Option<(f32, f32)> {
+    let above = n.dot(ray.origin) - offset;
+    if above <= 0.0 {
+        return Some((t0, t1));
+    }
+    let closing = -n.dot(ray.dir);
+    if closing <= 0.0 {
+        return None;
+    }
+    let enter = above / closing;
+    let t0 = t0.max(enter - enter * 1e-6);
     (t0 <= t1).then_some((t0, t1))
 }
 

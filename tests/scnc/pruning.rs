@@ -224,6 +224,52 @@ fn bounds_contain_the_solid() {
     assert!(inside > 1_000, "only {inside} points fell inside the solids");
 }
 
+/// An unbounded tree's half-space (`ir::shape_half_space`, where a ray's march starts)
+/// holds every point where its field is at or below zero: a plane turned, stretched,
+/// cut by random solids, rounded and shelled, in sharp and smooth operators.
+#[test]
+fn half_spaces_contain_unbounded_solids() {
+    let mut rng = Rng(0x4a1f_5bac);
+    let mut inside = 0;
+    for case in 0..80 {
+        let mut budget = 20;
+        let mut num = |lo: f32, hi: f32| lo + (hi - lo) * rng.f32();
+        let (nx, ny, nz) = (num(-1.0, 1.0), num(-1.0, 1.0), num(-1.0, 1.0));
+        let mut tree = format!("plane([{nx}, {ny}, {nz}], {})", num(-1.0, 1.0));
+        for _ in 0..3 {
+            let other = solid(&mut rng, 2, &mut budget);
+            tree = match rng.below(7) {
+                0 => format!("intersect({tree}, {other})"),
+                1 => format!("intersect({other}, {tree}, smooth = {})", 0.05 + 0.3 * rng.f32()),
+                2 => format!("subtract({tree}, {other})"),
+                3 => format!("round({tree}, {})", 0.02 + 0.2 * rng.f32()),
+                4 => format!("shell({tree}, {})", 0.02 + 0.2 * rng.f32()),
+                5 => format!("({tree}) rotate [{}, {}, 0]", rng.below(180), rng.below(180)),
+                _ => format!("({tree}) scale [{}, 1, {}]", 0.3 + 2.0 * rng.f32(), 0.3 + 2.0 * rng.f32()),
+            };
+        }
+        let text = format!("light ambient(1)\nobject {tree} at [0, 0, 8]\n");
+        let shape = &shape_of(&text);
+        if scnc::ir::shape_bounds(shape).is_some() {
+            continue;
+        }
+        let (n, offset) =
+            scnc::ir::shape_half_space(shape).unwrap_or_else(|| panic!("case {case}: no half-space\n{text}"));
+        assert!((n.length() - 1.0).abs() < 1e-12, "case {case}: normal {n} is not unit");
+        let (field, _) = build(shape, true);
+        for _ in 0..2_000 {
+            let p = Vec3A::new(rng.f32() * 12.0 - 6.0, rng.f32() * 12.0 - 6.0, rng.f32() * 12.0 + 2.0);
+            if field(p) > 0.0 {
+                continue;
+            }
+            inside += 1;
+            let beyond = n.dot(p.as_dvec3()) - offset;
+            assert!(beyond <= 1e-5, "case {case}: {p} is inside the solid, {beyond} beyond its half-space\n{text}");
+        }
+    }
+    assert!(inside > 10_000, "only {inside} points fell inside the solids");
+}
+
 /// The same spheres as one union and as separate objects make the same picture: the
 /// union's part-by-part march finds what the world's object hierarchy finds.
 #[test]

@@ -63,8 +63,9 @@ fn grazing_rays_match_analytic_coverage() {
             assert!(near_edge, "pixel ({x}, {y}) disagrees with exact intersection away from any silhouette");
         }
     }
-    // Grazing rays near the horizon march long, but the budget is not what decides them.
-    assert!(c.budget_misses * 100 <= (N * N) as u64, "{} of {} rays ran out of steps", c.budget_misses, N * N);
+    // A ray grazing the plane starts marching where it enters the plane's half-space,
+    // so no ray spends its budget creeping towards the horizon.
+    assert_eq!(c.budget_misses, 0, "rays ran out of steps");
 }
 
 const FAR_SCENE: &str = "render(depth = 2)
