@@ -8,7 +8,8 @@ use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glam::Vec3A;
-use scnc::render::{Counters, Frame, Geometry, Packet, Ray};
+use scnc::render::Frame;
+use scnc::trace::{Counters, Geometry, Packet, Ray};
 
 fn lower(path: &str, w: u32, h: u32) -> (Frame, scnc::world::World) {
     lower_mode(path, w, h, scnc::world::Mode::Sdf)

@@ -20,6 +20,9 @@
 //! - [`sdf`] and [`mesh`]: the two geometry back-ends; [`world`] puts their objects, in
 //!   camera-relative f32, under one top-level [`accel::Bvh`].
 //! - [`accel`]: boxes, the robust slab test and the BVH (build, single-ray and packet walks).
+//! - [`trace`]: what the back-ends and the tracer share: rays, packets, hits, the
+//!   [`trace::Geometry`] contract, counters, materials and patterns. Both back-ends and
+//!   the tracer stand on it, so neither depends on the other (`tests/scnc/layers.rs`).
 //! - [`render`]: the one Whitted tracer, built for the scene's [`render::effects`].
 //! - [`study`]: what accuracy costs (`--tolerance`, `scnc sweep`, its report and charts).
 //! - [`source`], [`span`] and [`diag`]: input text, positions and diagnostics; [`fmt`] and
@@ -45,6 +48,7 @@ pub mod source;
 pub mod span;
 pub mod study;
 pub mod syntax;
+pub mod trace;
 pub mod world;
 
 use std::path::Path;

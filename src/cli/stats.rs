@@ -1,7 +1,7 @@
 //! What `render --stats` prints: rays by kind, work per ray, and memory by structure.
 
-use scnc::render::Counters;
 use scnc::source::SourceMap;
+use scnc::trace::Counters;
 use scnc::world::World;
 
 /// The statistics of one render, for stderr.

@@ -17,9 +17,9 @@ use glam::{DAffine3, DVec3};
 use crate::diag::{codes, Diagnostic};
 use crate::ir::{self, Scene};
 use crate::mesh::{self, Detail};
-use crate::render::MaterialTable;
 use crate::source::Loader;
 use crate::span::Span;
+use crate::trace::MaterialTable;
 
 /// Which output axis is up.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

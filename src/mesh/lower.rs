@@ -10,10 +10,10 @@ use super::tessellate::count;
 use super::{isosurface, obj, octree, parts, tessellate, Detail, IsoAccuracy, MeshJob, TriMesh};
 use crate::diag::{codes, Diagnostic};
 use crate::ir::{self, MeshSource, Primitive, Shape, ShapeKind};
-use crate::render::MaterialTable;
 use crate::sdf::Builder;
 use crate::source::Loader;
 use crate::span::Span;
+use crate::trace::MaterialTable;
 
 /// Tessellates a shape object at `detail`: a primitive with a generator by it, a plane
 /// as a square reaching the far limit, anything else as an isosurface.

@@ -23,7 +23,7 @@ use rayon::prelude::*;
 pub use detail::Detail;
 
 use crate::accel::{Aabb, Bvh, Rays4};
-use crate::render::{Counters, Hit, Ray, NO_OBJECT};
+use crate::trace::{Counters, Hit, Ray, NO_OBJECT};
 
 /// An indexed triangle mesh in some frame (local for generators, render space once lowered).
 #[derive(Clone, Debug, Default, PartialEq)]

@@ -157,7 +157,7 @@ impl<const N: usize> PacketShear<N> {
             !((su ^ sv) | (su ^ sw)) & lanes
         } else {
             // Rare: the ray passes through an edge or vertex's projection.
-            for l in crate::render::lanes(zero) {
+            for l in crate::trace::lanes(zero) {
                 [u[l], v[l], w[l]] = edge_functions_f64((ax[l], ay[l]), (bx[l], by[l]), (cx[l], cy[l]));
             }
             let neg = u.cmplt(Vec4::ZERO) | v.cmplt(Vec4::ZERO) | w.cmplt(Vec4::ZERO);

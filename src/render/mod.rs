@@ -9,12 +9,8 @@
 //! **Invariant:** the image depends only on the scene and the settings, never on the
 //! thread count: rows are independent and counters are summed exactly.
 
-mod counters;
 pub mod effects;
 mod frame;
-mod geometry;
-pub mod pattern;
-mod ray;
 mod shade;
 mod transmit;
 
@@ -22,10 +18,9 @@ use glam::Vec3A;
 use rayon::prelude::*;
 use shade::fx;
 
-pub use counters::Counters;
-pub use frame::{Frame, MaterialTable, ShadeLight, ShadeMaterial};
-pub use geometry::{intersect_each, Geometry, Hit};
-pub use ray::{lanes, spawn_offset, Packet, Ray, NO_OBJECT};
+pub use frame::{Frame, ShadeLight};
+
+use crate::trace::{pattern, take_leaf_evals, Counters, Geometry};
 
 /// A rendered image: RGB, rows top to bottom.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -179,7 +174,7 @@ fn rows<const FX: u8>(
             let (y, rows_here) = (4 * strip, (h - 4 * strip).min(4));
             let mut c = Counters::default();
             // Leaves are counted per thread; a strip runs on one thread from start to end.
-            let _ = crate::sdf::take_leaf_evals();
+            let _ = take_leaf_evals();
             let mut rows: Vec<Vec<u8>> =
                 (0..rows_here).map(|_| Vec::with_capacity((region.x1 - bx) as usize * bytes)).collect();
             for x in (bx..region.x1).step_by(4) {
@@ -191,7 +186,7 @@ fn rows<const FX: u8>(
                     }
                 }
             }
-            c.leaf_evals += crate::sdf::take_leaf_evals();
+            c.leaf_evals += take_leaf_evals();
             let kept: Vec<Vec<u8>> = rows
                 .into_iter()
                 .enumerate()

@@ -16,7 +16,8 @@
 use glam::Vec3A;
 
 use super::transmit::{self, Media};
-use super::{lanes, spawn_offset, Counters, Frame, Geometry, Hit, Packet, Ray, ShadeLight};
+use super::{Frame, ShadeLight};
+use crate::trace::{lanes, spawn_offset, Counters, Geometry, Hit, Packet, Ray};
 
 /// The effect flags a tracer variant is built with (bits of its `FX` parameter).
 pub(super) mod fx {

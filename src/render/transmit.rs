@@ -8,7 +8,8 @@
 
 use glam::Vec3A;
 
-use super::{spawn_offset, Counters, Frame, Geometry, Hit, Ray, NO_OBJECT};
+use super::Frame;
+use crate::trace::{spawn_offset, Counters, Geometry, Hit, Ray, NO_OBJECT};
 
 /// How many transparent objects one ray can be inside at once; deeper nesting is
 /// traced as if the innermost ones were not entered.

@@ -11,7 +11,7 @@ use super::prim;
 use super::union::{self, Fold, PartTree, RayParts};
 use crate::accel::{padded_sphere, Aabb};
 use crate::ir::{min_singular_value, similarity, CsgOp, Primitive, Shape, ShapeKind};
-use crate::render::MaterialTable;
+use crate::trace::MaterialTable;
 
 /// A distance bound: never more than the true distance to the surface.
 pub type Sdf = Arc<dyn Fn(Vec3A) -> f32 + Send + Sync>;
@@ -153,7 +153,7 @@ impl<'a> Builder<'a> {
                     let r = (radius * scale) as f32;
                     let d = self.leaf(move |p| prim::sphere(p - c, r));
                     let m = self.mat(move |p| {
-                        super::count_leaf();
+                        crate::trace::count_leaf();
                         (prim::sphere(p - c, r), mat)
                     });
                     return (d, m);
@@ -174,7 +174,7 @@ impl<'a> Builder<'a> {
                 let (n, o) = (n_world.as_vec3a(), o_world as f32);
                 let d = self.leaf(move |p| prim::plane(p, n, o));
                 let m = self.mat(move |p| {
-                    super::count_leaf();
+                    crate::trace::count_leaf();
                     (prim::plane(p, n, o), mat)
                 });
                 return (d, m);
@@ -196,10 +196,10 @@ impl<'a> Builder<'a> {
         self.leaf(move |p| f(p, a, b))
     }
 
-    /// A primitive's distance closure, counted in [`leaf_evals`](super::take_leaf_evals).
+    /// A primitive's distance closure, counted in [`leaf_evals`](crate::trace::take_leaf_evals).
     fn leaf<F: Fn(Vec3A) -> f32 + Send + Sync + 'static>(&mut self, f: F) -> Sdf {
         self.sdf(move |p| {
-            super::count_leaf();
+            crate::trace::count_leaf();
             f(p)
         })
     }

@@ -9,7 +9,7 @@
 
 use glam::Vec3A;
 
-use crate::render::{Counters, Ray};
+use crate::trace::{Counters, Ray};
 
 /// The accuracy knobs.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -11,8 +11,6 @@ pub mod march;
 pub mod prim;
 pub mod union;
 
-use std::cell::Cell;
-
 use glam::{DAffine3, Vec3A};
 
 pub use crate::ir::min_singular_value;
@@ -20,24 +18,7 @@ pub use build::{Builder, MatSdf, Sdf};
 pub use march::MarchParams;
 
 use crate::ir;
-use crate::render::{Counters, Hit, Packet, Ray};
-
-thread_local! {
-    /// Primitive evaluations on this thread, for `--stats`: how much a tree costs,
-    /// where the march counts only evaluations of a whole object.
-    static LEAVES: Cell<u64> = const { Cell::new(0) };
-}
-
-/// Counts one primitive evaluation.
-#[inline(always)]
-fn count_leaf() {
-    LEAVES.with(|c| c.set(c.get() + 1));
-}
-
-/// Primitive (leaf) evaluations on this thread since the last call.
-pub fn take_leaf_evals() -> u64 {
-    LEAVES.with(|c| c.replace(0))
-}
+use crate::trace::{Counters, Hit, Packet, Ray};
 
 /// One shape object ready for marching, in render space.
 #[derive(Clone)]
@@ -105,7 +86,7 @@ impl SdfObject {
             return parts.march_packet(quads, mask, spans, params, c, evals);
         }
         let mut hits = [[None; 4]; N];
-        for lane in crate::render::lanes(mask) {
+        for lane in crate::trace::lanes(mask) {
             let (g, l) = (lane / 4, lane % 4);
             hits[g][l] = self.closest(&quads[g].rays[l], spans[g][l], false, params, c, &mut evals[g][l]);
         }

@@ -290,10 +290,10 @@ impl RayParts {
     /// threshold there. A sharp union is marched part by part, front to back.
     pub fn march(
         &self,
-        ray: &crate::render::Ray,
+        ray: &crate::trace::Ray,
         (t0, t1): (f32, f32),
         params: super::MarchParams,
-        c: &mut crate::render::Counters,
+        c: &mut crate::trace::Counters,
         evals: &mut u64,
     ) -> Option<(f32, f32)> {
         let frame = FrameRay::new(self.inv.transform_point3a(ray.origin), self.inv.transform_vector3a(ray.dir));
@@ -367,11 +367,11 @@ impl RayParts {
     /// --stats`, medians of 15 alternating runs).
     fn march_sharp(
         &self,
-        ray: &crate::render::Ray,
+        ray: &crate::trace::Ray,
         frame: &FrameRay,
         (t0, t1): (f32, f32),
         params: super::MarchParams,
-        c: &mut crate::render::Counters,
+        c: &mut crate::trace::Counters,
         evals: &mut u64,
     ) -> Option<(f32, f32)> {
         let base = ray.origin.length();
@@ -392,11 +392,11 @@ impl RayParts {
     /// distance and the threshold there.
     pub fn march_packet<const N: usize>(
         &self,
-        quads: &[crate::render::Packet; N],
+        quads: &[crate::trace::Packet; N],
         mask: u32,
         spans: &[[(f32, f32); 4]; N],
         params: super::MarchParams,
-        c: &mut crate::render::Counters,
+        c: &mut crate::trace::Counters,
         evals: &mut [[u64; 4]; N],
     ) -> [[Option<(f32, f32)>; 4]; N] {
         debug_assert!(self.k == 0.0, "only a sharp union's first hit is the nearest of its parts'");
@@ -420,7 +420,7 @@ impl RayParts {
         let mut hits = [[None; 4]; N];
         let (mut visits, mut misses) = (0, 0);
         self.tree.bvh.each_packet(&rays, mask, &mut t_max, &mut visits, |i, lanes, t_max| {
-            for lane in crate::render::lanes(lanes) {
+            for lane in crate::trace::lanes(lanes) {
                 let (g, l) = (lane / 4, lane % 4);
                 let span = (spans[g][l].0, t_max[g][l]);
                 if let Some(t) =

@@ -15,7 +15,8 @@
 
 use glam::Vec3A;
 
-use crate::render::{Counters, Frame, Geometry, Image, Ray};
+use crate::render::{Frame, Image};
+use crate::trace::{Counters, Geometry, Ray};
 use crate::world::World;
 
 /// Where each pixel's centre ray first hits geometry (render space), `None` for a miss.

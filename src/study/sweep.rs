@@ -9,8 +9,9 @@ use crate::diag::Diagnostic;
 use crate::ir::Scene;
 use crate::mesh::Detail;
 use crate::render::effects;
-use crate::render::{self, Counters, Image};
+use crate::render::{self, Image};
 use crate::source::Loader;
+use crate::trace::Counters;
 use crate::world::{self, Mode};
 
 /// One accuracy setting.

@@ -6,11 +6,11 @@ use glam::Vec3A;
 use super::query::Query;
 use super::{Object, ObjectKind, World};
 use crate::accel::sphere_interval;
-use crate::render::{Counters, Ray};
 use crate::sdf::SdfObject;
+use crate::trace::{Counters, Ray};
 
 impl World {
-    /// [`Geometry::soft_visibility`](crate::render::Geometry::soft_visibility): the penumbra estimate, for scenes of SDF objects only.
+    /// [`Geometry::soft_visibility`](crate::trace::Geometry::soft_visibility): the penumbra estimate, for scenes of SDF objects only.
     pub(super) fn soft_visibility(&self, ray: &Ray, cone: f32, c: &mut Counters) -> Option<f32> {
         let sdfs = self.sdf_objects()?;
         // The penumbra reaches `cone·t` beyond an object, so each object's bounding sphere
@@ -38,7 +38,7 @@ impl World {
         Some(visibility)
     }
 
-    /// [`Geometry::occlusion`](crate::render::Geometry::occlusion): the five-tap estimate, for scenes of SDF objects only.
+    /// [`Geometry::occlusion`](crate::trace::Geometry::occlusion): the five-tap estimate, for scenes of SDF objects only.
     pub(super) fn occlusion(&self, point: Vec3A, normal: Vec3A, reach: f32, c: &mut Counters) -> Option<f32> {
         let sdfs = self.sdf_objects()?;
         // Five taps along the normal (Quilez): where the field is below the distance

@@ -12,9 +12,10 @@ use crate::accel::{padded_sphere, Aabb, Bvh};
 use crate::diag::Diagnostic;
 use crate::ir;
 use crate::mesh;
-use crate::render::{Frame, ShadeMaterial};
+use crate::render::Frame;
 use crate::sdf::{self, MarchParams, SdfObject};
 use crate::source::Loader;
+use crate::trace::ShadeMaterial;
 
 /// An object between lowering and building: an SDF object with its bounds, a mesh to
 /// build, or an object an earlier frame lowered.

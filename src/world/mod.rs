@@ -1,12 +1,12 @@
 //! The lowered scene: every object, SDF or mesh, under one top-level BVH, implementing
-//! the tracer's [`Geometry`](crate::render::Geometry) contract. Lowering picks each object's back-end: shapes go
+//! the tracer's [`Geometry`](crate::trace::Geometry) contract. Lowering picks each object's back-end: shapes go
 //! to the SDF back-end, or are tessellated in mesh mode; explicit meshes are always meshes.
 //!
 //! **Invariant:** every object lies in render space (camera at the origin); each bounded
 //! object's box and sphere contain its surface, so a ray outside them cannot hit it.
 //!
 //! - [`lower`](mod@lower): objects to their back-ends, meshes built in parallel.
-//! - `query`: the [`Geometry`](crate::render::Geometry) contract for single rays (closest and any hit).
+//! - `query`: the [`Geometry`](crate::trace::Geometry) contract for single rays (closest and any hit).
 //! - `packet`: camera rays four and sixteen at a time.
 //! - `estimate`: soft shadows and ambient occlusion estimated from SDFs.
 

@@ -8,11 +8,11 @@ use super::{Object, ObjectKind, World};
 use crate::accel::bvh::splat3;
 use crate::accel::Rays4;
 use crate::mesh::triangle::PacketShear;
-use crate::render::{intersect_each, lanes, Counters, Hit, Packet, NO_OBJECT};
 use crate::sdf::SdfObject;
+use crate::trace::{intersect_each, lanes, Counters, Hit, Packet, NO_OBJECT};
 
 impl World {
-    /// [`Geometry::intersect4`](crate::render::Geometry::intersect4) for `N` packets of four traced together: one walk of the
+    /// [`Geometry::intersect4`](crate::trace::Geometry::intersect4) for `N` packets of four traced together: one walk of the
     /// top-level tree and of each mesh's tree for all of their rays.
     #[inline]
     pub(super) fn intersect_packet<const N: usize>(
@@ -113,7 +113,7 @@ impl World {
         evals: &mut [[u64; 4]; N],
         c: &mut Counters,
     ) {
-        for lane in crate::render::lanes(lanes) {
+        for lane in crate::trace::lanes(lanes) {
             let (g, l) = (lane / 4, lane % 4);
             let mut q = Query::resumed(&quads[g].rays[l], evals[g][l]);
             if let Some(found) = self.find(i, &mut q, t_max[g][l], c) {
@@ -146,12 +146,12 @@ impl World {
             let ray = &quads[lane / 4].rays[lane % 4];
             ray.inside == i || ray.skip == i
         };
-        if crate::render::lanes(lanes).any(alone) {
+        if crate::trace::lanes(lanes).any(alone) {
             return self.find_each(i, quads, lanes, t_max, best, evals, c);
         }
         let mut spans = [[(0.0, 0.0); 4]; N];
         let mut reach = 0;
-        for lane in crate::render::lanes(lanes) {
+        for lane in crate::trace::lanes(lanes) {
             let (g, l) = (lane / 4, lane % 4);
             if let Some(span) = self.interval(i, &quads[g].rays[l], t_max[g][l]) {
                 spans[g][l] = span;
@@ -162,7 +162,7 @@ impl World {
             return;
         }
         let found = sdf.closest_packet(quads, reach, &spans, self.params, c, evals);
-        for lane in crate::render::lanes(reach) {
+        for lane in crate::trace::lanes(reach) {
             let (g, l) = (lane / 4, lane % 4);
             if let Some((t, error)) = found[g][l] {
                 t_max[g][l] = t;

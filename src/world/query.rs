@@ -6,8 +6,8 @@ use glam::Vec3A;
 use super::{Object, ObjectKind, World};
 use crate::accel::sphere_interval;
 use crate::mesh::{self, MeshObject};
-use crate::render::{Counters, Geometry, Hit, Packet, Ray};
 use crate::sdf::SdfObject;
+use crate::trace::{Counters, Geometry, Hit, Packet, Ray};
 
 impl World {
     /// The interval of the ray inside object `i`'s bounds, clipped to `[ray.t_min, t_max]`.

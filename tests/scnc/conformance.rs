@@ -43,7 +43,7 @@ conformance! {
 /// is at a finite point, with a unit normal facing the ray (an outward normal seen from
 /// outside). The world's memory is accounted for.
 fn primitive_hits_are_outside_in_and_finite(mode: Mode) {
-    use scnc::render::{Counters, Geometry, Ray};
+    use scnc::trace::{Counters, Geometry, Ray};
     let path = std::path::Path::new("tests/data/primitives.scn");
     let scene = compile(path).scene.expect("the primitives list compiles");
     let (frame, world) = lower(&scene, 64, mode);

@@ -5,7 +5,8 @@ use std::path::Path;
 
 use glam::Vec3A;
 use scnc::render::effects::{self, Effects};
-use scnc::render::{Counters, Geometry, Image, Ray};
+use scnc::render::Image;
+use scnc::trace::{Counters, Geometry, Ray};
 use scnc::world::Mode;
 
 fn scene(text: &str) -> scnc::ir::Scene {

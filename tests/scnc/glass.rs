@@ -3,7 +3,8 @@
 //! never grows), patterns that stay on their object, and sRGB and 16-bit pixels.
 
 use scnc::render::effects;
-use scnc::render::{BitDepth, Counters, Frame, Image};
+use scnc::render::{BitDepth, Frame, Image};
+use scnc::trace::Counters;
 use scnc::world::{Mode, World};
 
 use crate::conformance::MODES;

@@ -8,8 +8,8 @@ use proptest::prelude::*;
 use scnc::mesh::isosurface::{extract, IsoError};
 use scnc::mesh::octree::Grid;
 use scnc::mesh::TriMesh;
-use scnc::render::MaterialTable;
 use scnc::sdf::{Builder, Sdf};
+use scnc::trace::MaterialTable;
 
 use crate::support::scene;
 

@@ -12,6 +12,7 @@ mod glass;
 mod golden;
 mod grammar;
 mod isosurface;
+mod layers;
 mod lsp;
 mod mesh;
 mod nopanic;

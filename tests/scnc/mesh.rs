@@ -4,7 +4,7 @@ use glam::{DAffine3, DVec3, Vec3A, Vec4};
 use scnc::accel::Rays4;
 use scnc::mesh::Detail;
 use scnc::mesh::{tessellate, triangle, MeshObject, TriMesh};
-use scnc::render::{Counters, Geometry, Hit, Packet, Ray};
+use scnc::trace::{Counters, Geometry, Hit, Packet, Ray};
 use scnc::world::Mode;
 
 use crate::support::{compile, coverage, lower, Rng};

@@ -2,8 +2,8 @@
 //! evaluating every part gives, on random CSG trees, and stay 1-Lipschitz.
 
 use glam::{DAffine3, Vec3A};
-use scnc::render::MaterialTable;
 use scnc::sdf::{Builder, MatSdf, Sdf};
+use scnc::trace::MaterialTable;
 
 use crate::support::{scene, Rng};
 
@@ -131,8 +131,8 @@ fn primitive_evaluations_are_counted_and_pruned() {
 /// the parts gathered around it are those of the whole field.
 #[test]
 fn unions_marched_part_by_part_hit_where_the_whole_field_does() {
-    use scnc::render::{Counters, Ray};
     use scnc::sdf::{march, MarchParams, SdfObject};
+    use scnc::trace::{Counters, Ray};
     let mut rng = Rng(0xfee1_900d);
     let params = MarchParams { epsilon: 1e-4, max_steps: 2_000 };
     let tight = MarchParams { epsilon: 1e-6, max_steps: 100_000 };

@@ -4,7 +4,8 @@ use std::path::Path;
 
 use glam::Vec3A;
 use scnc::mesh::Detail;
-use scnc::render::{Counters, Image};
+use scnc::render::Image;
+use scnc::trace::Counters;
 use scnc::world::Mode;
 
 use crate::support::{cases, finish, updating, Rng};

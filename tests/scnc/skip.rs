@@ -4,7 +4,7 @@
 
 use glam::Vec3A;
 use scnc::mesh::Detail;
-use scnc::render::{spawn_offset, Counters, Geometry, Hit, Ray, NO_OBJECT};
+use scnc::trace::{spawn_offset, Counters, Geometry, Hit, Ray, NO_OBJECT};
 use scnc::world::Mode;
 
 use crate::support::{compile, lower, scene};

@@ -2,7 +2,8 @@
 
 use glam::{DVec3, Vec3A};
 use proptest::prelude::*;
-use scnc::render::{Counters, Geometry, Image, Ray};
+use scnc::render::Image;
+use scnc::trace::{Counters, Geometry, Ray};
 use scnc::world::Mode;
 
 use crate::support::{lower, scene, Rng};

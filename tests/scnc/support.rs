@@ -73,7 +73,7 @@ pub fn lower(scene: &scnc::ir::Scene, size: u32, mode: scnc::world::Mode) -> (sc
 /// Which pixels of a `size × size` image hit geometry when `scene` is lowered by `mode`
 /// (primary rays only, no shading).
 pub fn coverage(scene: &scnc::ir::Scene, mode: scnc::world::Mode, size: u32) -> Vec<bool> {
-    use scnc::render::{Counters, Geometry, Ray};
+    use scnc::trace::{Counters, Geometry, Ray};
     let (frame, world) = lower(scene, size, mode);
     let mut counters = Counters::default();
     (0..size * size)

@@ -58,3 +58,20 @@ impl Counters {
         self.primary_rays + self.shadow_rays + self.reflection_rays + self.refraction_rays + self.occlusion_rays
     }
 }
+
+thread_local! {
+    /// Primitive evaluations on this thread, for `--stats`: how much a tree costs,
+    /// where the march counts only evaluations of a whole object.
+    static LEAVES: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
+/// Counts one primitive evaluation (the SDF back-end's leaves call it).
+#[inline(always)]
+pub fn count_leaf() {
+    LEAVES.with(|c| c.set(c.get() + 1));
+}
+
+/// Primitive (leaf) evaluations on this thread since the last call.
+pub fn take_leaf_evals() -> u64 {
+    LEAVES.with(|c| c.replace(0))
+}
