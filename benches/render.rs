@@ -170,7 +170,7 @@ fn bvh(c: &mut Criterion) {
     let mut group = c.benchmark_group("bvh");
     group.sample_size(10);
     for rings in [14u32, 100, 700] {
-        let mesh = scnc::mesh::tessellate::uvsphere(1.0, rings, 2 * rings);
+        let mesh = scnc::geom::tessellate::uvsphere(1.0, rings, 2 * rings);
         group.throughput(Throughput::Elements(mesh.triangles.len() as u64));
         group.bench_function(BenchmarkId::new("build uvsphere triangles", mesh.triangles.len()), |b| {
             b.iter(|| {
@@ -186,10 +186,10 @@ fn bvh(c: &mut Criterion) {
     }
     // Issue 22's target: a million triangles generated and built in ≤ 0.3 s on 2 cores.
     let (rings, segments) = (500, 1000);
-    group.throughput(Throughput::Elements(scnc::mesh::tessellate::count::uvsphere(rings, segments)));
+    group.throughput(Throughput::Elements(scnc::geom::tessellate::count::uvsphere(rings, segments)));
     group.bench_function("tessellate and build smooth uvsphere 998000", |b| {
         b.iter(|| {
-            let mesh = scnc::mesh::tessellate::uvsphere(1.0, rings, segments);
+            let mesh = scnc::geom::tessellate::uvsphere(1.0, rings, segments);
             scnc::mesh::MeshObject::new(
                 &mesh,
                 glam::DAffine3::from_translation(glam::DVec3::new(0.0, 0.0, 5.0)),

@@ -373,7 +373,15 @@ impl Ctx<'_> {
             }
         }
         let poisoned = vals.iter().flatten().any(|(v, _)| v.is_error()) || rest.iter().any(|(v, _)| v.is_error());
-        (ok && !poisoned && !recovered).then_some(BoundArgs { vals, rest, call })
+        // Ranges, from the declaration: defaults are in range (tested for every one).
+        if ok && !poisoned {
+            for (p, slot) in b.params.iter().zip(&vals) {
+                if let Some((v, span)) = slot {
+                    ok &= self.in_range(p, v, *span);
+                }
+            }
+        }
+        (ok && !poisoned && !recovered).then_some(BoundArgs { params: b.params, vals, rest, call })
     }
 
     /// Converts `v` to `ty` or reports a mismatch; poison passes through. `what` names

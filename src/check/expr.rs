@@ -21,6 +21,8 @@ pub(super) struct ArgVal {
 
 /// Arguments bound to a builtin's parameters, after arity, name and type checks.
 pub(super) struct BoundArgs {
+    /// The builtin's parameters, for the defaults of the slots not given.
+    pub params: &'static [crate::sig::Param],
     /// One slot per parameter: the value and the span to blame for it.
     pub vals: Vec<Option<(Value, Span)>>,
     /// Variadic positional arguments.
@@ -39,13 +41,6 @@ pub(super) const SYNONYMS: &[(&str, &str)] = &[
     ("shininess", "specular"),
     ("direction", "towards"),
 ];
-
-fn vec3_of(v: &Value) -> Option<DVec3> {
-    match v {
-        Value::Vec3(v) => Some(*v),
-        _ => None,
-    }
-}
 
 impl Ctx<'_> {
     pub(super) fn expr(&mut self, e: &ast::Expr) -> Value {
@@ -538,8 +533,4 @@ impl Ctx<'_> {
         );
         Value::Error
     }
-}
-
-pub(super) fn vec3(v: &Value) -> DVec3 {
-    vec3_of(v).unwrap_or(DVec3::ZERO)
 }

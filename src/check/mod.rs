@@ -39,7 +39,7 @@ use crate::source::{FileId, Loader, SourceMap};
 use crate::span::Span;
 use crate::syntax::ast;
 pub use construct::{
-    EPSILON_RULE, MAX_DEPTH, MAX_FPS, MAX_FRAMES, MAX_GENERATED_TRIANGLES, MAX_IMAGE_SIDE, MAX_MESH_RESOLUTION,
+    EPSILON_RANGE, MAX_DEPTH, MAX_FPS, MAX_FRAMES, MAX_GENERATED_TRIANGLES, MAX_IMAGE_SIDE, MAX_MESH_RESOLUTION,
     MAX_PIXELS, MAX_REPEAT, MAX_SAMPLES, MAX_STEPS, MIN_EPSILON,
 };
 use env::{Binding, Captured, Env, Found};

@@ -143,14 +143,15 @@ impl Ctx<'_> {
             }
             match &s.kind {
                 ShapeKind::Transform { xf, .. } => ok &= self.transform_in_range(xf, s.span),
-                ShapeKind::Primitive(ir::Primitive::Plane { offset, .. }) if offset.abs() > MAX_REACH => {
+                ShapeKind::Primitive(p) if p.half_space().is_some_and(|(_, offset)| offset.abs() > MAX_REACH) => {
                     ok = false;
+                    let offset = p.half_space().map_or(0.0, |(_, offset)| offset);
                     self.report(
                         Diagnostic::error(
                             codes::OUT_OF_REACH,
                             s.span,
-                            "this plane is beyond the renderable range",
-                            format!("its offset is {}", shown(*offset)),
+                            format!("this {} is beyond the renderable range", p.name()),
+                            format!("its offset is {}", shown(offset)),
                         )
                         .with_note(format!("positions must lie within {} units of the origin", shown(MAX_REACH))),
                     );

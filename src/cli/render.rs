@@ -9,9 +9,7 @@ use std::time::Instant;
 
 use clap::ValueEnum;
 
-use scnc::check::{
-    Time, EPSILON_RULE, MAX_DEPTH, MAX_FRAMES, MAX_IMAGE_SIDE, MAX_PIXELS, MAX_SAMPLES, MAX_STEPS, MIN_EPSILON,
-};
+use scnc::check::{Time, EPSILON_RANGE, MAX_DEPTH, MAX_FRAMES, MAX_IMAGE_SIDE, MAX_PIXELS, MAX_SAMPLES, MAX_STEPS};
 use scnc::source::FsLoader;
 use scnc::study::tolerance::Tolerance;
 use scnc::Compiled;
@@ -172,10 +170,10 @@ pub(crate) fn parse_detail(s: &str) -> Result<scnc::mesh::Detail, String> {
 
 fn parse_epsilon(s: &str) -> Result<f64, String> {
     let x: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
-    if (MIN_EPSILON..1.0).contains(&x) {
+    if EPSILON_RANGE.admits(x) {
         Ok(x)
     } else {
-        Err(format!("must be {EPSILON_RULE}"))
+        Err(format!("must be {} (f32 cannot resolve less than 1e-6)", EPSILON_RANGE.rule(false)))
     }
 }
 

@@ -89,7 +89,7 @@ pub struct Part {
     /// The `object` statement.
     pub span: Span,
     /// The triangles in the file's frame, counter-clockwise seen from outside.
-    pub mesh: mesh::TriMesh,
+    pub mesh: crate::geom::TriMesh,
     /// Each triangle's material, an index into [`Export::colours`].
     pub materials: Vec<u32>,
     /// Whether the surface is smooth (shaded with interpolated normals when rendered).
@@ -229,7 +229,7 @@ fn part(n: usize, job: mesh::MeshJob, span: Span, frame: Frame) -> Part {
     Part {
         name: format!("object_{}", n + 1),
         span,
-        mesh: mesh::TriMesh { positions, triangles },
+        mesh: crate::geom::TriMesh { positions, triangles },
         materials,
         smooth: job.smooth,
         degenerate,

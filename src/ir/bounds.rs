@@ -3,53 +3,7 @@
 use glam::{DAffine3, DMat3, DVec3};
 
 use super::{CsgOp, Geometry, Mesh, MeshSource, Shape, ShapeKind};
-
-/// An axis-aligned box.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Aabb {
-    /// Smallest corner.
-    pub min: DVec3,
-    /// Largest corner.
-    pub max: DVec3,
-}
-
-impl Aabb {
-    /// A box centred at the origin.
-    pub fn centred(half: DVec3) -> Aabb {
-        Aabb { min: -half, max: half }
-    }
-
-    /// Grown by `d` on every side.
-    pub fn grow(self, d: f64) -> Aabb {
-        Aabb { min: self.min - d, max: self.max + d }
-    }
-
-    /// The smallest box containing both.
-    pub fn union(self, o: Aabb) -> Aabb {
-        Aabb { min: self.min.min(o.min), max: self.max.max(o.max) }
-    }
-
-    /// The overlap of both (may be empty: `min > max` on some axis).
-    pub fn intersect(self, o: Aabb) -> Aabb {
-        Aabb { min: self.min.max(o.min), max: self.max.min(o.max) }
-    }
-
-    /// The bounds of this box after an affine map.
-    pub fn transform(self, xf: &DAffine3) -> Aabb {
-        let centre = (self.min + self.max) * 0.5;
-        let half = (self.max - self.min) * 0.5;
-        let m = xf.matrix3;
-        let abs = glam::DMat3::from_cols(m.x_axis.abs(), m.y_axis.abs(), m.z_axis.abs());
-        let c = xf.transform_point3(centre);
-        let h = abs * half;
-        Aabb { min: c - h, max: c + h }
-    }
-
-    /// Centre point.
-    pub fn centre(self) -> DVec3 {
-        (self.min + self.max) * 0.5
-    }
-}
+use crate::geom::Aabb;
 
 /// Bounds of a shape tree; `None` when it is unbounded (it contains a half-space).
 pub fn shape_bounds(shape: &Shape) -> Option<Aabb> {

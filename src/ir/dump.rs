@@ -10,21 +10,7 @@ use super::{
 use crate::source::SourceMap;
 use crate::span::Span;
 
-/// Formats a number with at most 12 decimals, trailing zeros trimmed and `-0` as `0`,
-/// so dumps do not change with the last bits of a rotation matrix.
-pub(crate) fn num(x: f64) -> String {
-    let s = format!("{x:.12}");
-    let s = s.trim_end_matches('0').trim_end_matches('.');
-    if s == "-0" {
-        "0".to_string()
-    } else {
-        s.to_string()
-    }
-}
-
-pub(crate) fn vec(v: DVec3) -> String {
-    format!("[{}, {}, {}]", num(v.x), num(v.y), num(v.z))
-}
+pub(crate) use crate::sig::{num, vec};
 
 fn color(c: DVec3) -> String {
     format!("rgb({}, {}, {})", num(c.x), num(c.y), num(c.z))
@@ -222,16 +208,6 @@ pub fn dump(scene: &Scene, map: &SourceMap) -> String {
 
 /// A primitive's dump line: its name and its parameters.
 fn primitive(p: &Primitive) -> String {
-    let name = p.name();
-    match p {
-        Primitive::Sphere { radius } => format!("{name} radius {}", num(*radius)),
-        Primitive::Box { half } => format!("{name} half {}", vec(*half)),
-        Primitive::Cylinder { radius, half_height }
-        | Primitive::Capsule { radius, half_height }
-        | Primitive::Cone { radius, half_height } => {
-            format!("{name} radius {} half_height {}", num(*radius), num(*half_height))
-        }
-        Primitive::Torus { major, minor } => format!("{name} major {} minor {}", num(*major), num(*minor)),
-        Primitive::Plane { normal, offset } => format!("{name} normal {} offset {}", vec(*normal), num(*offset)),
-    }
+    let fields: Vec<String> = p.fields().into_iter().map(|(name, value)| format!("{name} {value}")).collect();
+    format!("{} {}", p.name(), fields.join(" "))
 }

@@ -1,5 +1,7 @@
 //! How finely the mesh back-end tessellates shapes.
 
+use crate::primitive::Resolution;
+
 /// How finely shapes are tessellated in mesh mode.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Detail {
@@ -28,5 +30,10 @@ impl Detail {
             Detail::High => 50,
             Detail::N(n) => 2 * n.max(3),
         }
+    }
+
+    /// The resolution primitives are tessellated at.
+    pub fn resolution(self) -> Resolution {
+        Resolution { rings: self.rings(), circle: self.circle() }
     }
 }

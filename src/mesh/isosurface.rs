@@ -23,7 +23,7 @@ use rayon::prelude::*;
 
 use super::octree::{key, unkey, Grid};
 use super::qef::Qef;
-use super::TriMesh;
+use crate::geom::TriMesh;
 
 /// Most finest cells one isosurface may refine. A cell takes about 200 bytes at the peak
 /// of extraction (its key, its share of corner values and crossings, its sheets and

@@ -6,10 +6,12 @@
 use glam::{DAffine3, DVec3};
 use rayon::prelude::*;
 
-use super::tessellate::count;
-use super::{isosurface, obj, octree, parts, tessellate, Detail, IsoAccuracy, MeshJob, TriMesh};
+use super::{isosurface, obj, octree, parts, Detail, IsoAccuracy, MeshJob};
 use crate::diag::{codes, Diagnostic};
-use crate::ir::{self, MeshSource, Primitive, Shape, ShapeKind};
+use crate::geom::tessellate::count;
+use crate::geom::{tessellate, TriMesh};
+use crate::ir::{self, MeshSource, Shape, ShapeKind};
+use crate::primitive::Tessellation;
 use crate::sdf::Builder;
 use crate::source::Loader;
 use crate::span::Span;
@@ -45,16 +47,16 @@ pub fn tessellate(
         }
     }
     let made = match &node.kind {
-        ShapeKind::Primitive(p) => generator(p, detail),
+        ShapeKind::Primitive(p) => p.tessellate(detail.resolution()),
         ShapeKind::Csg { .. }
         | ShapeKind::Round { .. }
         | ShapeKind::Shell { .. }
         | ShapeKind::Repeat { .. }
         | ShapeKind::Transform { .. }
-        | ShapeKind::Paint { .. } => Generator::None,
+        | ShapeKind::Paint { .. } => Tessellation::Isosurface,
     };
     match made {
-        Generator::Triangles(triangles, make) => {
+        Tessellation::Triangles(triangles, make) => {
             budget.spend(triangles, shape.span)?;
             // A generator's polytope is convex exactly when its shape is (tested for each);
             // isosurfaces (below) may dent even a convex shape, so they are never marked.
@@ -69,7 +71,7 @@ pub fn tessellate(
                 isosurface: None,
             })
         }
-        Generator::Square { normal, offset } => {
+        Tessellation::HalfSpace { normal, offset } => {
             budget.spend(tessellate::count::SQUARE, shape.span)?;
             // A square centred on the point of the plane nearest the camera, reaching the far limit.
             let inv = xf.inverse();
@@ -94,7 +96,7 @@ pub fn tessellate(
                 isosurface: None,
             })
         }
-        Generator::None => {
+        Tessellation::Isosurface => {
             // An isosurface of the subtree in render space, at a cell size that follows the
             // detail (a 1/(4·rings) fraction of the bounding diameter).
             let bounds = ir::shape_bounds(node).ok_or_else(|| unbounded(node.span))?.transform(&xf);
@@ -106,42 +108,6 @@ pub fn tessellate(
             budget.spend(job.mesh.triangles.len() as u64, shape.span)?;
             Ok(job)
         }
-    }
-}
-
-/// How the mesh back-end makes a primitive at a detail level.
-enum Generator {
-    /// Its generator: the exact triangle count (charged before anything is allocated)
-    /// and the call that makes them.
-    Triangles(u64, Box<dyn FnOnce() -> TriMesh>),
-    /// A half-space: a square reaching the far limit.
-    Square { normal: DVec3, offset: f64 },
-    /// No generator: an isosurface.
-    None,
-}
-
-/// The generator of every primitive, one exhaustive match: a new primitive must say how
-/// it is meshed (and `Primitive::facets` what that costs in accuracy; the two are tested
-/// to agree in `generators_agree_with_facets`).
-fn generator(p: &Primitive, detail: Detail) -> Generator {
-    let (rings, circle) = (detail.rings(), detail.circle());
-    let made = |n: u64, make: Box<dyn FnOnce() -> TriMesh>| Generator::Triangles(n, make);
-    match *p {
-        Primitive::Sphere { radius } => {
-            made(count::uvsphere(rings, 2 * rings), Box::new(move || tessellate::uvsphere(radius, rings, 2 * rings)))
-        }
-        Primitive::Box { half } => made(count::CUBOID, Box::new(move || tessellate::cuboid(half))),
-        Primitive::Cylinder { radius, half_height } => {
-            made(count::cylinder(circle), Box::new(move || tessellate::cylinder(radius, half_height, circle)))
-        }
-        Primitive::Cone { radius, half_height } => {
-            made(count::cone(circle), Box::new(move || tessellate::cone(radius, half_height, circle)))
-        }
-        Primitive::Torus { major, minor } => {
-            made(count::torus(circle, rings), Box::new(move || tessellate::torus(major, minor, circle, rings)))
-        }
-        Primitive::Plane { normal, offset } => Generator::Square { normal, offset },
-        Primitive::Capsule { .. } => Generator::None,
     }
 }
 
@@ -565,7 +531,7 @@ pub fn explicit(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ir::Facets;
+    use crate::ir::{Facets, Primitive};
 
     /// Every primitive of `tests/data/primitives.scn`.
     fn primitives() -> Vec<Primitive> {
@@ -598,16 +564,17 @@ mod tests {
     #[test]
     fn generators_agree_with_facets() {
         let all = primitives();
-        for name in ["sphere", "box", "cylinder", "torus", "plane", "capsule", "cone"] {
-            assert!(all.iter().any(|p| p.name() == name), "no {name} in tests/data/primitives.scn");
+        for entry in crate::primitive::PRIMITIVES {
+            assert!(all.iter().any(|p| p.name() == entry.name), "no {} in tests/data/primitives.scn", entry.name);
         }
         for p in &all {
             for detail in [Detail::Low, Detail::High, Detail::N(3), Detail::N(40)] {
-                match (generator(p, detail), p.facets()) {
-                    (Generator::Triangles(n, make), Facets::Inscribed(_) | Facets::Exact) => {
+                match (p.tessellate(detail.resolution()), p.facets()) {
+                    (Tessellation::Triangles(n, make), Facets::Inscribed(_) | Facets::Exact) => {
                         assert_eq!(make().triangles.len() as u64, n, "{} at {detail:?}", p.name());
                     }
-                    (Generator::Square { .. }, Facets::Exact) | (Generator::None, Facets::Isosurface) => {}
+                    (Tessellation::HalfSpace { .. }, Facets::Exact)
+                    | (Tessellation::Isosurface, Facets::Isosurface) => {}
                     (_, facets) => panic!("{}: the generator does not match {facets:?}", p.name()),
                 }
             }

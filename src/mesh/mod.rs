@@ -14,53 +14,17 @@ pub mod obj;
 pub mod octree;
 pub mod parts;
 mod qef;
-pub mod tessellate;
 pub mod triangle;
 
-use glam::{DAffine3, DVec3, Vec3A, Vec4};
+use glam::{DAffine3, Vec3A, Vec4};
 use rayon::prelude::*;
 
 pub use detail::Detail;
 
+use crate::geom::TriMesh;
+
 use crate::accel::{Aabb, Bvh, Rays4};
 use crate::trace::{Counters, Hit, Ray, NO_OBJECT};
-
-/// An indexed triangle mesh in some frame (local for generators, render space once lowered).
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct TriMesh {
-    /// Vertex positions.
-    pub positions: Vec<DVec3>,
-    /// Triangles as vertex indices, counter-clockwise seen from outside.
-    pub triangles: Vec<[u32; 3]>,
-}
-
-impl TriMesh {
-    /// Signed volume (positive for a closed mesh wound outward).
-    pub fn signed_volume(&self) -> f64 {
-        self.triangles
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|i| self.positions[i as usize]);
-                a.dot(b.cross(c)) / 6.0
-            })
-            .sum()
-    }
-
-    /// Edges used by a number of triangles other than two, counting each undirected edge;
-    /// 0 for a closed (watertight) mesh. Directed edges used twice mean inconsistent winding.
-    pub fn open_edges(&self) -> (usize, usize) {
-        let mut undirected = std::collections::HashMap::new();
-        let mut directed = std::collections::HashMap::new();
-        for t in &self.triangles {
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                *undirected.entry((a.min(b), a.max(b))).or_insert(0usize) += 1;
-                *directed.entry((a, b)).or_insert(0usize) += 1;
-            }
-        }
-        (undirected.values().filter(|&&n| n != 2).count(), directed.values().filter(|&&n| n > 1).count())
-    }
-}
 
 /// What a mesh object is made from. Lowering makes these in scene order (interning
 /// materials and spending the triangle budget as it goes); the world then builds them

@@ -4,7 +4,7 @@
 
 use glam::DVec3;
 
-use super::TriMesh;
+use crate::geom::TriMesh;
 
 /// A problem in an OBJ file.
 #[derive(Clone, Debug, PartialEq)]

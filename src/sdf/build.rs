@@ -11,6 +11,7 @@ use super::prim;
 use super::union::{self, Fold, PartTree, RayParts};
 use crate::accel::{padded_sphere, Aabb};
 use crate::ir::{min_singular_value, similarity, CsgOp, Primitive, Shape, ShapeKind};
+use crate::primitive::{Plane, Solid, Sphere, Visit};
 use crate::trace::MaterialTable;
 
 /// A distance bound: never more than the true distance to the surface.
@@ -44,6 +45,17 @@ struct LastUnion {
     parts: Arc<[Sdf]>,
     mats: Arc<[MatSdf]>,
     k: f32,
+}
+
+/// The distance closure of one primitive in its own frame, its distance inlined.
+struct Leaf<'b, 'a>(&'b mut Builder<'a>);
+
+impl Visit for Leaf<'_, '_> {
+    type Out = Sdf;
+
+    fn visit<S: Solid>(self, s: &S) -> Sdf {
+        self.0.leaf(s.distance())
+    }
 }
 
 /// Arc header (two counts) that every closure allocation carries.
@@ -144,56 +156,42 @@ impl<'a> Builder<'a> {
     }
 
     fn primitive(&mut self, p: &Primitive, xf: DAffine3, mat: u32) -> (Sdf, MatSdf) {
-        let local: Sdf = match *p {
-            Primitive::Sphere { radius } => {
-                let r = radius as f32;
-                // A sphere under a similarity is a sphere: no inverse map needed.
-                if let Some(scale) = similarity(xf.matrix3) {
-                    let c = Vec3A::from(xf.translation.as_vec3());
-                    let r = (radius * scale) as f32;
-                    let d = self.leaf(move |p| prim::sphere(p - c, r));
-                    let m = self.mat(move |p| {
-                        crate::trace::count_leaf();
-                        (prim::sphere(p - c, r), mat)
-                    });
-                    return (d, m);
-                }
-                self.leaf(move |p| prim::sphere(p, r))
-            }
-            Primitive::Box { half } => {
-                let b = half.as_vec3a();
-                self.leaf(move |p| prim::cuboid(p, b))
-            }
-            Primitive::Cylinder { radius, half_height } => self.leaf2(prim::cylinder, radius, half_height),
-            Primitive::Torus { major, minor } => self.leaf2(prim::torus, major, minor),
-            Primitive::Plane { normal, offset } => {
-                // Transform the plane itself (exact for any invertible map), in f64; the
-                // checker refuses maps degenerate enough to fail (E0403).
-                let (n_world, o_world) =
-                    crate::ir::transform_half_space((normal, offset), &xf).unwrap_or((normal, offset));
-                let (n, o) = (n_world.as_vec3a(), o_world as f32);
-                let d = self.leaf(move |p| prim::plane(p, n, o));
+        // A sphere under a similarity is a sphere: no inverse map needed.
+        if let (Primitive::Sphere(s), Some(scale)) = (p, similarity(xf.matrix3)) {
+            let c = Vec3A::from(xf.translation.as_vec3());
+            let f = Sphere { r: s.r * scale }.distance();
+            let g = f.clone();
+            let d = self.leaf(move |p| f(p - c));
+            let m = self.mat(move |p| {
+                crate::trace::count_leaf();
+                (g(p - c), mat)
+            });
+            return (d, m);
+        }
+        match p {
+            // Transform the plane itself (exact for any invertible map), in f64; the
+            // checker refuses maps degenerate enough to fail (E0403).
+            Primitive::Plane(plane) => {
+                let (normal, offset) = crate::ir::transform_half_space((plane.normal, plane.offset), &xf)
+                    .unwrap_or((plane.normal, plane.offset));
+                let f = Plane { normal, offset }.distance();
+                let g = f.clone();
+                let d = self.leaf(f);
                 let m = self.mat(move |p| {
                     crate::trace::count_leaf();
-                    (prim::plane(p, n, o), mat)
+                    (g(p), mat)
                 });
-                return (d, m);
+                (d, m)
             }
-            Primitive::Capsule { radius, half_height } => self.leaf2(prim::capsule, radius, half_height),
-            Primitive::Cone { radius, half_height } => self.leaf2(prim::cone, radius, half_height),
-        };
-        let m = {
-            let local = local.clone();
-            self.mat(move |p| (local(p), mat))
-        };
-        self.wrap(local, m, xf)
-    }
-
-    /// A primitive of two sizes in its own frame. `f` is a function item, so each
-    /// primitive's closure is its own type with the distance inlined (no indirect call).
-    fn leaf2<F: Fn(Vec3A, f32, f32) -> f32 + Send + Sync + 'static>(&mut self, f: F, a: f64, b: f64) -> Sdf {
-        let (a, b) = (a as f32, b as f32);
-        self.leaf(move |p| f(p, a, b))
+            _ => {
+                let local = p.visit(Leaf(self));
+                let m = {
+                    let local = local.clone();
+                    self.mat(move |p| (local(p), mat))
+                };
+                self.wrap(local, m, xf)
+            }
+        }
     }
 
     /// A primitive's distance closure, counted in [`leaf_evals`](crate::trace::take_leaf_evals).

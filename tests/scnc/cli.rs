@@ -55,7 +55,7 @@ fn ir_prints_the_scene() {
     let out = scnc(&["ir", "examples/seed/01-sphere.scn"]);
     assert_eq!(out.status.code(), Some(0));
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains("sphere radius 1"), "{text}");
+    assert!(text.contains("sphere r 1"), "{text}");
     assert!(text.starts_with("camera position [0, 0, 0]"), "{text}");
 }
 

@@ -5,9 +5,9 @@
 
 use glam::{DAffine3, DVec3};
 use proptest::prelude::*;
+use scnc::geom::TriMesh;
 use scnc::mesh::isosurface::{extract, IsoError};
 use scnc::mesh::octree::Grid;
-use scnc::mesh::TriMesh;
 use scnc::sdf::{Builder, Sdf};
 use scnc::trace::MaterialTable;
 

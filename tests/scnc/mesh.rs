@@ -2,8 +2,9 @@
 
 use glam::{DAffine3, DVec3, Vec3A, Vec4};
 use scnc::accel::Rays4;
+use scnc::geom::{tessellate, TriMesh};
 use scnc::mesh::Detail;
-use scnc::mesh::{tessellate, triangle, MeshObject, TriMesh};
+use scnc::mesh::{triangle, MeshObject};
 use scnc::trace::{Counters, Geometry, Hit, Packet, Ray};
 use scnc::world::Mode;
 

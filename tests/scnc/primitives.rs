@@ -77,7 +77,7 @@ fn framing(geometry: &scnc::ir::Geometry) -> String {
 
 #[test]
 fn every_builtin_compiles_from_its_signature() {
-    for b in BUILTINS {
+    for b in BUILTINS.iter() {
         let text = format!("light ambient(1)\n{}\n", statement(b));
         let s = scene(&text);
         match (b.kind(), b.result) {
@@ -115,7 +115,7 @@ fn every_geometry_builtin_renders_in_every_mode() {
 fn every_geometry_builtin_is_listed() {
     let text = std::fs::read_to_string("tests/data/primitives.scn").expect("reading the primitives list");
     let code: String = text.lines().filter(|l| !l.trim_start().starts_with("//")).collect::<Vec<_>>().join("\n");
-    for b in BUILTINS {
+    for b in BUILTINS.iter() {
         let listed = match (b.kind(), b.result) {
             (Kind::MeshGenerator, _) => code.contains(&format!("mesh {}(", b.name)),
             (Kind::Function, Ty::Shape) => code

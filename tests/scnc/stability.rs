@@ -269,7 +269,7 @@ fn degenerate_input_is_an_error_or_defined() {
         );
     }
     // Zero-area triangles and duplicate vertices in a mesh are dropped, not hit.
-    let mut mesh = scnc::mesh::tessellate::cuboid(DVec3::ONE);
+    let mut mesh = scnc::geom::tessellate::cuboid(DVec3::ONE);
     let dup = mesh.positions[0];
     mesh.positions.push(dup);
     let n = mesh.positions.len() as u32;

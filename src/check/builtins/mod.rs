@@ -4,103 +4,15 @@
 //! checker, the docs and the editor tooling read this one table.
 
 use std::collections::HashMap;
-use std::fmt;
 use std::sync::OnceLock;
 
 use foldhash::fast::FixedState;
 
 use crate::ir::CsgOp;
+pub use crate::sig::{Default, Param, Range, Ty};
 
 mod table;
 pub use table::{constant, ConstValue, Constant, BUILTINS, CONSTANTS};
-
-/// The types of the language.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Ty {
-    /// A number.
-    Num,
-    /// A whole number.
-    Int,
-    /// `true` or `false`.
-    Bool,
-    /// A string.
-    Str,
-    /// `[x, y, z]`.
-    Vec3,
-    /// A number or a `vec3` (a number `k` means `[k, k, k]`).
-    Size,
-    /// `rgb(r, g, b)` or `#rrggbb`.
-    Color,
-    /// `material(…)`.
-    Material,
-    /// `checker(…)`, `stripes(…)`, `gradient(…)` or `noise(…)`.
-    Pattern,
-    /// A colour or a pattern: what a material's colour can be.
-    Paint,
-    /// An SDF-able solid.
-    Shape,
-    /// A triangle mesh.
-    Mesh,
-    /// A light.
-    Light,
-    /// A list.
-    List,
-    /// A number, a `vec3` or a colour: what can be scaled and added (`mix`, `sum`).
-    Linear,
-}
-
-impl fmt::Display for Ty {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let s = match self {
-            Ty::Num => "num",
-            Ty::Int => "int",
-            Ty::Bool => "bool",
-            Ty::Str => "string",
-            Ty::Vec3 => "vec3",
-            Ty::Size => "num or vec3",
-            Ty::Color => "color",
-            Ty::Material => "material",
-            Ty::Pattern => "pattern",
-            Ty::Paint => "color or pattern",
-            Ty::Shape => "shape",
-            Ty::Mesh => "mesh",
-            Ty::Light => "light",
-            Ty::List => "list",
-            Ty::Linear => "num, vec3 or color",
-        };
-        f.write_str(s)
-    }
-}
-
-/// A parameter's default.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Default {
-    /// Must be given.
-    Required,
-    /// A number.
-    Num(f64),
-    /// A vector.
-    Vec3([f64; 3]),
-    /// A boolean.
-    Bool(bool),
-    /// A colour, 0–255.
-    Color([f64; 3]),
-    /// A string.
-    Str(&'static str),
-    /// Absent means "derived from the other arguments" (documented per builtin).
-    Derived,
-}
-
-/// One parameter.
-#[derive(Clone, Copy, Debug)]
-pub struct Param {
-    /// Its name, for named arguments.
-    pub name: &'static str,
-    /// Its type.
-    pub ty: Ty,
-    /// Its default.
-    pub default: Default,
-}
 
 /// Where a builtin may be used (follows from its [`Ctor`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -124,8 +36,8 @@ impl Kind {
 /// entry of [`BUILTINS`] cannot lack a constructor, nor a constructor its entry.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Ctor {
-    /// A primitive shape.
-    Primitive(Prim),
+    /// A primitive shape (its definition: [`crate::primitive`]).
+    Primitive(&'static crate::primitive::Entry),
     /// A CSG operator.
     Csg(CsgOp),
     /// A shape modifier.
@@ -154,19 +66,6 @@ pub enum Ctor {
     Camera,
     /// The `render` statement's arguments.
     Render,
-}
-
-/// The primitive shape builtins.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[allow(missing_docs, reason = "each variant is the builtin of the same name, documented in BUILTINS")]
-pub enum Prim {
-    Sphere,
-    Box,
-    Cylinder,
-    Torus,
-    Plane,
-    Capsule,
-    Cone,
 }
 
 /// The shape modifiers.
@@ -313,22 +212,6 @@ impl Builtin {
     }
 }
 
-impl Param {
-    /// `name: type = default`, as in a signature.
-    pub fn describe(&self) -> String {
-        let default = match self.default {
-            Default::Required => String::new(),
-            Default::Num(x) => format!(" = {}", crate::ir::dump_num(x)),
-            Default::Vec3(v) => format!(" = {}", crate::ir::dump_vec(v.into())),
-            Default::Bool(b) => format!(" = {b}"),
-            Default::Color(c) => format!(" = rgb({}, {}, {})", c[0], c[1], c[2]),
-            Default::Str(s) => format!(" = \"{s}\""),
-            Default::Derived => " = …".into(),
-        };
-        format!("{}: {}{default}", self.name, self.ty)
-    }
-}
-
 /// The entries of each name, by kind (in [`Kind`]'s order), in table order.
 type Index = HashMap<&'static str, [Vec<&'static Builtin>; Kind::COUNT], FixedState>;
 
@@ -340,7 +223,7 @@ fn index() -> &'static Index {
     static INDEX: OnceLock<Index> = OnceLock::new();
     INDEX.get_or_init(|| {
         let mut index = Index::default();
-        for b in BUILTINS {
+        for b in BUILTINS.iter() {
             index.entry(b.name).or_default()[b.kind() as usize].push(b);
         }
         index

@@ -5,30 +5,162 @@ use std::rc::Rc;
 
 use glam::DVec3;
 
-use super::{Range, NONNEG};
 use crate::check::builtins::{Builtin, Extreme, MathFn, NumFn, VecFn};
 use crate::check::expr::BoundArgs;
 use crate::check::{direction, Ctx, Value, MAX_LIST};
 use crate::diag::{codes, Diagnostic};
-use crate::ir::{dump_num, dump_vec};
+use crate::ir::dump_num;
+use crate::sig::{Default, Param, Range, Ty};
 use crate::span::Span;
 
-/// The rule of `asin` and `acos`.
-const UNIT: &str = "between -1 and 1";
+crate::params! {
+    /// A function of one number: its one argument, whatever its name.
+    pub struct OneNumber {
+        /// a number
+        x: f64 as Num = required;
+    }
+}
+
+/// The parameter lists of functions of one number `x`, each with the function's domain
+/// as its range (the checker checks it, the docs print it).
+pub struct NumberArgs;
+
+/// One required number named `name`, of the values in `range`.
+const fn number(name: &'static str, range: Range, doc: &'static str) -> [Param; 1] {
+    [Param { name, ty: Ty::Num, default: Default::Required, range, doc }]
+}
+
+impl NumberArgs {
+    /// Any number.
+    pub const ANY: &'static [Param] = &number("x", Range::ANY, "a number");
+    /// `sqrt`'s domain.
+    pub const NONNEG: &'static [Param] = &number("x", Range::NONNEG, "a number");
+    /// `log`'s domain.
+    pub const POSITIVE: &'static [Param] = &number("x", Range::POSITIVE, "a number");
+    /// `asin`'s and `acos`'s domain.
+    pub const UNIT: &'static [Param] = &number("x", Range::closed(-1.0, 1.0), "a sine or cosine");
+    /// `random`'s seed.
+    pub const SEED: &'static [Param] = &number("seed", Range::ANY, "any number; the same seed gives the same result");
+}
+
+crate::params! {
+    /// A function of one vector: its one argument.
+    pub struct OneVector {
+        /// a vector
+        v: DVec3 as Vec3 = required;
+    }
+}
+
+/// The parameter lists of functions of one vector `v`.
+pub struct VectorArgs;
+
+/// One required vector named `v`, of the values in `range`.
+const fn vector(range: Range) -> [Param; 1] {
+    [Param { name: "v", ty: Ty::Vec3, default: Default::Required, range, doc: "a vector" }]
+}
+
+impl VectorArgs {
+    /// Any vector.
+    pub const ANY: &'static [Param] = &vector(Range::ANY);
+    /// A vector that has a direction.
+    pub const NONZERO: &'static [Param] = &vector(Range::NONZERO);
+}
+
+crate::params! {
+    /// `pow(x, y)`.
+    pub struct PowArgs {
+        /// the base
+        x: f64 as Num = required;
+        /// the exponent (whole when `x` is negative)
+        y: f64 as Num = required;
+    }
+}
+
+crate::params! {
+    /// `atan2(y, x)`.
+    pub struct Atan2Args {
+        /// the point's y
+        y: f64 as Num = required;
+        /// the point's x
+        x: f64 as Num = required;
+    }
+}
+
+crate::params! {
+    /// `clamp(x, lo, hi)`.
+    pub struct ClampArgs {
+        /// the number to limit
+        x: f64 as Num = required;
+        /// the lowest result
+        lo: f64 as Num = required;
+        /// the highest result, at least `lo`
+        hi: f64 as Num = required;
+    }
+}
+
+crate::params! {
+    /// `mix(a, b, t)`.
+    pub struct MixArgs {
+        /// the value at `t = 0`
+        a: Value as Linear = required;
+        /// the value at `t = 1`, of `a`'s type
+        b: Value as Linear = required;
+        /// how far from `a` to `b`
+        t: f64 as Num = required;
+    }
+}
+
+crate::params! {
+    /// `hsv(h, s, v)`.
+    pub struct HsvArgs {
+        /// the hue in degrees (0 red, 120 green, 240 blue; it wraps)
+        h: f64 as Num = required;
+        /// the saturation
+        s: f64 as Num = required, Range::UNIT;
+        /// the value (brightness)
+        v: f64 as Num = required, Range::UNIT;
+    }
+}
+
+crate::params! {
+    /// `range(from, to, step)`.
+    pub struct RangeArgs {
+        /// the first element
+        from: f64 as Num = required;
+        /// the bound the elements stay before
+        to: f64 as Num = required;
+        /// the distance between elements
+        step: f64 as Num = 1.0, Range::NONZERO;
+    }
+}
+
+crate::params! {
+    /// `sum(list)` and `len(list)`.
+    pub struct ListArgs {
+        /// a list
+        list: Value as List = required;
+    }
+}
+
+crate::params! {
+    /// `dot(a, b)` and `cross(a, b)`.
+    pub struct PairArgs {
+        /// the first vector
+        a: DVec3 as Vec3 = required;
+        /// the second vector
+        b: DVec3 as Vec3 = required;
+    }
+}
 
 impl Ctx<'_> {
     /// A function of one number, `x` given at `arg` in the call at `call`.
     pub(in crate::check) fn math(&mut self, b: &Builtin, f: MathFn, x: f64, arg: Span, call: Span) -> Value {
         let r = x.to_radians();
-        let domain = match f {
-            MathFn::Sqrt => Some((x >= 0.0, NONNEG)),
-            MathFn::Log => Some((x > 0.0, "greater than 0")),
-            MathFn::Asin | MathFn::Acos => Some(((-1.0..=1.0).contains(&x), UNIT)),
-            _ => None,
-        };
-        if let Some((false, rule)) = domain {
-            self.range_error(arg, Range { name: b.params[0].name, rule }, dump_num(x));
-            return Value::Error;
+        // The domain is the declared range (the fast path of a call reaches here unbound).
+        if let Some(p) = b.params.first() {
+            if !self.in_range(p, &Value::Num(x), arg) {
+                return Value::Error;
+            }
         }
         let y = match f {
             MathFn::Sin => r.sin(),
@@ -60,36 +192,33 @@ impl Ctx<'_> {
     pub(super) fn numeric(&mut self, b: &Builtin, f: NumFn, a: &BoundArgs) -> Value {
         let v = match f {
             NumFn::Pow => {
-                let (x, y) = (a.num(b, 0), a.num(b, 1));
+                let PowArgs { x, y } = PowArgs::from_args(a);
                 if x < 0.0 && y.fract() != 0.0 {
-                    let rule = "a whole number when `x` is negative";
-                    self.range_error(a.span(1), Range { name: "y", rule }, dump_num(y));
+                    self.range_error(a.span_of("y"), "y", "a whole number when `x` is negative", dump_num(y));
                     return Value::Error;
                 }
                 Value::Num(x.powf(y))
             }
-            // `+ 0.0` reads -0 as 0, so the angle stays in (-180, 180] as documented.
-            NumFn::Atan2 => Value::Num((a.num(b, 0) + 0.0).atan2(a.num(b, 1)).to_degrees()),
+            NumFn::Atan2 => {
+                let Atan2Args { y, x } = Atan2Args::from_args(a);
+                // `+ 0.0` reads -0 as 0, so the angle stays in (-180, 180] as documented.
+                Value::Num((y + 0.0).atan2(x).to_degrees())
+            }
             NumFn::Clamp => {
-                let (x, lo, hi) = (a.num(b, 0), a.num(b, 1), a.num(b, 2));
+                let ClampArgs { x, lo, hi } = ClampArgs::from_args(a);
                 if lo > hi {
                     let rule = format!("at least `lo` ({})", dump_num(lo));
-                    self.range_error(a.span(2), Range { name: "hi", rule: &rule }, dump_num(hi));
+                    self.range_error(a.span_of("hi"), "hi", &rule, dump_num(hi));
                     return Value::Error;
                 }
                 Value::Num(x.clamp(lo, hi))
             }
             NumFn::Mix => return self.mix(b, a),
             NumFn::Hsv => {
-                let (h, s, v) = (a.num(b, 0), a.num(b, 1), a.num(b, 2));
-                let ok_s = self.check_num(a, b, 1, |x| (0.0..=1.0).contains(&x), "between 0 and 1");
-                let ok_v = self.check_num(a, b, 2, |x| (0.0..=1.0).contains(&x), "between 0 and 1");
-                if !(ok_s && ok_v) {
-                    return Value::Error;
-                }
+                let HsvArgs { h, s, v } = HsvArgs::from_args(a);
                 Value::Color(hsv(h, s, v) * 255.0)
             }
-            NumFn::Range => return self.range(b, a),
+            NumFn::Range => return self.range(a),
             NumFn::Sum => return self.sum(b, a),
         };
         self.finite(v, a.call, || format!("`{}` overflowed", b.name))
@@ -97,7 +226,7 @@ impl Ctx<'_> {
 
     /// `mix(a, b, t)`: `a·(1 − t) + b·t`, which is exactly `a` at 0 and `b` at 1.
     fn mix(&mut self, b: &Builtin, a: &BoundArgs) -> Value {
-        let (from, to, t) = (a.value(b, 0), a.value(b, 1), a.num(b, 2));
+        let MixArgs { a: from, b: to, t } = MixArgs::from_args(a);
         let lerp = |x: DVec3, y: DVec3| x * (1.0 - t) + y * t;
         let v = match (&from, &to) {
             (Value::Num(x), Value::Num(y)) => Value::Num(x * (1.0 - t) + y * t),
@@ -107,11 +236,11 @@ impl Ctx<'_> {
                 self.report(
                     Diagnostic::error(
                         codes::TYPE_MISMATCH,
-                        a.span(1),
+                        a.span_of("b"),
                         format!("expected `{}`, found `{}`", from.ty_name(), to.ty_name()),
                         to.this_is(),
                     )
-                    .with_label(a.span(0), from.this_is())
+                    .with_label(a.span_of("a"), from.this_is())
                     .with_note("`mix` blends two values of one type"),
                 );
                 return Value::Error;
@@ -122,11 +251,8 @@ impl Ctx<'_> {
 
     /// `range(from, to, step)`: every `from + i·step` before `to`. Each element is
     /// computed from `i`, not by adding steps, so `range(0, 1, 0.1)` has no drift.
-    fn range(&mut self, b: &Builtin, a: &BoundArgs) -> Value {
-        let (from, to, step) = (a.num(b, 0), a.num(b, 1), a.num(b, 2));
-        if !self.check_num(a, b, 2, |s| s != 0.0, "other than 0") {
-            return Value::Error;
-        }
+    fn range(&mut self, a: &BoundArgs) -> Value {
+        let RangeArgs { from, to, step } = RangeArgs::from_args(a);
         let at = |i: f64| from + i * step;
         let before = |x: f64| if step > 0.0 { x < to } else { x > to };
         let estimate = ((to - from) / step).ceil();
@@ -150,7 +276,7 @@ impl Ctx<'_> {
 
     /// `sum(list)` of numbers, vectors or colours, all of one type; 0 when empty.
     fn sum(&mut self, b: &Builtin, a: &BoundArgs) -> Value {
-        let Value::List(items) = a.value(b, 0) else {
+        let ListArgs { list: Value::List(items) } = ListArgs::from_args(a) else {
             return Value::Error;
         };
         if !self.burn(items.len() as u64, a.call) {
@@ -163,7 +289,7 @@ impl Ctx<'_> {
             let ty = Value::List(items.clone()).ty_name();
             let mut d = Diagnostic::error(
                 codes::TYPE_MISMATCH,
-                a.span(0),
+                a.span_of("list"),
                 format!("cannot `sum` a `{ty}`"),
                 format!("this is a `{ty}`"),
             )
@@ -193,15 +319,22 @@ impl Ctx<'_> {
 
     /// A function of vectors.
     pub(super) fn vector(&mut self, b: &Builtin, f: VecFn, a: &BoundArgs) -> Value {
-        let u = a.vec(b, 0);
         let v = match f {
-            VecFn::Dot => Value::Num(u.dot(a.vec(b, 1))),
-            VecFn::Cross => Value::Vec3(u.cross(a.vec(b, 1))),
-            VecFn::Length => Value::Num(u.length()),
-            VecFn::Normalize => match direction(u) {
+            VecFn::Dot | VecFn::Cross => {
+                let PairArgs { a: u, b: w } = PairArgs::from_args(a);
+                if f == VecFn::Dot {
+                    Value::Num(u.dot(w))
+                } else {
+                    Value::Vec3(u.cross(w))
+                }
+            }
+            VecFn::Length => Value::Num(OneVector::from_args(a).v.length()),
+            // The range refused zero; one too small to scale is refused the same way.
+            VecFn::Normalize => match direction(OneVector::from_args(a).v) {
                 Some(n) => Value::Vec3(n),
                 None => {
-                    self.range_error(a.span(0), Range { name: "v", rule: "a non-zero vector" }, dump_vec(u));
+                    let v = OneVector::from_args(a).v;
+                    self.range_error(a.span_of("v"), "v", "a non-zero vector", crate::ir::dump_vec(v));
                     return Value::Error;
                 }
             },

@@ -2,93 +2,162 @@
 
 use std::sync::Arc;
 
-use glam::DAffine3;
+use glam::{DAffine3, DVec3};
 
-use super::{MAX_MESH_RESOLUTION, POS};
-use crate::check::builtins::{Builtin, Gen};
+use super::MAX_MESH_RESOLUTION;
+use crate::check::builtins::Gen;
 use crate::check::expr::BoundArgs;
 use crate::check::{Ctx, Value};
 use crate::ir::{self, MeshSource};
+use crate::sig::Range;
+
+/// The number of points or sides a generator's circles may have.
+const RESOLUTION: Range = Range::closed(3.0, MAX_MESH_RESOLUTION as f64);
+
+crate::params! {
+    /// `mesh uvsphere(…)`.
+    pub struct UvSphereArgs {
+        /// the radius
+        r: f64 as Num = 1.0, Range::POSITIVE;
+        /// latitude bands
+        rings: u32 as Int = 14, RESOLUTION;
+        /// longitudes (twice `rings` when not given)
+        segments: Option<u32> as Int = derived, RESOLUTION;
+        /// whether normals are interpolated across faces
+        smooth: bool as Bool = false;
+    }
+}
+
+crate::params! {
+    /// `mesh icosphere(…)`.
+    pub struct IcoSphereArgs {
+        /// the radius
+        r: f64 as Num = 1.0, Range::POSITIVE;
+        /// how many times each triangle of the icosahedron is split in four
+        subdivisions: u32 as Int = 2, Range::closed(0.0, 10.0);
+        /// whether normals are interpolated across faces
+        smooth: bool as Bool = false;
+    }
+}
+
+crate::params! {
+    /// `mesh box(…)`.
+    pub struct BoxMeshArgs {
+        /// half-extents (a number for a cube)
+        size: DVec3 as Size = 1.0, Range::POSITIVE;
+        /// whether normals are interpolated across faces
+        smooth: bool as Bool = false;
+    }
+}
+
+crate::params! {
+    /// `mesh cylinder(…)`.
+    pub struct CylinderMeshArgs {
+        /// the radius
+        r: f64 as Num = 1.0, Range::POSITIVE;
+        /// half the height, along y
+        half_height: f64 as Num = 1.0, Range::POSITIVE;
+        /// points on each cap's circle
+        segments: u32 as Int = 32, RESOLUTION;
+        /// whether normals are interpolated across faces
+        smooth: bool as Bool = false;
+    }
+}
+
+crate::params! {
+    /// `mesh torus(…)`.
+    pub struct TorusMeshArgs {
+        /// the distance from the centre to the middle of the tube
+        major: f64 as Num = 1.0, Range::POSITIVE;
+        /// the tube's radius
+        minor: f64 as Num = 0.25, Range::POSITIVE;
+        /// points around the major circle
+        segments: u32 as Int = 32, RESOLUTION;
+        /// points around the tube
+        sides: u32 as Int = 16, RESOLUTION;
+        /// whether normals are interpolated across faces
+        smooth: bool as Bool = false;
+    }
+}
+
+crate::params! {
+    /// `mesh plane(…)`.
+    pub struct PlaneMeshArgs {
+        /// half the square's side
+        size: f64 as Num = 10.0, Range::POSITIVE;
+        /// whether normals are interpolated across faces
+        smooth: bool as Bool = false;
+    }
+}
+
+crate::params! {
+    /// `mesh isosurface(…)`.
+    pub struct IsosurfaceArgs {
+        /// the shape to triangulate
+        shape: Value as Shape = required;
+        /// the side of the grid's cells, in the shape's units
+        cell: f64 as Num = 0.02, Range::POSITIVE;
+        /// whether normals are interpolated across faces
+        smooth: bool as Bool = false;
+    }
+}
+
+crate::params! {
+    /// `mesh file(…)`.
+    pub struct FileArgs {
+        /// the OBJ file, relative to the scene file
+        path: String as Str = required;
+        /// whether normals are interpolated across faces
+        smooth: bool as Bool = false;
+    }
+}
 
 impl Ctx<'_> {
     /// A mesh from a generator, or `Value::Error` after reporting.
-    pub(super) fn mesh(&mut self, b: &Builtin, g: Gen, a: BoundArgs) -> Value {
-        let pos = |x: f64| x > 0.0;
-        let smooth_idx = b.params.iter().position(|p| p.name == "smooth").unwrap_or(0);
-        let res = MAX_MESH_RESOLUTION;
-        let source = match g {
+    pub(super) fn mesh(&mut self, g: Gen, a: BoundArgs) -> Value {
+        let (source, smooth) = match g {
             Gen::UvSphere => {
-                let ok_r = self.check_num(&a, b, 0, pos, POS);
-                let rings = self.check_int(&a, b, 1, 3, res);
-                let segments = if a.given(2) { self.check_int(&a, b, 2, 3, res) } else { rings.map(|r| 2 * r) };
-                let (true, Some(rings), Some(segments)) = (ok_r, rings, segments) else {
-                    return Value::Error;
-                };
+                let UvSphereArgs { r, rings, segments, smooth } = UvSphereArgs::from_args(&a);
+                let segments = segments.unwrap_or(2 * rings);
                 if !self.triangle_budget(2 * rings as u64 * segments as u64, a.call) {
                     return Value::Error;
                 }
-                MeshSource::UvSphere { radius: a.num(b, 0), rings, segments }
+                (MeshSource::UvSphere { radius: r, rings, segments }, smooth)
             }
             Gen::IcoSphere => {
-                let ok_r = self.check_num(&a, b, 0, pos, POS);
-                let (true, Some(subdivisions)) = (ok_r, self.check_int(&a, b, 1, 0, 10)) else {
-                    return Value::Error;
-                };
-                MeshSource::IcoSphere { radius: a.num(b, 0), subdivisions }
+                let IcoSphereArgs { r, subdivisions, smooth } = IcoSphereArgs::from_args(&a);
+                (MeshSource::IcoSphere { radius: r, subdivisions }, smooth)
             }
             Gen::Box => {
-                if !self.check_vec(&a, b, 0, pos, POS) {
-                    return Value::Error;
-                }
-                MeshSource::Box { half: a.vec(b, 0) }
+                let BoxMeshArgs { size, smooth } = BoxMeshArgs::from_args(&a);
+                (MeshSource::Box { half: size }, smooth)
             }
             Gen::Cylinder => {
-                let ok = self.check_num(&a, b, 0, pos, POS) & self.check_num(&a, b, 1, pos, POS);
-                let (true, Some(segments)) = (ok, self.check_int(&a, b, 2, 3, res)) else {
-                    return Value::Error;
-                };
-                MeshSource::Cylinder { radius: a.num(b, 0), half_height: a.num(b, 1), segments }
+                let CylinderMeshArgs { r, half_height, segments, smooth } = CylinderMeshArgs::from_args(&a);
+                (MeshSource::Cylinder { radius: r, half_height, segments }, smooth)
             }
             Gen::Torus => {
-                let ok = self.check_num(&a, b, 0, pos, POS) & self.check_num(&a, b, 1, pos, POS);
-                let segments = self.check_int(&a, b, 2, 3, res);
-                let sides = self.check_int(&a, b, 3, 3, res);
-                let (true, Some(segments), Some(sides)) = (ok, segments, sides) else {
-                    return Value::Error;
-                };
+                let TorusMeshArgs { major, minor, segments, sides, smooth } = TorusMeshArgs::from_args(&a);
                 if !self.triangle_budget(2 * segments as u64 * sides as u64, a.call) {
                     return Value::Error;
                 }
-                MeshSource::Torus { major: a.num(b, 0), minor: a.num(b, 1), segments, sides }
+                (MeshSource::Torus { major, minor, segments, sides }, smooth)
             }
             Gen::Plane => {
-                if !self.check_num(&a, b, 0, pos, POS) {
-                    return Value::Error;
-                }
-                MeshSource::Plane { size: a.num(b, 0) }
+                let PlaneMeshArgs { size, smooth } = PlaneMeshArgs::from_args(&a);
+                (MeshSource::Plane { size }, smooth)
             }
             Gen::Isosurface => {
-                let Value::Shape(shape) = a.value(b, 0) else {
+                let IsosurfaceArgs { shape: Value::Shape(shape), cell, smooth } = IsosurfaceArgs::from_args(&a) else {
                     return Value::Error;
                 };
-                if !self.check_num(&a, b, 1, pos, POS) {
-                    return Value::Error;
-                }
-                MeshSource::Isosurface { shape, cell: a.num(b, 1) }
+                (MeshSource::Isosurface { shape, cell }, smooth)
             }
             Gen::File => {
-                let Value::Str(written) = a.value(b, 0) else {
-                    return Value::Error;
-                };
-                MeshSource::File { path: self.dir.join(&*written), written: written.to_string() }
+                let FileArgs { path, smooth } = FileArgs::from_args(&a);
+                (MeshSource::File { path: self.dir.join(&path), written: path }, smooth)
             }
         };
-        Value::Mesh(Arc::new(ir::Mesh {
-            source,
-            xf: DAffine3::IDENTITY,
-            material: None,
-            smooth: a.flag(b, smooth_idx),
-            span: a.call,
-        }))
+        Value::Mesh(Arc::new(ir::Mesh { source, xf: DAffine3::IDENTITY, material: None, smooth, span: a.call }))
     }
 }

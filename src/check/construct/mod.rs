@@ -1,21 +1,23 @@
-//! Builtin constructors: turn bound, type-checked arguments into values, checking ranges.
+//! Builtin constructors: turn bound, type-checked, range-checked arguments into values.
 //! One exhaustive match per family over the builtin's [`Ctor`]: shapes, meshes, and
-//! plain values (materials, colours, lights, numbers).
+//! plain values (materials, colours, lights, numbers). Each family declares its
+//! builtins' parameters with [`params!`](crate::params) and reads them as typed fields.
 
-mod maths;
-mod meshes;
-mod shapes;
-mod values;
+pub(super) mod maths;
+pub(super) mod meshes;
+pub(super) mod shapes;
+pub(super) mod values;
 
 use std::sync::Arc;
 
 use glam::DVec3;
 
 use super::builtins::{self, Builtin, Ctor, Kind, Ty};
-use super::expr::{vec3, BoundArgs};
-use super::{direction, Ctx, Value};
+use super::expr::BoundArgs;
+use super::{direction, Ctx, Value, MAX_REACH};
 use crate::diag::{codes, Diagnostic};
 use crate::ir::{self, dump_num, dump_vec, Camera, Settings, ShapeKind};
+use crate::sig::{self, Args, FromArg, Param, Range};
 use crate::span::Span;
 use crate::syntax::ast;
 
@@ -36,8 +38,8 @@ pub const MAX_STEPS: u32 = 1_000_000;
 /// The smallest relative hit threshold: a few f32 ulps (2⁻²³ ≈ 1.2e-7) of the distance
 /// travelled, below which a march cannot get that close to a surface and ends as a miss.
 pub const MIN_EPSILON: f64 = 1e-6;
-/// How a bad `epsilon` is explained, in the scene and on the command line.
-pub const EPSILON_RULE: &str = "at least 1e-6 (f32 cannot resolve less) and less than 1";
+/// The values `epsilon` takes, in the scene and on the command line.
+pub const EPSILON_RANGE: Range = Range::ge_lt(MIN_EPSILON, 1.0);
 /// Most frames of an animation: an hour at 24 frames a second is 86,400.
 pub const MAX_FRAMES: u32 = 1_000_000;
 /// Highest frame rate.
@@ -47,91 +49,106 @@ pub const MAX_REPEAT: u32 = 1_000;
 /// Most nodes of one shape, shared parts counted each time they are used.
 pub const MAX_SHAPE_NODES: u64 = 1_000_000;
 
-/// The rule of sizes, radii and intensities that must be positive.
-const POS: &str = "greater than 0";
-/// The rule of quantities that may be zero.
-const NONNEG: &str = "at least 0";
-
 impl BoundArgs {
-    fn value(&self, b: &Builtin, i: usize) -> Value {
+    /// The value of slot `i`: the argument given, or the parameter's default (poison for
+    /// one that has none: a required argument's absence was reported when binding).
+    pub(super) fn value(&self, i: usize) -> Value {
         match &self.vals[i] {
             Some((v, _)) => v.clone(),
-            None => match b.params[i].default {
+            None => match self.params[i].default {
                 // A size's number default means a cube, as a number argument does.
-                builtins::Default::Num(x) if b.params[i].ty == Ty::Size => Value::Vec3(DVec3::splat(x)),
-                builtins::Default::Num(x) => Value::Num(x),
-                builtins::Default::Vec3(v) => Value::Vec3(DVec3::from(v)),
-                builtins::Default::Bool(x) => Value::Bool(x),
-                builtins::Default::Color(c) => Value::Color(DVec3::from(c)),
-                builtins::Default::Str(s) => Value::Str(s.into()),
-                builtins::Default::Required | builtins::Default::Derived => Value::Error,
+                sig::Default::Num(x) if self.params[i].ty == Ty::Size => Value::Vec3(DVec3::splat(x)),
+                sig::Default::Num(x) => Value::Num(x),
+                sig::Default::Vec3(v) => Value::Vec3(DVec3::from(v)),
+                sig::Default::Bool(x) => Value::Bool(x),
+                sig::Default::Color(c) => Value::Color(DVec3::from(c)),
+                sig::Default::Str(s) => Value::Str(s.into()),
+                sig::Default::Required | sig::Default::Derived => Value::Error,
             },
         }
     }
 
-    fn num(&self, b: &Builtin, i: usize) -> f64 {
-        match self.value(b, i) {
+    /// The slot of the parameter `name` (a name of the builtin's own declaration).
+    pub(super) fn slot(&self, name: &str) -> Option<usize> {
+        let slot = self.params.iter().position(|p| p.name == name);
+        debug_assert!(slot.is_some(), "no parameter `{name}`");
+        slot
+    }
+
+    /// The span to blame for parameter `name`: its argument, or the whole call for a default.
+    pub(super) fn span_of(&self, name: &str) -> Span {
+        self.slot(name).and_then(|i| self.vals[i].as_ref()).map_or(self.call, |(_, s)| *s)
+    }
+
+    /// Whether parameter `name` was given.
+    pub(super) fn was_given(&self, name: &str) -> bool {
+        self.slot(name).is_some_and(|i| self.vals[i].is_some())
+    }
+}
+
+impl Args for BoundArgs {
+    fn num(&self, i: usize) -> f64 {
+        match self.value(i) {
             Value::Num(x) => x,
             _ => 0.0,
         }
     }
 
-    fn vec(&self, b: &Builtin, i: usize) -> DVec3 {
-        vec3(&self.value(b, i))
+    fn vec3(&self, i: usize) -> DVec3 {
+        match self.value(i) {
+            Value::Vec3(v) | Value::Color(v) => v,
+            Value::Num(x) => DVec3::splat(x),
+            _ => DVec3::ZERO,
+        }
     }
 
-    fn flag(&self, b: &Builtin, i: usize) -> bool {
-        matches!(self.value(b, i), Value::Bool(true))
+    fn flag(&self, i: usize) -> bool {
+        matches!(self.value(i), Value::Bool(true))
+    }
+
+    fn text(&self, i: usize) -> String {
+        match self.value(i) {
+            Value::Str(s) => s.to_string(),
+            _ => String::new(),
+        }
     }
 
     fn given(&self, i: usize) -> bool {
         self.vals[i].is_some()
     }
+}
 
-    /// The span to blame for parameter `i`: its argument, or the whole call for a default.
-    fn span(&self, i: usize) -> Span {
-        self.vals[i].as_ref().map_or(self.call, |(_, s)| *s)
+/// A parameter whose value stays a language value: a shape, a paint, a list, or one of
+/// several types (`mix`'s operands). Its type was checked when binding.
+impl FromArg<BoundArgs> for Value {
+    fn from_arg(a: &BoundArgs, i: usize) -> Value {
+        a.value(i)
     }
 }
 
-/// One range rule violated.
-struct Range<'a> {
-    name: &'a str,
-    rule: &'a str,
-}
-
 impl Ctx<'_> {
-    fn range_error(&mut self, span: Span, r: Range<'_>, shown: String) {
+    /// Reports that parameter `name`, at `span`, breaks `rule`; `shown` is its value.
+    fn range_error(&mut self, span: Span, name: &str, rule: &str, shown: String) {
         self.report(Diagnostic::error(
             codes::OUT_OF_RANGE,
             span,
-            format!("`{}` must be {}", r.name, r.rule),
+            format!("`{name}` must be {rule}"),
             format!("this is {shown}"),
         ));
     }
 
-    /// Checks `ok` for parameter `i`; reports and returns false otherwise.
-    fn check_num(&mut self, bound: &BoundArgs, b: &Builtin, i: usize, ok: impl Fn(f64) -> bool, rule: &str) -> bool {
-        let x = bound.num(b, i);
-        if ok(x) {
-            return true;
+    /// Whether the value given for `p` at `span` is in its declared range; reports it
+    /// when not.
+    pub(super) fn in_range(&mut self, p: &Param, v: &Value, span: Span) -> bool {
+        let (ok, shown) = match v {
+            Value::Num(x) => (p.range.admits(*x), dump_num(*x)),
+            Value::Vec3(v) | Value::Color(v) => (p.range.admits_vec(*v), dump_vec(*v)),
+            _ => return true,
+        };
+        if !ok {
+            self.range_error(span, p.name, &p.range.rule(p.is_vector()), shown);
         }
-        self.range_error(bound.span(i), Range { name: b.params[i].name, rule }, dump_num(x));
-        false
-    }
-
-    fn check_vec(&mut self, bound: &BoundArgs, b: &Builtin, i: usize, ok: impl Fn(f64) -> bool, rule: &str) -> bool {
-        let v = bound.vec(b, i);
-        if ok(v.x) && ok(v.y) && ok(v.z) {
-            return true;
-        }
-        self.range_error(bound.span(i), Range { name: b.params[i].name, rule }, dump_vec(v));
-        false
-    }
-
-    fn check_int(&mut self, bound: &BoundArgs, b: &Builtin, i: usize, lo: u32, hi: u32) -> Option<u32> {
-        let rule = format!("between {lo} and {hi}");
-        self.check_num(bound, b, i, |x| x >= lo as f64 && x <= hi as f64, &rule).then(|| bound.num(b, i) as u32)
+        ok
     }
 
     /// The shape value of a node made by a constructor, or `Value::Error` if it reported.
@@ -170,7 +187,7 @@ impl Ctx<'_> {
     pub(super) fn construct(&mut self, b: &Builtin, a: BoundArgs) -> Value {
         match b.ctor {
             Ctor::Primitive(p) => {
-                let kind = self.primitive(b, p, &a).map(ShapeKind::Primitive);
+                let kind = self.primitive(p, &a).map(ShapeKind::Primitive);
                 self.shape(kind, a.call)
             }
             Ctor::Csg(op) => {
@@ -178,22 +195,27 @@ impl Ctx<'_> {
                 self.shape(kind, a.call)
             }
             Ctor::Modifier(m) => {
-                let kind = self.modifier(b, m, &a);
+                let kind = self.modifier(m, &a);
                 self.shape(kind, a.call)
             }
-            Ctor::Material => self.material(b, &a),
-            Ctor::Rgb => self.rgb(b, &a),
-            Ctor::Pattern(f) => self.pattern(b, f, &a),
-            Ctor::Light(l) => self.light(b, l, &a),
-            Ctor::Math(f) => self.math(b, f, a.num(b, 0), a.span(0), a.call),
+            Ctor::Material => self.material(&a),
+            Ctor::Rgb => self.rgb(&a),
+            Ctor::Pattern(f) => self.pattern(f, &a),
+            Ctor::Light(l) => self.light(l, &a),
+            Ctor::Math(f) => {
+                // A function of one number, whatever its parameter is called.
+                let x = maths::OneNumber::from_args(&a).x;
+                let span = a.vals[0].as_ref().map_or(a.call, |(_, s)| *s);
+                self.math(b, f, x, span, a.call)
+            }
             Ctor::Numeric(f) => self.numeric(b, f, &a),
             Ctor::Vector(f) => self.vector(b, f, &a),
             Ctor::Extreme(e) => self.extreme(b, e, &a),
-            Ctor::Len => match a.value(b, 0) {
+            Ctor::Len => match maths::ListArgs::from_args(&a).list {
                 Value::List(items) => Value::Num(items.len() as f64),
                 _ => Value::Error,
             },
-            Ctor::Generator(g) => self.mesh(b, g, a),
+            Ctor::Generator(g) => self.mesh(g, a),
             Ctor::Camera | Ctor::Render => {
                 // Statement argument lists are bound by `camera_stmt` and `render_stmt`;
                 // no expression can name them, but say so rather than lose the value.
@@ -240,33 +262,29 @@ impl Ctx<'_> {
     }
 
     pub(super) fn camera_stmt(&mut self, args: &[ast::Arg], span: Span) -> Option<Camera> {
-        let (b, a) = self.statement_args("camera", args, span)?;
-        let (position, look_at, up) = (a.vec(b, 0), a.vec(b, 1), a.vec(b, 2));
-        let mut ok = self.check_num(&a, b, 3, |f| f > 0.0 && f < 180.0, "between 0 and 180 (exclusive)");
+        let (_, a) = self.statement_args("camera", args, span)?;
+        let CameraArgs { position, look_at, up, fov } = CameraArgs::from_args(&a);
+        let mut ok = true;
         let view = direction(look_at - position);
         if view.is_none() {
             self.report(
                 Diagnostic::error(
                     codes::BAD_CAMERA,
-                    a.span(1),
+                    a.span_of("look_at"),
                     "the camera looks at its own position",
                     "`look_at` equals `position`",
                 )
-                .with_label(a.span(0), "the camera is here")
+                .with_label(a.span_of("position"), "the camera is here")
                 .with_hint("try moving `look_at` away from `position`"),
             );
             ok = false;
         }
-        match (view, direction(up)) {
-            (_, None) => {
-                self.range_error(a.span(2), Range { name: "up", rule: "a non-zero vector" }, dump_vec(up));
-                ok = false;
-            }
-            (Some(v), Some(u)) if v.cross(u).length() < 1e-9 => {
+        if let (Some(v), Some(u)) = (view, direction(up)) {
+            if v.cross(u).length() < 1e-9 {
                 self.report(
                     Diagnostic::error(
                         codes::BAD_CAMERA,
-                        a.span(2),
+                        a.span_of("up"),
                         "`up` is parallel to the view direction",
                         "this points along the view",
                     )
@@ -275,75 +293,102 @@ impl Ctx<'_> {
                 );
                 ok = false;
             }
-            _ => {}
         }
-        ok.then(|| Camera { position, look_at, up, fov: a.num(b, 3), span: Some(span) })
+        ok.then_some(Camera { position, look_at, up, fov, span: Some(span) })
     }
 
     pub(super) fn render_stmt(&mut self, args: &[ast::Arg], span: Span) -> Option<Settings> {
-        let (b, a) = self.statement_args("render", args, span)?;
-        let width = self.check_int(&a, b, 0, 1, MAX_IMAGE_SIDE);
-        let height = self.check_int(&a, b, 1, 1, MAX_IMAGE_SIDE);
-        let depth = self.check_int(&a, b, 2, 0, MAX_DEPTH);
-        let ok_eps = self.check_num(&a, b, 4, |e| (MIN_EPSILON..1.0).contains(&e), EPSILON_RULE);
-        let steps = self.check_int(&a, b, 5, 1, MAX_STEPS);
-        let ok_dist = self.check_num(&a, b, 6, |d| d > 0.0 && d <= super::MAX_REACH, "greater than 0 and at most 1e15");
-        let samples = self.check_int(&a, b, 7, 1, MAX_SAMPLES);
-        let ok_ao = self.check_num(&a, b, 8, |d| d >= 0.0, "at least 0 (0 turns it off)");
-        let frames = self.check_int(&a, b, 9, 1, MAX_FRAMES);
-        let ok_fps = self.check_num(&a, b, 10, |f| f > 0.0 && f <= MAX_FPS, "greater than 0 and at most 1000");
-        let (Some(width), Some(height), Some(depth), true, Some(max_steps), true, Some(samples), Some(frames)) =
-            (width, height, depth, ok_eps && ok_ao && ok_fps, steps, ok_dist, samples, frames)
-        else {
-            return None;
-        };
-        if width as u64 * height as u64 > MAX_PIXELS {
+        let (_, a) = self.statement_args("render", args, span)?;
+        let r = RenderArgs::from_args(&a);
+        if r.width as u64 * r.height as u64 > MAX_PIXELS {
             self.report(
                 Diagnostic::error(
                     codes::OUT_OF_RANGE,
                     span,
                     "image is too large",
-                    format!("{width}×{height} is {} pixels", width as u64 * height as u64),
+                    format!("{}×{} is {} pixels", r.width, r.height, r.width as u64 * r.height as u64),
                 )
                 .with_note(format!("an image may have at most {MAX_PIXELS} pixels")),
             );
             return None;
         }
-        let Value::Color(background) = a.value(b, 3) else {
-            return None;
-        };
-        let color = match a.value(b, 12) {
-            Value::Str(s) if &*s == "linear" => ir::ColorSpace::Linear,
-            Value::Str(s) if &*s == "srgb" => ir::ColorSpace::Srgb,
-            Value::Str(s) => {
+        let color = match &*r.color {
+            "linear" => ir::ColorSpace::Linear,
+            "srgb" => ir::ColorSpace::Srgb,
+            other => {
                 self.report(
                     Diagnostic::error(
                         codes::OUT_OF_RANGE,
-                        a.span(12),
+                        a.span_of("color"),
                         "`color` must be \"linear\" or \"srgb\"",
-                        format!("this is {:?}", &*s),
+                        format!("this is {other:?}"),
                     )
                     .with_note("\"linear\" shades colours as written (the study's); \"srgb\" reads them as sRGB and shades in linear light"),
                 );
                 return None;
             }
-            _ => return None,
         };
         Some(Settings {
-            width,
-            height,
-            depth,
-            background,
-            epsilon: a.num(b, 4),
-            max_steps,
-            max_distance: a.num(b, 6),
-            samples,
-            ambient_occlusion: a.num(b, 8),
-            frames,
-            fps: a.num(b, 10),
-            cyclic: a.flag(b, 11),
+            width: r.width,
+            height: r.height,
+            depth: r.depth,
+            background: r.background,
+            epsilon: r.epsilon,
+            max_steps: r.max_steps,
+            max_distance: r.max_distance,
+            samples: r.samples,
+            ambient_occlusion: r.ambient_occlusion,
+            frames: r.frames,
+            fps: r.fps,
+            cyclic: r.cyclic,
             color,
             span: Some(span),
         })
+    }
+}
+
+crate::params! {
+    /// The `camera` statement's arguments.
+    pub struct CameraArgs {
+        /// where the eye is
+        position: DVec3 as Vec3 = [0.0, 0.0, 0.0];
+        /// a point the camera looks at, other than `position`
+        look_at: DVec3 as Vec3 = [0.0, 0.0, 1.0];
+        /// which way is up in the image, not along the view
+        up: DVec3 as Vec3 = [0.0, 1.0, 0.0], Range::NONZERO;
+        /// the vertical field of view in degrees
+        fov: f64 as Num = (ir::SEED_FOV), Range::open(0.0, 180.0);
+    }
+}
+
+crate::params! {
+    /// The `render` statement's arguments.
+    pub struct RenderArgs {
+        /// image width in pixels
+        width: u32 as Int = 500, Range::closed(1.0, MAX_IMAGE_SIDE as f64);
+        /// image height in pixels
+        height: u32 as Int = 500, Range::closed(1.0, MAX_IMAGE_SIDE as f64);
+        /// how many reflections and refractions deep rays are traced (0: none)
+        depth: u32 as Int = 5, Range::closed(0.0, MAX_DEPTH as f64);
+        /// the colour where rays meet nothing
+        background: DVec3 as Color = [245.0, 245.0, 245.0];
+        /// the sphere-tracing hit threshold, relative to the distance from the camera (f32 cannot resolve less than 1e-6)
+        epsilon: f64 as Num = 1e-4, EPSILON_RANGE;
+        /// the most sphere-tracing steps one ray may take
+        max_steps: u32 as Int = 512, Range::closed(1.0, MAX_STEPS as f64);
+        /// the farthest any ray reaches
+        max_distance: f64 as Num = 1000.0, Range::gt_le(0.0, MAX_REACH);
+        /// samples per pixel (antialiasing)
+        samples: u32 as Int = 1, Range::closed(1.0, MAX_SAMPLES as f64);
+        /// how far ambient occlusion looks (0 turns it off)
+        ambient_occlusion: f64 as Num = 0.0, Range::NONNEG;
+        /// frames of the animation (1: a still)
+        frames: u32 as Int = 1, Range::closed(1.0, MAX_FRAMES as f64);
+        /// frames per second, for `scnc encode`
+        fps: f64 as Num = 24.0, Range::gt_le(0.0, MAX_FPS);
+        /// whether the animation loops (then `clock` stops a frame short of 1)
+        cyclic: bool as Bool = false;
+        /// how colours are read and pixels written: "linear" (the study's) or "srgb"
+        color: String as Str = "linear";
     }
 }

@@ -1,46 +1,73 @@
-//! Shape builtins: primitives, CSG operators and modifiers.
+//! Shape builtins: primitives (declared in [`crate::primitive`]), CSG operators and
+//! modifiers.
 
-use super::{Range, MAX_REPEAT, NONNEG, POS};
-use crate::check::builtins::{Builtin, Modifier, Prim};
+use glam::DVec3;
+
+use super::MAX_REPEAT;
+use crate::check::builtins::{Builtin, Modifier};
 use crate::check::expr::BoundArgs;
-use crate::check::{direction, Ctx, Value, MAX_OBJECTS};
+use crate::check::{Ctx, Value, MAX_OBJECTS};
 use crate::diag::{codes, Diagnostic};
-use crate::ir::{dump_vec, CsgOp, Primitive, ShapeKind};
+use crate::ir::{CsgOp, Primitive, ShapeKind};
+use crate::primitive::Entry;
+use crate::sig::Range;
+
+crate::params! {
+    /// `union`, `intersect` and `subtract`, after their shapes.
+    pub struct CsgArgs {
+        /// how far the seams are blended (0: sharp)
+        smooth: f64 as Num = 0.0, Range::NONNEG;
+    }
+}
+
+crate::params! {
+    /// `round(shape, r)`.
+    pub struct RoundArgs {
+        /// the shape to round
+        shape: Value as Shape = required;
+        /// how far the shape grows, rounding its edges by as much
+        r: f64 as Num = required, Range::NONNEG;
+    }
+}
+
+crate::params! {
+    /// `shell(shape, thickness)`.
+    pub struct ShellArgs {
+        /// the shape to hollow
+        shape: Value as Shape = required;
+        /// the wall's thickness, centred on the surface
+        thickness: f64 as Num = required, Range::POSITIVE;
+    }
+}
+
+crate::params! {
+    /// `repeat(shape, period, count)`.
+    pub struct RepeatArgs {
+        /// the shape to copy
+        shape: Value as Shape = required;
+        /// the spacing of the copies along each axis
+        period: DVec3 as Size = required, Range::POSITIVE;
+        /// copies along each axis
+        count: DVec3 as Size = required, Range::closed(1.0, MAX_REPEAT as f64).whole();
+    }
+}
 
 impl Ctx<'_> {
-    /// A primitive, or `None` after reporting a value out of range.
-    pub(super) fn primitive(&mut self, b: &Builtin, p: Prim, a: &BoundArgs) -> Option<Primitive> {
-        let pos = |x: f64| x > 0.0;
-        // Every primitive but the plane takes two positive sizes, or a positive `size`.
-        let mut two = || {
-            let ok = self.check_num(a, b, 0, pos, POS) & self.check_num(a, b, 1, pos, POS);
-            ok.then(|| (a.num(b, 0), a.num(b, 1)))
-        };
-        Some(match p {
-            Prim::Sphere => {
-                self.check_num(a, b, 0, pos, POS).then_some(())?;
-                Primitive::Sphere { radius: a.num(b, 0) }
-            }
-            Prim::Box => {
-                self.check_vec(a, b, 0, pos, POS).then_some(())?;
-                Primitive::Box { half: a.vec(b, 0) }
-            }
-            Prim::Cylinder => two().map(|(radius, half_height)| Primitive::Cylinder { radius, half_height })?,
-            Prim::Capsule => two().map(|(radius, half_height)| Primitive::Capsule { radius, half_height })?,
-            Prim::Cone => two().map(|(radius, half_height)| Primitive::Cone { radius, half_height })?,
-            Prim::Torus => two().map(|(major, minor)| Primitive::Torus { major, minor })?,
-            Prim::Plane => {
-                let Some(normal) = direction(a.vec(b, 0)) else {
-                    self.range_error(
-                        a.span(0),
-                        Range { name: "normal", rule: "a non-zero vector" },
-                        dump_vec(a.vec(b, 0)),
-                    );
-                    return None;
+    /// A primitive from its definition, or `None` after reporting a rule between its
+    /// parameters that the arguments break.
+    pub(super) fn primitive(&mut self, e: &Entry, a: &BoundArgs) -> Option<Primitive> {
+        match (e.build)(a) {
+            Ok(p) => Some(p),
+            Err(refusal) => {
+                let shown = match a.slot(refusal.param).map(|i| a.value(i)) {
+                    Some(Value::Num(x)) => crate::ir::dump_num(x),
+                    Some(Value::Vec3(v)) => crate::ir::dump_vec(v),
+                    _ => "given".into(),
                 };
-                Primitive::Plane { normal, offset: a.num(b, 1) }
+                self.range_error(a.span_of(refusal.param), refusal.param, &refusal.rule, shown);
+                None
             }
-        })
+        }
     }
 
     /// A CSG node, or `None` after reporting.
@@ -73,36 +100,29 @@ impl Ctx<'_> {
             );
             return None;
         }
-        self.check_num(a, b, 0, |x| x >= 0.0, NONNEG).then_some(())?;
+        let CsgArgs { smooth } = CsgArgs::from_args(a);
         let children =
             a.rest.iter().filter_map(|(v, _)| if let Value::Shape(s) = v { Some(s.clone()) } else { None }).collect();
-        Some(ShapeKind::Csg { op, children, smooth: a.num(b, 0) })
+        Some(ShapeKind::Csg { op, children, smooth })
     }
 
-    /// A modifier node, or `None` after reporting.
-    pub(super) fn modifier(&mut self, b: &Builtin, m: Modifier, a: &BoundArgs) -> Option<ShapeKind> {
-        let Value::Shape(child) = a.value(b, 0) else {
-            return None;
-        };
-        match m {
+    /// A modifier node, or `None` for poison.
+    pub(super) fn modifier(&mut self, m: Modifier, a: &BoundArgs) -> Option<ShapeKind> {
+        Some(match m {
             Modifier::Round => {
-                self.check_num(a, b, 1, |x| x >= 0.0, NONNEG).then_some(())?;
-                Some(ShapeKind::Round { child, radius: a.num(b, 1) })
+                let RoundArgs { shape: Value::Shape(child), r } = RoundArgs::from_args(a) else { return None };
+                ShapeKind::Round { child, radius: r }
             }
             Modifier::Shell => {
-                self.check_num(a, b, 1, |x| x > 0.0, POS).then_some(())?;
-                Some(ShapeKind::Shell { child, thickness: a.num(b, 1) })
+                let ShellArgs { shape: Value::Shape(child), thickness } = ShellArgs::from_args(a) else { return None };
+                ShapeKind::Shell { child, thickness }
             }
             Modifier::Repeat => {
-                let ok_period = self.check_vec(a, b, 1, |x| x > 0.0, POS);
-                let rule = format!("whole numbers between 1 and {MAX_REPEAT}");
-                let ok_count =
-                    self.check_vec(a, b, 2, |x| x.fract() == 0.0 && (1.0..=MAX_REPEAT as f64).contains(&x), &rule);
-                (ok_period && ok_count).then_some(())?;
-                let c = a.vec(b, 2);
-                let count = [c.x as u32, c.y as u32, c.z as u32];
-                Some(ShapeKind::Repeat { child, period: a.vec(b, 1), count })
+                let RepeatArgs { shape: Value::Shape(child), period, count } = RepeatArgs::from_args(a) else {
+                    return None;
+                };
+                ShapeKind::Repeat { child, period, count: [count.x as u32, count.y as u32, count.z as u32] }
             }
-        }
+        })
     }
 }

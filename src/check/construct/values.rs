@@ -4,18 +4,134 @@ use std::sync::Arc;
 
 use glam::DVec3;
 
-use super::{Range, NONNEG, POS};
-use crate::check::builtins::{Builtin, LightFn, PatternFn};
+use crate::check::builtins::{LightFn, PatternFn};
 use crate::check::expr::BoundArgs;
-use crate::check::{direction, Ctx, Value};
+use crate::check::{Ctx, Value};
 use crate::diag::{codes, Diagnostic};
 use crate::ir::{self, dump_vec, Material, Paint, Pattern, PatternKind};
+use crate::sig::Range;
 
 /// Highest index of refraction (germanium's is about 4; nothing in nature reaches 10).
 pub const MAX_IOR: f64 = 10.0;
 /// Most patterns in one pattern, itself included: each is evaluated at every shaded
 /// point, and a blend evaluates both of its paints.
 pub const MAX_PATTERN_NODES: usize = 64;
+
+crate::params! {
+    /// `material(…)`.
+    pub struct MaterialArgs {
+        /// the surface's colour, or a pattern painting it
+        color: Value as Paint = [200.0, 200.0, 200.0];
+        /// the Phong exponent of its highlight (-1: none)
+        specular: f64 as Num = (-1.0), Range::NONNEG.or(-1.0);
+        /// the share of light it reflects as a mirror
+        reflective: f64 as Num = 0.0, Range::UNIT;
+        /// the share of light passing into it (0: opaque)
+        transparency: f64 as Num = 0.0, Range::UNIT;
+        /// the index of refraction of the medium inside (1: air)
+        ior: f64 as Num = 1.0, Range::closed(1.0, MAX_IOR);
+        /// how much of each channel the medium absorbs per unit of distance
+        absorption: DVec3 as Vec3 = [0.0, 0.0, 0.0], Range::NONNEG;
+    }
+}
+
+crate::params! {
+    /// `checker(a, b, size)`.
+    pub struct CheckerArgs {
+        /// the paint of the even cubes
+        a: Value as Paint = required;
+        /// the paint of the odd cubes
+        b: Value as Paint = required;
+        /// the cubes' edge
+        size: f64 as Num = 1.0, Range::POSITIVE;
+    }
+}
+
+crate::params! {
+    /// `stripes(a, b, width, axis)`.
+    pub struct StripesArgs {
+        /// the paint of the even slabs
+        a: Value as Paint = required;
+        /// the paint of the odd slabs
+        b: Value as Paint = required;
+        /// each slab's thickness
+        width: f64 as Num = 1.0, Range::POSITIVE;
+        /// the direction the slabs alternate along
+        axis: DVec3 as Vec3 = [1.0, 0.0, 0.0], Range::NONZERO;
+    }
+}
+
+crate::params! {
+    /// `gradient(a, b, from, to)`.
+    pub struct GradientArgs {
+        /// the paint at `from`
+        a: Value as Paint = required;
+        /// the paint at `to`
+        b: Value as Paint = required;
+        /// where the blend starts
+        from: DVec3 as Vec3 = [0.0, 0.0, 0.0];
+        /// where it ends, a point other than `from`
+        to: DVec3 as Vec3 = [0.0, 1.0, 0.0];
+    }
+}
+
+crate::params! {
+    /// `noise(a, b, size, seed)`.
+    pub struct NoiseArgs {
+        /// the paint where the noise is lowest
+        a: Value as Paint = required;
+        /// the paint where it is highest
+        b: Value as Paint = required;
+        /// the size of its features
+        size: f64 as Num = 1.0, Range::POSITIVE;
+        /// which noise: another seed, another pattern
+        seed: u32 as Int = 0, Range::closed(0.0, u32::MAX as f64);
+    }
+}
+
+crate::params! {
+    /// `rgb(r, g, b)`.
+    pub struct RgbArgs {
+        /// red
+        r: f64 as Num = required, Range::closed(0.0, 255.0);
+        /// green
+        g: f64 as Num = required, Range::closed(0.0, 255.0);
+        /// blue
+        b: f64 as Num = required, Range::closed(0.0, 255.0);
+    }
+}
+
+crate::params! {
+    /// `ambient(intensity)`.
+    pub struct AmbientArgs {
+        /// how bright
+        intensity: f64 as Num = required, Range::NONNEG;
+    }
+}
+
+crate::params! {
+    /// `point(intensity, shadows, radius)`.
+    pub struct PointArgs {
+        /// how bright
+        intensity: f64 as Num = required, Range::NONNEG;
+        /// whether it casts shadows
+        shadows: bool as Bool = true;
+        /// the light's radius, for soft shadows (0: hard)
+        radius: f64 as Num = 0.0, Range::NONNEG;
+    }
+}
+
+crate::params! {
+    /// `directional(intensity, towards, shadows)`.
+    pub struct DirectionalArgs {
+        /// how bright
+        intensity: f64 as Num = required, Range::NONNEG;
+        /// the direction towards the light
+        towards: DVec3 as Vec3 = required, Range::NONZERO;
+        /// whether it casts shadows
+        shadows: bool as Bool = true;
+    }
+}
 
 /// A colour or pattern value as a material's paint (`None` for poison).
 fn paint(v: &Value) -> Option<Paint> {
@@ -37,41 +153,31 @@ fn pattern_nodes(p: &Pattern) -> usize {
 
 impl Ctx<'_> {
     /// `material(color, specular, reflective, transparency, ior, absorption)`.
-    pub(super) fn material(&mut self, b: &Builtin, a: &BoundArgs) -> Value {
-        let spec = a.num(b, 1);
-        let ok = [
-            self.check_num(a, b, 1, |s| s == -1.0 || s >= 0.0, "-1 (no highlight) or at least 0"),
-            self.check_num(a, b, 2, |r| (0.0..=1.0).contains(&r), "between 0 and 1"),
-            self.check_num(a, b, 3, |t| (0.0..=1.0).contains(&t), "between 0 and 1"),
-            self.check_num(a, b, 4, |n| n > 0.0 && n <= MAX_IOR, "greater than 0 and at most 10"),
-            self.check_vec(a, b, 5, |x| x >= 0.0, NONNEG),
-        ];
-        if ok.contains(&false) {
-            return Value::Error;
-        }
-        let Some(color) = paint(&a.value(b, 0)) else {
+    pub(super) fn material(&mut self, a: &BoundArgs) -> Value {
+        let m = MaterialArgs::from_args(a);
+        let Some(color) = paint(&m.color) else {
             return Value::Error;
         };
         let m = Material {
             color,
-            specular: (spec >= 0.0).then_some(spec),
-            reflective: a.num(b, 2),
-            transparency: a.num(b, 3),
-            ior: a.num(b, 4),
-            absorption: a.vec(b, 5),
+            specular: (m.specular >= 0.0).then_some(m.specular),
+            reflective: m.reflective,
+            transparency: m.transparency,
+            ior: m.ior,
+            absorption: m.absorption,
             span: a.call,
         };
         if !m.is_transparent() {
-            let idle: Vec<usize> = [(4, m.ior != 1.0), (5, m.absorption != DVec3::ZERO)]
+            let idle: Vec<&str> = [("ior", m.ior != 1.0), ("absorption", m.absorption != DVec3::ZERO)]
                 .into_iter()
-                .filter_map(|(i, set)| (set && a.vals[i].is_some()).then_some(i))
+                .filter_map(|(name, set)| (set && a.was_given(name)).then_some(name))
                 .collect();
             if let Some(&first) = idle.first() {
-                let names: Vec<String> = idle.iter().map(|&i| format!("`{}`", b.params[i].name)).collect();
+                let names: Vec<String> = idle.iter().map(|name| format!("`{name}`")).collect();
                 self.report(
                     Diagnostic::warning(
                         codes::NO_EFFECT,
-                        a.span(first),
+                        a.span_of(first),
                         format!(
                             "{} {} no effect on an opaque material",
                             names.join(" and "),
@@ -87,39 +193,32 @@ impl Ctx<'_> {
     }
 
     /// `checker`, `stripes`, `gradient` and `noise`: two paints and where each goes.
-    pub(super) fn pattern(&mut self, b: &Builtin, f: PatternFn, a: &BoundArgs) -> Value {
-        let kind = match f {
+    pub(super) fn pattern(&mut self, f: PatternFn, a: &BoundArgs) -> Value {
+        let (kind, pa, pb) = match f {
             PatternFn::Checker => {
-                self.check_num(a, b, 2, |x| x > 0.0, POS).then(|| PatternKind::Checker { size: a.num(b, 2) })
+                let CheckerArgs { a: pa, b: pb, size } = CheckerArgs::from_args(a);
+                (Some(PatternKind::Checker { size }), pa, pb)
             }
             PatternFn::Stripes => {
-                let ok_width = self.check_num(a, b, 2, |x| x > 0.0, POS);
-                let axis = a.vec(b, 3);
-                let ok_axis = direction(axis).is_some();
-                if !ok_axis {
-                    self.range_error(a.span(3), Range { name: "axis", rule: "a non-zero vector" }, dump_vec(axis));
-                }
-                (ok_width && ok_axis).then_some(PatternKind::Stripes { width: a.num(b, 2), axis })
+                let StripesArgs { a: pa, b: pb, width, axis } = StripesArgs::from_args(a);
+                (Some(PatternKind::Stripes { width, axis }), pa, pb)
             }
             PatternFn::Gradient => {
-                let (from, to) = (a.vec(b, 2), a.vec(b, 3));
-                if direction(to - from).is_none() {
-                    self.range_error(a.span(3), Range { name: "to", rule: "a point other than `from`" }, dump_vec(to));
+                let GradientArgs { a: pa, b: pb, from, to } = GradientArgs::from_args(a);
+                let kind = if crate::check::direction(to - from).is_none() {
+                    self.range_error(a.span_of("to"), "to", "a point other than `from`", dump_vec(to));
                     None
                 } else {
                     Some(PatternKind::Gradient { from, to })
-                }
+                };
+                (kind, pa, pb)
             }
             PatternFn::Noise => {
-                let ok_size = self.check_num(a, b, 2, |x| x > 0.0, POS);
-                let seed = self.check_int(a, b, 3, 0, u32::MAX);
-                match (ok_size, seed) {
-                    (true, Some(seed)) => Some(PatternKind::Noise { size: a.num(b, 2), seed }),
-                    _ => None,
-                }
+                let NoiseArgs { a: pa, b: pb, size, seed } = NoiseArgs::from_args(a);
+                (Some(PatternKind::Noise { size, seed }), pa, pb)
             }
         };
-        let (Some(kind), Some(pa), Some(pb)) = (kind, paint(&a.value(b, 0)), paint(&a.value(b, 1))) else {
+        let (Some(kind), Some(pa), Some(pb)) = (kind, paint(&pa), paint(&pb)) else {
             return Value::Error;
         };
         let pattern = Pattern { kind, a: pa, b: pb, span: a.call };
@@ -142,43 +241,24 @@ impl Ctx<'_> {
     }
 
     /// `rgb(r, g, b)` in 0–255.
-    pub(super) fn rgb(&mut self, b: &Builtin, a: &BoundArgs) -> Value {
-        let mut ok = true;
-        for i in 0..3 {
-            ok &= self.check_num(a, b, i, |x| (0.0..=255.0).contains(&x), "between 0 and 255");
-        }
-        if !ok {
-            return Value::Error;
-        }
-        Value::Color(DVec3::new(a.num(b, 0), a.num(b, 1), a.num(b, 2)))
+    pub(super) fn rgb(&mut self, a: &BoundArgs) -> Value {
+        let RgbArgs { r, g, b } = RgbArgs::from_args(a);
+        Value::Color(DVec3::new(r, g, b))
     }
 
     /// A light (placed later by `at`).
-    pub(super) fn light(&mut self, b: &Builtin, l: LightFn, a: &BoundArgs) -> Value {
-        if !self.check_num(a, b, 0, |x| x >= 0.0, NONNEG) {
-            return Value::Error;
-        }
-        let (kind, shadows, radius) = match l {
-            LightFn::Ambient => (ir::LightKind::Ambient, false, 0.0),
+    pub(super) fn light(&mut self, l: LightFn, a: &BoundArgs) -> Value {
+        let (kind, intensity, shadows, radius) = match l {
+            LightFn::Ambient => (ir::LightKind::Ambient, AmbientArgs::from_args(a).intensity, false, 0.0),
             LightFn::Point => {
-                if !self.check_num(a, b, 2, |x| x >= 0.0, NONNEG) {
-                    return Value::Error;
-                }
-                (ir::LightKind::Point { position: DVec3::ZERO }, a.flag(b, 1), a.num(b, 2))
+                let PointArgs { intensity, shadows, radius } = PointArgs::from_args(a);
+                (ir::LightKind::Point { position: DVec3::ZERO }, intensity, shadows, radius)
             }
             LightFn::Directional => {
-                let towards = a.vec(b, 1);
-                if direction(towards).is_none() {
-                    self.range_error(
-                        a.span(1),
-                        Range { name: "towards", rule: "a non-zero vector" },
-                        dump_vec(towards),
-                    );
-                    return Value::Error;
-                }
-                (ir::LightKind::Directional { towards }, a.flag(b, 2), 0.0)
+                let DirectionalArgs { intensity, towards, shadows } = DirectionalArgs::from_args(a);
+                (ir::LightKind::Directional { towards }, intensity, shadows, 0.0)
             }
         };
-        Value::Light(Arc::new(ir::Light { kind, intensity: a.num(b, 0), shadows, radius, span: a.call }))
+        Value::Light(Arc::new(ir::Light { kind, intensity, shadows, radius, span: a.call }))
     }
 }

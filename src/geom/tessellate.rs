@@ -39,6 +39,12 @@ pub mod count {
         2 * segments.max(3) as u64
     }
 
+    /// [`frustum`](super::frustum): a side and a cap for each end that is a circle.
+    pub fn frustum(r_bottom: f64, r_top: f64, segments: u32) -> u64 {
+        let ends = (r_bottom > 0.0) as u64 + (r_top > 0.0) as u64;
+        (ends * 2) * segments.max(3) as u64
+    }
+
     /// [`torus`](super::torus).
     pub fn torus(segments: u32, sides: u32) -> u64 {
         2 * segments.max(3) as u64 * sides.max(3) as u64
@@ -151,6 +157,51 @@ pub fn cone(r: f64, h: f64, segments: u32) -> TriMesh {
         let k = (j + 1) % n;
         m.triangles.push([apex, k, j]);
         m.triangles.push([base, j, k]);
+    }
+    m
+}
+
+/// Frustum along y: radius `r_bottom` at `−h`, `r_top` at `h` (at least one of them
+/// positive; an end of radius 0 is an apex, one vertex), `segments` points per circle.
+pub fn frustum(r_bottom: f64, r_top: f64, h: f64, segments: u32) -> TriMesh {
+    let n = segments.max(3);
+    let mut m = TriMesh::default();
+    // Each end: its first vertex, and whether it is a circle of `n` points (else an apex).
+    let mut end = |r: f64, y: f64| {
+        let first = m.positions.len() as u32;
+        if r > 0.0 {
+            for j in 0..n {
+                let phi = TAU * j as f64 / n as f64;
+                m.positions.push(DVec3::new(r * phi.cos(), y, r * phi.sin()));
+            }
+        } else {
+            m.positions.push(DVec3::new(0.0, y, 0.0));
+        }
+        (first, r > 0.0)
+    };
+    let (top, top_ring) = end(r_top, h);
+    let (bottom, bottom_ring) = end(r_bottom, -h);
+    let at = |(first, ring): (u32, bool), j: u32| if ring { first + j % n } else { first };
+    for j in 0..n {
+        let (tj, tk) = (at((top, top_ring), j), at((top, top_ring), j + 1));
+        let (bj, bk) = (at((bottom, bottom_ring), j), at((bottom, bottom_ring), j + 1));
+        // The side quad (tj, tk, bk, bj), one triangle dropped where an apex folds it.
+        if top_ring {
+            m.triangles.push([tj, tk, bk]);
+        }
+        if bottom_ring {
+            m.triangles.push([tj, bk, bj]);
+        }
+    }
+    for (first, ring, y, flip) in [(top, top_ring, h, false), (bottom, bottom_ring, -h, true)] {
+        if ring {
+            let centre = m.positions.len() as u32;
+            m.positions.push(DVec3::new(0.0, y, 0.0));
+            for j in 0..n {
+                let (a, b) = (first + j, first + (j + 1) % n);
+                m.triangles.push(if flip { [centre, a, b] } else { [centre, b, a] });
+            }
+        }
     }
     m
 }
@@ -271,6 +322,11 @@ mod tests {
         closed_and_outward("cylinder", &cylinder(1.0, 1.0, 64), 2.0 * PI, 0.01);
         closed_and_outward("cone", &cone(1.0, 1.0, 64), 2.0 * PI / 3.0, 0.01);
         closed_and_outward("torus", &torus(1.0, 0.25, 64, 32), 2.0 * PI * PI * 0.0625, 0.01);
+        // A frustum of height 2h holds πh·2(r₁² + r₁r₂ + r₂²)/3.
+        let frustum_volume = |r1: f64, r2: f64| PI * 2.0 * (r1 * r1 + r1 * r2 + r2 * r2) / 3.0;
+        for (r1, r2) in [(1.0, 0.5), (0.5, 1.0), (1.0, 0.0), (0.0, 1.0), (0.7, 0.7)] {
+            closed_and_outward(&format!("frustum {r1} {r2}"), &frustum(r1, r2, 1.0, 64), frustum_volume(r1, r2), 0.01);
+        }
     }
 
     #[test]
@@ -283,6 +339,9 @@ mod tests {
             }
             assert_eq!(count::cylinder(a), n(cylinder(1.0, 1.0, a)), "cylinder({a})");
             assert_eq!(count::cone(a), n(cone(1.0, 1.0, a)), "cone({a})");
+            for (r1, r2) in [(1.0, 0.5), (0.0, 1.0), (1.0, 0.0)] {
+                assert_eq!(count::frustum(r1, r2, a), n(frustum(r1, r2, 1.0, a)), "frustum({r1}, {r2}, {a})");
+            }
         }
         for s in 0..4 {
             assert_eq!(count::icosphere(s), n(icosphere(1.0, s)), "icosphere({s})");

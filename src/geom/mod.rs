@@ -1,0 +1,90 @@
+//! Plain geometry in f64 that every stage shares: axis-aligned boxes, indexed triangle
+//! meshes and the parametric generators that make them.
+
+pub mod tessellate;
+
+use glam::{DAffine3, DVec3};
+
+/// An axis-aligned box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    /// Smallest corner.
+    pub min: DVec3,
+    /// Largest corner.
+    pub max: DVec3,
+}
+
+impl Aabb {
+    /// A box centred at the origin.
+    pub fn centred(half: DVec3) -> Aabb {
+        Aabb { min: -half, max: half }
+    }
+
+    /// Grown by `d` on every side.
+    pub fn grow(self, d: f64) -> Aabb {
+        Aabb { min: self.min - d, max: self.max + d }
+    }
+
+    /// The smallest box containing both.
+    pub fn union(self, o: Aabb) -> Aabb {
+        Aabb { min: self.min.min(o.min), max: self.max.max(o.max) }
+    }
+
+    /// The overlap of both (may be empty: `min > max` on some axis).
+    pub fn intersect(self, o: Aabb) -> Aabb {
+        Aabb { min: self.min.max(o.min), max: self.max.min(o.max) }
+    }
+
+    /// The bounds of this box after an affine map.
+    pub fn transform(self, xf: &DAffine3) -> Aabb {
+        let centre = (self.min + self.max) * 0.5;
+        let half = (self.max - self.min) * 0.5;
+        let m = xf.matrix3;
+        let abs = glam::DMat3::from_cols(m.x_axis.abs(), m.y_axis.abs(), m.z_axis.abs());
+        let c = xf.transform_point3(centre);
+        let h = abs * half;
+        Aabb { min: c - h, max: c + h }
+    }
+
+    /// Centre point.
+    pub fn centre(self) -> DVec3 {
+        (self.min + self.max) * 0.5
+    }
+}
+
+/// An indexed triangle mesh in some frame (local for generators, render space once lowered).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TriMesh {
+    /// Vertex positions.
+    pub positions: Vec<DVec3>,
+    /// Triangles as vertex indices, counter-clockwise seen from outside.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl TriMesh {
+    /// Signed volume (positive for a closed mesh wound outward).
+    pub fn signed_volume(&self) -> f64 {
+        self.triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| self.positions[i as usize]);
+                a.dot(b.cross(c)) / 6.0
+            })
+            .sum()
+    }
+
+    /// Edges used by a number of triangles other than two, counting each undirected edge;
+    /// 0 for a closed (watertight) mesh. Directed edges used twice mean inconsistent winding.
+    pub fn open_edges(&self) -> (usize, usize) {
+        let mut undirected = std::collections::HashMap::new();
+        let mut directed = std::collections::HashMap::new();
+        for t in &self.triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                *undirected.entry((a.min(b), a.max(b))).or_insert(0usize) += 1;
+                *directed.entry((a, b)).or_insert(0usize) += 1;
+            }
+        }
+        (undirected.values().filter(|&&n| n != 2).count(), directed.values().filter(|&&n| n > 1).count())
+    }
+}

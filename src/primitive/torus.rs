@@ -1,0 +1,81 @@
+//! `torus(major, minor)`: the ring in the xz plane.
+
+use glam::{DVec3, Vec2, Vec3A};
+
+use super::{profile, revolve, Facets, Field, Refusal, Resolution, Solid, Tessellation};
+use crate::geom::{tessellate, Aabb};
+use crate::sig::{Args, Param, Range};
+
+crate::params! {
+    /// A torus in the xz plane, centred at the origin.
+    #[derive(Clone, Debug, PartialEq)]
+    pub struct Torus {
+        /// the distance from the centre to the middle of the tube
+        major: f64 as Num = required, Range::POSITIVE;
+        /// the tube's radius
+        minor: f64 as Num = required, Range::POSITIVE;
+    }
+}
+
+impl Solid for Torus {
+    const NAME: &'static str = "torus";
+    const DOC: &'static str = "torus in the xz plane";
+    const PARAMS: &'static [Param] = Torus::PARAMS;
+
+    fn new(args: &dyn Args) -> Result<Torus, Refusal> {
+        Ok(Torus::from_args(args))
+    }
+
+    fn bounds(&self) -> Option<Aabb> {
+        let outer = self.major + self.minor;
+        Some(Aabb::centred(DVec3::new(outer, self.minor, outer)))
+    }
+
+    fn sphere_radius(&self) -> Option<f64> {
+        Some(self.major + self.minor)
+    }
+
+    fn half_space(&self) -> Option<(DVec3, f64)> {
+        None
+    }
+
+    fn is_convex(&self) -> bool {
+        false
+    }
+
+    fn is_exact(&self) -> bool {
+        true
+    }
+
+    fn distance(&self) -> impl Field<f32> {
+        let (major, minor) = (self.major as f32, self.minor as f32);
+        move |p: Vec3A| {
+            let q = profile(p);
+            Vec2::new(q.x - major, q.y).length() - minor
+        }
+    }
+
+    fn gradient(&self) -> impl Field<Vec3A> {
+        let major = self.major as f32;
+        move |p: Vec3A| {
+            let q = profile(p);
+            revolve(p, Vec2::new(q.x - major, q.y).try_normalize().unwrap_or(Vec2::Y))
+        }
+    }
+
+    fn facets(&self) -> Facets {
+        Facets::Inscribed(self.major + self.minor)
+    }
+
+    fn tessellate(&self, res: Resolution) -> Tessellation {
+        let (major, minor, n, sides) = (self.major, self.minor, res.circle, res.rings);
+        Tessellation::Triangles(
+            tessellate::count::torus(n, sides),
+            Box::new(move || tessellate::torus(major, minor, n, sides)),
+        )
+    }
+
+    fn fields(&self) -> Vec<(&'static str, String)> {
+        self.shown::<()>()
+    }
+}
