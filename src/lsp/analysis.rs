@@ -37,6 +37,20 @@ pub struct Candidate {
     pub doc: Option<String>,
 }
 
+/// The signature of the builtin whose call is being typed, for signature help.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SignatureHelp {
+    /// The signature, such as `sphere(r: num)`.
+    pub label: String,
+    /// The builtin's doc.
+    pub doc: String,
+    /// Each parameter: its text within `label` (as `describe` writes it) and its doc with
+    /// its range.
+    pub params: Vec<(String, String)>,
+    /// The parameter the cursor is at: the one named before it, or the next positional one.
+    pub active: Option<usize>,
+}
+
 /// Kinds of completion candidates.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CandidateKind {
@@ -150,8 +164,13 @@ impl Analysis {
         if let Some(span) = self.name_at(at) {
             if let Some(b) = self.index.builtins.get(&span) {
                 let text = match b.param {
-                    Some(p) => format!("```scn\n{}\n```\nparameter of `{}`", p.describe(), b.builtin.signature()),
-                    None => format!("```scn\n{}\n```\n{}", b.builtin.signature(), b.builtin.doc),
+                    Some(p) => format!(
+                        "```scn\n{}\n```\n{}\n\nparameter of `{}`",
+                        p.describe(),
+                        p.explain(),
+                        b.builtin.signature()
+                    ),
+                    None => format!("```scn\n{}\n```\n{}", b.builtin.signature(), b.builtin.explained()),
                 };
                 return Some((span, text));
             }
@@ -240,16 +259,64 @@ impl Analysis {
         out
     }
 
-    fn named_arguments(&self, callee: &str, after_mesh: bool, at: u32, given: &[String]) -> Vec<Candidate> {
+    /// The builtin whose call the cursor is in, with the parameter it is at; `None` outside
+    /// a builtin's call (a user function's call, or no call).
+    pub fn signature_help(&self, at: u32) -> Option<SignatureHelp> {
+        let text = self.text();
+        let at = (at as usize).min(text.len());
+        let tokens: Vec<(Token<'_>, Span)> = syntax::lex(text, 0)
+            .into_iter()
+            .filter(|(t, s)| !matches!(t, Token::LineComment | Token::BlockComment(_)) && (s.end as usize) <= at)
+            .collect();
+        let (callee, after_mesh, _) = enclosing_call(&tokens)?;
+        let b = self.builtin_called(&callee, after_mesh, at as u32)?;
+        // The current argument: its position among the call's commas, or its name.
+        let (mut depth, mut commas, mut named) = (0i32, 0usize, None);
+        for (i, (t, _)) in tokens.iter().enumerate().rev() {
+            match t {
+                Token::RParen | Token::RBracket => depth += 1,
+                Token::LParen | Token::LBracket if depth > 0 => depth -= 1,
+                Token::LParen => break,
+                Token::Comma if depth == 0 => commas += 1,
+                Token::Eq if depth == 0 && commas == 0 => {
+                    if let Some((Token::Ident(name), _)) = i.checked_sub(1).map(|j| &tokens[j]) {
+                        named = Some(name.to_string());
+                    }
+                }
+                _ => {}
+            }
+        }
+        let skip = usize::from(b.variadic.is_some()).min(commas);
+        let active = match named {
+            Some(name) => b.params.iter().position(|p| p.name == name),
+            None if b.variadic.is_some() => None,
+            None => (commas - skip < b.params.len()).then_some(commas - skip),
+        };
+        Some(SignatureHelp {
+            label: b.signature(),
+            doc: b.doc.to_string(),
+            params: b.params.iter().map(|p| (p.describe(), p.explain())).collect(),
+            active,
+        })
+    }
+
+    /// The builtin a call of `callee` names at `at`: a statement's argument list, a mesh
+    /// generator after `mesh`, or a function no name in scope hides.
+    fn builtin_called(&self, callee: &str, after_mesh: bool, at: u32) -> Option<&'static Builtin> {
         let builtin = match callee {
             "camera" => builtins::lookup(callee, Kind::Camera),
             "render" => builtins::lookup(callee, Kind::Render),
             _ if after_mesh => builtins::lookup(callee, Kind::MeshGenerator),
             _ => None,
         };
+        let user = self.index.in_scope(at).into_iter().any(|d| d.name == callee && d.kind == DefKind::Function);
+        builtin.or_else(|| (!user).then(|| builtins::lookup(callee, Kind::Function)).flatten())
+    }
+
+    fn named_arguments(&self, callee: &str, after_mesh: bool, at: u32, given: &[String]) -> Vec<Candidate> {
+        let builtin = self.builtin_called(callee, after_mesh, at);
         // A name in scope hides a builtin of the same name.
         let user = self.index.in_scope(at).into_iter().find(|d| d.name == callee && d.kind == DefKind::Function);
-        let builtin = builtin.or_else(|| user.is_none().then(|| builtins::lookup(callee, Kind::Function)).flatten());
         let fresh = |name: &str| !given.iter().any(|g| g == name);
         match (builtin, user) {
             (Some(b), _) => b
@@ -260,7 +327,7 @@ impl Analysis {
                     label: p.name.to_string(),
                     kind: CandidateKind::Argument,
                     detail: p.describe(),
-                    doc: Some(format!("parameter of `{}`", b.signature())),
+                    doc: Some(format!("{}; parameter of `{}`", p.explain(), b.signature())),
                 })
                 .collect(),
             (None, Some(def)) => def
@@ -317,7 +384,7 @@ fn builtin_candidate(b: &Builtin) -> Candidate {
         label: b.name.to_string(),
         kind: CandidateKind::Builtin,
         detail: b.signature(),
-        doc: Some(b.doc.to_string()),
+        doc: Some(b.explained()),
     }
 }
 
@@ -434,4 +501,31 @@ fn symbols_of(stmts: &[ast::Stmt], map: &SourceMap) -> Vec<Symbol> {
             })
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The parameter signature help marks, with the cursor at the end of `text`.
+    fn active(text: &str) -> Option<(String, Option<usize>)> {
+        let a = Analysis::new(Path::new("t.scn"), text.to_string(), &crate::source::FsLoader, &|| false)?;
+        a.signature_help(text.len() as u32).map(|h| (h.label, h.active))
+    }
+
+    #[test]
+    fn signature_help_follows_the_argument_being_typed() {
+        let at = |text: &str| active(text).and_then(|(_, i)| i);
+        assert_eq!(at("object cylinder("), Some(0));
+        assert_eq!(at("object cylinder(1, "), Some(1));
+        assert_eq!(at("object cylinder(max(1, 2), "), Some(1), "a nested call's comma is not the call's");
+        assert_eq!(at("let m = material(ior = "), Some(4));
+        assert_eq!(at("object union(sphere(1), box(1), smooth = "), Some(0));
+        assert_eq!(at("object union(sphere(1), "), None, "a variadic shape is no parameter");
+        assert_eq!(at("render(width = 10, "), Some(1));
+        assert_eq!(at("object mesh uvsphere(1, "), Some(1));
+        assert_eq!(active("object sphere(1) at [0, 0, 5]"), None, "outside any call");
+        let user = "let f(a, b) = sphere(a + b)\nobject f(";
+        assert_eq!(active(user), None, "a user function's call");
+    }
 }

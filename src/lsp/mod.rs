@@ -24,7 +24,7 @@ use lsp_types::notification::{
 };
 use lsp_types::request::{
     CodeActionRequest, Completion, DocumentSymbolRequest, Formatting, GotoDefinition, HoverRequest, References,
-    Request as _,
+    Request as _, SignatureHelpRequest,
 };
 use lsp_types::{self as lt, Uri};
 
@@ -87,6 +87,10 @@ fn capabilities() -> lt::ServerCapabilities {
         definition_provider: Some(lt::OneOf::Left(true)),
         references_provider: Some(lt::OneOf::Left(true)),
         completion_provider: Some(lt::CompletionOptions {
+            trigger_characters: Some(vec!["(".into(), ",".into()]),
+            ..Default::default()
+        }),
+        signature_help_provider: Some(lt::SignatureHelpOptions {
             trigger_characters: Some(vec!["(".into(), ",".into()]),
             ..Default::default()
         }),
@@ -400,6 +404,29 @@ impl Server {
                     })
                     .collect();
                 Ok(json(&lt::CompletionResponse::Array(items)))
+            }
+            SignatureHelpRequest::METHOD => {
+                let p: lt::SignatureHelpParams = params(req)?;
+                let (_, a, at) = self.at(&p.text_document_position_params)?;
+                let help = a.signature_help(at).map(|h| lt::SignatureHelp {
+                    active_parameter: h.active.map(|i| i as u32),
+                    signatures: vec![lt::SignatureInformation {
+                        label: h.label,
+                        documentation: Some(lt::Documentation::String(h.doc)),
+                        parameters: Some(
+                            h.params
+                                .into_iter()
+                                .map(|(label, doc)| lt::ParameterInformation {
+                                    label: lt::ParameterLabel::Simple(label),
+                                    documentation: Some(lt::Documentation::String(doc)),
+                                })
+                                .collect(),
+                        ),
+                        active_parameter: h.active.map(|i| i as u32),
+                    }],
+                    active_signature: Some(0),
+                });
+                Ok(json(&help))
             }
             DocumentSymbolRequest::METHOD => {
                 let p: lt::DocumentSymbolParams = params(req)?;

@@ -1,4 +1,7 @@
-//! `torus(major, minor)`: the ring in the xz plane.
+//! `torus(major, minor)`: the ring in the xz plane. A tube as wide as its ring or wider
+//! (a horn or spindle torus) overlaps itself across the axis: its distance is then exact
+//! only outside (inside it is a bound), and the isosurface mesher makes its triangles,
+//! as a parametric surface would fold through the solid.
 
 use glam::{DVec3, Vec2, Vec3A};
 
@@ -14,6 +17,13 @@ crate::params! {
         major: f64 as Num = required, Range::POSITIVE;
         /// the tube's radius
         minor: f64 as Num = required, Range::POSITIVE;
+    }
+}
+
+impl Torus {
+    /// Whether the tube leaves a hole: then the solid is the tube's parametric surface.
+    fn is_ring(&self) -> bool {
+        self.minor < self.major
     }
 }
 
@@ -44,7 +54,7 @@ impl Solid for Torus {
     }
 
     fn is_exact(&self) -> bool {
-        true
+        self.is_ring()
     }
 
     fn distance(&self) -> impl Field<f32> {
@@ -64,10 +74,17 @@ impl Solid for Torus {
     }
 
     fn facets(&self) -> Facets {
-        Facets::Inscribed(self.major + self.minor)
+        if self.is_ring() {
+            Facets::Inscribed(self.major + self.minor)
+        } else {
+            Facets::Isosurface
+        }
     }
 
     fn tessellate(&self, res: Resolution) -> Tessellation {
+        if !self.is_ring() {
+            return Tessellation::Isosurface;
+        }
         let (major, minor, n, sides) = (self.major, self.minor, res.circle, res.rings);
         Tessellation::Triangles(
             tessellate::count::torus(n, sides),

@@ -132,3 +132,10 @@ fn lowering_diagnostics() {
     }
     finish(failures);
 }
+
+/// `docs/builtins.md` is the reference the table writes (`UPDATE_EXPECT=1` rewrites it).
+#[test]
+fn reference_is_written_from_the_table() {
+    let failures = check_golden(std::path::Path::new("docs/builtins.md"), &scnc::check::builtins::reference());
+    finish(failures.into_iter().collect());
+}

@@ -235,7 +235,7 @@ object sphere(
 
     // Hover: a builtin's signature and doc, a name's type, an expression's type, a parameter.
     let h = c.hover(&doc, 2, 12);
-    assert!(h.contains("sphere(r: num)") && h.contains("radius"), "{h}");
+    assert!(h.contains("sphere(r: num)") && h.contains("- `r`: the radius; greater than 0"), "{h}");
     let h = c.at("textDocument/hover", &doc, 6, 8);
     assert!(h["contents"]["value"].as_str().is_some_and(|v| v.contains("let ball: shape")), "{h}");
     assert_eq!(h["range"], range(6, 7, 11));
@@ -268,9 +268,21 @@ object sphere(
         assert!(labels.contains(&name), "{name} missing from {labels:?}");
     }
     assert!(!labels.contains(&"i"), "the loop variable is out of scope here: {labels:?}");
+    assert!(
+        items[0]["documentation"].as_str().is_some_and(|d| d.starts_with("the radius; greater than 0")),
+        "{}",
+        items[0]
+    );
     let inside = c.at("textDocument/completion", &doc, 4, 24);
     let inside: Vec<&str> = inside.as_array().expect("items").iter().filter_map(|i| i["label"].as_str()).collect();
     assert!(inside.contains(&"i"), "{inside:?}");
+
+    // Signature help: the builtin being called, its parameters' docs and ranges, and the
+    // one the cursor is at (after `sphere(`, the first).
+    let help = c.at("textDocument/signatureHelp", &doc, 8, 14);
+    assert_eq!(help["signatures"][0]["label"], "sphere(r: num)", "{help}");
+    assert_eq!(help["signatures"][0]["parameters"][0]["documentation"], "the radius; greater than 0");
+    assert_eq!(help["activeParameter"], 0);
 
     // The outline.
     let symbols = c.request("textDocument/documentSymbol", json!({ "textDocument": { "uri": doc } }));

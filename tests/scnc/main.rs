@@ -5,6 +5,7 @@ mod budget;
 mod cli;
 mod conformance;
 mod deploy;
+mod derived;
 mod effects;
 mod export;
 mod fmt;

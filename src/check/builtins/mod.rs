@@ -11,7 +11,9 @@ use foldhash::fast::FixedState;
 use crate::ir::CsgOp;
 pub use crate::sig::{Default, Param, Range, Ty};
 
+mod reference;
 mod table;
+pub use reference::reference;
 pub use table::{constant, ConstValue, Constant, BUILTINS, CONSTANTS};
 
 /// Where a builtin may be used (follows from its [`Ctor`]).
@@ -199,6 +201,16 @@ impl Builtin {
             Ctor::Camera => Kind::Camera,
             Ctor::Render => Kind::Render,
         }
+    }
+
+    /// Its doc, then each parameter with its own doc and range, as Markdown: what hover
+    /// and the reference show.
+    pub fn explained(&self) -> String {
+        let mut out = self.doc.to_string();
+        for p in self.params {
+            out.push_str(&format!("\n- `{}`: {}", p.name, p.explain()));
+        }
+        out
     }
 
     /// The signature as users read it, such as `sphere(r: num)` or `min(num…)`.
