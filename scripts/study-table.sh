@@ -14,7 +14,7 @@ trap 'rm -rf "$out"' EXIT
 echo "| scene | SDF (epsilon 1e-4) | mesh low | mesh high | mesh matching SDF accuracy |"
 echo "|---|---|---|---|---|"
 for scene in examples/seed/0*.scn; do
-  ./target/release/scnc sweep "$scene" --out "$out" --width "$size" --height "$size" --runs "$runs" 2> /dev/null
+  ./target/release/scnc sweep "$scene" -o "$out" --width "$size" --height "$size" --runs "$runs" 2> /dev/null
   awk -F, -v name="$(basename "$scene" .scn)" '
     NR == 1 { for (i = 1; i <= NF; i++) col[$i] = i; next }
     { setting[NR] = $col["setting"]; backend[NR] = $col["backend"]; wall[NR] = $col["wall_ms"];

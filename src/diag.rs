@@ -404,6 +404,23 @@ pub fn suggest<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) ->
         .map(|(_, c)| c)
 }
 
+/// A byte count for people, in the largest binary unit it fills (`1 KiB`, `3.5 GiB`,
+/// `512 B`): a limit given as `1K` is reported as 1 KiB, not as 0 MiB.
+pub fn bytes(n: u64) -> String {
+    const UNITS: [&str; 5] = ["B", "KiB", "MiB", "GiB", "TiB"];
+    let mut value = n as f64;
+    let mut unit = 0;
+    while value >= 1024.0 && unit + 1 < UNITS.len() {
+        value /= 1024.0;
+        unit += 1;
+    }
+    if unit == 0 || value >= 10.0 || value.fract() == 0.0 {
+        format!("{value:.0} {}", UNITS[unit])
+    } else {
+        format!("{value:.1} {}", UNITS[unit])
+    }
+}
+
 #[cfg(test)]
 mod position_tests {
     use std::path::Path;
@@ -438,5 +455,18 @@ mod position_tests {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod bytes_tests {
+    #[test]
+    fn byte_counts_read_in_the_unit_they_fill() {
+        assert_eq!(super::bytes(512), "512 B");
+        assert_eq!(super::bytes(1024), "1 KiB");
+        assert_eq!(super::bytes(1536), "1.5 KiB");
+        assert_eq!(super::bytes(4 << 30), "4 GiB");
+        assert_eq!(super::bytes(100 << 20), "100 MiB");
+        assert_eq!(super::bytes(0), "0 B");
     }
 }

@@ -5,7 +5,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use super::files::{check_output_as, stop_on_interrupt, write_atomic, Pending};
+use super::files::{cannot_write, check_output_as, stop_on_interrupt, write_atomic, Pending};
 use super::frames::{frame_path, Pattern};
 use super::usage_error;
 
@@ -114,7 +114,7 @@ pub(crate) fn encode_cmd(args: EncodeArgs) -> ExitCode {
                 Format::Gif => gif(out, &frames, w, h, args.fps),
                 _ => apng(out, &frames, w, h, args.fps),
             });
-            written.map_err(|e| format!("cannot write `{}`: {e}", args.output.display()))
+            written.map_err(|e| cannot_write(&args.output, &e))
         }),
     };
     match result {
@@ -194,9 +194,7 @@ fn mp4(args: &EncodeArgs, numbers: &[u32]) -> Result<(), String> {
         }
         Err(e) => Err(format!("cannot run `ffmpeg`: {e}")),
         Ok(s) if !s.success() => Err(format!("`ffmpeg` failed ({s})")),
-        Ok(_) => {
-            std::fs::rename(&tmp, &args.output).map_err(|e| format!("cannot write `{}`: {e}", args.output.display()))
-        }
+        Ok(_) => std::fs::rename(&tmp, &args.output).map_err(|e| cannot_write(&args.output, &e)),
     };
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);

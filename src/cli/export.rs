@@ -14,7 +14,7 @@ use scnc::export::{Frame, Up};
 use scnc::source::FsLoader;
 use scnc::study::tolerance::Tolerance;
 
-use super::files::{check_output_as, write_atomic};
+use super::files::{cannot_write, check_output_as, write_atomic};
 use super::render::{parse_bytes, parse_detail};
 use super::{compile, report, usage_error, worker_pool, MessageFormat};
 
@@ -213,7 +213,7 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
             bytes += counted.bytes;
             Ok(())
         })
-        .map_err(|e| format!("cannot write `{}`: {e}", path.display()))
+        .map_err(|e| cannot_write(path, &e))
     };
     let mut written = Ok(());
     // The MTL goes first (an OBJ must not name a file that is not there); if the OBJ

@@ -76,6 +76,26 @@ pub(crate) fn check_output_as(path: &Path, what: &str) -> Result<(), String> {
     Ok(())
 }
 
+/// Why `path` could not be written, in the user's terms: their path (never the
+/// temporary file beside it), the reason, and what to do.
+pub(crate) fn cannot_write(path: &Path, e: &std::io::Error) -> String {
+    use std::io::ErrorKind;
+    let dir = parent_dir(&link_target(path)).display().to_string();
+    let reason = match e.kind() {
+        ErrorKind::PermissionDenied => {
+            format!("permission denied: `{dir}` is not writable (check its permissions, or write elsewhere)")
+        }
+        ErrorKind::NotFound => format!("the directory `{dir}` does not exist (or is not a real directory)"),
+        ErrorKind::StorageFull => "the disk is full".to_string(),
+        ErrorKind::ReadOnlyFilesystem => format!("`{dir}` is on a read-only file system"),
+        ErrorKind::QuotaExceeded => "the disk quota is exceeded".to_string(),
+        // An encoder's own error says what went wrong in its words.
+        ErrorKind::Other => e.to_string(),
+        kind => kind.to_string(),
+    };
+    format!("cannot write `{}`: {reason}", path.display())
+}
+
 /// The directory a file is in (`.` for a bare file name).
 fn parent_dir(path: &Path) -> &Path {
     match path.parent() {

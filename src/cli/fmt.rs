@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use scnc::source::{FsLoader, Loader};
 
-use super::files::write_text;
+use super::files::{cannot_write, write_text};
 use super::{report_in, MessageFormat};
 
 /// Formats each file in place, or with `check` lists those that would change.
@@ -41,7 +41,7 @@ pub(crate) fn fmt_cmd(files: &[PathBuf], check: bool) -> ExitCode {
             let _ = writeln!(std::io::stdout(), "{name}");
             unformatted = true;
         } else if let Err(e) = write_text(path, &formatted) {
-            let _ = writeln!(std::io::stderr(), "error: cannot write `{name}`: {e}");
+            let _ = writeln!(std::io::stderr(), "error: {}", cannot_write(path, &e));
             failed = true;
         }
     }

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use scnc::render::BitDepth;
 
-use super::files::{check_output, write_png};
+use super::files::{cannot_write, check_output, write_png};
 
 #[derive(clap::Args)]
 pub(crate) struct MergeArgs {
@@ -131,7 +131,7 @@ pub(crate) fn merge_cmd(args: MergeArgs) -> ExitCode {
         }
     };
     if let Err(e) = write_png(&args.output, &image) {
-        let _ = writeln!(std::io::stderr(), "error: cannot write `{}`: {e}", args.output.display());
+        let _ = writeln!(std::io::stderr(), "error: {}", cannot_write(&args.output, &e));
         return ExitCode::from(1);
     }
     let _ = writeln!(

@@ -13,6 +13,7 @@ mod files;
 mod fmt;
 mod frames;
 mod merge;
+mod progress;
 mod render;
 mod stats;
 mod sweep;
@@ -121,32 +122,62 @@ pub(crate) fn compile(path: &Path, format: MessageFormat) -> Option<Compiled> {
                 })
                 .to_string(),
             };
-            let _ = writeln!(std::io::stderr(), "{line}");
+            match format {
+                MessageFormat::Human => {
+                    let _ = writeln!(std::io::stderr(), "{line}");
+                }
+                // Machine output goes to stdout, as cargo's and rustc's does.
+                MessageFormat::Json => {
+                    let _ = writeln!(std::io::stdout(), "{line}");
+                }
+            }
             None
         }
     }
 }
 
-/// Prints diagnostics to stderr; returns whether any was an error.
+/// Prints diagnostics (to stderr for people, as JSON lines to stdout for tools); returns
+/// whether any was an error.
 pub(crate) fn report(c: &Compiled, format: MessageFormat) -> bool {
     report_in(&c.map, &c.diagnostics, format)
 }
 
-/// Prints diagnostics about the files of `map` to stderr (lowering's warnings come after
-/// the checker's); returns whether any was an error.
+/// Prints diagnostics about the files of `map` (lowering's warnings come after the
+/// checker's): rendered to stderr for people, at most [`SHOWN`] of them and then how many
+/// more; or every one as a JSON line to stdout for tools, as cargo's and rustc's machine
+/// output goes. Returns whether any was an error.
 pub(crate) fn report_in(map: &scnc::source::SourceMap, diagnostics: &[Diagnostic], format: MessageFormat) -> bool {
-    let color = std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none();
-    let mut err = std::io::stderr().lock();
-    let mut sources = scnc::diag::Sources::new(map);
-    for d in diagnostics {
-        let text = match format {
-            MessageFormat::Human => d.render_with(&mut sources, color),
-            MessageFormat::Json => format!("{}\n", d.to_json(map)),
-        };
-        let _ = err.write_all(text.as_bytes());
+    match format {
+        MessageFormat::Human => {
+            let color = std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none();
+            let mut err = std::io::stderr().lock();
+            let mut sources = scnc::diag::Sources::new(map);
+            for d in diagnostics.iter().take(SHOWN) {
+                let _ = err.write_all(d.render_with(&mut sources, color).as_bytes());
+            }
+            if let Some(more) = diagnostics.len().checked_sub(SHOWN).filter(|&n| n > 0) {
+                let errors = diagnostics[SHOWN..].iter().filter(|d| d.is_error()).count();
+                let _ = writeln!(
+                    err,
+                    "… and {more} more diagnostic{} ({errors} error{}); `--message-format json` lists every one",
+                    if more == 1 { "" } else { "s" },
+                    if errors == 1 { "" } else { "s" }
+                );
+            }
+        }
+        MessageFormat::Json => {
+            let mut out = std::io::stdout().lock();
+            for d in diagnostics {
+                let _ = writeln!(out, "{}", d.to_json(map));
+            }
+        }
     }
     diagnostics.iter().any(Diagnostic::is_error)
 }
+
+/// Most diagnostics printed for people: past a screenful the rest are one mistake
+/// repeated, or a file that is not a scene at all.
+const SHOWN: usize = 50;
 
 /// A usage problem found after argument parsing: printed like clap's, exit 2.
 pub(crate) fn usage_error(msg: &str) -> ExitCode {

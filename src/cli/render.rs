@@ -1,7 +1,7 @@
 //! `scnc render`: one scene compiled, lowered and rendered to a PNG.
 
 use std::collections::HashSet;
-use std::io::{IsTerminal, Write};
+use std::io::Write;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -16,8 +16,9 @@ use scnc::Compiled;
 
 use scnc::render::{BitDepth, Region};
 
-use super::files::{check_output, stop_on_interrupt, write_part_png, write_png};
+use super::files::{cannot_write, check_output, stop_on_interrupt, write_part_png, write_png};
 use super::frames::{frame_path, is_pattern, parse_frames, FrameChoice};
+use super::progress::Progress;
 use super::{compile, report, usage_error, worker_pool, MessageFormat};
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -272,6 +273,15 @@ impl RenderArgs {
     /// process with `interrupted` (leaving no partial output): what `render` and `watch`
     /// both need before any work.
     pub(crate) fn checked_pool(&self, interrupted: i32) -> Result<rayon::ThreadPool, ExitCode> {
+        // A frame sequence gets its directory made, as Blender's output path does: an
+        // animation is written into a directory of its own.
+        if is_pattern(&self.output) {
+            if let Some(dir) = self.output.parent().filter(|d| !d.as_os_str().is_empty() && !d.exists()) {
+                std::fs::create_dir_all(dir).map_err(|e| {
+                    usage_error(&format!("cannot create `{}` for the frames: {}", dir.display(), e.kind()))
+                })?;
+            }
+        }
         check_output(&self.output).map_err(|e| usage_error(&e))?;
         if let Err(e) = stop_on_interrupt(interrupted) {
             let _ = writeln!(std::io::stderr(), "warning: {e}");
@@ -388,9 +398,12 @@ fn render_scene(
         EffectsArg::Derived => scnc::render::effects::derive(&scene),
         EffectsArg::All => scnc::render::effects::Effects::all(&scene),
     };
+    let building = Progress::new(scnc::world::lowering_steps(&scene), "steps", "lowering");
     let lowered = pool.install(|| {
-        scnc::world::prepare_reusing(&scene, effects, mode, &FsLoader, args.memory_limit, &mut sequence.cache)
+        let cache = &mut sequence.cache;
+        scnc::world::prepare_reusing(&scene, effects, mode, &FsLoader, args.memory_limit, cache, &|| building.step())
     });
+    building.finish();
     let (mut frame, geometry) = match lowered {
         Ok(g) => {
             let fresh: Vec<_> =
@@ -406,8 +419,9 @@ fn render_scene(
     frame.bit_depth = args.bit_depth;
     let lowered = started.elapsed();
     let region = part.unwrap_or(Region::full(frame.width, frame.height));
-    let progress = Progress::new(region.height());
-    let (image, counters) = pool.install(|| scnc::render::render_region(&geometry, &frame, region, &|| progress.row()));
+    let progress = Progress::new(region.height() as u64, "rows", "rendering");
+    let (image, counters) =
+        pool.install(|| scnc::render::render_region(&geometry, &frame, region, &|| progress.step()));
     progress.finish();
     let traced = started.elapsed() - lowered;
     let written = match part {
@@ -415,7 +429,7 @@ fn render_scene(
         None => write_png(output, &image),
     };
     if let Err(e) = written {
-        let _ = writeln!(std::io::stderr(), "error: cannot write `{}`: {e}", output.display());
+        let _ = writeln!(std::io::stderr(), "error: {}", cannot_write(output, &e));
         return Err(ExitCode::from(1));
     }
     let secs = traced.as_secs_f64();
@@ -426,11 +440,12 @@ fn render_scene(
     };
     let _ = writeln!(
         err,
-        "rendered {}: {size} in {:.3} s ({:.2} M rays/s, {} threads)",
+        "rendered {}: {size} in {:.3} s ({:.2} M rays/s, {} thread{})",
         output.display(),
         started.elapsed().as_secs_f64(),
         counters.rays() as f64 / secs.max(1e-9) / 1e6,
-        pool.current_num_threads()
+        pool.current_num_threads(),
+        if pool.current_num_threads() == 1 { "" } else { "s" }
     );
     if args.stats {
         let _ = writeln!(err, "{}", frame.effects);
@@ -445,39 +460,4 @@ fn render_scene(
         }
     }
     Ok(())
-}
-
-/// A progress bar on a terminal, shown only once a render has taken a second.
-struct Progress {
-    bar: Option<indicatif::ProgressBar>,
-    started: Instant,
-}
-
-impl Progress {
-    fn new(rows: u32) -> Progress {
-        let bar = std::io::stderr().is_terminal().then(|| {
-            let bar =
-                indicatif::ProgressBar::with_draw_target(Some(rows as u64), indicatif::ProgressDrawTarget::hidden());
-            if let Ok(style) = indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} rows, {eta} left") {
-                bar.set_style(style);
-            }
-            bar
-        });
-        Progress { bar, started: Instant::now() }
-    }
-
-    fn row(&self) {
-        if let Some(bar) = &self.bar {
-            if bar.is_hidden() && self.started.elapsed().as_secs_f64() > 1.0 {
-                bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
-            }
-            bar.inc(1);
-        }
-    }
-
-    fn finish(&self) {
-        if let Some(bar) = &self.bar {
-            bar.finish_and_clear();
-        }
-    }
 }

@@ -9,16 +9,16 @@ use scnc::study::sweep::{Options, PeakMemory, Setting};
 use scnc::study::tolerance::Tolerance;
 use scnc::study::{chart, report as table, sweep};
 
-use super::files::{write_png, write_text};
+use super::files::{cannot_write, write_png, write_text};
 use super::{compile, report, usage_error, MessageFormat};
 
 #[derive(clap::Args)]
 pub(crate) struct SweepArgs {
     /// The scene file.
     file: PathBuf,
-    /// Directory for sweep.csv and sweep.md (created if missing).
-    #[arg(long)]
-    out: PathBuf,
+    /// Directory for sweep.csv, sweep.md and the charts (created if missing).
+    #[arg(short, long, alias = "out")]
+    output: PathBuf,
     /// Image width for the sweep.
     #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u32).range(1..=4096))]
     width: u32,
@@ -41,8 +41,8 @@ pub(crate) struct SweepArgs {
 }
 
 pub(crate) fn sweep_cmd(args: SweepArgs) -> ExitCode {
-    if let Err(e) = std::fs::create_dir_all(&args.out) {
-        return usage_error(&format!("cannot create `{}`: {e}", args.out.display()));
+    if let Err(e) = std::fs::create_dir_all(&args.output) {
+        return usage_error(&format!("cannot create `{}`: {e}", args.output.display()));
     }
     let Some(compiled) = compile(&args.file, args.message_format) else { return ExitCode::from(1) };
     if report(&compiled, args.message_format) {
@@ -81,23 +81,23 @@ pub(crate) fn sweep_cmd(args: SweepArgs) -> ExitCode {
     }
     let title = format!("{} at {}×{}", args.file.display(), args.width, args.height);
     for (name, text) in [("sweep.csv", table::csv(&rows)), ("sweep.md", table::markdown(&rows, &title))] {
-        let path = args.out.join(name);
+        let path = args.output.join(name);
         if let Err(e) = write_text(&path, &text) {
-            let _ = writeln!(std::io::stderr(), "error: cannot write `{}`: {e}", path.display());
+            let _ = writeln!(std::io::stderr(), "error: {}", cannot_write(&path, &e));
             return ExitCode::from(1);
         }
     }
     for (name, axis) in [("time-vs-error.png", chart::Axis::Time), ("memory-vs-error.png", chart::Axis::Memory)] {
-        let path = args.out.join(name);
+        let path = args.output.join(name);
         let written = chart::error_chart(&rows, axis, &title)
             .map_err(std::io::Error::other)
             .and_then(|img| write_png(&path, &img));
         if let Err(e) = written {
-            let _ = writeln!(std::io::stderr(), "error: cannot write `{}`: {e}", path.display());
+            let _ = writeln!(std::io::stderr(), "error: {}", cannot_write(&path, &e));
             return ExitCode::from(1);
         }
     }
-    let _ = writeln!(std::io::stderr(), "swept {} settings: {}", rows.len(), args.out.join("sweep.md").display());
+    let _ = writeln!(std::io::stderr(), "swept {} settings: {}", rows.len(), args.output.join("sweep.md").display());
     ExitCode::SUCCESS
 }
 

@@ -169,7 +169,7 @@ impl Budget {
             codes::LOWERING,
             span,
             "the system would not give the memory the scene's meshes need",
-            format!("the meshes need about {} more here, most of it for this object", mib(planned)),
+            format!("the meshes need about {} more here, most of it for this object", crate::diag::bytes(planned)),
         )
         .with_note("the memory limit allowed it, but the process may not have that much (see `ulimit -v`)")
         .with_hint("try a lower `--detail`, coarser meshes, or a lower `--memory-limit`"))
@@ -199,12 +199,12 @@ impl Budget {
                 codes::LOWERING,
                 span,
                 "the scene's meshes would need more memory than the limit",
-                format!("this object needs about {} ({triangles} triangles)", mib(bytes)),
+                format!("this object needs about {} ({triangles} triangles)", crate::diag::bytes(bytes)),
             )
             .with_note(format!(
                 "the memory limit is {}, of which {} is left; a triangle takes up to {BYTES_PER_TRIANGLE} bytes while it is built",
-                mib(self.limit),
-                mib(self.bytes)
+                crate::diag::bytes(self.limit),
+                crate::diag::bytes(self.bytes)
             ))
             .with_hint("try a lower `--detail`, coarser meshes, or a higher `--memory-limit`"));
         }
@@ -219,11 +219,6 @@ impl Budget {
         }
         Ok(())
     }
-}
-
-/// Bytes in MiB, for people.
-fn mib(bytes: u64) -> String {
-    format!("{:.0} MiB", bytes as f64 / (1u64 << 20) as f64)
 }
 
 /// The cell of an isosurface made at `rings` of detail: a 1/(4·rings) fraction of the

@@ -68,13 +68,17 @@ pub fn prepare_within(
     loader: &dyn Loader,
     memory_limit: u64,
 ) -> Result<(Frame, World), Diagnostic> {
-    prepare_reusing(scene, effects, mode, loader, memory_limit, &mut FrameCache::default())
+    prepare_reusing(scene, effects, mode, loader, memory_limit, &mut FrameCache::default(), &|| {})
 }
 
 /// [`prepare_within`] for one frame of an animation: objects equal to the previous
 /// frame's, seen from the same place, are taken from `reuse` instead of lowered again
 /// (their meshes are shared, not rebuilt), and this frame's objects are kept there for
 /// the next. The world is the one [`prepare_within`] would make, bit for bit.
+///
+/// `step` is called twice per object, as it is lowered (in scene order: an isosurface is
+/// extracted here) and as it is built (in parallel: vertices to render space and BVHs),
+/// for a progress bar of [`lowering_steps`].
 pub fn prepare_reusing(
     scene: &ir::Scene,
     effects: crate::render::effects::Effects,
@@ -82,11 +86,12 @@ pub fn prepare_reusing(
     loader: &dyn Loader,
     memory_limit: u64,
     reuse: &mut FrameCache,
+    step: &(dyn Fn() + Sync),
 ) -> Result<(Frame, World), Diagnostic> {
     let mut frame = Frame::with_effects(scene, effects);
     let params = MarchParams { epsilon: scene.settings.epsilon as f32, max_steps: scene.settings.max_steps };
     let budget = mesh::lower::Budget::new(memory_limit);
-    let world = lower_reusing(scene, &mut frame, mode, params, loader, budget, reuse)?;
+    let world = lower_reusing(scene, &mut frame, mode, params, loader, budget, reuse, step)?;
     Ok((frame, world))
 }
 
@@ -100,7 +105,12 @@ pub fn lower(
     loader: &dyn Loader,
     budget: mesh::lower::Budget,
 ) -> Result<World, Diagnostic> {
-    lower_reusing(scene, frame, mode, params, loader, budget, &mut FrameCache::default())
+    lower_reusing(scene, frame, mode, params, loader, budget, &mut FrameCache::default(), &|| {})
+}
+
+/// How many times lowering `scene` calls [`prepare_reusing`]'s `step`.
+pub fn lowering_steps(scene: &ir::Scene) -> u64 {
+    2 * scene.objects.len() as u64
 }
 
 /// Objects one frame lowered, for the next frame to reuse.
@@ -144,6 +154,7 @@ fn reads_files(obj: &ir::Object) -> bool {
     matches!(&obj.geometry, ir::Geometry::Mesh(m) if matches!(m.source, ir::MeshSource::File { .. }))
 }
 
+#[allow(clippy::too_many_arguments, reason = "prepare_reusing's arguments, and the frame it fills")]
 fn lower_reusing(
     scene: &ir::Scene,
     frame: &mut Frame,
@@ -152,6 +163,7 @@ fn lower_reusing(
     loader: &dyn Loader,
     mut budget: mesh::lower::Budget,
     reuse: &mut FrameCache,
+    step: &(dyn Fn() + Sync),
 ) -> Result<World, Diagnostic> {
     // Render space: world translated so the camera is at the origin, composed in f64.
     let to_render = DAffine3::from_translation(-frame.origin);
@@ -220,6 +232,7 @@ fn lower_reusing(
         let (closure_bytes, triangles) = (after.1 - before.1, before.2 - after.2);
         kept.push((obj, (before.0, after.0), closure_bytes, triangles, warnings.clone()));
         lowered.push((part, warnings, obj.span));
+        step();
     }
     budget.confirm()?;
     let warnings: Vec<Diagnostic> = lowered.iter().flat_map(|(_, w, _)| w.iter().cloned()).collect();
@@ -227,16 +240,20 @@ fn lower_reusing(
     // of a scene of many meshes; they are independent, so they are built in parallel.
     let objects: Vec<Object> = lowered
         .into_par_iter()
-        .map(|(part, _, span)| match part {
-            Lowered::Sdf(s, Reach { bounds, sphere, half_space }) => {
-                Object { kind: ObjectKind::Sdf(s), bounds, sphere, half_space, span }
-            }
-            Lowered::Mesh(job) => {
-                let m = job.build();
-                let (bounds, sphere) = (Some(m.bounds()), m.sphere());
-                Object { bounds, sphere, half_space: None, kind: ObjectKind::Mesh(Arc::new(m)), span }
-            }
-            Lowered::Kept(object) => object,
+        .map(|(part, _, span)| {
+            let object = match part {
+                Lowered::Sdf(s, Reach { bounds, sphere, half_space }) => {
+                    Object { kind: ObjectKind::Sdf(s), bounds, sphere, half_space, span }
+                }
+                Lowered::Mesh(job) => {
+                    let m = job.build();
+                    let (bounds, sphere) = (Some(m.bounds()), m.sphere());
+                    Object { bounds, sphere, half_space: None, kind: ObjectKind::Mesh(Arc::new(m)), span }
+                }
+                Lowered::Kept(object) => object,
+            };
+            step();
+            object
         })
         .collect();
     let closure_bytes = builder.bytes;

@@ -36,7 +36,9 @@ fn missing_file_is_an_error() {
 fn json_message_format_has_one_object_per_diagnostic() {
     let out = scnc(&["check", "--message-format", "json", "tests/data/diag/two-syntax-errors.scn"]);
     assert_eq!(out.status.code(), Some(1));
-    let text = String::from_utf8_lossy(&out.stderr);
+    // Machine output on stdout, as cargo's and rustc's; nothing for people on stderr.
+    assert!(out.stderr.is_empty(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
     let lines: Vec<serde_json::Value> =
         text.lines().map(|l| serde_json::from_str(l).expect("valid JSON line")).collect();
     assert_eq!(lines.len(), 2, "{text}");
@@ -151,7 +153,7 @@ fn sweep_writes_csv_with_monotone_errors() {
     let o = scnc(&[
         "sweep",
         "examples/seed/01-sphere.scn",
-        "--out",
+        "-o",
         out,
         "--width",
         "48",
@@ -246,12 +248,12 @@ fn empty_and_unreadable_files_are_reported_for_what_they_are() {
     let o = scnc(&["check", "--message-format", "json", "no/such/file.scn"]);
     assert_eq!(o.status.code(), Some(1));
     let line: serde_json::Value =
-        serde_json::from_str(String::from_utf8_lossy(&o.stderr).trim()).expect("one JSON line");
+        serde_json::from_str(String::from_utf8_lossy(&o.stdout).trim()).expect("one JSON line");
     assert_eq!((line["code"].as_str(), line["severity"].as_str()), (Some("E0600"), Some("error")));
     assert_eq!(line["span"]["file"], "no/such/file.scn");
     // It has the documented fields of every diagnostic, a zero-length span at the start.
     let o = scnc(&["check", "--message-format", "json", "tests/data/diag/two-syntax-errors.scn"]);
-    let text = String::from_utf8_lossy(&o.stderr);
+    let text = String::from_utf8_lossy(&o.stdout);
     let normal: serde_json::Value = serde_json::from_str(text.lines().next().unwrap_or_default()).expect("JSON");
     let keys = |v: &serde_json::Value| v.as_object().map(|o| o.keys().cloned().collect::<Vec<_>>()).unwrap_or_default();
     assert_eq!(keys(&line), keys(&normal));
@@ -364,4 +366,54 @@ fn memory_limit_refuses_meshes_before_building_them() {
         let o = scnc(&["render", scene, "-o", png, "--memory-limit", bad]);
         assert_eq!(o.status.code(), Some(2), "--memory-limit {bad}");
     }
+}
+
+/// What a newcomer meets first, each said plainly: plurals, the unit a size was given
+/// in, a cap on a flood of diagnostics, OS errors in terms of the user's own path, a
+/// frame sequence's directory made for it, `-o` for every output.
+#[test]
+fn messages_a_newcomer_meets() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let at = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
+    let seed = "examples/seed/01-sphere.scn";
+
+    let out = scnc(&["render", seed, "-o", &at("a.png"), "--width", "8", "--height", "8", "--threads", "1"]);
+    ok(&out);
+    assert!(String::from_utf8_lossy(&out.stderr).contains(" M rays/s, 1 thread)"), "{out:?}");
+
+    let out = scnc(&["render", seed, "-o", &at("m.png"), "--geometry", "mesh", "--memory-limit", "1K"]);
+    refused(&out, 1, "the memory limit is 1 KiB");
+
+    let out = scnc(&["check", "README.md"]);
+    refused(&out, 1, "more diagnostics (");
+    let shown = String::from_utf8_lossy(&out.stderr).matches("] Error:").count();
+    assert_eq!(shown, 50, "the first fifty are shown");
+
+    // A directory that exists but cannot hold files: the error names the user's path,
+    // never the temporary file beside it.
+    let out = scnc(&["render", seed, "-o", "/proc/scnc-test.png", "--width", "8", "--height", "8"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("cannot write `/proc/scnc-test.png`") && !err.contains(".tmp") && !err.contains("os error"),
+        "{err}"
+    );
+
+    let frames = at("frames/f-##.png");
+    ok(&scnc(&[
+        "render",
+        "tests/data/animation/bounce.scn",
+        "-o",
+        &frames,
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--frames",
+        "0..2",
+    ]));
+    assert!(dir.path().join("frames/f-00.png").exists() && dir.path().join("frames/f-01.png").exists());
+
+    let out = scnc(&["sweep", "--help"]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("-o, --output <OUTPUT>"));
 }

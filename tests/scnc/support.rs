@@ -164,3 +164,26 @@ impl Rng {
         glam::Vec3A::new(self.f32() * 2.0 - 1.0, self.f32() * 2.0 - 1.0, self.f32() * 2.0 - 1.0) * r
     }
 }
+
+/// Whether the program `name` can be run (a tool some tests drive, such as `nvim` or
+/// `chromium`). Where it cannot, those tests are skipped with a note, unless
+/// `SCNC_REQUIRE_TOOLS=1` (set by `.ci/run`, which installs them) makes that a failure.
+pub fn have_tool(name: &str) -> bool {
+    let found = std::process::Command::new(name)
+        .arg("--version")
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success());
+    if !found {
+        assert!(
+            std::env::var_os("SCNC_REQUIRE_TOOLS").is_none_or(|v| v != "1"),
+            "`{name}` is required (SCNC_REQUIRE_TOOLS=1) but cannot be run"
+        );
+        #[allow(clippy::print_stderr, reason = "a skipped test says why, where cargo test shows it")]
+        {
+            eprintln!("skipped: `{name}` is not installed");
+        }
+    }
+    found
+}
