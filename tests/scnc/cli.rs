@@ -1,6 +1,6 @@
 //! The binary: exit codes, streams, and output formats.
 
-use crate::support::scnc;
+use crate::support::{ok, refused, scnc};
 
 #[test]
 fn check_clean_file_exits_0() {
