@@ -372,6 +372,8 @@ pub mod codes {
     pub const LOST_PARTS: &str = "W0801";
     /// Isosurface edges left on four triangles where parts are thinner than the cell.
     pub const PINCHED_EDGES: &str = "W0802";
+    /// An unbounded object left out of an export.
+    pub const SKIPPED_UNBOUNDED: &str = "W0803";
 }
 
 /// Edit distance for "did you mean" suggestions.

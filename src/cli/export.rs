@@ -97,6 +97,10 @@ pub(crate) struct ExportArgs {
     /// Most memory the meshes may take while they are made (as `render`).
     #[arg(long, value_parser = parse_bytes, default_value = "4G")]
     memory_limit: u64,
+    /// Leave out unbounded objects (a `plane`), with a warning, instead of stopping at
+    /// them: always so for STL and 3MF, which are for printing.
+    #[arg(long)]
+    skip_unbounded: bool,
     /// Check each object's mesh: watertight and manifold, degenerate triangles dropped,
     /// enclosed volume and bounds.
     #[arg(long)]
@@ -193,7 +197,9 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
         None => Up::Y,
     };
     let frame = Frame { up, scale: args.scale };
-    let export = match pool.install(|| scnc::export::collect(scene, detail, frame, args.memory_limit, &FsLoader)) {
+    let skip = args.skip_unbounded || format.for_printing();
+    let export = match pool.install(|| scnc::export::collect(scene, detail, frame, args.memory_limit, skip, &FsLoader))
+    {
         Ok(e) => {
             super::report_in(&compiled.map, &e.warnings, args.message_format);
             e

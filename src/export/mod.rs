@@ -175,13 +175,15 @@ impl Export {
 }
 
 /// Meshes every object of `scene` at `detail` into `frame`, within `memory_limit`
-/// bytes of meshes (as `render` counts them). An unbounded shape (a `plane`, an
-/// infinite `repeat`) cannot be a mesh file's solid: it is an error at its object.
+/// bytes of meshes (as `render` counts them). An unbounded shape (a `plane`) cannot be
+/// a mesh file's solid: with `skip_unbounded` it is left out with a warning, otherwise
+/// it is an error at its object.
 pub fn collect(
     scene: &Scene,
     detail: Detail,
     frame: Frame,
     memory_limit: u64,
+    skip_unbounded: bool,
     loader: &dyn Loader,
 ) -> Result<Export, Diagnostic> {
     let mut materials = MaterialTable::default();
@@ -189,11 +191,24 @@ pub fn collect(
     // As the world lowers: every object's mesh made in scene order (materials interned
     // and the budget spent as they come), the memory confirmed once, then converted.
     let mut jobs = Vec::with_capacity(scene.objects.len());
+    let mut skipped = Vec::new();
     for obj in &scene.objects {
         let job = match &obj.geometry {
             ir::Geometry::Shape(shape) => {
                 if ir::shape_bounds(shape).is_none() {
-                    return Err(unbounded(obj.span));
+                    if !skip_unbounded {
+                        return Err(unbounded(obj.span));
+                    }
+                    skipped.push(
+                        Diagnostic::warning(
+                            codes::SKIPPED_UNBOUNDED,
+                            obj.span,
+                            "this unbounded object is left out of the export",
+                            "it has no finite surface",
+                        )
+                        .with_note("a mesh file holds closed solids; a `plane` has no finite surface to write"),
+                    );
+                    continue;
                 }
                 // Only planes use the far limit, and they were refused above.
                 mesh::lower::tessellate(shape, DAffine3::IDENTITY, detail, 0.0, &mut budget, &mut materials)?
@@ -203,7 +218,8 @@ pub fn collect(
         jobs.push((job, obj.span));
     }
     budget.confirm()?;
-    let warnings = jobs.iter_mut().flat_map(|(job, _)| std::mem::take(&mut job.warnings)).collect();
+    let warnings =
+        skipped.into_iter().chain(jobs.iter_mut().flat_map(|(job, _)| std::mem::take(&mut job.warnings))).collect();
     let parts = jobs.into_iter().enumerate().map(|(n, (job, span))| part(n, job, span, frame)).collect();
     let colours = materials.materials.iter().map(|m| Colour(m.color.as_dvec3().to_array())).collect();
     Ok(Export { parts, colours, warnings })
@@ -239,5 +255,5 @@ fn part(n: usize, job: mesh::MeshJob, span: Span, frame: Frame) -> Part {
 fn unbounded(span: Span) -> Diagnostic {
     Diagnostic::error(codes::LOWERING, span, "cannot export an unbounded shape", "this object has no finite extent")
         .with_note("a mesh file holds closed solids; a `plane` or an infinite `repeat` has no finite surface")
-        .with_hint("intersect it with a `box` to bound it, or leave the object out of the exported scene")
+        .with_hint("intersect it with a `box` to bound it, or pass `--skip-unbounded` to leave it out")
 }

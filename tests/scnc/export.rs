@@ -228,6 +228,8 @@ fn obj_mtl_and_ascii_stl_match_their_golden_files() {
 
 #[test]
 fn every_example_exports_to_every_format_or_names_its_unbounded_object() {
+    // Formats for printing leave an unbounded object out (W0803); the others stop at it
+    // unless asked to leave it out.
     let dir = tempfile::tempdir().expect("temp dir");
     let mut scenes: Vec<PathBuf> = ["examples/seed", "examples/features"]
         .iter()
@@ -239,9 +241,12 @@ fn every_example_exports_to_every_format_or_names_its_unbounded_object() {
     for scene in &scenes {
         for ext in ["stl", "obj", "ply", "3mf", "glb"] {
             let out = dir.path().join(format!("out.{ext}"));
-            let run =
-                scnc(&["export", scene.to_str().expect("path"), "-o", out.to_str().expect("path"), "--detail", "low"]);
+            let args = ["export", scene.to_str().expect("path"), "-o", out.to_str().expect("path"), "--detail", "low"];
+            let run = scnc(&args);
             let err = String::from_utf8_lossy(&run.stderr);
+            if matches!(ext, "stl" | "3mf") {
+                assert_eq!(run.status.code(), Some(0), "{}: {err}", scene.display());
+            }
             if run.status.code() == Some(0) {
                 // Warnings may come first (a shell thinner than the low-detail cell has a
                 // pinched edge, W0802), never an error.
@@ -257,6 +262,10 @@ fn every_example_exports_to_every_format_or_names_its_unbounded_object() {
                     scene.display()
                 );
                 assert!(!out.exists(), "nothing written for {}", scene.display());
+                let skipped = scnc(&[&args[..], &["--skip-unbounded"]].concat());
+                let err = String::from_utf8_lossy(&skipped.stderr);
+                assert_eq!(skipped.status.code(), Some(0), "{}: {err}", scene.display());
+                assert!(err.contains("[W0803]"), "{}: {err}", scene.display());
             }
             let _ = std::fs::remove_file(&out);
         }
@@ -284,10 +293,10 @@ fn bad_exports_are_clear_errors_and_write_nothing() {
         assert_eq!(run.status.code(), Some(code), "{args:?}: {err}");
         assert!(err.contains(message), "{args:?}: {err}");
     }
-    let run = scnc(&["export", "tests/data/export/plane.scn", "-o", &at("p.stl")]);
+    let run = scnc(&["export", "tests/data/export/plane.scn", "-o", &at("p.glb")]);
     let err = String::from_utf8_lossy(&run.stderr);
     assert_eq!(run.status.code(), Some(1));
-    assert!(err.contains("E0800") && err.contains("plane.scn:5:1"), "{err}");
+    assert!(err.contains("E0800") && err.contains("plane.scn:5:1") && err.contains("--skip-unbounded"), "{err}");
     assert_eq!(std::fs::read_dir(dir.path()).expect("dir").count(), 0, "nothing written");
 }
 

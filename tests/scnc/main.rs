@@ -19,6 +19,7 @@ mod mesh;
 mod nopanic;
 mod primitives;
 mod pruning;
+mod readme;
 mod render;
 mod skip;
 mod stability;

@@ -1,0 +1,177 @@
+//! The README works as written on a fresh clone: every command of its `sh` blocks runs
+//! in a copy of the repository's files (what a clone has) and succeeds, and every link
+//! of the README and the docs points at a file that is there.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The files a clone would have: tracked, and new ones not ignored (so a file about to
+/// be committed counts, and a build product never does).
+fn clone_files() -> Vec<PathBuf> {
+    let out = Command::new("git")
+        .args(["ls-files", "--cached", "--others", "--exclude-standard", "-z"])
+        .output()
+        .expect("running git ls-files");
+    assert!(out.status.success(), "git ls-files: {}", String::from_utf8_lossy(&out.stderr));
+    out.stdout
+        .split(|&b| b == 0)
+        .filter(|p| !p.is_empty())
+        .map(|p| PathBuf::from(String::from_utf8_lossy(p).into_owned()))
+        .filter(|p| p.exists())
+        .collect()
+}
+
+/// A fresh copy of the repository's files in a temporary directory.
+fn fresh_clone() -> tempfile::TempDir {
+    let dir = tempfile::tempdir().expect("temp dir");
+    for file in clone_files() {
+        let to = dir.path().join(&file);
+        std::fs::create_dir_all(to.parent().expect("a parent")).expect("making a directory");
+        // Links are copied as links (the VS Code extension's grammar is one).
+        match std::fs::read_link(&file) {
+            Ok(target) => {
+                #[cfg(unix)]
+                std::os::unix::fs::symlink(target, &to).expect("copying a link");
+            }
+            Err(_) => {
+                std::fs::copy(&file, &to).expect("copying a file");
+            }
+        }
+    }
+    dir
+}
+
+/// The command lines of the `sh` blocks of a Markdown text, comments removed.
+fn shell_commands(markdown: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut in_sh = false;
+    for line in markdown.lines() {
+        if let Some(lang) = line.strip_prefix("```") {
+            in_sh = !in_sh && lang.trim() == "sh";
+            continue;
+        }
+        if in_sh {
+            let command = line.split(" #").next().unwrap_or("").trim();
+            if !command.is_empty() && !command.starts_with('#') {
+                out.push(command.to_string());
+            }
+        }
+    }
+    out
+}
+
+/// Commands the test does not run itself, and why: it is one (`cargo test`), and an
+/// install builds the release binary the test already has.
+const NOT_RUN: &[&str] = &["cargo test", "cargo install --path ."];
+
+#[test]
+fn every_readme_command_works_on_a_fresh_clone() {
+    let readme = std::fs::read_to_string("README.md").expect("reading README.md");
+    let commands = shell_commands(&readme);
+    assert!(commands.len() >= 4, "{commands:?}");
+    let clone = fresh_clone();
+    let bin = Path::new(env!("CARGO_BIN_EXE_scnc")).parent().expect("the binary's directory");
+    let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap_or_default());
+    for command in commands {
+        if NOT_RUN.contains(&command.as_str()) {
+            continue;
+        }
+        // `cargo run --release --` is the binary under test (already built).
+        let line = command.replacen("cargo run --release --", "scnc", 1);
+        assert!(line.starts_with("scnc "), "a README command the test cannot run: `{command}`");
+        let out = Command::new("sh")
+            .args(["-c", &line])
+            .current_dir(clone.path())
+            .env("PATH", &path)
+            .env("NO_COLOR", "1")
+            .output()
+            .expect("running a README command");
+        assert!(
+            out.status.success(),
+            "`{command}` failed on a fresh clone ({}):\n{}",
+            out.status,
+            String::from_utf8_lossy(&out.stderr)
+        );
+        // What it says it writes, it writes.
+        let words: Vec<&str> = line.split_whitespace().collect();
+        if let Some(i) = words.iter().position(|w| *w == "-o") {
+            let written = clone.path().join(words[i + 1]);
+            assert!(written.exists(), "`{command}` did not write {}", written.display());
+        }
+    }
+}
+
+/// Relative links of a Markdown file (`[text](target)`, anchors dropped).
+fn links(markdown: &str) -> Vec<String> {
+    markdown
+        .match_indices("](")
+        .filter_map(|(i, _)| {
+            let rest = &markdown[i + 2..];
+            let target = &rest[..rest.find(')')?];
+            let target = target.split('#').next().unwrap_or("");
+            (!target.is_empty() && !target.contains("://") && !target.starts_with("mailto:"))
+                .then(|| target.to_string())
+        })
+        .collect()
+}
+
+#[test]
+fn every_link_of_the_readme_and_docs_is_in_a_clone() {
+    let files = clone_files();
+    let mut pages: Vec<PathBuf> =
+        files.iter().filter(|p| p.starts_with("docs") && p.extension().is_some_and(|e| e == "md")).cloned().collect();
+    pages.push(PathBuf::from("README.md"));
+    let mut missing = Vec::new();
+    for page in &pages {
+        let text = std::fs::read_to_string(page).expect("reading a page");
+        let dir = page.parent().unwrap_or(Path::new(""));
+        for link in links(&text) {
+            let target = dir.join(&link);
+            // Normalise `docs/../x` lexically, as a browser does.
+            let mut parts: Vec<&std::ffi::OsStr> = Vec::new();
+            for c in target.components() {
+                match c {
+                    std::path::Component::ParentDir => {
+                        parts.pop();
+                    }
+                    std::path::Component::CurDir => {}
+                    c => parts.push(c.as_os_str()),
+                }
+            }
+            let target: PathBuf = parts.iter().collect();
+            let present = files.iter().any(|f| *f == target || f.starts_with(&target));
+            if !present {
+                missing.push(format!("{}: `{link}` is not in a clone", page.display()));
+            }
+        }
+    }
+    assert!(missing.is_empty(), "{}", missing.join("\n"));
+}
+
+/// A `scn` block of the README or the docs that names its file on its first line
+/// (`// examples/tour.scn: …`) is that file, word for word, so the tour shown is the
+/// tour that runs.
+#[test]
+fn every_scene_shown_is_the_file_it_names() {
+    let mut pages: Vec<PathBuf> = clone_files()
+        .into_iter()
+        .filter(|p| p.starts_with("docs") && p.extension().is_some_and(|e| e == "md"))
+        .collect();
+    pages.push(PathBuf::from("README.md"));
+    let mut shown = 0;
+    for page in pages {
+        let text = std::fs::read_to_string(&page).expect("reading a page");
+        for block in text.split("```scn\n").skip(1) {
+            let block = &block[..block.find("```").expect("a closed block")];
+            let Some(name) =
+                block.strip_prefix("// ").and_then(|l| l.split(':').next()).filter(|n| n.ends_with(".scn"))
+            else {
+                continue;
+            };
+            let file = std::fs::read_to_string(name).unwrap_or_else(|e| panic!("{}: {name}: {e}", page.display()));
+            assert_eq!(block, file, "{} shows {name} other than it is", page.display());
+            shown += 1;
+        }
+    }
+    assert!(shown >= 2, "the README's and the language's tours name their files");
+}
