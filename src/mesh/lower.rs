@@ -363,7 +363,7 @@ fn isosurface_object(
         .iter()
         .map(|t| {
             let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
-            mat(((a + b + c) / 3.0).as_vec3a()).1
+            mat(((a + b + c) / 3.0).as_vec3a()).mat
         })
         .collect();
     let mut solid = Vec::new();

@@ -16,8 +16,58 @@ use crate::trace::MaterialTable;
 
 /// A distance bound: never more than the true distance to the surface.
 pub type Sdf = Arc<dyn Fn(Vec3A) -> f32 + Send + Sync>;
-/// A distance bound and the material of the nearest part.
-pub type MatSdf = Arc<dyn Fn(Vec3A) -> (f32, u32) + Send + Sync>;
+/// The distance bound with its gradient and the material of the nearest part:
+/// evaluated once per hit, for its normal and material.
+pub type SurfSdf = Arc<dyn Fn(Vec3A) -> Surf + Send + Sync>;
+
+/// The field at a point: its value, its gradient (composed analytically through the
+/// tree, so a normal carries no finite-difference noise at any hit threshold) and the
+/// material of the part that decides it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Surf {
+    /// The distance bound.
+    pub d: f32,
+    /// Its gradient (not normalised: blends weigh their parts' gradients by it).
+    pub g: Vec3A,
+    /// Index into the material table.
+    pub mat: u32,
+}
+
+impl Surf {
+    /// The lower of two (a sharp union); ties go to `self`.
+    #[inline]
+    pub fn min(self, o: Surf) -> Surf {
+        if o.d < self.d {
+            o
+        } else {
+            self
+        }
+    }
+
+    /// The higher of two (a sharp intersection); ties go to `self`.
+    #[inline]
+    pub fn max(self, o: Surf) -> Surf {
+        if o.d > self.d {
+            o
+        } else {
+            self
+        }
+    }
+
+    /// The complement's field: the solid turned inside out.
+    #[inline]
+    pub fn neg(self) -> Surf {
+        Surf { d: -self.d, g: -self.g, ..self }
+    }
+
+    /// The polynomial smooth minimum of two (radius `k` > 0), its gradient the same
+    /// blend of theirs; the material is the lower part's.
+    #[inline]
+    pub fn smin(self, o: Surf, k: f32) -> Surf {
+        let (d, w) = prim::smin_weighted(self.d, o.d, k);
+        Surf { d, g: self.g * (1.0 - w) + o.g * w, mat: if o.d < self.d { o.mat } else { self.mat } }
+    }
+}
 
 /// Builds closures and counts the bytes they capture.
 pub struct Builder<'a> {
@@ -43,18 +93,28 @@ struct LastUnion {
     node: usize,
     tree: Arc<PartTree>,
     parts: Arc<[Sdf]>,
-    mats: Arc<[MatSdf]>,
+    surfs: Arc<[SurfSdf]>,
     k: f32,
 }
 
-/// The distance closure of one primitive in its own frame, its distance inlined.
-struct Leaf<'b, 'a>(&'b mut Builder<'a>);
+/// The closures of one primitive in its own frame, painted `mat`: its distance inlined
+/// in the one, and with its analytic gradient in the other.
+struct Leaf<'b, 'a> {
+    builder: &'b mut Builder<'a>,
+    mat: u32,
+}
 
 impl Visit for Leaf<'_, '_> {
-    type Out = Sdf;
+    type Out = (Sdf, SurfSdf);
 
-    fn visit<S: Solid>(self, s: &S) -> Sdf {
-        self.0.leaf(s.distance())
+    fn visit<S: Solid>(self, s: &S) -> (Sdf, SurfSdf) {
+        let (f, g, mat) = (s.distance(), s.gradient(), self.mat);
+        let d = self.builder.leaf(f.clone());
+        let m = self.builder.mat(move |p| {
+            crate::trace::count_leaf();
+            Surf { d: f(p), g: g(p), mat }
+        });
+        (d, m)
     }
 }
 
@@ -69,7 +129,7 @@ impl<'a> Builder<'a> {
 
     /// [`build`](Self::build), and when the shape is a union of bounded parts (under
     /// transforms and paint) that a ray can march part by part, what it needs for that.
-    pub fn build_root(&mut self, shape: &Shape, xf: DAffine3, mat: u32) -> (Sdf, MatSdf, Option<RayParts>) {
+    pub fn build_root(&mut self, shape: &Shape, xf: DAffine3, mat: u32) -> (Sdf, SurfSdf, Option<RayParts>) {
         self.last_union = None;
         let (d, m) = self.build(shape, xf, mat);
         let mut node = shape;
@@ -85,7 +145,7 @@ impl<'a> Builder<'a> {
             }
         }
         let parts = match self.last_union.take() {
-            Some(LastUnion { node: addr, tree, parts, mats, k }) if addr == node as *const Shape as usize => {
+            Some(LastUnion { node: addr, tree, parts, surfs, k }) if addr == node as *const Shape as usize => {
                 // Sharp unions are built in render space; smooth ones in their own frame.
                 let (inv, scale) = if k == 0.0 || acc == DAffine3::IDENTITY {
                     (Affine3A::IDENTITY, 1.0)
@@ -96,7 +156,7 @@ impl<'a> Builder<'a> {
                         if acc.matrix3 == DMat3::IDENTITY { 1.0 } else { min_singular_value(acc.matrix3) as f32 };
                     (inv32, scale)
                 };
-                Some(RayParts { inv, scale, tree, parts, mats, k })
+                Some(RayParts { inv, scale, tree, parts, surfs, k })
             }
             _ => None,
         };
@@ -108,14 +168,14 @@ impl<'a> Builder<'a> {
         Arc::new(f)
     }
 
-    fn mat<F: Fn(Vec3A) -> (f32, u32) + Send + Sync + 'static>(&mut self, f: F) -> MatSdf {
+    fn mat<F: Fn(Vec3A) -> Surf + Send + Sync + 'static>(&mut self, f: F) -> SurfSdf {
         // Material closures mirror the distance ones; their bytes count too.
         self.bytes += std::mem::size_of_val(&f) + ARC_HEADER;
         Arc::new(f)
     }
 
     /// Lowers `shape` seen through `xf` (render from local), painted `mat` where it has no material.
-    pub fn build(&mut self, shape: &Shape, xf: DAffine3, mat: u32) -> (Sdf, MatSdf) {
+    pub fn build(&mut self, shape: &Shape, xf: DAffine3, mat: u32) -> (Sdf, SurfSdf) {
         match &shape.kind {
             ShapeKind::Transform { child, xf: inner } => self.build(child, xf * *inner, mat),
             ShapeKind::Paint { child, material } => {
@@ -123,14 +183,14 @@ impl<'a> Builder<'a> {
                 self.build(child, xf, id)
             }
             ShapeKind::Csg { op: CsgOp::Union, children, smooth } if *smooth == 0.0 && children.len() >= MANY => {
-                let kids: Vec<(Sdf, MatSdf)> = children.iter().map(|c| self.build(c, xf, mat)).collect();
+                let kids: Vec<(Sdf, SurfSdf)> = children.iter().map(|c| self.build(c, xf, mat)).collect();
                 match part_bounds(children, xf) {
                     Some(bounds) => self.pruned_union(shape, kids, bounds, 0.0),
                     None => self.combine(kids, CsgOp::Union),
                 }
             }
             ShapeKind::Csg { op: CsgOp::Subtract, children, smooth } if *smooth == 0.0 && children.len() > MANY => {
-                let kids: Vec<(Sdf, MatSdf)> = children.iter().map(|c| self.build(c, xf, mat)).collect();
+                let kids: Vec<(Sdf, SurfSdf)> = children.iter().map(|c| self.build(c, xf, mat)).collect();
                 match part_bounds(&children[1..], xf) {
                     Some(bounds) => {
                         let (first, cutters) = (kids[0].clone(), kids[1..].to_vec());
@@ -140,7 +200,7 @@ impl<'a> Builder<'a> {
                 }
             }
             ShapeKind::Csg { op, children, smooth } if *smooth == 0.0 => {
-                let kids: Vec<(Sdf, MatSdf)> = children.iter().map(|c| self.build(c, xf, mat)).collect();
+                let kids: Vec<(Sdf, SurfSdf)> = children.iter().map(|c| self.build(c, xf, mat)).collect();
                 self.combine(kids, *op)
             }
             ShapeKind::Primitive(p) => self.primitive(p, xf, mat),
@@ -155,16 +215,19 @@ impl<'a> Builder<'a> {
         }
     }
 
-    fn primitive(&mut self, p: &Primitive, xf: DAffine3, mat: u32) -> (Sdf, MatSdf) {
+    fn primitive(&mut self, p: &Primitive, xf: DAffine3, mat: u32) -> (Sdf, SurfSdf) {
         // A sphere under a similarity is a sphere: no inverse map needed.
         if let (Primitive::Sphere(s), Some(scale)) = (p, similarity(xf.matrix3)) {
             let c = Vec3A::from(xf.translation.as_vec3());
-            let f = Sphere { r: s.r * scale }.distance();
-            let g = f.clone();
-            let d = self.leaf(move |p| f(p - c));
+            let sphere = Sphere { r: s.r * scale };
+            let (f, g) = (sphere.distance(), sphere.gradient());
+            let d = self.leaf({
+                let f = f.clone();
+                move |p| f(p - c)
+            });
             let m = self.mat(move |p| {
                 crate::trace::count_leaf();
-                (g(p - c), mat)
+                Surf { d: f(p - c), g: g(p - c), mat }
             });
             return (d, m);
         }
@@ -174,22 +237,18 @@ impl<'a> Builder<'a> {
             Primitive::Plane(plane) => {
                 let (normal, offset) = crate::ir::transform_half_space((plane.normal, plane.offset), &xf)
                     .unwrap_or((plane.normal, plane.offset));
-                let f = Plane { normal, offset }.distance();
-                let g = f.clone();
-                let d = self.leaf(f);
+                let plane = Plane { normal, offset };
+                let (f, g) = (plane.distance(), plane.gradient());
+                let d = self.leaf(f.clone());
                 let m = self.mat(move |p| {
                     crate::trace::count_leaf();
-                    (g(p), mat)
+                    Surf { d: f(p), g: g(p), mat }
                 });
                 (d, m)
             }
             _ => {
-                let local = p.visit(Leaf(self));
-                let m = {
-                    let local = local.clone();
-                    self.mat(move |p| (local(p), mat))
-                };
-                self.wrap(local, m, xf)
+                let (d, m) = p.visit(Leaf { builder: self, mat });
+                self.wrap(d, m, xf)
             }
         }
     }
@@ -205,7 +264,7 @@ impl<'a> Builder<'a> {
     /// Applies `xf` (render from local) to a local-frame evaluator: the inverse maps the
     /// query point; the distance is scaled by the smallest singular value of the linear
     /// part, which keeps it a bound under any scale (exact under a similarity).
-    fn wrap(&mut self, d: Sdf, m: MatSdf, xf: DAffine3) -> (Sdf, MatSdf) {
+    fn wrap(&mut self, d: Sdf, m: SurfSdf, xf: DAffine3) -> (Sdf, SurfSdf) {
         if xf.matrix3 == DMat3::IDENTITY {
             if xf.translation == glam::DVec3::ZERO {
                 return (d, m);
@@ -218,20 +277,22 @@ impl<'a> Builder<'a> {
         let inv = xf.inverse();
         let inv32 = Affine3A::from_mat3_translation(inv.matrix3.as_mat3(), inv.translation.as_vec3());
         let k = min_singular_value(xf.matrix3) as f32;
+        // The chain rule: the gradient of k·f(M⁻¹p) is k·M⁻ᵀ∇f.
+        let to_world = glam::Mat3A::from(inv.matrix3.transpose().as_mat3()) * k;
         let dd = self.sdf(move |p| d(inv32.transform_point3a(p)) * k);
         let mm = self.mat(move |p| {
-            let (dist, id) = m(inv32.transform_point3a(p));
-            (dist * k, id)
+            let s = m(inv32.transform_point3a(p));
+            Surf { d: s.d * k, g: to_world * s.g, mat: s.mat }
         });
         (dd, mm)
     }
 
     /// Builds an operator or modifier node in its own frame.
-    fn local(&mut self, shape: &Shape, mat: u32) -> (Sdf, MatSdf) {
+    fn local(&mut self, shape: &Shape, mat: u32) -> (Sdf, SurfSdf) {
         let id = DAffine3::IDENTITY;
         match &shape.kind {
             ShapeKind::Csg { op, children, smooth } => {
-                let kids: Vec<(Sdf, MatSdf)> = children.iter().map(|c| self.build(c, id, mat)).collect();
+                let kids: Vec<(Sdf, SurfSdf)> = children.iter().map(|c| self.build(c, id, mat)).collect();
                 match (op, part_bounds(children, id)) {
                     (CsgOp::Union, Some(bounds)) => self.pruned_union(shape, kids, bounds, *smooth as f32),
                     _ => self.smooth(kids, *op, *smooth as f32),
@@ -243,8 +304,8 @@ impl<'a> Builder<'a> {
                 (
                     self.sdf(move |p| d(p) - r),
                     self.mat(move |p| {
-                        let (x, i) = m(p);
-                        (x - r, i)
+                        let s = m(p);
+                        Surf { d: s.d - r, ..s }
                     }),
                 )
             }
@@ -254,8 +315,10 @@ impl<'a> Builder<'a> {
                 (
                     self.sdf(move |p| d(p).abs() - half),
                     self.mat(move |p| {
-                        let (x, i) = m(p);
-                        (x.abs() - half, i)
+                        let s = m(p);
+                        // Inside the original solid the wall's outside is the other way.
+                        let g = if s.d < 0.0 { -s.g } else { s.g };
+                        Surf { d: s.d.abs() - half, g, mat: s.mat }
                     }),
                 )
             }
@@ -263,7 +326,7 @@ impl<'a> Builder<'a> {
                 let (d, m) = self.build(child, id, mat);
                 let rep = Repeat::new(period.as_vec3a(), *count);
                 let rep2 = rep.clone();
-                (self.sdf(move |p| rep.eval(p, |q| d(q))), self.mat(move |p| rep2.eval_mat(p, |q| m(q))))
+                (self.sdf(move |p| rep.eval(p, |q| d(q))), self.mat(move |p| rep2.eval_surf(p, |q| m(q))))
             }
             ShapeKind::Primitive(_) | ShapeKind::Transform { .. } | ShapeKind::Paint { .. } => {
                 self.build(shape, id, mat)
@@ -271,50 +334,44 @@ impl<'a> Builder<'a> {
         }
     }
 
-    fn combine(&mut self, kids: Vec<(Sdf, MatSdf)>, op: CsgOp) -> (Sdf, MatSdf) {
+    fn combine(&mut self, kids: Vec<(Sdf, SurfSdf)>, op: CsgOp) -> (Sdf, SurfSdf) {
         let mut kids = kids;
         if kids.len() == 1 {
             if let Some(only) = kids.pop() {
                 return only;
             }
         }
-        let (ds, ms): (Vec<Sdf>, Vec<MatSdf>) = kids.into_iter().unzip();
+        let (ds, ms): (Vec<Sdf>, Vec<SurfSdf>) = kids.into_iter().unzip();
         self.bytes += ds.len() * 2 * std::mem::size_of::<Sdf>();
         match op {
             CsgOp::Union => (
                 self.sdf(move |p| ds.iter().fold(f32::INFINITY, |a, f| a.min(f(p)))),
-                self.mat(move |p| {
-                    ms.iter().map(|f| f(p)).fold((f32::INFINITY, 0), |a, b| if b.0 < a.0 { b } else { a })
-                }),
+                self.mat(move |p| ms[1..].iter().fold(ms[0](p), |a, f| a.min(f(p)))),
             ),
             CsgOp::Intersect => (
                 self.sdf(move |p| ds.iter().fold(f32::NEG_INFINITY, |a, f| a.max(f(p)))),
-                self.mat(move |p| {
-                    ms.iter().map(|f| f(p)).fold((f32::NEG_INFINITY, 0), |a, b| if b.0 > a.0 { b } else { a })
-                }),
+                self.mat(move |p| ms[1..].iter().fold(ms[0](p), |a, f| a.max(f(p)))),
             ),
             CsgOp::Subtract => (
                 self.sdf(move |p| ds[1..].iter().fold(ds[0](p), |a, f| a.max(-f(p)))),
                 // The cut faces take the material of the part cut away.
-                self.mat(move |p| {
-                    ms[1..].iter().map(|f| f(p)).fold(ms[0](p), |a, (d, i)| if -d > a.0 { (-d, i) } else { a })
-                }),
+                self.mat(move |p| ms[1..].iter().fold(ms[0](p), |a, f| a.max(f(p).neg()))),
             ),
         }
     }
 
     /// A union of bounded parts, walked through a hierarchy of their boxes (see
     /// [`union`]); `k` is the blend radius, 0 for a sharp union.
-    fn pruned_union(&mut self, node: &Shape, kids: Vec<(Sdf, MatSdf)>, bounds: PartBounds, k: f32) -> (Sdf, MatSdf) {
+    fn pruned_union(&mut self, node: &Shape, kids: Vec<(Sdf, SurfSdf)>, bounds: PartBounds, k: f32) -> (Sdf, SurfSdf) {
         let tree = Arc::new(PartTree::new(bounds.boxes, bounds.spheres, self.prune));
-        let (ds, ms): (Vec<Sdf>, Vec<MatSdf>) = kids.into_iter().unzip();
-        let (ds, ms): (Arc<[Sdf]>, Arc<[MatSdf]>) = (ds.into(), ms.into());
+        let (ds, ms): (Vec<Sdf>, Vec<SurfSdf>) = kids.into_iter().unzip();
+        let (ds, ms): (Arc<[Sdf]>, Arc<[SurfSdf]>) = (ds.into(), ms.into());
         self.bytes += ds.len() * 2 * std::mem::size_of::<Sdf>() + tree.bytes();
         self.last_union = Some(LastUnion {
             node: node as *const Shape as usize,
             tree: tree.clone(),
             parts: ds.clone(),
-            mats: ms.clone(),
+            surfs: ms.clone(),
             k,
         });
         let t = tree.clone();
@@ -323,7 +380,7 @@ impl<'a> Builder<'a> {
             t.visit(p, f32::INFINITY, |i, bound| fold.push(union::clamp(ds[i](p), bound)));
             fold.finish()
         });
-        let m = self.mat(move |p| tree.material(&ms, (k, 0.0), p, f32::INFINITY, |_, _| {}));
+        let m = self.mat(move |p| tree.surface(&ms, k, p, f32::INFINITY));
         (d, m)
     }
 
@@ -334,12 +391,12 @@ impl<'a> Builder<'a> {
     /// bounds as a union's parts are.
     fn pruned_subtract(
         &mut self,
-        (first, first_mat): (Sdf, MatSdf),
-        cutters: Vec<(Sdf, MatSdf)>,
+        (first, first_mat): (Sdf, SurfSdf),
+        cutters: Vec<(Sdf, SurfSdf)>,
         bounds: PartBounds,
-    ) -> (Sdf, MatSdf) {
+    ) -> (Sdf, SurfSdf) {
         let tree = Arc::new(PartTree::new(bounds.boxes, bounds.spheres, self.prune));
-        let (cs, ms): (Vec<Sdf>, Vec<MatSdf>) = cutters.into_iter().unzip();
+        let (cs, ms): (Vec<Sdf>, Vec<SurfSdf>) = cutters.into_iter().unzip();
         self.bytes += (cs.len() + 1) * 2 * std::mem::size_of::<Sdf>() + tree.bytes();
         let t = tree.clone();
         let d = self.sdf(move |p| {
@@ -351,24 +408,23 @@ impl<'a> Builder<'a> {
             acc
         });
         let m = self.mat(move |p| {
-            let (mut acc, mut id) = first_mat(p);
+            let mut acc = first_mat(p);
             let mut cutter = usize::MAX;
-            tree.visit(p, -acc, |i, bound| {
-                let (v, material) = ms[i](p);
-                let v = -union::clamp(v, bound);
+            tree.visit(p, -acc.d, |i, _| {
+                let cut = tree.clamped(i, ms[i](p), p).neg();
                 // The cut faces take the material of the cutter; ties go to the first.
-                if v > acc || (v == acc && cutter != usize::MAX && i < cutter) {
-                    (acc, id, cutter) = (v, material, i);
+                if cut.d > acc.d || (cut.d == acc.d && cutter != usize::MAX && i < cutter) {
+                    (acc, cutter) = (cut, i);
                 }
-                -acc
+                -acc.d
             });
-            (acc, id)
+            acc
         });
         (d, m)
     }
 
-    fn smooth(&mut self, kids: Vec<(Sdf, MatSdf)>, op: CsgOp, k: f32) -> (Sdf, MatSdf) {
-        let (ds, ms): (Vec<Sdf>, Vec<MatSdf>) = kids.into_iter().unzip();
+    fn smooth(&mut self, kids: Vec<(Sdf, SurfSdf)>, op: CsgOp, k: f32) -> (Sdf, SurfSdf) {
+        let (ds, ms): (Vec<Sdf>, Vec<SurfSdf>) = kids.into_iter().unzip();
         self.bytes += ds.len() * 2 * std::mem::size_of::<Sdf>();
         // intersect = −smin(−a, −b); subtract(a, b) = −smin(−a, b).
         let fold = move |vals: &mut dyn Iterator<Item = f32>| -> f32 {
@@ -391,17 +447,15 @@ impl<'a> Builder<'a> {
                 }
             }
         };
-        let fold2 = fold;
         let d = self.sdf(move |p| fold(&mut ds.iter().map(|f| f(p))));
         let m = self.mat(move |p| {
-            let vals: Vec<(f32, u32)> = ms.iter().map(|f| f(p)).collect();
-            let dist = fold2(&mut vals.iter().map(|v| v.0));
-            let id = match op {
-                CsgOp::Union => vals.iter().fold((f32::INFINITY, 0), |a, b| if b.0 < a.0 { *b } else { a }).1,
-                CsgOp::Intersect => vals.iter().fold((f32::NEG_INFINITY, 0), |a, b| if b.0 > a.0 { *b } else { a }).1,
-                CsgOp::Subtract => vals[1..].iter().fold(vals[0], |a, &(d, i)| if -d > a.0 { (-d, i) } else { a }).1,
-            };
-            (dist, id)
+            let first = ms[0](p);
+            let rest = ms[1..].iter().map(|f| f(p));
+            match op {
+                CsgOp::Union => union::smooth_surf(std::iter::once(first).chain(rest), k),
+                CsgOp::Intersect => rest.fold(first.neg(), |a, b| a.smin(b.neg(), k)).neg(),
+                CsgOp::Subtract => rest.fold(first.neg(), |a, b| a.smin(b, k)).neg(),
+            }
         });
         (d, m)
     }
@@ -479,7 +533,7 @@ impl Repeat {
         self.cells(p).fold(f32::INFINITY, |a, q| a.min(f(q)))
     }
 
-    fn eval_mat(&self, p: Vec3A, f: impl Fn(Vec3A) -> (f32, u32)) -> (f32, u32) {
-        self.cells(p).map(f).fold((f32::INFINITY, 0), |a, b| if b.0 < a.0 { b } else { a })
+    fn eval_surf(&self, p: Vec3A, f: impl Fn(Vec3A) -> Surf) -> Surf {
+        self.cells(p).map(f).fold(Surf { d: f32::INFINITY, g: Vec3A::Y, mat: 0 }, Surf::min)
     }
 }

@@ -92,15 +92,3 @@ fn walk(
     c.budget_misses += 1;
     None
 }
-
-/// The unit gradient of `f` at `p` by the four-tap tetrahedral difference, step `h`.
-#[inline]
-pub fn normal(f: &dyn Fn(Vec3A) -> f32, p: Vec3A, h: f32) -> Vec3A {
-    const K0: Vec3A = Vec3A::new(1.0, -1.0, -1.0);
-    const K1: Vec3A = Vec3A::new(-1.0, -1.0, 1.0);
-    const K2: Vec3A = Vec3A::new(-1.0, 1.0, -1.0);
-    const K3: Vec3A = Vec3A::new(1.0, 1.0, 1.0);
-    let g = K0 * f(p + K0 * h) + K1 * f(p + K1 * h) + K2 * f(p + K2 * h) + K3 * f(p + K3 * h);
-    // A flat gradient (at a crease or a cusp) gets a defined, finite normal.
-    g.try_normalize().unwrap_or(Vec3A::Y)
-}

@@ -14,7 +14,7 @@ pub mod union;
 use glam::{DAffine3, Vec3A};
 
 pub use crate::ir::min_singular_value;
-pub use build::{Builder, MatSdf, Sdf};
+pub use build::{Builder, Sdf, Surf, SurfSdf};
 pub use march::MarchParams;
 
 use crate::ir;
@@ -25,8 +25,8 @@ use crate::trace::{Counters, Hit, Packet, Ray};
 pub struct SdfObject {
     /// Distance bound, for marching.
     pub dist: Sdf,
-    /// Distance and material, evaluated once per hit.
-    pub mat: MatSdf,
+    /// Distance, gradient and material, evaluated once per hit.
+    pub mat: SurfSdf,
     /// Whether the shape is a convex solid ([`ir::Shape::is_convex`]).
     convex: bool,
     /// A union at the root, marched part by part ([`union::RayParts`]).
@@ -93,8 +93,9 @@ impl SdfObject {
         hits
     }
 
-    /// The surface at a hit found by [`closest`](Self::closest): normal from the gradient
-    /// and material from the material closure, numbered `object`. Done once per ray, for the winner.
+    /// The surface at a hit found by [`closest`](Self::closest): normal from the field's
+    /// analytic gradient and material from the surface closure, numbered `object`. Done
+    /// once per ray, for the winner.
     /// `leaving` says the hit was found marching from inside: the ray is leaving the solid
     /// there whatever the gradient says (at grazing, or in a wall thinner than the
     /// threshold, it can point either way), so the normal is turned to agree.
@@ -104,15 +105,13 @@ impl SdfObject {
     #[inline(never)]
     pub fn surface(&self, ray: &Ray, t: f32, error: f32, object: u32, leaving: bool, c: &mut Counters) -> Hit {
         let point = ray.at(t);
-        let h = error.max(point.abs().max_element() * 8.0 * f32::EPSILON);
-        let (normal, d, material) = match &self.parts {
-            Some(parts) => parts.surface(point, h),
-            None => {
-                let (d, material) = (self.mat)(point);
-                (march::normal(&*self.dist, point, h), d, material)
-            }
+        let Surf { d, g, mat: material } = match &self.parts {
+            Some(parts) => parts.surface(point, error),
+            None => (self.mat)(point),
         };
-        c.sdf_shading_evals += 5;
+        // A flat gradient (at a crease or a cusp) gets a defined, finite normal.
+        let normal = g.try_normalize().unwrap_or(Vec3A::Y);
+        c.sdf_shading_evals += 1;
         // The gradient of a convex solid's field is its outward normal, but only on the
         // surface: a ray starting inside the solid "hits" where it starts, below it.
         let convex = self.convex && d > -error;

@@ -9,6 +9,15 @@ pub fn smin(a: f32, b: f32, k: f32) -> f32 {
     a.min(b) - h * h * k * 0.25
 }
 
+/// [`smin`] and the share of `b` in its gradient, `∂smin/∂b` (that of `a` is one less
+/// it): the blend `h/2` towards the higher of the two, `1 − h/2` towards the lower.
+#[inline]
+pub fn smin_weighted(a: f32, b: f32, k: f32) -> (f32, f32) {
+    let h = (k - (a - b).abs()).max(0.0) / k;
+    let w = if b < a { 1.0 - h * 0.5 } else { h * 0.5 };
+    (a.min(b) - h * h * k * 0.25, w)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -36,6 +45,14 @@ mod tests {
             assert!(s >= a.min(b) - k * 0.25 - 1e-6);
             // |Δsmin| ≤ max(|Δa|, |Δb|).
             assert!((smin(a + da, b + db, k) - s).abs() <= da.abs().max(db.abs()) + 1e-5);
+            // The weight is the slope in `b` (a central difference, away from the kinks).
+            let (v, w) = smin_weighted(a, b, k);
+            assert_eq!(v, s);
+            let e = 1e-3;
+            if ((a - b).abs() - k).abs() > 2.0 * e && (a - b).abs() > 2.0 * e {
+                let slope = (smin(a, b + e, k) - smin(a, b - e, k)) / (2.0 * e);
+                assert!((slope - w).abs() < 1e-2, "∂smin/∂b at {a}, {b}, {k}: {slope} vs {w}");
+            }
         }
     }
 }

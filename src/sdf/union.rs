@@ -22,8 +22,12 @@
 
 use glam::{Vec3A, Vec4};
 
+use super::build::Surf;
 use super::prim;
 use crate::accel::{sphere_interval, Aabb, Bvh, Child, Rays4, ROBUST};
+
+/// The field of no part at all: nothing there.
+const NOTHING: Surf = Surf { d: f32::INFINITY, g: Vec3A::Y, mat: 0 };
 
 /// Parts per leaf of the hierarchy.
 const LEAF: usize = 2;
@@ -76,32 +80,49 @@ impl PartTree {
         self.boxes[i].outside_squared(p).sqrt().max((p - centre).length() - radius)
     }
 
-    /// The union's value and material at `p` from the parts' distance-and-material
-    /// closures `mats`, blend radius `k`: ties go to the part written first, whatever
-    /// order the walk takes. Every part within `extra` beyond the union's own pruning
-    /// reach (best value + `k`) is also walked, and each part walked is passed to `seen`
-    /// with its value. Nothing `start` or more from `p` is walked until a part is found
-    /// (infinity: the whole reach; a smaller start is the caller's guess of the reach,
-    /// to be checked against the best value found).
-    pub fn material(
-        &self,
-        mats: &[super::MatSdf],
-        (k, extra): (f32, f32),
-        p: Vec3A,
-        start: f32,
-        mut seen: impl FnMut(usize, f32),
-    ) -> (f32, u32) {
-        let (mut fold, mut first, mut id) = (Fold::new(k), usize::MAX, 0);
-        self.visit(p, start, |i, bound| {
-            let (v, material) = mats[i](p);
-            let v = clamp(v, bound);
-            seen(i, v);
-            if v < fold.best() || (v == fold.best() && i < first) {
-                (first, id) = (i, material);
-            }
-            fold.push(v) + extra
+    /// Part `i`'s field at `p` raised to its bound as [`clamp`] raises its value, with the
+    /// gradient of whichever decides: the part's, or its box's or sphere's distance's.
+    #[inline]
+    pub fn clamped(&self, i: usize, s: Surf, p: Vec3A) -> Surf {
+        let (centre, radius) = self.spheres[i];
+        let b = self.boxes[i];
+        let outside = (b.min - p).max(p - b.max).max(Vec3A::ZERO);
+        let (to_box, to_sphere) = (outside.length(), (p - centre).length() - radius);
+        let bound = to_box.max(to_sphere);
+        if bound <= 0.0 || bound <= s.d {
+            return s;
+        }
+        // Outside the box, away from its nearest point: (p − clamp(p)) is `outside` with
+        // each axis's sign.
+        let g = if to_box >= to_sphere {
+            Vec3A::select((p - b.centre()).cmplt(Vec3A::ZERO), -outside, outside) / to_box
+        } else {
+            (p - centre).normalize_or(Vec3A::Y)
+        };
+        Surf { d: bound, g, mat: s.mat }
+    }
+
+    /// The union's field at `p` from the parts' surface closures `surfs`, blend radius
+    /// `k`: its value, its gradient and the material of the lowest part (ties go to the
+    /// part written first, whatever order the walk takes). Nothing `start` or more from
+    /// `p` is walked until a part is found (infinity: the whole reach; a smaller start is
+    /// the caller's guess of the reach, to be checked against the value found).
+    pub fn surface(&self, surfs: &[super::SurfSdf], k: f32, p: Vec3A, start: f32) -> Surf {
+        // Once per hit, and a part may be a union itself: a list of its own.
+        let mut near: Vec<(u32, Surf)> = Vec::with_capacity(8);
+        let mut best = f32::INFINITY;
+        self.visit(p, start, |i, _| {
+            let s = self.clamped(i, surfs[i](p), p);
+            best = best.min(s.d);
+            near.push((i as u32, s));
+            best + k
         });
-        (fold.finish(), id)
+        // In the order the parts were written, so the first of equal values wins.
+        near.sort_unstable_by_key(|&(i, _)| i);
+        if k == 0.0 {
+            return near.iter().map(|&(_, s)| s).reduce(Surf::min).unwrap_or(NOTHING);
+        }
+        smooth_surf(near.iter().map(|&(_, s)| s), k)
     }
 
     /// Walks the parts nearest first, calling `part(i, bound)` (see [`bound`](Self::bound))
@@ -141,6 +162,27 @@ fn smooth_fold(values: &mut [f32], k: f32) -> f32 {
     acc
 }
 
+/// A smooth union's field from its parts' (in the order written): the smooth minimum
+/// folded nearest first as [`smooth_fold`] does, gradients blended alike, and the lowest
+/// part's material (ties to the first written).
+pub(crate) fn smooth_surf(parts: impl Iterator<Item = Surf>, k: f32) -> Surf {
+    let mut all: Vec<Surf> = parts.collect();
+    let lowest = all.iter().copied().reduce(Surf::min).unwrap_or(NOTHING);
+    // A stable sort keeps equal values in the order written, as `smooth_fold` folds them.
+    all.sort_by(|a, b| a.d.total_cmp(&b.d));
+    let Some((&first, rest)) = all.split_first() else {
+        return NOTHING;
+    };
+    let mut acc = first;
+    for &s in rest {
+        if s.d - acc.d >= k {
+            break;
+        }
+        acc = acc.smin(s, k);
+    }
+    Surf { mat: lowest.mat, ..acc }
+}
+
 /// A union's value, gathered part by part: the minimum for a sharp union (`k = 0`), the
 /// nearest-first smooth fold for a smooth one, whose values are kept on the stack up to
 /// [`INLINE`], then on the heap.
@@ -157,12 +199,6 @@ impl Fold {
     #[inline]
     pub fn new(k: f32) -> Fold {
         Fold { k, best: f32::INFINITY, inline: [0.0; INLINE], len: 0, spill: Vec::new() }
-    }
-
-    /// The smallest value so far.
-    #[inline]
-    pub fn best(&self) -> f32 {
-        self.best
     }
 
     /// Adds a part's value; returns the threshold of [`PartTree::visit`] from then on
@@ -217,8 +253,8 @@ pub struct RayParts {
     pub tree: std::sync::Arc<PartTree>,
     /// The parts' distance bounds, in their frame.
     pub parts: std::sync::Arc<[super::Sdf]>,
-    /// The parts' distance and material, in their frame.
-    pub mats: std::sync::Arc<[super::MatSdf]>,
+    /// The parts' fields with gradients and materials, in their frame.
+    pub surfs: std::sync::Arc<[super::SurfSdf]>,
     /// Blend radius (0: sharp), in the parts' frame.
     pub k: f32,
 }
@@ -231,47 +267,24 @@ thread_local! {
     /// Per-ray scratch, kept between rays so marching allocates nothing.
     static SCRATCH: std::cell::RefCell<Scratch> =
         const { std::cell::RefCell::new((Vec::new(), Vec::new(), Vec::new())) };
-    /// The parts gathered around a hit for its normal and material.
-    static NEAR: std::cell::RefCell<Vec<(u32, f32)>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 impl RayParts {
-    /// The unit normal (tetrahedral difference, step `h`), the value and the material
-    /// at render-space `p`, from one walk of the hierarchy instead of one per tap.
-    ///
-    /// Why this is exact: the taps lie within `r = h·√3` of `p`. The walk gathers every
-    /// part whose bound at `p` is below the best value there plus `k + 2r`, and the taps
-    /// use those whose value is; a part left out has, at any tap, a value at least its
-    /// bound (or value) at `p` minus `r`, so at least the best value at that tap plus
-    /// `k`, and blends by exactly nothing there.
-    pub fn surface(&self, p: Vec3A, h: f32) -> (Vec3A, f32, u32) {
-        NEAR.with(|near| {
-            let near = &mut *near.borrow_mut();
-            near.clear();
-            let q = self.inv.transform_point3a(p);
-            let extra = 2.0 * h * 3f32.sqrt() / self.scale;
-            let best = |near: &Vec<(u32, f32)>| near.iter().fold(f32::INFINITY, |m, &(_, v)| m.min(v));
-            // At a hit the union's value is below the threshold, at most `h`, so the
-            // reach is at most `h + k + extra`: a walk that starts there skips the whole
-            // tree but the parts around `p`. Checked, and walked again from infinity
-            // when `p` is further out than that (a point that is not a march's hit).
-            let guess = h / self.scale + self.k + extra;
-            let walk = |start: f32, near: &mut Vec<(u32, f32)>| {
-                near.clear();
-                self.tree.material(&self.mats, (self.k, extra), q, start, |i, v| near.push((i as u32, v)))
-            };
-            let mut found = walk(guess, near);
-            if near.is_empty() || best(near) + self.k + extra > guess {
-                found = walk(f32::INFINITY, near);
-            }
-            let (value, id) = found;
-            // The walk kept every part within reach of the best value found so far; now
-            // that the best is known, the taps need only those within reach of it.
-            let best = best(near);
-            near.retain(|&(_, v)| v < best + self.k + extra);
-            let at = |x: Vec3A| self.value(x, near.iter().map(|&(i, _)| i));
-            (super::march::normal(&at, p, h), value * self.scale, id)
-        })
+    /// The union's field at a hit, render-space `p` within `h` of its surface: value,
+    /// gradient (analytic, in render space) and material, from one walk of the
+    /// hierarchy that starts at the reach a hit can have (the value is below `h`, so
+    /// every part that can blend in is within `h + k`), checked, and walked again from
+    /// infinity when `p` is further out than that.
+    pub fn surface(&self, p: Vec3A, h: f32) -> Surf {
+        let q = self.inv.transform_point3a(p);
+        let guess = h / self.scale + self.k;
+        let mut s = self.tree.surface(&self.surfs, self.k, q, guess);
+        if s.d + self.k > guess {
+            s = self.tree.surface(&self.surfs, self.k, q, f32::INFINITY);
+        }
+        // The chain rule through the frame: scale·M⁻ᵀ∇f.
+        let g = self.inv.matrix3.transpose() * s.g * self.scale;
+        Surf { d: s.d * self.scale, g, mat: s.mat }
     }
 
     /// Where `ray` (in the parts' frame) is inside part `i`'s box and sphere grown by
