@@ -56,7 +56,7 @@ impl Surf {
 
     /// The complement's field: the solid turned inside out.
     #[inline]
-    pub fn neg(self) -> Surf {
+    pub fn complement(self) -> Surf {
         Surf { d: -self.d, g: -self.g, ..self }
     }
 
@@ -355,7 +355,7 @@ impl<'a> Builder<'a> {
             CsgOp::Subtract => (
                 self.sdf(move |p| ds[1..].iter().fold(ds[0](p), |a, f| a.max(-f(p)))),
                 // The cut faces take the material of the part cut away.
-                self.mat(move |p| ms[1..].iter().fold(ms[0](p), |a, f| a.max(f(p).neg()))),
+                self.mat(move |p| ms[1..].iter().fold(ms[0](p), |a, f| a.max(f(p).complement()))),
             ),
         }
     }
@@ -411,7 +411,7 @@ impl<'a> Builder<'a> {
             let mut acc = first_mat(p);
             let mut cutter = usize::MAX;
             tree.visit(p, -acc.d, |i, _| {
-                let cut = tree.clamped(i, ms[i](p), p).neg();
+                let cut = tree.clamped(i, ms[i](p), p).complement();
                 // The cut faces take the material of the cutter; ties go to the first.
                 if cut.d > acc.d || (cut.d == acc.d && cutter != usize::MAX && i < cutter) {
                     (acc, cutter) = (cut, i);
@@ -453,8 +453,8 @@ impl<'a> Builder<'a> {
             let rest = ms[1..].iter().map(|f| f(p));
             match op {
                 CsgOp::Union => union::smooth_surf(std::iter::once(first).chain(rest), k),
-                CsgOp::Intersect => rest.fold(first.neg(), |a, b| a.smin(b.neg(), k)).neg(),
-                CsgOp::Subtract => rest.fold(first.neg(), |a, b| a.smin(b, k)).neg(),
+                CsgOp::Intersect => rest.fold(first.complement(), |a, b| a.smin(b.complement(), k)).complement(),
+                CsgOp::Subtract => rest.fold(first.complement(), |a, b| a.smin(b, k)).complement(),
             }
         });
         (d, m)
