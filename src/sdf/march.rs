@@ -1,15 +1,26 @@
 //! Sphere tracing: step along the ray by the distance bound until it falls below the
 //! hit threshold, the ray leaves the interval, or the step budget runs out.
 //!
-//! The threshold is *relative*: a hit is accepted when `f(p) < epsilon · (|origin| + t)`,
-//! i.e. `epsilon` times an upper bound of the point's distance from the camera. In render
-//! space the camera is the origin, so this is a cone around the ray whose width grows like
-//! a pixel's footprint, and the same `epsilon` means the same on-screen accuracy at any
-//! depth and for secondary rays alike.
+//! The threshold is *relative* ([`threshold`]): a hit is accepted when
+//! `f(p) < epsilon · (t + min(t, |origin|))`. For a camera ray (the camera is the origin of
+//! render space) that is `epsilon · t`, a cone around the ray whose width grows like a
+//! pixel's footprint, so the same `epsilon` means the same on-screen accuracy at any
+//! depth. A secondary ray starting `|origin|` from the camera is seen through that pixel,
+//! at `|origin| + t` from the camera: far along it, its cone is that footprint; near its
+//! start it narrows to nothing, as the ray leaves an exact point. So a surface beside the
+//! point a ray leaves (the floor at the foot of a wall, for the wall's shadow rays) is
+//! never taken for a hit at the start, as it was when the cone began at the footprint's
+//! width.
 
 use glam::Vec3A;
 
 use crate::trace::{Counters, Ray};
+
+/// The hit threshold `t` along a ray whose origin is `base` from the camera.
+#[inline(always)]
+pub fn threshold(epsilon: f32, base: f32, t: f32) -> f32 {
+    epsilon * (t + t.min(base))
+}
 
 /// The accuracy knobs.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -80,7 +91,7 @@ fn walk(
     for _ in 0..params.max_steps {
         let d = f(origin + dir * t);
         *evals += 1;
-        let threshold = params.epsilon * (base + t);
+        let threshold = threshold(params.epsilon, base, t);
         let Some(dt) = step(d, threshold, t) else {
             return Some((t, threshold));
         };

@@ -117,7 +117,7 @@ impl SdfObject {
         let convex = self.convex && d > -error;
         let from_inside = leaving || normal.dot(ray.dir) > 0.0;
         let normal = if leaving && normal.dot(ray.dir) < 0.0 { -normal } else { normal };
-        Hit { t, point, normal, material, error, object, convex, from_inside }
+        Hit { t, point, normal, material, error, object, behind: convex.then_some(normal), from_inside }
     }
 
     /// The unblocked fraction of a cone of slope `cone` around the ray over `[t0, t1]`: the
@@ -138,7 +138,7 @@ impl SdfObject {
         for _ in 0..params.max_steps {
             let h = (self.dist)(ray.at(t));
             *evals += 1;
-            if h < params.epsilon * (base + t) {
+            if h < march::threshold(params.epsilon, base, t) {
                 return 0.0;
             }
             res = res.min(h / (cone * t.max(f32::MIN_POSITIVE)));

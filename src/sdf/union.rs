@@ -356,7 +356,7 @@ impl RayParts {
                 steps += 1;
                 let d = self.value(ray.origin + ray.dir * t, active.iter().map(|&(_, i)| i));
                 *evals += 1;
-                let threshold = params.epsilon * (base + t);
+                let threshold = super::march::threshold(params.epsilon, base, t);
                 if d < threshold {
                     return Some((t, threshold));
                 }
@@ -394,7 +394,7 @@ impl RayParts {
         });
         c.node_visits += visits;
         c.budget_misses += misses;
-        hit.map(|(_, t)| (t, params.epsilon * (base + t)))
+        hit.map(|(_, t)| (t, super::march::threshold(params.epsilon, base, t)))
     }
 
     /// [`march`](Self::march) of a sharp union for the lanes `mask` of `N` packets of
@@ -440,7 +440,7 @@ impl RayParts {
                     self.march_part(i, &frames[g][l], span, base[g][l], params, &mut evals[g][l], &mut misses)
                 {
                     t_max[g][l] = t;
-                    hits[g][l] = Some((t, params.epsilon * (base[g][l] + t)));
+                    hits[g][l] = Some((t, super::march::threshold(params.epsilon, base[g][l], t)));
                 }
             }
         });
@@ -470,7 +470,7 @@ impl RayParts {
             let q = frame.origin + frame.dir * t;
             let d = clamp(self.parts[i](q), self.tree.bound(i, q)) * self.scale;
             *evals += 1;
-            if d < params.epsilon * (base + t) {
+            if d < super::march::threshold(params.epsilon, base, t) {
                 return Some(t);
             }
             t += d;
