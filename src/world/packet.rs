@@ -140,20 +140,20 @@ impl World {
         evals: &mut [[u64; 4]; N],
         c: &mut Counters,
     ) {
-        // A ray inside the object is marched out of it over the whole tree, alone; one
-        // that skips it is left to `find`, which knows why.
-        let alone = |lane: usize| {
-            let ray = &quads[lane / 4].rays[lane % 4];
-            ray.inside == i || ray.skip == i
-        };
-        if crate::trace::lanes(lanes).any(alone) {
-            return self.find_each(i, quads, lanes, t_max, best, evals, c);
-        }
+        // A ray that skips the object is left to `find`, which knows why; so is one that
+        // may start inside it (marched out of it over the whole tree, alone).
         let mut spans = [[(0.0, 0.0); 4]; N];
         let mut reach = 0;
         for lane in crate::trace::lanes(lanes) {
             let (g, l) = (lane / 4, lane % 4);
-            if let Some(span) = self.interval(i, &quads[g].rays[l], t_max[g][l]) {
+            let ray = &quads[g].rays[l];
+            if ray.skip == i || ray.inside == i {
+                return self.find_each(i, quads, lanes, t_max, best, evals, c);
+            }
+            if let Some(span) = self.interval(i, ray, t_max[g][l]) {
+                if span.0 <= ray.t_min {
+                    return self.find_each(i, quads, lanes, t_max, best, evals, c);
+                }
                 spans[g][l] = span;
                 reach |= 1 << lane;
             }

@@ -33,6 +33,22 @@ impl World {
         clip_to_sphere(o, ray, (ray.t_min, t_max)).is_some()
     }
 
+    /// Whether a ray starts inside SDF object `i` over `interval`, and so must be marched
+    /// out of it: it was refracted into it (`ray.inside`), or where it starts the solid's
+    /// field is negative — a ray in a bubble inside this water, or a camera inside a
+    /// solid. A march from outside would take its start for a hit.
+    #[inline]
+    fn leaving(&self, i: u32, sdf: &SdfObject, ray: &Ray, (t0, _): (f32, f32), evals: &mut u64) -> bool {
+        if i == ray.inside {
+            return true;
+        }
+        if t0 > ray.t_min {
+            return false;
+        }
+        *evals += 1;
+        sdf.eval(ray.at(ray.t_min)) < 0.0
+    }
+
     /// The closest surface of object `i` before `t_max`, without its shading data.
     pub(super) fn find(&self, i: u32, q: &mut Query<'_>, t_max: f32, c: &mut Counters) -> Option<Found<'_>> {
         if i == q.ray.skip {
@@ -41,9 +57,15 @@ impl World {
         let o = &self.objects[i as usize];
         match &o.kind {
             ObjectKind::Sdf(s) => {
-                let leaving = i == q.ray.inside;
-                s.closest(q.ray, self.interval(i, q.ray, t_max)?, leaving, self.params, c, &mut q.evals)
-                    .map(|(t, error)| Found::Sdf { object: i, sdf: s, t, error, leaving })
+                let interval = self.interval(i, q.ray, t_max)?;
+                let leaving = self.leaving(i, s, q.ray, interval, &mut q.evals);
+                s.closest(q.ray, interval, leaving, self.params, c, &mut q.evals).map(|(t, error)| Found::Sdf {
+                    object: i,
+                    sdf: s,
+                    t,
+                    error,
+                    leaving,
+                })
             }
             // Triangles are tested exactly; the sphere only decides whether to look.
             ObjectKind::Mesh(m) if self.may_reach_mesh(o, q.ray, t_max) => {
@@ -80,7 +102,8 @@ impl World {
         let o = &self.objects[i as usize];
         match &o.kind {
             ObjectKind::Sdf(s) => self.interval(i, q.ray, t_max).is_some_and(|interval| {
-                s.closest(q.ray, interval, i == q.ray.inside, self.params, c, &mut q.evals).is_some()
+                let leaving = self.leaving(i, s, q.ray, interval, &mut q.evals);
+                s.closest(q.ray, interval, leaving, self.params, c, &mut q.evals).is_some()
             }),
             ObjectKind::Mesh(m) => self.may_reach_mesh(o, q.ray, t_max) && m.occluded(q.ray, q.shear(), t_max, c),
         }
