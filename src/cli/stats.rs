@@ -15,6 +15,7 @@ pub(crate) fn stats_text(c: &Counters, g: &World, map: &SourceMap, lower_s: f64,
   sdf evaluations {} marching ({:.1} per ray, max {} on one ray), {} for normals and materials
   primitives      {} evaluations ({:.1} per ray), inside those
   step budget     {} marches ran out of steps (counted as misses)
+  ray trees       {} reflected or refracted rays pruned (below {:.4} of a pixel), {} samples at the {}-ray budget
   bvh             {} node visits ({:.2} per ray), {} triangle tests ({:.2} per ray)
   memory          {} bytes in total: {} SDF objects with {} bytes of closures, {} bytes of top-level BVH
 ",
@@ -34,6 +35,10 @@ pub(crate) fn stats_text(c: &Counters, g: &World, map: &SourceMap, lower_s: f64,
         c.leaf_evals,
         c.leaf_evals as f64 / rays,
         c.budget_misses,
+        c.pruned_rays,
+        scnc::render::MIN_WEIGHT,
+        c.tree_budget_hits,
+        scnc::render::MAX_TREE_RAYS,
         c.node_visits,
         c.node_visits as f64 / rays,
         c.triangle_tests,

@@ -17,6 +17,7 @@ mod transmit;
 use glam::Vec3A;
 use rayon::prelude::*;
 use shade::fx;
+pub use shade::{MAX_TREE_RAYS, MIN_WEIGHT};
 
 pub use frame::{Frame, ShadeLight};
 

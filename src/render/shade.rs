@@ -19,6 +19,43 @@ use super::transmit::{self, Media};
 use super::{Frame, ShadeLight};
 use crate::trace::{lanes, spawn_offset, Counters, Geometry, Hit, Packet, Ray};
 
+/// Below this share of a pixel a reflected or refracted ray is not traced (its weight
+/// is the product of the mirror and transmitted shares along its path): it could change
+/// the pixel by at most half an 8-bit step of a surface at full brightness (255 / 512).
+/// Deterministic, unlike Russian roulette, so images stay reproducible.
+pub const MIN_WEIGHT: f32 = 1.0 / 512.0;
+
+/// Most reflected and refracted rays one sample's ray tree may trace, whatever their
+/// weights: a last guard (`--stats` counts the samples that reach it).
+pub const MAX_TREE_RAYS: u32 = 4096;
+
+/// What a sample's ray tree may still spend: the share of the pixel the ray being
+/// shaded carries, and the rays left.
+struct Tree<'a> {
+    weight: f32,
+    left: &'a mut u32,
+}
+
+impl Tree<'_> {
+    /// Whether a ray carrying `share` of this one's light is worth tracing (counted as
+    /// pruned or over budget when not), and if so, the tree below it.
+    fn branch(&mut self, share: f32, c: &mut Counters) -> Option<Tree<'_>> {
+        let weight = self.weight * share;
+        if weight < MIN_WEIGHT {
+            c.pruned_rays += 1;
+            return None;
+        }
+        if *self.left == 0 {
+            return None;
+        }
+        *self.left -= 1;
+        if *self.left == 0 {
+            c.tree_budget_hits += 1;
+        }
+        Some(Tree { weight, left: &mut *self.left })
+    }
+}
+
 /// The effect flags a tracer variant is built with (bits of its `FX` parameter).
 pub(super) mod fx {
     /// Shadow rays.
@@ -72,7 +109,9 @@ pub(super) fn block<const FX: u8>(
         for (q, quad) in quads.iter().enumerate() {
             for l in lanes(quad.mask) {
                 let ray = &quad.rays[l];
-                let mut colour = shade::<FX>(g, frame, ray, hits[q][l], frame.depth, Media::AIR, c);
+                let mut left = MAX_TREE_RAYS;
+                let tree = Tree { weight: 1.0, left: &mut left };
+                let mut colour = shade::<FX>(g, frame, ray, hits[q][l], frame.depth, Media::AIR, tree, c);
                 if !colour.is_finite() {
                     c.nonfinite_samples += 1;
                     colour = Vec3A::ZERO;
@@ -224,10 +263,11 @@ fn trace<const FX: u8>(
     ray: &Ray,
     depth: u32,
     media: Media,
+    tree: Tree<'_>,
     c: &mut Counters,
 ) -> Vec3A {
     let hit = g.intersect(ray, c);
-    let colour = shade::<FX>(g, frame, ray, hit, depth, media, c);
+    let colour = shade::<FX>(g, frame, ray, hit, depth, media, tree, c);
     if FX & REFRACT == 0 {
         return colour;
     }
@@ -267,7 +307,9 @@ fn spawn<const FX: u8>(hit: &Hit, origin: Vec3A, dir: Vec3A, t_max: f32, media: 
     ray
 }
 
-/// The colour seen along `ray` (travelling in `media`) given what it hit (`None`: the background).
+/// The colour seen along `ray` (travelling in `media`) given what it hit (`None`: the
+/// background); `tree` is what its sample may still spend on reflected and refracted rays.
+#[allow(clippy::too_many_arguments, reason = "the state a ray is shaded in")]
 fn shade<const FX: u8>(
     g: &dyn Geometry,
     frame: &Frame,
@@ -275,6 +317,7 @@ fn shade<const FX: u8>(
     hit: Option<Hit>,
     depth: u32,
     media: Media,
+    mut tree: Tree<'_>,
     c: &mut Counters,
 ) -> Vec3A {
     let Some(hit) = hit else {
@@ -338,7 +381,10 @@ fn shade<const FX: u8>(
         // Patterns are read just inside the surface (see `ShadeMaterial::color_at`).
         let paint = material.color_at(hit.point - normal * offset);
         local = paint * light;
-        shine *= paint;
+        // A dielectric's highlight is the light's own colour, as in POV-Ray, Blender's
+        // principled BSDF and every physically based model (only metals tint theirs):
+        // white light at full brightness, not the surface's colour.
+        shine *= 255.0;
     }
     if FX & (REFLECT | REFRACT) == 0 {
         return local;
@@ -367,15 +413,19 @@ fn shade<const FX: u8>(
     }
     let mut colour = surface * (1.0 - transparency) + highlight;
     if mirror > 0.0 {
-        let reflected_dir = (normal * (2.0 * normal.dot(view)) - view).normalize();
-        c.reflection_rays += 1;
-        let ray = spawn::<FX>(&hit, origin, reflected_dir, frame.max_distance, &media);
-        colour += trace::<FX>(g, frame, &ray, depth - 1, media, c) * mirror;
+        if let Some(below) = tree.branch(mirror, c) {
+            let reflected_dir = (normal * (2.0 * normal.dot(view)) - view).normalize();
+            c.reflection_rays += 1;
+            let ray = spawn::<FX>(&hit, origin, reflected_dir, frame.max_distance, &media);
+            colour += trace::<FX>(g, frame, &ray, depth - 1, media, below, c) * mirror;
+        }
     }
     if let Some((dir, beyond, through)) = transmitted {
-        c.refraction_rays += 1;
-        let ray = spawn::<FX>(&hit, hit.point - normal * offset, dir, frame.max_distance, &beyond);
-        colour += trace::<FX>(g, frame, &ray, depth - 1, beyond, c) * through;
+        if let Some(below) = tree.branch(through, c) {
+            c.refraction_rays += 1;
+            let ray = spawn::<FX>(&hit, hit.point - normal * offset, dir, frame.max_distance, &beyond);
+            colour += trace::<FX>(g, frame, &ray, depth - 1, beyond, below, c) * through;
+        }
     }
     colour
 }

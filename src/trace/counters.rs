@@ -30,6 +30,12 @@ pub struct Counters {
     pub node_visits: u64,
     /// Ray–triangle tests (mesh back-end; a packet's test counts once per ray it tests).
     pub triangle_tests: u64,
+    /// Reflection and refraction rays not traced because their share of the pixel was
+    /// below [`MIN_WEIGHT`](crate::render::MIN_WEIGHT).
+    pub pruned_rays: u64,
+    /// Samples whose ray tree reached [`MAX_TREE_RAYS`](crate::render::MAX_TREE_RAYS)
+    /// (its further rays were not traced).
+    pub tree_budget_hits: u64,
     /// Samples whose colour was not finite (always 0 unless there is a bug; such a
     /// sample is written as black).
     pub nonfinite_samples: u64,
@@ -50,6 +56,8 @@ impl Counters {
         self.budget_misses += o.budget_misses;
         self.node_visits += o.node_visits;
         self.triangle_tests += o.triangle_tests;
+        self.pruned_rays += o.pruned_rays;
+        self.tree_budget_hits += o.tree_budget_hits;
         self.nonfinite_samples += o.nonfinite_samples;
     }
 
