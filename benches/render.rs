@@ -179,7 +179,7 @@ fn bvh(c: &mut Criterion) {
                     glam::DAffine3::from_translation(glam::DVec3::new(0.0, 0.0, 5.0)),
                     0,
                     None,
-                    false,
+                    scnc::mesh::Normals::Flat,
                 )
             })
         });
@@ -195,7 +195,7 @@ fn bvh(c: &mut Criterion) {
                 glam::DAffine3::from_translation(glam::DVec3::new(0.0, 0.0, 5.0)),
                 0,
                 None,
-                true,
+                scnc::mesh::Normals::Vertex,
             )
         })
     });

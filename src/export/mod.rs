@@ -247,7 +247,7 @@ fn part(n: usize, job: mesh::MeshJob, span: Span, frame: Frame) -> Part {
         span,
         mesh: crate::geom::TriMesh { positions, triangles },
         materials,
-        smooth: job.smooth,
+        smooth: job.normals != mesh::Normals::Flat,
         degenerate,
     }
 }

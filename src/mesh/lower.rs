@@ -6,12 +6,12 @@
 use glam::{DAffine3, DVec3};
 use rayon::prelude::*;
 
-use super::{isosurface, obj, octree, parts, Detail, IsoAccuracy, MeshJob};
+use super::{isosurface, obj, octree, parts, Detail, IsoAccuracy, MeshJob, Normals};
 use crate::diag::{codes, Diagnostic};
 use crate::geom::tessellate::count;
 use crate::geom::{tessellate, TriMesh};
 use crate::ir::{self, MeshSource, Shape, ShapeKind};
-use crate::primitive::Tessellation;
+use crate::primitive::{Facets, Tessellation};
 use crate::sdf::Builder;
 use crate::source::Loader;
 use crate::span::Span;
@@ -58,14 +58,24 @@ pub fn tessellate(
     match made {
         Tessellation::Triangles(triangles, make) => {
             budget.spend(triangles, shape.span)?;
+            let mesh = make();
+            // A curved primitive shades with its own normals: flat facets would bend
+            // light facet by facet (glass magnifies a normal's error far beyond its
+            // position's). A flat-faced one is exact as it is.
+            let normals = match &node.kind {
+                ShapeKind::Primitive(p) if matches!(p.facets(), Facets::Inscribed(_)) => {
+                    Normals::Corners(p.corner_normals(&mesh))
+                }
+                _ => Normals::Flat,
+            };
             // A generator's polytope is convex exactly when its shape is (tested for each);
             // isosurfaces (below) may dent even a convex shape, so they are never marked.
             Ok(MeshJob {
-                mesh: make(),
+                mesh,
                 xf,
                 material,
                 per_triangle: None,
-                smooth: false,
+                normals,
                 convex: node.is_convex(),
                 warnings: Vec::new(),
                 isosurface: None,
@@ -90,7 +100,7 @@ pub fn tessellate(
                 xf: xf * frame,
                 material,
                 per_triangle: None,
-                smooth: false,
+                normals: Normals::Flat,
                 convex: true,
                 warnings: Vec::new(),
                 isosurface: None,
@@ -379,7 +389,7 @@ fn isosurface_object(
         xf: place,
         material,
         per_triangle: Some(per_triangle),
-        smooth,
+        normals: if smooth { Normals::Vertex } else { Normals::Flat },
         convex: false,
         warnings,
         isosurface: Some(IsoAccuracy { cell, farthest }),
@@ -516,7 +526,7 @@ pub fn explicit(
         xf,
         material,
         per_triangle: None,
-        smooth: m.smooth,
+        normals: if m.smooth { Normals::Vertex } else { Normals::Flat },
         warnings: Vec::new(),
         convex: m.is_convex(),
         isosurface: None,

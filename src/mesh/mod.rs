@@ -16,7 +16,7 @@ pub mod parts;
 mod qef;
 pub mod triangle;
 
-use glam::{DAffine3, Vec3A, Vec4};
+use glam::{DAffine3, DVec3, Vec3A, Vec4};
 use rayon::prelude::*;
 
 pub use detail::Detail;
@@ -25,6 +25,19 @@ use crate::geom::TriMesh;
 
 use crate::accel::{Aabb, Bvh, Rays4};
 use crate::trace::{Counters, Hit, Ray, NO_OBJECT};
+
+/// How a mesh's hits get their shading normal.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Normals {
+    /// Each triangle's own: flat shading.
+    Flat,
+    /// Area-weighted vertex normals, interpolated (`smooth = true`).
+    Vertex,
+    /// One unit normal per triangle corner, in the mesh's frame, interpolated: a
+    /// tessellated primitive's analytic normals, each taken on its triangle's side of a
+    /// crease (a cylinder's rim has one for the cap and one for the side).
+    Corners(Vec<[DVec3; 3]>),
+}
 
 /// What a mesh object is made from. Lowering makes these in scene order (interning
 /// materials and spending the triangle budget as it goes); the world then builds them
@@ -38,8 +51,8 @@ pub struct MeshJob {
     pub material: u32,
     /// One material per triangle of `mesh`.
     pub per_triangle: Option<Vec<u32>>,
-    /// Interpolated vertex normals.
-    pub smooth: bool,
+    /// How hits get their shading normal.
+    pub normals: Normals,
     /// Whether the triangles bound a convex polytope (or lie in one plane), as the
     /// generator guarantees: secondary rays leaving a face outward may then skip the mesh.
     pub convex: bool,
@@ -63,17 +76,46 @@ pub struct IsoAccuracy {
 impl MeshJob {
     /// The mesh object, ready for tracing.
     pub fn build(self) -> MeshObject {
-        let object = MeshObject::new(&self.mesh, self.xf, self.material, self.per_triangle, self.smooth);
+        let object = MeshObject::new(&self.mesh, self.xf, self.material, self.per_triangle, self.normals);
         MeshObject { convex: self.convex, isosurface: self.isosurface, ..object }
     }
+}
+
+/// Where a mesh object's shading normals come from.
+enum Shading {
+    /// The faces'.
+    Flat,
+    /// Per vertex, unit, render space.
+    Vertex(Vec<Vec3A>),
+    /// Per triangle corner, octahedral-coded ([`octahedral`]), render space.
+    Corners(Vec<[u32; 3]>),
+}
+
+/// A unit vector in 32 bits: its octahedral projection (Meyer et al., *On floating-point
+/// normal vectors*, 2010), 16 bits per coordinate; decoded to within about 3e-5 rad.
+fn octahedral(n: Vec3A) -> u32 {
+    let p = n / (n.x.abs() + n.y.abs() + n.z.abs());
+    let (x, y) =
+        if p.z >= 0.0 { (p.x, p.y) } else { ((1.0 - p.y.abs()) * p.x.signum(), (1.0 - p.x.abs()) * p.y.signum()) };
+    let q = |c: f32| ((c.clamp(-1.0, 1.0) * 0.5 + 0.5) * 65535.0).round() as u32;
+    q(x) | q(y) << 16
+}
+
+/// The unit vector [`octahedral`] coded.
+fn from_octahedral(code: u32) -> Vec3A {
+    let f = |c: u32| (c & 0xffff) as f32 / 65535.0 * 2.0 - 1.0;
+    let (x, y) = (f(code), f(code >> 16));
+    let z = 1.0 - x.abs() - y.abs();
+    let (x, y) = if z >= 0.0 { (x, y) } else { ((1.0 - y.abs()) * x.signum(), (1.0 - x.abs()) * y.signum()) };
+    Vec3A::new(x, y, z).normalize_or(Vec3A::Y)
 }
 
 /// A mesh object ready for tracing.
 pub struct MeshObject {
     positions: Vec<Vec3A>,
     triangles: Vec<[u32; 3]>,
-    /// Per-vertex unit normals when shading is smooth.
-    normals: Option<Vec<Vec3A>>,
+    /// Where shading normals come from.
+    shading: Shading,
     /// Per-triangle material ids, or one for the whole mesh.
     materials: Materials,
     bvh: Bvh,
@@ -109,14 +151,14 @@ pub struct MeshMemory {
 
 impl MeshObject {
     /// Builds from a mesh in local space, mapped by `xf` (render from local), with one
-    /// material or one per triangle; `smooth` interpolates area-weighted vertex normals.
-    /// Degenerate (zero-area) triangles are dropped: they can never be hit.
+    /// material or one per triangle, shaded with `normals`. Degenerate (zero-area)
+    /// triangles are dropped: they can never be hit.
     pub fn new(
         mesh: &TriMesh,
         xf: DAffine3,
         material: u32,
         per_triangle: Option<Vec<u32>>,
-        smooth: bool,
+        normals: Normals,
     ) -> MeshObject {
         let positions: Vec<Vec3A> = mesh.positions.par_iter().map(|p| xf.transform_point3(*p).as_vec3a()).collect();
         // A mirroring map would turn the winding, and so every face normal, inward.
@@ -124,6 +166,15 @@ impl MeshObject {
         let mut triangles: Vec<[u32; 3]> =
             mesh.triangles.par_iter().map(|t| if mirrored { [t[0], t[2], t[1]] } else { *t }).collect();
         let mut per_triangle = per_triangle;
+        // Normals map by the inverse transpose, corners swapped as their triangles are.
+        let mut corners: Option<Vec<[u32; 3]>> = match &normals {
+            Normals::Corners(n) => {
+                let m = xf.matrix3.inverse().transpose();
+                let map = |v: DVec3| octahedral((m * v).normalize_or(DVec3::Y).as_vec3a());
+                Some(n.par_iter().map(|c| if mirrored { [c[0], c[2], c[1]] } else { *c }.map(map)).collect())
+            }
+            Normals::Flat | Normals::Vertex => None,
+        };
         let area = |t: &[u32; 3]| {
             let [a, b, c] = t.map(|k| positions[k as usize]);
             (b - a).cross(c - a).length_squared() > 0.0
@@ -137,8 +188,9 @@ impl MeshObject {
             }
             triangles = kept(triangles, &keep);
             per_triangle = per_triangle.map(|m| kept(m, &keep));
+            corners = corners.map(|c| kept(c, &keep));
         }
-        let normals = smooth.then(|| {
+        let vertex = (normals == Normals::Vertex).then(|| {
             let mut n = vec![Vec3A::ZERO; positions.len()];
             for t in &triangles {
                 let [a, b, c] = t.map(|k| positions[k as usize]);
@@ -155,6 +207,11 @@ impl MeshObject {
         };
         let (bvh, order) = Bvh::build_ordered(triangles.len(), bounds, 4);
         let triangles: Vec<[u32; 3]> = order.par_iter().map(|&k| triangles[k as usize]).collect();
+        let shading = match (vertex, corners) {
+            (Some(v), _) => Shading::Vertex(v),
+            (None, Some(c)) => Shading::Corners(order.par_iter().map(|&k| c[k as usize]).collect()),
+            (None, None) => Shading::Flat,
+        };
         let mats: Vec<u32> = match &per_triangle {
             Some(m) => order.par_iter().map(|&k| m[k as usize]).collect(),
             None => Vec::new(),
@@ -165,13 +222,13 @@ impl MeshObject {
             Some(_) => Materials::One(mats.first().copied().unwrap_or(material)),
             None => Materials::One(material),
         };
-        MeshObject { positions, triangles, normals, materials, bvh, bounds, convex: false, isosurface: None }
+        MeshObject { positions, triangles, shading, materials, bvh, bounds, convex: false, isosurface: None }
     }
 
-    /// Whether every hit's normal is the outward normal of a face of a convex polytope (or
-    /// of a flat mesh): interpolated normals are not, so a smooth mesh never is.
+    /// Whether the triangles bound a convex polytope (or lie in one plane): then every
+    /// hit lies in a face whose plane the whole mesh is behind, whatever its shading.
     pub fn is_convex(&self) -> bool {
-        self.convex && self.normals.is_none()
+        self.convex
     }
 
     /// Render-space bounds (empty for a mesh without triangles).
@@ -187,7 +244,12 @@ impl MeshObject {
     /// Memory by structure.
     pub fn memory(&self) -> MeshMemory {
         let vertex = std::mem::size_of::<Vec3A>();
-        let vertex_bytes = self.positions.len() * vertex + self.normals.as_ref().map_or(0, |n| n.len() * vertex);
+        let normal_bytes = match &self.shading {
+            Shading::Flat => 0,
+            Shading::Vertex(n) => n.len() * vertex,
+            Shading::Corners(c) => c.len() * 12,
+        };
+        let vertex_bytes = self.positions.len() * vertex + normal_bytes;
         let index_bytes =
             self.triangles.len() * 12 + if let Materials::PerTriangle(m) = &self.materials { m.len() * 4 } else { 0 };
         MeshMemory {
@@ -274,15 +336,22 @@ impl MeshObject {
         let (a, b, cc) = self.tri(i);
         let geometric = (b - a).cross(cc - a);
         let point = a * hit.bary[0] + b * hit.bary[1] + cc * hit.bary[2];
-        let normal = match &self.normals {
-            Some(n) => {
+        let [u, v, w] = hit.bary;
+        let face = geometric.normalize();
+        let shading = match &self.shading {
+            Shading::Vertex(n) => {
                 let t = self.triangles[i as usize];
-                (n[t[0] as usize] * hit.bary[0] + n[t[1] as usize] * hit.bary[1] + n[t[2] as usize] * hit.bary[2])
-                    .try_normalize()
+                (n[t[0] as usize] * u + n[t[1] as usize] * v + n[t[2] as usize] * w).try_normalize()
             }
-            None => None,
-        }
-        .unwrap_or_else(|| geometric.normalize());
+            Shading::Corners(c) => {
+                let [a, b, d] = c[i as usize].map(from_octahedral);
+                (a * u + b * v + d * w).try_normalize()
+            }
+            Shading::Flat => None,
+        };
+        // An interpolated normal can face away from the ray near a silhouette where the
+        // face does not; the face's is then the better guess of which side is seen.
+        let normal = shading.filter(|n| n.dot(dir).signum() == face.dot(dir).signum()).unwrap_or(face);
         let material = match &self.materials {
             Materials::One(m) => *m,
             Materials::PerTriangle(m) => m[i as usize],
@@ -290,7 +359,8 @@ impl MeshObject {
         // The interpolated point lies within a few ulps of the true plane.
         let error = point.abs().max_element() * 8.0 * f32::EPSILON;
         let from_inside = geometric.dot(dir) > 0.0;
-        Hit { t: hit.t, point, normal, material, error, object, convex: self.is_convex(), from_inside }
+        let behind = self.convex.then_some(face);
+        Hit { t: hit.t, point, normal, material, error, object, behind, from_inside }
     }
 
     /// The closest hit within `(ray.t_min, t_max)`, with its surface.

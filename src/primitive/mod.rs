@@ -273,6 +273,32 @@ impl Primitive {
         self.visit(Name)
     }
 
+    /// The analytic normal at each corner of each triangle of `mesh` (its
+    /// tessellation), taken a hair inside the triangle so that each face gets its own
+    /// side of a crease: the shading normals of a curved primitive's mesh.
+    pub fn corner_normals(&self, mesh: &TriMesh) -> Vec<[DVec3; 3]> {
+        struct Corners<'m>(&'m TriMesh);
+        impl Visit for Corners<'_> {
+            type Out = Vec<[DVec3; 3]>;
+            fn visit<S: Solid>(self, s: &S) -> Self::Out {
+                let g = s.gradient();
+                let m = self.0;
+                m.triangles
+                    .iter()
+                    .map(|t| {
+                        let corners = t.map(|i| m.positions[i as usize]);
+                        let centre = (corners[0] + corners[1] + corners[2]) / 3.0;
+                        corners.map(|c| {
+                            let inside = c + (centre - c) * 1e-3;
+                            g(inside.as_vec3a()).as_dvec3().normalize_or(DVec3::Y)
+                        })
+                    })
+                    .collect()
+            }
+        }
+        self.visit(Corners(mesh))
+    }
+
     /// Its triangles at a resolution ([`Solid::tessellate`]).
     pub fn tessellate(&self, res: Resolution) -> Tessellation {
         struct Tess(Resolution);

@@ -204,7 +204,7 @@ mod tests {
     }
 
     fn crossing(object: u32, material: u32, from_inside: bool) -> Hit {
-        Hit { t: 1.0, point: Vec3A::ZERO, normal: Vec3A::Z, material, error: 0.0, object, convex: false, from_inside }
+        Hit { t: 1.0, point: Vec3A::ZERO, normal: Vec3A::Z, material, error: 0.0, object, behind: None, from_inside }
     }
 
     #[test]

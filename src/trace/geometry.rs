@@ -20,10 +20,11 @@ pub struct Hit {
     pub error: f32,
     /// The object hit, in the back-end's numbering ([`NO_OBJECT`](super::NO_OBJECT) if it has none).
     pub object: u32,
-    /// Whether the object lies wholly behind the plane through `point` normal to `normal`
-    /// (a convex solid with its geometric normal, or a flat surface), so a ray leaving the
-    /// front of that plane cannot meet it again.
-    pub convex: bool,
+    /// When the object lies wholly behind the surface's tangent plane at `point` (a
+    /// convex solid, or a flat surface), that plane's unit normal (the face's for a mesh,
+    /// whatever its shading normal): a ray leaving the front of that plane cannot meet
+    /// the object again.
+    pub behind: Option<Vec3A>,
     /// Whether the ray met the surface from the object's inside (the side its normal
     /// points away from: the geometric side for a mesh, whatever its shading normal).
     pub from_inside: bool,
@@ -33,7 +34,7 @@ pub struct Hit {
 pub trait Geometry: Sync {
     /// The closest hit along the ray within `[t_min, t_max]`. A back-end may leave out
     /// the object `ray.skip`: the tracer names one only when the ray leaves a hit of it
-    /// marked [`Hit::convex`] outward ([`Ray::leaving`]), so the ray cannot meet it.
+    /// with a [`Hit::behind`] plane, outward ([`Ray::leaving`]), so the ray cannot meet it.
     fn intersect(&self, ray: &Ray, counters: &mut Counters) -> Option<Hit>;
     /// [`intersect`](Self::intersect) for each wanted lane of a packet (`None` for the
     /// others). A back-end may share work between the lanes, but each lane must hit or

@@ -37,15 +37,17 @@ impl Ray {
     }
 
     /// A secondary ray from `origin`, just off `hit`'s surface, along `dir`. When the hit
-    /// object lies wholly behind its tangent plane at the hit ([`Hit::convex`]) and the ray
+    /// object lies wholly behind its tangent plane at the hit ([`Hit::behind`]) and the ray
     /// starts in front of that plane and moves away from it, every point of the ray is in
     /// front of the plane, so the ray cannot meet the object again and skips it: that
     /// saves walking the object's own BVH, which every such ray starts inside, and makes
     /// self-intersection there impossible rather than only guarded by the offset.
     pub fn leaving(hit: &Hit, origin: Vec3A, dir: Vec3A, t_max: f32) -> Ray {
         let mut ray = Ray::new(origin, dir, t_max);
-        if hit.convex && hit.normal.dot(origin - hit.point) > 0.0 && hit.normal.dot(dir) > 0.0 {
-            ray.skip = hit.object;
+        if let Some(n) = hit.behind {
+            if n.dot(origin - hit.point) > 0.0 && n.dot(dir) > 0.0 {
+                ray.skip = hit.object;
+            }
         }
         ray
     }

@@ -15,6 +15,7 @@ mod grammar;
 mod isosurface;
 mod layers;
 mod lsp;
+mod media;
 mod mesh;
 mod nopanic;
 mod primitives;

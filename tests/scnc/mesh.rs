@@ -41,7 +41,7 @@ fn bvh_closest_hit_equals_brute_force() {
     let mut rng = Rng(0x0b5e_55ed);
     for (n, spread) in [(1usize, 1.0f32), (7, 1.0), (60, 2.0), (500, 3.0), (3000, 4.0)] {
         let mesh = soup(&mut rng, n, spread);
-        let obj = MeshObject::new(&mesh, DAffine3::IDENTITY, 0, None, false);
+        let obj = MeshObject::new(&mesh, DAffine3::IDENTITY, 0, None, scnc::mesh::Normals::Flat);
         for _ in 0..2000 {
             let origin = rng.vec(spread * 2.0);
             let dir = (rng.vec(spread) - origin).try_normalize().unwrap_or(Vec3A::Z);
@@ -78,7 +78,7 @@ fn rays_through_shared_edges_and_vertices_never_miss() {
     for (name, mesh) in generators() {
         assert_eq!(mesh.open_edges(), (0, 0), "{name} is not closed");
         let xf = DAffine3::from_translation(DVec3::new(0.3, -0.2, 6.0));
-        let obj = MeshObject::new(&mesh, xf, 0, None, false);
+        let obj = MeshObject::new(&mesh, xf, 0, None, scnc::mesh::Normals::Flat);
         let world: Vec<Vec3A> = mesh.positions.iter().map(|p| xf.transform_point3(*p).as_vec3a()).collect();
         let face_normal = |t: &[u32; 3]| {
             let [a, b, c] = t.map(|i| world[i as usize]);
@@ -263,7 +263,7 @@ pub fn packets_agree_with_single_rays(mode: Mode) {
 fn packet_closest_hit_equals_brute_force() {
     fn check<const N: usize>(rng: &mut Rng, n: usize, spread: f32) {
         let mesh = soup(rng, n, spread);
-        let obj = MeshObject::new(&mesh, DAffine3::IDENTITY, 0, None, false);
+        let obj = MeshObject::new(&mesh, DAffine3::IDENTITY, 0, None, scnc::mesh::Normals::Flat);
         let (mut packets, mut fallbacks) = (0, 0);
         for _ in 0..1000 {
             let origin = rng.vec(spread * 2.0);

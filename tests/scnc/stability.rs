@@ -275,8 +275,13 @@ fn degenerate_input_is_an_error_or_defined() {
     let n = mesh.positions.len() as u32;
     mesh.triangles.push([0, n - 1, 1]);
     mesh.triangles.push([2, 2, 3]);
-    let obj =
-        scnc::mesh::MeshObject::new(&mesh, glam::DAffine3::from_translation(DVec3::new(0.0, 0.0, 5.0)), 0, None, true);
+    let obj = scnc::mesh::MeshObject::new(
+        &mesh,
+        glam::DAffine3::from_translation(DVec3::new(0.0, 0.0, 5.0)),
+        0,
+        None,
+        scnc::mesh::Normals::Vertex,
+    );
     assert_eq!(obj.triangle_count(), 12);
 }
 
