@@ -8,7 +8,7 @@ use std::process::ExitCode;
 
 use plotters::chart::SeriesLabelPosition;
 use plotters::style::{BLACK, BLUE, GREEN, RED};
-use scnc::study::chart::{loglog, Series};
+use scnc::study::chart::{loglog, Point, Series};
 
 fn main() -> ExitCode {
     let Some(out) = std::env::args().nth(1) else {
@@ -37,7 +37,7 @@ fn main() -> ExitCode {
         };
         let [n, times @ ..] = fields.as_slice() else { continue };
         for (s, &t) in series.iter_mut().zip(times) {
-            s.points.push((*n, t * 1000.0, None));
+            s.points.push(Point { x: *n, y: t * 1000.0, ..Point::default() });
         }
     }
     let chart = loglog(

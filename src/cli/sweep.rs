@@ -19,15 +19,19 @@ pub(crate) struct SweepArgs {
     /// Directory for sweep.csv, sweep.md and the charts (created if missing).
     #[arg(short, long, alias = "out")]
     output: PathBuf,
-    /// Image width for the sweep.
-    #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u32).range(1..=4096))]
-    width: u32,
-    /// Image height for the sweep.
-    #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u32).range(1..=4096))]
-    height: u32,
-    /// Timed renders per setting (after one warm-up); the median is reported.
-    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u16).range(1..=100))]
+    /// Image width for the sweep (default: the scene's own).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    width: Option<u32>,
+    /// Image height for the sweep (default: the scene's own).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    height: Option<u32>,
+    /// The fewest timed renders per setting (after one warm-up); more are made until the
+    /// median's 95 % interval is within 2 % of it, or `--time-cap` is reached.
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u16).range(1..=100))]
     runs: u16,
+    /// Seconds one setting may be timed for before its median is taken as it is.
+    #[arg(long, default_value_t = 3.0, value_parser = parse_cap)]
+    time_cap: f64,
     /// Two settings per back-end instead of the full ladder.
     #[arg(long)]
     quick: bool,
@@ -49,8 +53,9 @@ pub(crate) fn sweep_cmd(args: SweepArgs) -> ExitCode {
         return ExitCode::from(1);
     }
     let Some(mut scene) = compiled.scene else { return ExitCode::from(1) };
-    scene.settings.width = args.width;
-    scene.settings.height = args.height;
+    scene.settings.width = args.width.unwrap_or(scene.settings.width);
+    scene.settings.height = args.height.unwrap_or(scene.settings.height);
+    let (width, height) = (scene.settings.width, scene.settings.height);
     let ladder = match args.tolerance {
         Some(tol) => sweep::picked(&scene, tol),
         None => sweep::ladder(args.quick),
@@ -68,7 +73,14 @@ pub(crate) fn sweep_cmd(args: SweepArgs) -> ExitCode {
             bar.inc(1);
         }
     };
-    let opts = Options { runs: args.runs as usize, loader: &FsLoader, memory: &ProcPeakMemory, progress: &progress };
+    let opts = Options {
+        min_runs: args.runs as usize,
+        cap: args.time_cap,
+        cpu_seconds: &cpu_seconds,
+        loader: &FsLoader,
+        memory: &ProcPeakMemory,
+        progress: &progress,
+    };
     let rows = match sweep::run(&scene, &ladder, &opts) {
         Ok(rows) => rows,
         Err(d) => {
@@ -79,7 +91,9 @@ pub(crate) fn sweep_cmd(args: SweepArgs) -> ExitCode {
     if let Some(bar) = &bar {
         bar.finish_and_clear();
     }
-    let title = format!("{} at {}×{}", args.file.display(), args.width, args.height);
+    // The file's name, not its path: a chart is read beside others of its kind.
+    let name = args.file.file_name().map_or_else(|| args.file.display().to_string(), |n| n.to_string_lossy().into());
+    let title = format!("{name} at {width}×{height}");
     for (name, text) in [("sweep.csv", table::csv(&rows)), ("sweep.md", table::markdown(&rows, &title))] {
         let path = args.output.join(name);
         if let Err(e) = write_text(&path, &text) {
@@ -87,7 +101,12 @@ pub(crate) fn sweep_cmd(args: SweepArgs) -> ExitCode {
             return ExitCode::from(1);
         }
     }
-    for (name, axis) in [("time-vs-error.png", chart::Axis::Time), ("memory-vs-error.png", chart::Axis::Memory)] {
+    let charts = [
+        ("time-vs-error.png", chart::Axis::Time),
+        ("work-vs-error.png", chart::Axis::Work),
+        ("memory-vs-error.png", chart::Axis::Memory),
+    ];
+    for (name, axis) in charts {
         let path = args.output.join(name);
         let written = chart::error_chart(&rows, axis, &title)
             .map_err(std::io::Error::other)
@@ -99,6 +118,27 @@ pub(crate) fn sweep_cmd(args: SweepArgs) -> ExitCode {
     }
     let _ = writeln!(std::io::stderr(), "swept {} settings: {}", rows.len(), args.output.join("sweep.md").display());
     ExitCode::SUCCESS
+}
+
+/// A time cap from 0.01 to 3600 seconds.
+fn parse_cap(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(x) if (0.01..=3600.0).contains(&x) => Ok(x),
+        _ => Err("must be a number of seconds from 0.01 to 3600".into()),
+    }
+}
+
+/// The CPU time the process has used (user and system, all threads), from Linux's
+/// procfs (`None` elsewhere): fields 14 and 15 of `/proc/self/stat`, in clock ticks of
+/// 1/100 s (the kernel's USER_HZ on every Linux port).
+fn cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // The command name may hold spaces; the fields after it are counted from its ')'.
+    let rest = &stat[stat.rfind(')')? + 1..];
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |i: usize| fields.get(i)?.parse::<f64>().ok();
+    // After the name: state is field 3, so utime (14) and stime (15) are at 11 and 12.
+    Some((ticks(11)? + ticks(12)?) / 100.0)
 }
 
 /// The process's peak resident memory, from Linux's procfs (`None` elsewhere).

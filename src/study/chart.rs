@@ -1,12 +1,15 @@
-//! Charts of a sweep: time and memory against geometric error, log–log, one curve per
-//! back-end, each point labelled by its setting. Drawn with plotters into memory; text
+//! Charts of a sweep: time, work and memory against geometric error, log–log, one curve
+//! per back-end, each point labelled by its setting, the Pareto front ringed. Drawn with plotters into memory; text
 //! uses the bundled DejaVu Sans, so no system font is needed.
 
 use std::sync::Once;
 
 use plotters::prelude::*;
 
-use super::sweep::Row;
+use super::sweep::{Row, Setting};
+
+/// The step budget of every rung of the thresholds' ladder (`Settings::default`'s).
+const DEFAULT_STEPS: u32 = 512;
 use crate::render::Image;
 
 static FONT: Once = Once::new();
@@ -26,8 +29,10 @@ fn register_font() {
 /// What the x axis shows.
 #[derive(Clone, Copy, Debug)]
 pub enum Axis {
-    /// Median wall time, milliseconds.
+    /// Median wall time, milliseconds, with the fastest and slowest run as a bar.
     Time,
+    /// Unit operations per frame (see [`Row::work`]): the same on every run and machine.
+    Work,
     /// Geometry bytes.
     Memory,
 }
@@ -35,46 +40,95 @@ pub enum Axis {
 impl Axis {
     fn value(self, r: &Row) -> f64 {
         match self {
-            Axis::Time => r.wall_ms,
+            Axis::Time => r.time.median_ms,
+            Axis::Work => r.work as f64,
             Axis::Memory => r.bytes as f64,
+        }
+    }
+
+    /// The spread of the value over the runs, where there is one.
+    fn range(self, r: &Row) -> Option<(f64, f64)> {
+        match self {
+            Axis::Time => Some((r.time.min_ms, r.time.max_ms)),
+            Axis::Work | Axis::Memory => None,
         }
     }
 
     fn label(self) -> &'static str {
         match self {
-            Axis::Time => "wall time per render (ms, lowering + tracing)",
+            Axis::Time => "wall time per render (ms, lowering + tracing; bars: fastest to slowest run)",
+            Axis::Work => "work per frame (primitive evaluations + BVH visits + triangle tests)",
             Axis::Memory => "geometry memory (bytes)",
         }
     }
 }
 
-/// One curve of a log–log chart: its name, colour and points (x, y, optional label).
+/// One point of a chart.
+#[derive(Clone, Debug, Default)]
+pub struct Point {
+    /// Where it is.
+    pub x: f64,
+    /// Where it is.
+    pub y: f64,
+    /// Its label, if it has one.
+    pub label: Option<String>,
+    /// A horizontal bar through it (the spread of `x`), if any.
+    pub x_range: Option<(f64, f64)>,
+    /// Whether it is on the Pareto front of its chart (ringed).
+    pub front: bool,
+}
+
+/// One curve of a log–log chart: its name, colour and points.
 pub struct Series {
     /// Legend entry.
     pub name: String,
     /// Line and point colour.
     pub colour: RGBColor,
     /// The points, joined in this order.
-    pub points: Vec<(f64, f64, Option<String>)>,
+    pub points: Vec<Point>,
 }
 
-/// Plots `axis` against mean geometric error for every row.
+/// Plots `axis` against mean geometric error for every row, one curve per back-end; the
+/// settings no other beats in both cost and error (the Pareto front) are ringed.
 pub fn error_chart(rows: &[Row], axis: Axis, title: &str) -> Result<Image, String> {
     let floor = 1e-9;
-    let series = [("sdf", RED), ("mesh", BLUE)].map(|(backend, colour)| {
-        let mut points: Vec<(f64, f64, Option<String>)> = rows
-            .iter()
-            .filter(|r| r.setting.backend() == backend)
-            .map(|r| (axis.value(r).max(floor), r.geo_mean.max(floor), Some(r.setting.label())))
-            .collect();
-        points.sort_by(|a, b| b.1.total_cmp(&a.1));
-        Series { name: backend.into(), colour, points }
-    });
+    let point = |r: &Row| Point {
+        x: axis.value(r).max(floor),
+        y: r.geo_mean.max(floor),
+        label: Some(r.setting.label()),
+        x_range: axis.range(r),
+        front: false,
+    };
+    let all: Vec<Point> = rows.iter().map(point).collect();
+    let dominated = |p: &Point| all.iter().any(|q| q.x <= p.x && q.y <= p.y && (q.x < p.x || q.y < p.y));
+    // The thresholds and the step budgets are two knobs: each its own curve.
+    let curve = |r: &Row| match r.setting {
+        Setting::Sdf { max_steps, .. } if max_steps < DEFAULT_STEPS => 1,
+        Setting::Sdf { .. } => 0,
+        Setting::Mesh(_) => 2,
+    };
+    let series = [("sdf", RED), ("sdf, fewer steps", RGBColor(230, 140, 0)), ("mesh", BLUE)]
+        .into_iter()
+        .enumerate()
+        .map(|(k, (name, colour))| {
+            let mut points: Vec<Point> = rows
+                .iter()
+                .filter(|r| curve(r) == k)
+                .map(|r| {
+                    let p = point(r);
+                    Point { front: !dominated(&p), ..p }
+                })
+                .collect();
+            points.sort_by(|a, b| b.y.total_cmp(&a.y));
+            Series { name: name.into(), colour, points }
+        });
+    let series: Vec<Series> = series.collect();
     loglog(title, (axis.label(), "mean geometric error (world units)"), &series, SeriesLabelPosition::UpperRight)
 }
 
 /// A log–log chart of `series` (empty ones left out), 960×640, axes described by
-/// `(x, y)`, the legend at `legend`.
+/// `(x, y)`, the legend at `legend`. Labels are placed beside their points where they
+/// overlap no label placed before them, and left out where no place is free.
 pub fn loglog(
     title: &str,
     (x_desc, y_desc): (&str, &str),
@@ -98,8 +152,12 @@ pub fn loglog(
                 (1e-9, 1.0)
             }
         };
-        let (x0, x1) = range(&mut all().map(|p| p.0));
-        let (y0, y1) = range(&mut all().map(|p| p.1));
+        let xs = |p: &Point| {
+            let (a, b) = p.x_range.unwrap_or((p.x, p.x));
+            [a.max(f64::MIN_POSITIVE), p.x, b]
+        };
+        let (x0, x1) = range(&mut all().flat_map(xs));
+        let (y0, y1) = range(&mut all().map(|p| p.y));
         let mut chart = ChartBuilder::on(&root)
             .caption(title, ("sans-serif", 22))
             .margin(20)
@@ -119,19 +177,56 @@ pub fn loglog(
         for s in series.iter().filter(|s| !s.points.is_empty()) {
             let colour = s.colour;
             chart
-                .draw_series(LineSeries::new(s.points.iter().map(|p| (p.0, p.1)), colour.stroke_width(2)))
+                .draw_series(LineSeries::new(s.points.iter().map(|p| (p.x, p.y)), colour.stroke_width(2)))
                 .map_err(|e| e.to_string())?
                 .label(s.name.as_str())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
             chart
-                .draw_series(s.points.iter().map(|p| Circle::new((p.0, p.1), 4, colour.filled())))
-                .map_err(|e| e.to_string())?;
-            chart
                 .draw_series(s.points.iter().filter_map(|p| {
-                    let label = p.2.clone()?;
-                    Some(Text::new(label, (p.0, p.1), ("sans-serif", 12).into_font().color(&colour)))
+                    let (a, b) = p.x_range?;
+                    Some(PathElement::new(vec![(a, p.y), (b, p.y)], colour.stroke_width(1)))
                 }))
                 .map_err(|e| e.to_string())?;
+            chart
+                .draw_series(s.points.iter().map(|p| Circle::new((p.x, p.y), 4, colour.filled())))
+                .map_err(|e| e.to_string())?;
+            chart
+                .draw_series(
+                    s.points.iter().filter(|p| p.front).map(|p| Circle::new((p.x, p.y), 8, BLACK.stroke_width(2))),
+                )
+                .map_err(|e| e.to_string())?;
+        }
+        // Labels last, each where it overlaps nothing placed so far: right of its point,
+        // then left, above or below.
+        let mut placed: Vec<(i32, i32, i32, i32)> = Vec::new();
+        let font = ("sans-serif", 12).into_font();
+        let style = TextStyle::from(font.clone());
+        for s in series.iter() {
+            for p in &s.points {
+                let Some(label) = &p.label else { continue };
+                let (px, py) = chart.backend_coord(&(p.x, p.y));
+                let (tw, th) = root.estimate_text_size(label, &style).map_err(|e| e.to_string())?;
+                let (tw, th) = (tw as i32, th as i32);
+                let spots = [
+                    (px + 8, py - th / 2),
+                    (px - 8 - tw, py - th / 2),
+                    (px - tw / 2, py - 10 - th),
+                    (px - tw / 2, py + 10),
+                ];
+                let free = spots.into_iter().find(|&(x, y)| {
+                    let b = (x, y, x + tw, y + th);
+                    b.0 >= 0
+                        && b.1 >= 0
+                        && b.2 <= w as i32
+                        && b.3 <= h as i32
+                        && placed.iter().all(|q| b.2 < q.0 || q.2 < b.0 || b.3 < q.1 || q.3 < b.1)
+                });
+                if let Some((x, y)) = free {
+                    placed.push((x, y, x + tw, y + th));
+                    root.draw(&Text::new(label.clone(), (x, y), font.clone().color(&s.colour)))
+                        .map_err(|e| e.to_string())?;
+                }
+            }
         }
         chart
             .configure_series_labels()

@@ -142,7 +142,7 @@ fn render_rejects_bad_flags_with_exit_2() {
 }
 
 /// The columns of `sweep.csv`.
-const SWEEP_COLUMNS: &str = "backend,setting,wall_ms,rays_per_s,sdf_evals_per_ray,leaf_evals_per_ray,node_visits_per_ray,triangle_tests_per_ray,geometry_bytes,triangles,peak_rss_kib,geo_error_mean,geo_error_max,geo_error_max_pixels,coverage_error_px,rmse,psnr_db";
+const SWEEP_COLUMNS: &str = "backend,setting,work,runs,wall_ms_min,wall_ms,wall_ms_max,wall_ci_ms,cpu_ms,rays_per_s,sdf_evals_per_ray,leaf_evals_per_ray,node_visits_per_ray,triangle_tests_per_ray,geometry_bytes,triangles,peak_rss_kib,geo_error_mean,geo_error_max,geo_error_max_pixels,coverage_error_px,rmse,psnr_db";
 
 /// The sweep runs on a seed scene at a tiny size with two settings per back-end, writes
 /// the expected columns, and errors fall where the maths says they must.
@@ -183,12 +183,59 @@ fn sweep_writes_csv_with_monotone_errors() {
     assert!(geo_max(2) >= geo_max(3), "mesh: low detail should not beat high");
     assert!(geo_max(2) > 0.0 && geo_max(1) < 1e-3, "errors in the expected ranges");
     assert!(std::fs::read_to_string(dir.path().join("sweep.md")).expect("sweep.md").contains("| mesh | detail high |"));
-    for chart in ["time-vs-error.png", "memory-vs-error.png"] {
+    for chart in ["time-vs-error.png", "work-vs-error.png", "memory-vs-error.png"] {
         let img = image::open(dir.path().join(chart)).expect("a chart was written").to_rgb8();
         assert!(
             img.pixels().any(|p| p.0 == [255, 0, 0]) && img.pixels().any(|p| p.0 == [0, 0, 255]),
             "{chart} has both curves"
         );
+    }
+}
+
+/// The cost axis that does not depend on the machine: each setting's work (unit
+/// operations per frame) is the same in two sweeps, and finer settings of a back-end
+/// take more of it; the timing columns say how the median was reached.
+#[test]
+fn sweep_work_is_deterministic_and_grows_with_accuracy() {
+    let work = |dir: &std::path::Path| {
+        let o = scnc(&[
+            "sweep",
+            "examples/seed/07-box-sphere-cylinder.scn",
+            "-o",
+            dir.to_str().unwrap_or_default(),
+            "--width",
+            "48",
+            "--height",
+            "48",
+            "--runs",
+            "2",
+            "--time-cap",
+            "0.05",
+        ]);
+        assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+        let csv = std::fs::read_to_string(dir.join("sweep.csv")).expect("sweep.csv");
+        let col = |name: &str| SWEEP_COLUMNS.split(',').position(|c| c == name).expect("column");
+        csv.lines()
+            .skip(1)
+            .map(|l| {
+                let f: Vec<&str> = l.split(',').collect();
+                let num = |name: &str| f[col(name)].parse::<f64>().expect("a number");
+                assert!(num("runs") >= 2.0, "{l}");
+                assert!(num("wall_ms_min") <= num("wall_ms") && num("wall_ms") <= num("wall_ms_max"), "{l}");
+                (f[col("backend")].to_string(), f[col("setting")].to_string(), num("work"))
+            })
+            .collect::<Vec<_>>()
+    };
+    let (a, b) = (tempfile::tempdir().expect("tempdir"), tempfile::tempdir().expect("tempdir"));
+    let (first, second) = (work(a.path()), work(b.path()));
+    assert_eq!(first, second, "work differs between two sweeps");
+    // The thresholds' rungs, coarse to fine, and the mesh details, coarse to fine.
+    let rung = |setting: &str| first.iter().find(|(_, s, _)| s == setting).map(|r| r.2).expect("a rung");
+    let sdf = ["epsilon 1e-2 steps 512", "epsilon 1e-3 steps 512", "epsilon 1e-4 steps 512", "epsilon 1e-5 steps 512"];
+    let mesh = ["detail low", "detail high", "detail 28", "detail 56", "detail 112"];
+    for ladder in [&sdf[..], &mesh[..]] {
+        let works: Vec<f64> = ladder.iter().map(|s| rung(s)).collect();
+        assert!(works.windows(2).all(|w| w[0] <= w[1]), "{ladder:?}: {works:?}");
     }
 }
 
