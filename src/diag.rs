@@ -316,6 +316,10 @@ pub mod codes {
     pub const BRANCH_MISMATCH: &str = "E0311";
     /// A `for` over something that is neither a range nor a list.
     pub const NOT_ITERABLE: &str = "E0312";
+    /// Something that must be known before rendering depends on a field's point.
+    pub const DEPENDS_ON_POINT: &str = "E0313";
+    /// A field literal `p => …` where no field is taken.
+    pub const MISPLACED_FIELD: &str = "E0314";
     /// Value out of its allowed range.
     pub const OUT_OF_RANGE: &str = "E0400";
     /// Arithmetic produced a non-finite number (division by zero, overflow).
@@ -324,6 +328,8 @@ pub mod codes {
     pub const BAD_CAMERA: &str = "E0402";
     /// Beyond the renderable range.
     pub const OUT_OF_REACH: &str = "E0403";
+    /// A field whose slope has no bound the checker can find.
+    pub const UNBOUNDED_SLOPE: &str = "E0404";
     /// `camera` or `render` given twice.
     pub const DUPLICATE_STATEMENT: &str = "E0500";
     /// `object` of something that is not a shape or mesh.
@@ -368,6 +374,8 @@ pub mod codes {
     pub const BEHIND_CAMERA: &str = "W0005";
     /// A material argument that does nothing (`ior` or `absorption` without `transparency`).
     pub const NO_EFFECT: &str = "W0006";
+    /// A field far from a distance (its slope bound far from 1): it is marched slowly.
+    pub const STEEP_FIELD: &str = "W0007";
     /// Parts of a shape too small for its isosurface's cell, left out of the mesh.
     pub const LOST_PARTS: &str = "W0801";
     /// Isosurface edges left on four triangles where parts are thinner than the cell.

@@ -194,13 +194,13 @@ impl<'t> Formatter<'t> {
             return true;
         }
         match prev {
-            Some(Token::LParen | Token::LBracket | Token::DotDot) => return false,
+            Some(Token::LParen | Token::LBracket | Token::DotDot | Token::Dot) => return false,
             // Negation binds to its operand.
             Some(Token::Minus) if self.minus_was_unary => return false,
             _ => {}
         }
         match tok {
-            Token::RParen | Token::RBracket | Token::Comma | Token::DotDot => false,
+            Token::RParen | Token::RBracket | Token::Comma | Token::DotDot | Token::Dot => false,
             Token::RBrace => !matches!(prev, Some(Token::LBrace)),
             Token::LParen => !matches!(prev, Some(Token::Ident(_) | Token::Camera | Token::Render)),
             // Directly after a value, `[` indexes it.

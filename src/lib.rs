@@ -17,6 +17,8 @@
 //!   every builtin names its constructor.
 //! - [`ir`]: the evaluated scene in f64 with source spans; every per-primitive fact in
 //!   [`ir::Primitive`]; bounds; a stable text dump.
+//! - [`field`]: field bodies (`p => …`) compiled to tapes and evaluated as f32, dual
+//!   numbers and intervals; the bound of their slope.
 //! - [`sdf`] and [`mesh`]: the two geometry back-ends; [`world`] puts their objects, in
 //!   camera-relative f32, under one top-level [`accel::Bvh`].
 //! - [`accel`]: boxes, the robust slab test and the BVH (build, single-ray and packet walks).
@@ -38,6 +40,7 @@ pub mod accel;
 pub mod check;
 pub mod diag;
 pub mod export;
+pub mod field;
 pub mod fmt;
 pub mod geom;
 pub mod ir;

@@ -44,6 +44,12 @@ pub enum Ty {
     List,
     /// A number, a `vec3` or a colour: what can be scaled and added (`mix`, `sum`).
     Linear,
+    /// A field literal `p => …` whose body is a number.
+    FieldNum,
+    /// A field literal `p => …` whose body is a vector.
+    FieldVec,
+    /// A box, `[[x0, y0, z0], [x1, y1, z1]]`.
+    Bounds,
 }
 
 impl fmt::Display for Ty {
@@ -64,6 +70,9 @@ impl fmt::Display for Ty {
             Ty::Light => "light",
             Ty::List => "list",
             Ty::Linear => "num, vec3 or color",
+            Ty::FieldNum => "p => num",
+            Ty::FieldVec => "p => vec3",
+            Ty::Bounds => "[vec3, vec3]",
         };
         f.write_str(s)
     }

@@ -5,6 +5,7 @@ use glam::DVec3;
 
 use super::builtins::{self, Builtin, Ctor, Kind, Ty};
 use super::expr::{ArgVal, BoundArgs, SYNONYMS};
+use super::field::has_sym;
 use super::{Bound, Ctx, Env, Func, Value, MAX_CALL_DEPTH};
 use crate::diag::{codes, suggest, Diagnostic};
 use crate::ir::dump_num;
@@ -36,12 +37,18 @@ impl Ctx<'_> {
                         for a in args {
                             values.push(self.expr(&a.value));
                         }
+                        for (v, a) in values.iter_mut().zip(args) {
+                            self.no_field_literal(v, a.value.span, &f.name);
+                        }
                         if values.iter().any(Value::is_error) {
                             return Value::Error;
                         }
                         return self.call_user(&f, values, span, false);
                     }
-                    let args = self.eval_args(args);
+                    let mut args = self.eval_args(args);
+                    for a in &mut args {
+                        self.no_field_literal(&mut a.value, a.span, &f.name);
+                    }
                     let Some(values) = self.bind_user(&f, args, span, callee.span) else {
                         return Value::Error;
                     };
@@ -85,6 +92,23 @@ impl Ctx<'_> {
             return Value::Error;
         }
         self.apply_builtin(all, callee.span, args, span)
+    }
+
+    /// Turns a field literal passed to the user function `name` into poison, reported.
+    fn no_field_literal(&mut self, v: &mut Value, span: Span, name: &str) {
+        if matches!(v, Value::Field(_)) {
+            self.report(
+                Diagnostic::error(
+                    codes::MISPLACED_FIELD,
+                    span,
+                    format!("a field literal cannot be passed to `{name}`"),
+                    "a field literal",
+                )
+                .with_note("`p => …` is an argument of `field`, `warp` or `displace` only")
+                .with_hint(format!("call `field(…)` inside `{name}` and pass what it needs instead")),
+            );
+            *v = Value::Error;
+        }
     }
 
     /// Among a builtin's overloads `all` (`round(x)`, `round(shape, r)`; never empty),
@@ -151,7 +175,15 @@ impl Ctx<'_> {
             return Value::Error;
         };
         self.note_builtin(name, builtin);
-        match self.bind_builtin(builtin, args, span) {
+        // The maths builtins take values that depend on a field's point, and give one.
+        let symbolic = Self::takes_symbolic(builtin);
+        let outer = std::mem::replace(&mut self.symbolic_args, symbolic);
+        let bound = self.bind_builtin(builtin, args, span);
+        self.symbolic_args = outer;
+        match bound {
+            Some(bound) if symbolic && bound.vals.iter().flatten().chain(&bound.rest).any(|(v, _)| has_sym(v)) => {
+                self.symbolic_call(builtin, &bound)
+            }
             Some(bound) => self.construct(builtin, bound),
             None => Value::Error,
         }
@@ -389,6 +421,20 @@ impl Ctx<'_> {
     fn coerce(&mut self, v: &Value, ty: Ty, span: Span, what: &dyn Fn() -> String) -> Option<Value> {
         let ok = match (ty, v) {
             (_, Value::Error) => return Some(Value::Error),
+            (Ty::Num | Ty::Int | Ty::Vec3 | Ty::Size | Ty::Linear | Ty::List, Value::Sym(e)) => {
+                use crate::ir::field::Ty as F;
+                let fits = match ty {
+                    Ty::Num => e.ty == F::Num,
+                    Ty::Vec3 => e.ty == F::Vec3,
+                    Ty::Linear => e.ty != F::Bool,
+                    _ => false,
+                };
+                if self.symbolic_args && fits {
+                    return Some(v.clone());
+                }
+                self.depends_on_point(span, &what());
+                return None;
+            }
             (Ty::Int, Value::Num(x)) => {
                 if x.fract() != 0.0 {
                     self.report(
@@ -434,6 +480,10 @@ impl Ctx<'_> {
             (Ty::Vec3, Value::List(items)) => {
                 d = d.with_note(format!("a vector has exactly 3 numbers; this list has {}", items.len()))
             }
+            (_, Value::Field(_)) => {
+                d = d.with_note("a field literal `p => …` is an argument of `field`, `warp` or `displace`")
+            }
+            (Ty::FieldNum | Ty::FieldVec, _) => d = d.with_hint("try a field literal, such as `p => length(p) - 1`"),
             _ => {}
         }
         self.report(d);
@@ -526,6 +576,10 @@ fn admits(ty: Ty, v: &Value) -> bool {
         Ty::Mesh => matches!(v, Value::Mesh(_)),
         Ty::Light => matches!(v, Value::Light(_)),
         Ty::List => matches!(v, Value::List(_) | Value::Vec3(_)),
+        Ty::FieldNum => matches!(v, Value::Field(f) if f.body.ty == crate::ir::field::Ty::Num),
+        Ty::FieldVec => matches!(v, Value::Field(f) if f.body.ty == crate::ir::field::Ty::Vec3),
+        // Its two corners are checked by the builtin, which can say which is wrong.
+        Ty::Bounds => matches!(v, Value::List(_)),
     }
 }
 

@@ -74,6 +74,10 @@ impl Ctx<'_> {
         match v {
             Value::Bool(b) => Some(*b),
             Value::Error => None,
+            Value::Sym(e) if e.ty == crate::ir::field::Ty::Bool => {
+                self.depends_on_point(span, what);
+                None
+            }
             other => {
                 let mut d = Diagnostic::error(
                     codes::NOT_A_BOOL,
@@ -116,6 +120,11 @@ impl Ctx<'_> {
     /// `if cond then a else b`.
     pub(super) fn if_expr(&mut self, cond: &ast::Expr, then: &ast::Expr, otherwise: &ast::Expr) -> Value {
         let c = self.expr(cond);
+        if let Value::Sym(s) = &c {
+            if s.ty == crate::ir::field::Ty::Bool {
+                return self.symbolic_if(s.clone(), then, otherwise);
+            }
+        }
         let taken = self.condition(&c, cond.span, "the condition of `if`");
         let (ran, other) = match taken {
             Some(true) => (then, otherwise),

@@ -87,7 +87,11 @@ impl Captured {
                 }
                 ExprKind::Mesh { generator: _, args } => stack.extend(args.iter().map(|a| &a.value)),
                 ExprKind::Index { base, index } => stack.extend([&**base, &**index]),
-                ExprKind::Neg(inner) | ExprKind::Not(inner) => stack.push(inner),
+                ExprKind::Neg(inner) | ExprKind::Not(inner) | ExprKind::Component { base: inner, axis: _ } => {
+                    stack.push(inner)
+                }
+                // The point is local, like a comprehension's variable.
+                ExprKind::Field { param: _, body } => stack.push(body),
                 ExprKind::If { cond, then, otherwise } => stack.extend([&**cond, &**then, &**otherwise]),
                 // A comprehension's variables are local, so capturing an outer binding of
                 // the same name is harmless: the local one is found first.

@@ -9,6 +9,7 @@ use super::builtins::{self, Kind};
 use super::{Bound, Ctx, Value, MAX_EXPR_DEPTH, MAX_LIST};
 use crate::diag::{codes, suggest, Diagnostic};
 use crate::ir::dump_num;
+use crate::ir::field::Ty as FTy;
 use crate::span::Span;
 use crate::syntax::ast::{self, BinOp, ExprKind};
 
@@ -103,9 +104,15 @@ impl Ctx<'_> {
                 let i = self.expr(index);
                 self.index(b, base.span, i, index.span)
             }
+            ExprKind::Component { base, axis } => {
+                let b = self.expr(base);
+                self.component(b, base.span, axis)
+            }
+            ExprKind::Field { param, body } => self.field_literal(param, body),
             ExprKind::Neg(inner) => match self.expr(inner) {
                 Value::Num(x) => Value::Num(-x),
                 Value::Vec3(v) => Value::Vec3(-v),
+                Value::Sym(s) => self.symbolic_neg(s, e.span),
                 Value::Error => Value::Error,
                 other => {
                     self.report(
@@ -128,6 +135,9 @@ impl Ctx<'_> {
             }
             ExprKind::Not(inner) => {
                 let v = self.expr(inner);
+                if let Value::Sym(s) = v {
+                    return self.symbolic_not(s, e.span);
+                }
                 match self.condition(&v, inner.span, "the operand of `not`") {
                     Some(b) => Value::Bool(!b),
                     None => Value::Error,
@@ -228,6 +238,12 @@ impl Ctx<'_> {
             let n = |i: usize| if let Value::Num(x) = values[i].0 { x } else { 0.0 };
             return Value::Vec3(DVec3::new(n(0), n(1), n(2)));
         }
+        // Three numbers, some depending on a field's point: a vector that does too.
+        let num = |v: &Value| matches!(v, Value::Num(_)) || matches!(v, Value::Sym(e) if e.ty == FTy::Num);
+        if values.len() == 3 && values.iter().all(|(v, _)| num(v)) {
+            let c = |i: usize| values[i].0.as_field().unwrap_or_else(|| crate::ir::field::Expr::num(0.0));
+            return Value::Sym(super::field::vector([c(0), c(1), c(2)]));
+        }
         self.uniform_list(values).unwrap_or(Value::Error)
     }
 
@@ -259,6 +275,20 @@ impl Ctx<'_> {
     }
 
     fn index(&mut self, base: Value, base_span: Span, index: Value, index_span: Span) -> Value {
+        if matches!(index, Value::Sym(_)) {
+            self.depends_on_point(index_span, "an index");
+            return Value::Error;
+        }
+        if let Value::Sym(e) = &base {
+            if e.ty == FTy::Vec3 {
+                if let Value::Num(i) = index {
+                    if i.fract() == 0.0 && (0.0..3.0).contains(&i) {
+                        let axis = ["x", "y", "z"][i as usize];
+                        return self.component(base, base_span, &ast::Ident { name: axis.into(), span: index_span });
+                    }
+                }
+            }
+        }
         let len = match &base {
             Value::List(items) => items.len(),
             Value::Vec3(_) => 3,
@@ -325,6 +355,11 @@ impl Ctx<'_> {
         if a.is_error() || b.is_error() {
             return Value::Error;
         }
+        if matches!(op, BinOp::Div | BinOp::Rem) && matches!(a, Value::Sym(_)) {
+            // A constant zero divisor is still refused below; a varying one is the field's.
+        } else if let Some(v) = self.symbolic_binary(op, (&a, a_span), (&b, b_span), span) {
+            return v;
+        }
         match op {
             BinOp::Eq | BinOp::Ne => return self.equality(op, &a, a_span, &b, b_span, span),
             BinOp::Lt => return self.ordering(op, |x, y| x < y, &a, a_span, &b, b_span, span),
@@ -354,6 +389,9 @@ impl Ctx<'_> {
                         .with_label(span, "in this expression"),
                 );
                 return Value::Error;
+            }
+            if let Some(v) = self.symbolic_binary(op, (&a, a_span), (&b, b_span), span) {
+                return v;
             }
         }
         let f = |x: f64, y: f64| match op {
@@ -462,6 +500,15 @@ impl Ctx<'_> {
     fn logic(&mut self, op: BinOp, lhs: &ast::Expr, rhs: &ast::Expr) -> Value {
         let what = format!("an operand of `{}`", op.symbol());
         let a = self.expr(lhs);
+        if matches!(a, Value::Sym(_)) {
+            // Decided per point: both sides, whatever the left is at any one point.
+            let b = self.expr(rhs);
+            let span = lhs.span.to(rhs.span);
+            if b.is_error() {
+                return Value::Error;
+            }
+            return self.symbolic_binary(op, (&a, lhs.span), (&b, rhs.span), span).unwrap_or(Value::Error);
+        }
         match (op, self.condition(&a, lhs.span, &what)) {
             (BinOp::And, Some(false)) | (BinOp::Or, Some(true)) => {
                 let _ = self.explore(rhs.span, |this| this.expr(rhs));
@@ -469,6 +516,10 @@ impl Ctx<'_> {
             }
             (_, Some(_)) => {
                 let b = self.expr(rhs);
+                // `true and c` is `c`, also where `c` depends on a field's point.
+                if matches!(&b, Value::Sym(s) if s.ty == FTy::Bool) {
+                    return b;
+                }
                 self.condition(&b, rhs.span, &what).map_or(Value::Error, Value::Bool)
             }
             (_, None) => {

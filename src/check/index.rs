@@ -21,6 +21,8 @@ pub enum DefKind {
     Param,
     /// A `for` loop variable.
     LoopVar,
+    /// A field literal's point (`p` in `p => …`).
+    Point,
 }
 
 /// One definition.

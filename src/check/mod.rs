@@ -18,6 +18,7 @@ mod construct;
 mod control;
 mod env;
 mod expr;
+mod field;
 mod include;
 pub mod index;
 mod range;
@@ -157,6 +158,11 @@ struct Ctx<'a> {
     index: Option<index::Index>,
     /// Where the innermost block being evaluated ends (global offset), for scopes in the index.
     block_end: u32,
+    /// How many field literals' bodies are being evaluated (`dist` needs one).
+    field_depth: u32,
+    /// Set while binding the arguments of a builtin that takes values depending on a
+    /// field's point (the maths builtins), so they pass the type checks.
+    symbolic_args: bool,
     /// While evaluating a file included from the root file: the span in the root after
     /// which the included top-level names are in scope, and the scope depth of that level.
     export: Option<(u32, u32, usize)>,
@@ -515,6 +521,8 @@ fn run(
         too_deep: false,
         index: indexed.then(index::Index::default),
         block_end: u32::MAX,
+        field_depth: 0,
+        symbolic_args: false,
         export: None,
     };
     ctx.reuse.start();

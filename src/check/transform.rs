@@ -27,6 +27,10 @@ impl Ctx<'_> {
             return Value::Error;
         }
         let kw = op.keyword();
+        if matches!(arg, Value::Sym(_)) {
+            self.depends_on_point(arg_span, &format!("`{kw}`'s argument"));
+            return Value::Error;
+        }
         let bad_target = |this: &mut Self, note: &str| {
             this.report(
                 Diagnostic::error(
@@ -177,6 +181,11 @@ fn apply_xf(shape: Arc<ir::Shape>, xf: DAffine3, span: Span) -> Arc<ir::Shape> {
         | ir::ShapeKind::Csg { .. }
         | ir::ShapeKind::Round { .. }
         | ir::ShapeKind::Shell { .. }
-        | ir::ShapeKind::Repeat { .. } => Arc::new(ir::Shape::new(ir::ShapeKind::Transform { child: shape, xf }, span)),
+        | ir::ShapeKind::Repeat { .. }
+        | ir::ShapeKind::Field { .. }
+        | ir::ShapeKind::Warp { .. }
+        | ir::ShapeKind::Displace { .. } => {
+            Arc::new(ir::Shape::new(ir::ShapeKind::Transform { child: shape, xf }, span))
+        }
     }
 }

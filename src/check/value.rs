@@ -7,6 +7,16 @@ use glam::DVec3;
 
 use super::builtins::Ty;
 use crate::ir;
+use crate::span::Span;
+
+/// A field literal's value: its body, evaluated with the point unknown.
+#[derive(Debug)]
+pub struct FieldLit {
+    /// The body.
+    pub body: Arc<ir::field::Expr>,
+    /// The body's span, to blame for what it computes.
+    pub span: Span,
+}
 
 /// A compile-time value. `Error` is poison: an expression that already failed, which
 /// every operation passes through silently so one mistake is reported once.
@@ -34,6 +44,11 @@ pub enum Value {
     Light(Arc<ir::Light>),
     /// A list.
     List(Rc<Vec<Value>>),
+    /// A number, vector or truth value that depends on a field's point: inside a field
+    /// literal's body, what the point flows into.
+    Sym(Arc<ir::field::Expr>),
+    /// A field literal `p => …`, its body evaluated.
+    Field(Rc<FieldLit>),
     /// Poison.
     Error,
 }
@@ -54,6 +69,13 @@ impl Value {
             Value::Mesh(_) => Ty::Mesh,
             Value::Light(_) => Ty::Light,
             Value::List(_) => Ty::List,
+            Value::Sym(e) => match e.ty {
+                ir::field::Ty::Num => Ty::Num,
+                ir::field::Ty::Vec3 => Ty::Vec3,
+                ir::field::Ty::Bool => Ty::Bool,
+            },
+            Value::Field(f) if f.body.ty == ir::field::Ty::Vec3 => Ty::FieldVec,
+            Value::Field(_) => Ty::FieldNum,
             Value::Error => return None,
         })
     }
@@ -67,6 +89,7 @@ impl Value {
     pub fn ty_name(&self) -> String {
         match self {
             Value::Num(_) => "num".into(),
+            Value::Sym(e) => format!("{} (depends on the point)", e.ty.name()),
             Value::List(items) => match items.first().and_then(Value::ty) {
                 Some(Ty::Int) => "list<num>".into(),
                 Some(t) => format!("list<{t}>"),
@@ -101,6 +124,19 @@ impl Value {
             Value::Vec3(v) | Value::Color(v) => v.is_finite(),
             _ => true,
         }
+    }
+
+    /// The value as a field expression, if it is a number, vector or truth value
+    /// (known, or depending on the point).
+    pub fn as_field(&self) -> Option<Arc<ir::field::Expr>> {
+        use ir::field::{Expr, Kind, Ty};
+        Some(match self {
+            Value::Num(x) => Expr::num(*x),
+            Value::Vec3(v) => Expr::vec(*v),
+            Value::Bool(b) => Expr::new(Kind::Num(f64::from(*b)), Ty::Bool),
+            Value::Sym(e) => e.clone(),
+            _ => return None,
+        })
     }
 
     /// True for poison.

@@ -1,7 +1,10 @@
 //! Plain geometry in f64 that every stage shares: axis-aligned boxes, indexed triangle
 //! meshes and the parametric generators that make them.
 
+pub mod noise;
 pub mod tessellate;
+
+pub use noise::noise;
 
 use glam::{DAffine3, DVec3};
 

@@ -41,6 +41,13 @@ fn bounds_within(shape: &Shape, g: f64) -> Option<Aabb> {
         }
         ShapeKind::Transform { child, xf } => bounds_within(child, within_child(g, xf)).map(|b| b.transform(xf)),
         ShapeKind::Paint { child, .. } => bounds_within(child, g),
+        // A field cut to a box is at most `g` only within `g` of the box.
+        ShapeKind::Field { bounds, .. } | ShapeKind::Warp { bounds, .. } => bounds.map(|b| b.grow(g)),
+        // (child + d) / (1 + L) ≤ g where child ≤ g·(1 + L) − d ≤ g·(1 + L) + reach.
+        ShapeKind::Displace { child, bounds, lipschitz, reach, .. } => match bounds {
+            Some(b) => Some(b.grow(g)),
+            None => bounds_within(child, g * (1.0 + lipschitz.value) + reach),
+        },
     }
 }
 
@@ -110,6 +117,9 @@ fn sphere_within(shape: &Shape, g: f64) -> Option<(DVec3, f64)> {
             Some((xf.transform_point3(c), r * max_stretch(xf.matrix3)))
         }
         ShapeKind::Paint { child, .. } => sphere_within(child, g),
+        ShapeKind::Field { .. } | ShapeKind::Warp { .. } | ShapeKind::Displace { .. } => {
+            bounds_within(shape, g).map(from_box)
+        }
     }
 }
 
@@ -138,6 +148,7 @@ fn half_space_within(shape: &Shape, g: f64) -> Option<(DVec3, f64)> {
             transform_half_space((n, o), xf)
         }
         ShapeKind::Paint { child, .. } => half_space_within(child, g),
+        ShapeKind::Field { .. } | ShapeKind::Warp { .. } | ShapeKind::Displace { .. } => None,
     }
 }
 

@@ -112,6 +112,39 @@ impl Dumper<'_> {
                 self.line(indent, &format!("paint {}", Self::material(material)), Some(material.span));
                 self.shape(indent + 1, child);
             }
+            ShapeKind::Field { body, bounds, lipschitz } => {
+                self.line(indent, &format!("field{}{}", Self::bounds(bounds), Self::lipschitz(lipschitz)), span);
+                self.body(indent + 1, body);
+            }
+            ShapeKind::Warp { child, map, bounds, lipschitz } => {
+                self.line(indent, &format!("warp{}{}", Self::bounds(bounds), Self::lipschitz(lipschitz)), span);
+                self.body(indent + 1, map);
+                self.shape(indent + 1, child);
+            }
+            ShapeKind::Displace { child, by, bounds, lipschitz, reach } => {
+                let reach = format!(" reach {}", num(*reach));
+                let head = format!("displace{}{}{reach}", Self::bounds(bounds), Self::lipschitz(lipschitz));
+                self.line(indent, &head, span);
+                self.body(indent + 1, by);
+                self.shape(indent + 1, child);
+            }
+        }
+    }
+
+    fn bounds(b: &Option<super::Aabb>) -> String {
+        b.map_or(String::new(), |b| format!(" bounds [{}, {}]", vec(b.min), vec(b.max)))
+    }
+
+    fn lipschitz(l: &super::Lipschitz) -> String {
+        format!(" lipschitz {} ({})", num(l.value), if l.given { "given" } else { "estimated" })
+    }
+
+    /// A field body as source, then each shape its `dist` calls read.
+    fn body(&mut self, indent: usize, body: &std::sync::Arc<super::field::Expr>) {
+        self.line(indent, &format!("p => {}", body.source(2000)), None);
+        for (i, s) in body.shapes().iter().enumerate() {
+            self.line(indent, &format!("shape#{i}"), None);
+            self.shape(indent + 1, s);
         }
     }
 

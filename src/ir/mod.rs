@@ -10,6 +10,7 @@
 
 mod bounds;
 mod dump;
+pub mod field;
 mod paint;
 
 use std::path::PathBuf;
@@ -248,7 +249,14 @@ impl Shape {
     /// A node over `kind`, counting its expanded size from its children's.
     pub fn new(kind: ShapeKind, span: Span) -> Shape {
         let mut shape = Shape { kind, span, nodes: 1 };
-        shape.nodes = shape.children().iter().fold(1u64, |n, c| n.saturating_add(c.nodes));
+        let own = match &shape.kind {
+            // A body is its operations and the shapes it measures.
+            ShapeKind::Field { body: e, .. } | ShapeKind::Warp { map: e, .. } | ShapeKind::Displace { by: e, .. } => {
+                e.shapes().iter().fold(e.size() as u64, |n, s| n.saturating_add(s.nodes))
+            }
+            _ => 1,
+        };
+        shape.nodes = shape.children().iter().fold(own, |n, c| n.saturating_add(c.nodes));
         shape
     }
 }
@@ -326,6 +334,50 @@ pub enum ShapeKind {
         /// The material.
         material: Arc<Material>,
     },
+    /// `field(p => f)`: inside where `f(p) < 0`, cut to `bounds` when given.
+    Field {
+        /// The body, a number.
+        body: Arc<field::Expr>,
+        /// Where it lives; `None`: everywhere, like a plane.
+        bounds: Option<Aabb>,
+        /// The bound of the body's slope it is marched with.
+        lipschitz: Lipschitz,
+    },
+    /// `warp(shape, p => q)`: the shape seen at `q(p)`, cut to `bounds` when given.
+    Warp {
+        /// The shape.
+        child: Arc<Shape>,
+        /// The map, a vector.
+        map: Arc<field::Expr>,
+        /// Where the result lives; `None`: everywhere.
+        bounds: Option<Aabb>,
+        /// The bound of how much the map stretches a distance.
+        lipschitz: Lipschitz,
+    },
+    /// `displace(shape, p => d)`: the shape's distance plus `d(p)`.
+    Displace {
+        /// The shape.
+        child: Arc<Shape>,
+        /// The displacement, a number.
+        by: Arc<field::Expr>,
+        /// Where the result lives, when given; otherwise the shape's bounds grown by `reach`.
+        bounds: Option<Aabb>,
+        /// The bound of the displacement's slope.
+        lipschitz: Lipschitz,
+        /// How far the displacement can push the surface out: the most `-d` gets
+        /// where the shape's bounds grown by it reach (0 when `d` ≥ 0 there).
+        reach: f64,
+    },
+}
+
+/// The bound of a field's slope (its Lipschitz constant) a march divides it by, so
+/// that a step never crosses the surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lipschitz {
+    /// The bound, > 0.
+    pub value: f64,
+    /// Whether the scene states it (`lipschitz = …`) rather than the checker's estimate.
+    pub given: bool,
 }
 
 impl Shape {
@@ -341,7 +393,10 @@ impl Shape {
             | ShapeKind::Round { .. }
             | ShapeKind::Shell { .. }
             | ShapeKind::Repeat { .. }
-            | ShapeKind::Paint { .. } => DAffine3::IDENTITY,
+            | ShapeKind::Paint { .. }
+            | ShapeKind::Field { .. }
+            | ShapeKind::Warp { .. }
+            | ShapeKind::Displace { .. } => DAffine3::IDENTITY,
         }
     }
 
@@ -361,21 +416,29 @@ impl Shape {
             ShapeKind::Round { child, .. } | ShapeKind::Paint { child, .. } | ShapeKind::Transform { child, .. } => {
                 child.is_convex()
             }
-            // A shell is hollow and repeated copies leave gaps between them.
-            ShapeKind::Shell { .. } | ShapeKind::Repeat { .. } => false,
+            // A shell is hollow and repeated copies leave gaps between them; a field may
+            // be any set at all.
+            ShapeKind::Shell { .. }
+            | ShapeKind::Repeat { .. }
+            | ShapeKind::Field { .. }
+            | ShapeKind::Warp { .. }
+            | ShapeKind::Displace { .. } => false,
         }
     }
 
     /// The node's children, in order (none for a primitive).
     pub fn children(&self) -> &[Arc<Shape>] {
         match &self.kind {
-            ShapeKind::Primitive(_) => &[],
+            // A field's shapes are inside its body ([`field::Expr::shapes`]).
+            ShapeKind::Primitive(_) | ShapeKind::Field { .. } => &[],
             ShapeKind::Csg { children, .. } => children,
             ShapeKind::Round { child, .. }
             | ShapeKind::Shell { child, .. }
             | ShapeKind::Repeat { child, .. }
             | ShapeKind::Transform { child, .. }
-            | ShapeKind::Paint { child, .. } => std::slice::from_ref(child),
+            | ShapeKind::Paint { child, .. }
+            | ShapeKind::Warp { child, .. }
+            | ShapeKind::Displace { child, .. } => std::slice::from_ref(child),
         }
     }
 }

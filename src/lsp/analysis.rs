@@ -369,12 +369,14 @@ fn describe_def(def: &Def) -> String {
         DefKind::Function => format!("let {ty}"),
         DefKind::Param => format!("{}: {ty}", def.name),
         DefKind::LoopVar => format!("for {}: {ty}", def.name),
+        DefKind::Point => format!("{} => …", def.name),
     };
     let what = match def.kind {
         DefKind::Value => "value",
         DefKind::Function => "function",
         DefKind::Param => "parameter",
         DefKind::LoopVar => "loop variable",
+        DefKind::Point => "the point: a `vec3`, where the field is evaluated (`.x`, `.y`, `.z` are its coordinates)",
     };
     format!("```scn\n{line}\n```\n{what}")
 }

@@ -43,7 +43,10 @@ pub fn tessellate(
             | ShapeKind::Csg { .. }
             | ShapeKind::Round { .. }
             | ShapeKind::Shell { .. }
-            | ShapeKind::Repeat { .. } => break,
+            | ShapeKind::Repeat { .. }
+            | ShapeKind::Field { .. }
+            | ShapeKind::Warp { .. }
+            | ShapeKind::Displace { .. } => break,
         }
     }
     let made = match &node.kind {
@@ -53,7 +56,10 @@ pub fn tessellate(
         | ShapeKind::Shell { .. }
         | ShapeKind::Repeat { .. }
         | ShapeKind::Transform { .. }
-        | ShapeKind::Paint { .. } => Tessellation::Isosurface,
+        | ShapeKind::Paint { .. }
+        | ShapeKind::Field { .. }
+        | ShapeKind::Warp { .. }
+        | ShapeKind::Displace { .. } => Tessellation::Isosurface,
     };
     match made {
         Tessellation::Triangles(triangles, make) => {

@@ -47,7 +47,12 @@ pub fn solid_parts(shape: &Shape, xf: DAffine3, out: &mut Vec<Part>) {
         }
     };
     match &shape.kind {
-        ShapeKind::Primitive(_) | ShapeKind::Round { .. } | ShapeKind::Shell { .. } => whole(out),
+        ShapeKind::Primitive(_)
+        | ShapeKind::Round { .. }
+        | ShapeKind::Shell { .. }
+        | ShapeKind::Field { .. }
+        | ShapeKind::Warp { .. }
+        | ShapeKind::Displace { .. } => whole(out),
         ShapeKind::Csg { op: CsgOp::Intersect, .. } => whole(out),
         ShapeKind::Csg { op: CsgOp::Union, children, .. } => {
             for c in children {

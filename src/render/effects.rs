@@ -88,8 +88,11 @@ fn materials_of(geometry: &Geometry) -> Vec<ir::Material> {
 fn painted_everywhere(shape: &ir::Shape) -> bool {
     match &shape.kind {
         ShapeKind::Paint { .. } => true,
-        ShapeKind::Primitive(_) => false,
-        ShapeKind::Csg { .. }
+        // A field's surface is its own: the shapes its body measures paint nothing.
+        ShapeKind::Primitive(_) | ShapeKind::Field { .. } => false,
+        ShapeKind::Warp { .. }
+        | ShapeKind::Displace { .. }
+        | ShapeKind::Csg { .. }
         | ShapeKind::Round { .. }
         | ShapeKind::Shell { .. }
         | ShapeKind::Repeat { .. }

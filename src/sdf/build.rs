@@ -7,6 +7,7 @@ use std::sync::Arc;
 
 use glam::{Affine3A, DAffine3, DMat3, Vec3A};
 
+use super::field::{self, BoxCut};
 use super::prim;
 use super::union::{self, Fold, PartTree, RayParts};
 use crate::accel::{padded_sphere, Aabb};
@@ -204,7 +205,13 @@ impl<'a> Builder<'a> {
                 self.combine(kids, *op)
             }
             ShapeKind::Primitive(p) => self.primitive(p, xf, mat),
-            ShapeKind::Csg { .. } | ShapeKind::Round { .. } | ShapeKind::Shell { .. } | ShapeKind::Repeat { .. } => {
+            ShapeKind::Csg { .. }
+            | ShapeKind::Round { .. }
+            | ShapeKind::Shell { .. }
+            | ShapeKind::Repeat { .. }
+            | ShapeKind::Field { .. }
+            | ShapeKind::Warp { .. }
+            | ShapeKind::Displace { .. } => {
                 // Smooth operators and modifiers work in their own units: build locally, then wrap.
                 let outer = self.frame;
                 self.frame = outer * xf;
@@ -328,10 +335,68 @@ impl<'a> Builder<'a> {
                 let rep2 = rep.clone();
                 (self.sdf(move |p| rep.eval(p, |q| d(q))), self.mat(move |p| rep2.eval_surf(p, |q| m(q))))
             }
+            ShapeKind::Field { body, bounds, lipschitz } => {
+                let body = self.body(body, mat);
+                let (k, cut) = (1.0 / lipschitz.value as f32, bounds.as_ref().map(BoxCut::new));
+                let b = body.clone();
+                (
+                    self.sdf(move |p| {
+                        crate::trace::count_leaf();
+                        field::cut(&cut, p, b.num(p) * k)
+                    }),
+                    self.mat(move |p| {
+                        crate::trace::count_leaf();
+                        let v = body.dual(p);
+                        field::cut_surf(&cut, p, Surf { d: v.v * k, g: v.g * k, mat })
+                    }),
+                )
+            }
+            ShapeKind::Warp { child, map, bounds, lipschitz } => {
+                let (d, m) = self.build(child, id, mat);
+                let map = self.body(map, mat);
+                let (k, cut) = (1.0 / lipschitz.value as f32, bounds.as_ref().map(BoxCut::new));
+                let q = map.clone();
+                (
+                    self.sdf(move |p| field::cut(&cut, p, d(q.vec(p)) * k)),
+                    self.mat(move |p| {
+                        let j = map.vec_dual(p);
+                        let s = m(Vec3A::new(j[0].v, j[1].v, j[2].v));
+                        // The chain rule: ∇(f∘q) = Jᵀ∇f.
+                        let g = j[0].g * s.g.x + j[1].g * s.g.y + j[2].g * s.g.z;
+                        field::cut_surf(&cut, p, Surf { d: s.d * k, g: g * k, mat: s.mat })
+                    }),
+                )
+            }
+            ShapeKind::Displace { child, by, bounds, lipschitz, .. } => {
+                let (d, m) = self.build(child, id, mat);
+                let by = self.body(by, mat);
+                // The sum's slope is at most the shape's 1 plus the displacement's.
+                let (k, cut) = (1.0 / (1.0 + lipschitz.value as f32), bounds.as_ref().map(BoxCut::new));
+                let b = by.clone();
+                (
+                    self.sdf(move |p| field::cut(&cut, p, (d(p) + b.num(p)) * k)),
+                    self.mat(move |p| {
+                        let s = m(p);
+                        let v = by.dual(p);
+                        field::cut_surf(&cut, p, Surf { d: (s.d + v.v) * k, g: (s.g + v.g) * k, mat: s.mat })
+                    }),
+                )
+            }
             ShapeKind::Primitive(_) | ShapeKind::Transform { .. } | ShapeKind::Paint { .. } => {
                 self.build(shape, id, mat)
             }
         }
+    }
+
+    /// A field body compiled, the shapes its `dist` calls read lowered in its frame
+    /// (their materials are not the field's: a field's surface is its own).
+    fn body(&mut self, e: &Arc<crate::ir::field::Expr>, mat: u32) -> field::Body {
+        let tape = crate::field::Tape::new(e);
+        let built: Vec<(Sdf, SurfSdf)> = tape.shapes.iter().map(|s| self.build(s, DAffine3::IDENTITY, mat)).collect();
+        let (dist, surf): (Vec<Sdf>, Vec<SurfSdf>) = built.into_iter().unzip();
+        let body = field::Body::new(tape, field::Shapes { dist: dist.into(), surf: surf.into() });
+        self.bytes += body.bytes() + ARC_HEADER;
+        body
     }
 
     fn combine(&mut self, kids: Vec<(Sdf, SurfSdf)>, op: CsgOp) -> (Sdf, SurfSdf) {

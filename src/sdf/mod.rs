@@ -7,6 +7,7 @@
 //! back-end.
 
 mod build;
+mod field;
 pub mod march;
 pub mod prim;
 pub mod union;

@@ -106,9 +106,13 @@ fn curvature_radius(shape: &Shape, scale: f64) -> (f64, Option<f64>) {
             curvature_radius(child, scale * k)
         }
         ShapeKind::Paint { child, .. } => curvature_radius(child, scale),
-        ShapeKind::Csg { .. } | ShapeKind::Round { .. } | ShapeKind::Shell { .. } | ShapeKind::Repeat { .. } => {
-            isosurface()
-        }
+        ShapeKind::Csg { .. }
+        | ShapeKind::Round { .. }
+        | ShapeKind::Shell { .. }
+        | ShapeKind::Repeat { .. }
+        | ShapeKind::Field { .. }
+        | ShapeKind::Warp { .. }
+        | ShapeKind::Displace { .. } => isosurface(),
     }
 }
 

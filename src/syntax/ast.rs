@@ -220,6 +220,21 @@ pub enum ExprKind {
         /// The index.
         index: Box<Expr>,
     },
+    /// `base.x`, `base.y` or `base.z`: one component of a vector.
+    Component {
+        /// The vector.
+        base: Box<Expr>,
+        /// The component's name, as written (the checker refuses any but `x`, `y`, `z`).
+        axis: Ident,
+    },
+    /// `p => body`, a field literal: a function of the point `p`, written only as an
+    /// argument of a builtin that takes one (`field`, `warp`, `displace`).
+    Field {
+        /// The point's name.
+        param: Ident,
+        /// The value at the point.
+        body: Box<Expr>,
+    },
     /// `-expr`.
     Neg(Box<Expr>),
     /// `not expr`.

@@ -37,7 +37,14 @@ pub fn lex(text: &str, base: u32) -> Vec<(Token<'_>, Span)> {
 /// reports no second error for the same mistake) and drops comments.
 fn clean_tokens<'s>(tokens: Vec<(Token<'s>, Span)>, diags: &mut Vec<Diagnostic>) -> Vec<(Token<'s>, Span)> {
     let mut out: Vec<(Token<'s>, Span)> = Vec::with_capacity(tokens.len());
-    for (tok, span) in tokens {
+    let mut tokens = tokens.into_iter().peekable();
+    while let Some((tok, span)) = tokens.next() {
+        // `1.` glued to a number and not followed by a component name is a number
+        // missing its digits, not a component read.
+        let glued_dot = tok == Token::Dot
+            && matches!(out.last(), Some((Token::Number(_), prev)) if prev.end == span.start)
+            && !matches!(tokens.peek(), Some((Token::Ident(_), next)) if next.start == span.end);
+        let tok = if glued_dot { Token::Error(".") } else { tok };
         match tok {
             Token::BlockComment(true) | Token::LineComment => {}
             Token::BlockComment(false) => diags.push(

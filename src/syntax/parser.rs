@@ -2,7 +2,8 @@
 //! with `foldl`), error recovery at delimiters and at statement starts.
 //!
 //! Precedence, loosest first (see `grammar/scn.ebnf`): postfix transforms
-//! (`at rotate scale with`), `+ -`, `* / %`, unary `-` and `mesh`, indexing `x[i]`, atoms.
+//! (`at rotate scale with`), `+ -`, `* / %`, unary `-` and `mesh`, indexing `x[i]` and
+//! components `v.x`, atoms. A field literal `p => body` is an argument form only.
 
 use chumsky::input::ValueInput;
 use chumsky::prelude::*;
@@ -61,7 +62,18 @@ where
     I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
     P: Parser<'t, I, Expr, Extra<'t, 's>> + Clone,
 {
-    let arg = ident().then_ignore(just(Token::Eq)).or_not().then(expr).map(|(name, value)| Arg { name, value });
+    // `p => body` is a field literal: an argument form only, so a comprehension's
+    // `for x in xs => body` never reads as one.
+    let field = ident()
+        .then_ignore(just(Token::Arrow))
+        .then(expr.clone())
+        .map_with(|(param, body), e| Expr {
+            kind: ExprKind::Field { param, body: Box::new(body) },
+            span: Span::from(e.span()),
+        })
+        .labelled("field literal");
+    let arg =
+        ident().then_ignore(just(Token::Eq)).or_not().then(field.or(expr)).map(|(name, value)| Arg { name, value });
     arg.separated_by(just(Token::Comma))
         .allow_trailing()
         .collect::<Vec<_>>()
@@ -74,6 +86,12 @@ where
             // One error argument tells the checker not to report arity on a list it never saw.
             |span| vec![Arg { name: None, value: error_expr(span) }],
         )))
+}
+
+/// What follows an atom: `[index]` or `.component`.
+enum Postfix {
+    Index(Expr),
+    Component(Ident),
 }
 
 /// `var in start..end` or `var in list`, for loops and comprehensions.
@@ -157,13 +175,18 @@ where
         )))
         .boxed();
 
-        let index = atom.foldl_with(
-            expr.clone().delimited_by(just(Token::LBracket), just(Token::RBracket)).repeated(),
-            |base, index, e| Expr {
-                kind: ExprKind::Index { base: Box::new(base), index: Box::new(index) },
-                span: Span::from(e.span()),
+        // Indexing and components bind tightest, left to right: `ps[0].x`.
+        let postfix = choice((
+            expr.clone().delimited_by(just(Token::LBracket), just(Token::RBracket)).map(Postfix::Index),
+            just(Token::Dot).ignore_then(ident().labelled("component (x, y or z)")).map(Postfix::Component),
+        ));
+        let index = atom.foldl_with(postfix.repeated(), |base, post, e| Expr {
+            kind: match post {
+                Postfix::Index(index) => ExprKind::Index { base: Box::new(base), index: Box::new(index) },
+                Postfix::Component(axis) => ExprKind::Component { base: Box::new(base), axis },
             },
-        );
+            span: Span::from(e.span()),
+        });
 
         let unary = just(Token::Minus)
             .to_span()

@@ -123,6 +123,9 @@ pub enum Token<'src> {
     /// `..`
     #[token("..")]
     DotDot,
+    /// `.`, before a vector's component (`v.x`)
+    #[token(".")]
+    Dot,
     /// `==`
     #[token("==")]
     EqEq,
@@ -251,6 +254,7 @@ impl fmt::Display for Token<'_> {
             Token::Slash => "/",
             Token::Percent => "%",
             Token::DotDot => "..",
+            Token::Dot => ".",
             Token::EqEq => "==",
             Token::NotEq => "!=",
             Token::Lt => "<",

@@ -1,5 +1,5 @@
 //! Patterns ready for shading: the IR's pattern trees, each with the map from render
-//! space into the space of the object it paints, and the gradient noise.
+//! space into the space of the object it paints (the noise is `geom::noise`).
 //!
 //! Patterns are evaluated in f64. An object's space can be world-sized (a floor is
 //! painted in world coordinates), and there f32 keeps too few digits: 1e4 from the
@@ -10,6 +10,7 @@ use std::sync::Arc;
 
 use glam::{DAffine3, DVec3, Vec3A};
 
+use crate::geom::noise;
 use crate::ir::{self, ColorSpace, Paint, PatternKind};
 
 /// A pattern as one material shows it: where render-space points go, then the tree.
@@ -130,59 +131,6 @@ pub fn linear_to_srgb(x: f32) -> f32 {
     }
 }
 
-/// Perlin's improved gradient noise (Perlin 2002): at integer lattice points the value
-/// is 0 and the gradient one of the twelve cube-edge directions, chosen by hashing the
-/// point with `seed` (integer arithmetic, so every machine gives the same field);
-/// between them the quintic fade blends the eight corners. Values lie in about [−1, 1].
-pub fn noise(p: DVec3, seed: u32) -> f64 {
-    let cell = p.floor();
-    let f = p - cell;
-    // Lattice points wrap at i32 (saturating casts, then wrapping sums): far points stay
-    // defined, and the field repeats there.
-    let (x, y, z) = (cell.x as i32, cell.y as i32, cell.z as i32);
-    let fade = |t: f64| t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
-    let (u, v, w) = (fade(f.x), fade(f.y), fade(f.z));
-    let corner = |dx: i32, dy: i32, dz: i32| {
-        let h = hash(x.wrapping_add(dx), y.wrapping_add(dy), z.wrapping_add(dz), seed);
-        grad(h, f.x - dx as f64, f.y - dy as f64, f.z - dz as f64)
-    };
-    let lerp = |t: f64, a: f64, b: f64| a + t * (b - a);
-    lerp(
-        w,
-        lerp(v, lerp(u, corner(0, 0, 0), corner(1, 0, 0)), lerp(u, corner(0, 1, 0), corner(1, 1, 0))),
-        lerp(v, lerp(u, corner(0, 0, 1), corner(1, 0, 1)), lerp(u, corner(0, 1, 1), corner(1, 1, 1))),
-    )
-}
-
-/// A well-mixed 32-bit hash of a lattice point and a seed (the `lowbias32` finaliser
-/// over a combination of the coordinates).
-fn hash(x: i32, y: i32, z: i32, seed: u32) -> u32 {
-    let mut h = (x as u32).wrapping_mul(0x8da6_b343)
-        ^ (y as u32).wrapping_mul(0xd816_3841)
-        ^ (z as u32).wrapping_mul(0xcb1a_b31f)
-        ^ seed.wrapping_mul(0x9e37_79b9);
-    h ^= h >> 16;
-    h = h.wrapping_mul(0x7feb_352d);
-    h ^= h >> 15;
-    h = h.wrapping_mul(0x846c_a68b);
-    h ^ (h >> 16)
-}
-
-/// The dot product of `(x, y, z)` with the cube-edge gradient `h` picks (Perlin's
-/// sixteen-entry table: the twelve edges, four of them twice).
-fn grad(h: u32, x: f64, y: f64, z: f64) -> f64 {
-    let h = h >> 28;
-    let u = if h < 8 { x } else { y };
-    let v = if h < 4 {
-        y
-    } else if h == 12 || h == 14 {
-        x
-    } else {
-        z
-    };
-    (if h & 1 == 0 { u } else { -u }) + (if h & 2 == 0 { v } else { -v })
-}
-
 /// The texture of a material and where it sits, if it has a pattern.
 pub fn of_material(m: &ir::Material, render_from_local: DAffine3, space: ColorSpace) -> Option<ShadePattern> {
     m.color
@@ -193,28 +141,6 @@ pub fn of_material(m: &ir::Material, render_from_local: DAffine3, space: ColorSp
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn noise_is_zero_on_the_lattice_and_bounded_between() {
-        let mut most = 0.0f64;
-        for i in 0..2000 {
-            let p = DVec3::new(i as f64 * 0.137, i as f64 * 0.071 - 40.0, (i % 17) as f64 * 0.29);
-            let n = noise(p, 7);
-            assert!(n.is_finite());
-            most = most.max(n.abs());
-            assert_eq!(noise(p.floor(), 7), 0.0);
-        }
-        // Improved noise stays within about ±1, and this many points reach well inside it.
-        assert!(most <= 1.05 && most > 0.3, "{most}");
-    }
-
-    #[test]
-    fn noise_is_continuous_and_depends_on_the_seed() {
-        let p = DVec3::new(3.3, -1.7, 0.45);
-        let step = DVec3::splat(1e-4);
-        assert!((noise(p, 1) - noise(p + step, 1)).abs() < 1e-3);
-        assert_ne!(noise(p, 1), noise(p, 2));
-    }
 
     #[test]
     fn srgb_round_trips() {

@@ -26,6 +26,9 @@ fn argument(ty: Ty) -> &'static str {
         Ty::Light => "ambient(1)",
         Ty::List => "[1, 2]",
         Ty::Linear => "0.5",
+        Ty::FieldNum => "p => length(p) - 0.5",
+        Ty::FieldVec => "p => p * [1, 1.5, 1]",
+        Ty::Bounds => "[[-1, -1, -1], [1, 1, 1]]",
     }
 }
 
@@ -38,12 +41,19 @@ fn another(ty: Ty) -> &'static str {
     }
 }
 
-/// A call of `b` with two variadic arguments and every required parameter.
+/// A call of `b` with two variadic arguments and every required parameter (and a box
+/// for a field, which every mode can then mesh).
 fn call(b: &Builtin) -> String {
-    let mut args: Vec<&str> = b.variadic.map_or(vec![], |ty| vec![argument(ty), another(ty)]);
+    let mut args: Vec<String> = b.variadic.map_or(vec![], |ty| vec![argument(ty).into(), another(ty).into()]);
     args.extend(
-        b.params.iter().filter(|p| p.default == scnc::check::builtins::Default::Required).map(|p| argument(p.ty)),
+        b.params
+            .iter()
+            .filter(|p| p.default == scnc::check::builtins::Default::Required)
+            .map(|p| argument(p.ty).to_string()),
     );
+    if b.params.iter().any(|p| p.ty == Ty::Bounds) {
+        args.push(format!("bounds = {}", argument(Ty::Bounds)));
+    }
     format!("{}({})", b.name, args.join(", "))
 }
 
@@ -53,6 +63,8 @@ fn statement(b: &Builtin) -> String {
         (Kind::MeshGenerator, _) => format!("object mesh {}", call(b)),
         (Kind::Function, Ty::Shape) => format!("object {}", call(b)),
         (Kind::Function, Ty::Light) => format!("light {}", call(b)),
+        // `dist` measures at a field's point.
+        (Kind::Function, _) if b.name == "dist" => "let value = field(p => dist(sphere(0.5), p))".into(),
         (Kind::Function, _) => format!("let value = {}", call(b)),
         (Kind::Camera, _) => "camera(position = [0, 0, -4], look_at = [0, 0, 0])".into(),
         (Kind::Render, _) => "render(width = 24, height = 24)".into(),

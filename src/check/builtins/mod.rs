@@ -44,6 +44,12 @@ pub enum Ctor {
     Csg(CsgOp),
     /// A shape modifier.
     Modifier(Modifier),
+    /// A shape from a field literal.
+    Field(FieldFn),
+    /// `dist(shape, q)`, inside a field's body.
+    Dist,
+    /// `noise3(q, size, seed)`.
+    Noise3,
     /// `material(…)`.
     Material,
     /// `rgb(…)`.
@@ -77,6 +83,15 @@ pub enum Modifier {
     Round,
     Shell,
     Repeat,
+}
+
+/// The shapes made from field literals.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(missing_docs, reason = "each variant is the builtin of the same name, documented in BUILTINS")]
+pub enum FieldFn {
+    Field,
+    Warp,
+    Displace,
 }
 
 /// The patterns.
@@ -196,6 +211,9 @@ impl Builtin {
             | Ctor::Numeric(_)
             | Ctor::Vector(_)
             | Ctor::Extreme(_)
+            | Ctor::Field(_)
+            | Ctor::Dist
+            | Ctor::Noise3
             | Ctor::Len => Kind::Function,
             Ctor::Generator(_) => Kind::MeshGenerator,
             Ctor::Camera => Kind::Camera,

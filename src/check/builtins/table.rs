@@ -4,7 +4,8 @@
 
 use std::sync::LazyLock;
 
-use super::{Builtin, Ctor, Extreme, Gen, LightFn, MathFn, Modifier, NumFn, PatternFn, Ty, VecFn};
+use super::{Builtin, Ctor, Extreme, FieldFn, Gen, LightFn, MathFn, Modifier, NumFn, PatternFn, Ty, VecFn};
+use crate::check::construct::fields::{DisplaceArgs, DistArgs, FieldArgs, Noise3Args, WarpArgs};
 use crate::check::construct::maths::{
     Atan2Args, ClampArgs, HsvArgs, ListArgs, MixArgs, NumberArgs, PairArgs, PowArgs, RangeArgs, VectorArgs,
 };
@@ -93,6 +94,36 @@ static REST: &[Builtin] = &[
         RepeatArgs::PARAMS,
         Ty::Shape,
         "`count` copies per axis, `period` apart, centred at the origin",
+    ),
+    // Fields.
+    f(
+        "field",
+        Ctor::Field(FieldFn::Field),
+        FieldArgs::PARAMS,
+        Ty::Shape,
+        "any function of the point as a shape: inside where `f` is negative (docs/fields.md)",
+    ),
+    f(
+        "warp",
+        Ctor::Field(FieldFn::Warp),
+        WarpArgs::PARAMS,
+        Ty::Shape,
+        "the shape deformed: at each point `p` it is what the shape is at `f(p)` (a twist, a bend)",
+    ),
+    f(
+        "displace",
+        Ctor::Field(FieldFn::Displace),
+        DisplaceArgs::PARAMS,
+        Ty::Shape,
+        "the shape's distance plus `f(p)`: bumps, ripples, noise on its surface",
+    ),
+    f("dist", Ctor::Dist, DistArgs::PARAMS, Ty::Num, "inside a field's body, the shape's signed distance at `q`"),
+    f(
+        "noise3",
+        Ctor::Noise3,
+        Noise3Args::PARAMS,
+        Ty::Num,
+        "Perlin gradient noise at `q` (the `noise` pattern's), about −1 to 1, features `size` across",
     ),
     // Materials and colours.
     f(

@@ -3,6 +3,7 @@
 //! plain values (materials, colours, lights, numbers). Each family declares its
 //! builtins' parameters with [`params!`](crate::params) and reads them as typed fields.
 
+pub(super) mod fields;
 pub(super) mod maths;
 pub(super) mod meshes;
 pub(super) mod shapes;
@@ -198,6 +199,12 @@ impl Ctx<'_> {
                 let kind = self.modifier(m, &a);
                 self.shape(kind, a.call)
             }
+            Ctor::Field(f) => {
+                let kind = self.field_shape(f, &a);
+                self.shape(kind, a.call)
+            }
+            Ctor::Dist => self.dist(&a),
+            Ctor::Noise3 => self.noise3(&a),
             Ctor::Material => self.material(&a),
             Ctor::Rgb => self.rgb(&a),
             Ctor::Pattern(f) => self.pattern(f, &a),

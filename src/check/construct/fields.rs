@@ -1,0 +1,324 @@
+//! Field builtins: `field`, `warp` and `displace` (shapes from field literals), and
+//! `dist` and `noise3` (numbers inside their bodies). Each shape states the bound of its
+//! body's slope that the march divides by: given with `lipschitz`, or estimated here
+//! (`crate::field::lipschitz`), so `scnc ir` shows it and a steep field is reported
+//! where it is written.
+
+use std::sync::Arc;
+
+use glam::DVec3;
+
+use crate::check::builtins::FieldFn;
+use crate::check::expr::BoundArgs;
+use crate::check::{Ctx, Value};
+use crate::diag::{codes, Diagnostic};
+use crate::field::{lipschitz, Estimate, SlopeDistances, Tape};
+use crate::geom::Aabb;
+use crate::ir::field::{Expr, Kind, Ty};
+use crate::ir::{self, Lipschitz, ShapeKind};
+use crate::sig::Range;
+use crate::span::Span;
+
+crate::params! {
+    /// `field(f, bounds, lipschitz)`.
+    pub struct FieldArgs {
+        /// the field, `p => …` of the point `p`: inside where it is negative
+        f: Value as FieldNum = required;
+        /// the box the shape is cut to, `[[x0, y0, z0], [x1, y1, z1]]`; absent: all of space, like a plane
+        bounds: Option<Value> as Bounds = derived;
+        /// a bound of the body's slope; absent: estimated over `bounds`
+        lipschitz: Option<f64> as Num = derived, Range::POSITIVE;
+    }
+}
+
+crate::params! {
+    /// `warp(shape, f, bounds, lipschitz)`.
+    pub struct WarpArgs {
+        /// the shape to deform
+        shape: Value as Shape = required;
+        /// where each point `p` looks in the shape, `p => …` giving a point
+        f: Value as FieldVec = required;
+        /// the box the result is cut to; absent: all of space
+        bounds: Option<Value> as Bounds = derived;
+        /// a bound of how much the map stretches a distance; absent: estimated over `bounds`
+        lipschitz: Option<f64> as Num = derived, Range::POSITIVE;
+    }
+}
+
+crate::params! {
+    /// `displace(shape, f, bounds, lipschitz)`.
+    pub struct DisplaceArgs {
+        /// the shape whose surface moves
+        shape: Value as Shape = required;
+        /// what is added to its distance at `p`, `p => …` (negative pushes the surface out)
+        f: Value as FieldNum = required;
+        /// the box the result is cut to; absent: the shape's box grown by how far the surface can move
+        bounds: Option<Value> as Bounds = derived;
+        /// a bound of the displacement's slope; absent: estimated where the shape can reach
+        lipschitz: Option<f64> as Num = derived, Range::POSITIVE;
+    }
+}
+
+crate::params! {
+    /// `dist(shape, q)`.
+    pub struct DistArgs {
+        /// the shape
+        shape: Value as Shape = required;
+        /// the point, inside a field's body
+        q: Value as Vec3 = required;
+    }
+}
+
+crate::params! {
+    /// `noise3(q, size, seed)`.
+    pub struct Noise3Args {
+        /// the point
+        q: Value as Vec3 = required;
+        /// the feature size
+        size: f64 as Num = 1.0, Range::POSITIVE;
+        /// which noise; the same seed gives the same field on every machine
+        seed: u32 as Int = 0, Range::closed(0.0, u32::MAX as f64);
+    }
+}
+
+/// `x` rounded up to four significant digits.
+fn round_up(x: f64) -> f64 {
+    let unit = 10f64.powf(x.log10().floor() - 3.0);
+    let r = (x / unit).ceil() * unit;
+    // The product may round below `x` in the last bit.
+    if r < x {
+        r.next_up()
+    } else {
+        r
+    }
+}
+
+/// Slope bounds above this or below its inverse are reported (W0007).
+const STEEP: f64 = 2.5;
+
+/// Most operations one field body may have after folding (shared ones once).
+pub const MAX_FIELD_OPS: usize = 100_000;
+
+impl Ctx<'_> {
+    /// `field`, `warp` or `displace`, or `None` after reporting.
+    pub(in crate::check) fn field_shape(&mut self, f: FieldFn, a: &BoundArgs) -> Option<ShapeKind> {
+        match f {
+            FieldFn::Field => {
+                let FieldArgs { f: Value::Field(lit), bounds, lipschitz: given } = FieldArgs::from_args(a) else {
+                    return None;
+                };
+                let bounds = self.bounds(bounds, a.span_of("bounds"))?;
+                let tape = self.tape(&lit.body, lit.span)?;
+                let l = self.slope(&tape, bounds, given, lit.span, "this field")?;
+                Some(ShapeKind::Field { body: lit.body.clone(), bounds, lipschitz: l })
+            }
+            FieldFn::Warp => {
+                let WarpArgs { shape: Value::Shape(child), f: Value::Field(lit), bounds, lipschitz: given } =
+                    WarpArgs::from_args(a)
+                else {
+                    return None;
+                };
+                let bounds = self.bounds(bounds, a.span_of("bounds"))?;
+                let tape = self.tape(&lit.body, lit.span)?;
+                let l = self.slope(&tape, bounds, given, lit.span, "this warp")?;
+                Some(ShapeKind::Warp { child, map: lit.body.clone(), bounds, lipschitz: l })
+            }
+            FieldFn::Displace => {
+                let DisplaceArgs { shape: Value::Shape(child), f: Value::Field(lit), bounds, lipschitz: given } =
+                    DisplaceArgs::from_args(a)
+                else {
+                    return None;
+                };
+                let bounds = self.bounds(bounds, a.span_of("bounds"))?;
+                let tape = self.tape(&lit.body, lit.span)?;
+                let (region, reach) = self.reach(&tape, &child, bounds, lit.span)?;
+                let l = self.slope(&tape, region, given, lit.span, "this displacement")?;
+                // A displacement's slope adds to the shape's 1: only the sum is far from 1.
+                Some(ShapeKind::Displace { child, by: lit.body.clone(), bounds, lipschitz: l, reach })
+            }
+        }
+    }
+
+    /// `dist(shape, q)`: only inside a field's body, where there is a point to measure at.
+    pub(in crate::check) fn dist(&mut self, a: &BoundArgs) -> Value {
+        let DistArgs { shape: Value::Shape(shape), q } = DistArgs::from_args(a) else {
+            return Value::Error;
+        };
+        if self.field_depth == 0 {
+            self.report(
+                Diagnostic::error(
+                    codes::DEPENDS_ON_POINT,
+                    a.call,
+                    "`dist` measures a shape inside a field's body",
+                    "not inside `p => …`",
+                )
+                .with_note("`dist(shape, q)` is the shape's signed distance at `q`, evaluated at every point `p`"),
+            );
+            return Value::Error;
+        }
+        match q.as_field() {
+            Some(q) => Value::Sym(Expr::new(Kind::Dist(shape, q), Ty::Num)),
+            None => Value::Error,
+        }
+    }
+
+    /// `noise3(q, size, seed)`: folded when `q` is known.
+    pub(in crate::check) fn noise3(&mut self, a: &BoundArgs) -> Value {
+        let Noise3Args { q, size, seed } = Noise3Args::from_args(a);
+        match q {
+            Value::Vec3(v) => Value::Num(crate::geom::noise(v / size, seed)),
+            Value::Sym(q) => Value::Sym(Expr::new(Kind::Noise { at: q, size, seed }, Ty::Num)),
+            _ => Value::Error,
+        }
+    }
+
+    /// A `bounds` argument as a box, `Some(None)` when absent, `None` after reporting.
+    fn bounds(&mut self, v: Option<Value>, span: Span) -> Option<Option<Aabb>> {
+        let Some(v) = v else { return Some(None) };
+        let corners: Option<Vec<DVec3>> = match &v {
+            Value::List(items) if items.len() == 2 => {
+                items.iter().map(|c| if let Value::Vec3(c) = c { Some(*c) } else { None }).collect()
+            }
+            _ => None,
+        };
+        match corners.as_deref() {
+            Some(&[lo, hi]) if lo.cmplt(hi).all() => Some(Some(Aabb { min: lo, max: hi })),
+            Some(&[lo, hi]) => {
+                let shown = format!("from {} to {}", ir::dump_vec(lo), ir::dump_vec(hi));
+                self.range_error(span, "bounds", "a box whose first corner is below its second on every axis", shown);
+                None
+            }
+            _ => {
+                self.report(
+                    Diagnostic::error(
+                        codes::TYPE_MISMATCH,
+                        span,
+                        format!("expected `[vec3, vec3]`, found `{}`", v.ty_name()),
+                        v.this_is(),
+                    )
+                    .with_note("`bounds` is a box, its lowest and highest corners: `[[x0, y0, z0], [x1, y1, z1]]`"),
+                );
+                None
+            }
+        }
+    }
+
+    /// The body compiled, or `None` after reporting one too large.
+    fn tape(&mut self, body: &Arc<Expr>, span: Span) -> Option<Tape> {
+        let tape = Tape::new(body);
+        if tape.ops.len() > MAX_FIELD_OPS {
+            self.report(
+                Diagnostic::error(
+                    codes::SHAPE_TOO_LARGE,
+                    span,
+                    "this field's body is too large",
+                    format!("it takes {} operations", tape.ops.len()),
+                )
+                .with_note(format!("a field's body may take at most {MAX_FIELD_OPS} operations")),
+            );
+            return None;
+        }
+        Some(tape)
+    }
+
+    /// What the body's slope is bounded by: `given`, or estimated over `domain`;
+    /// `None` after reporting that no bound was found. `what` names the field.
+    fn slope(
+        &mut self,
+        tape: &Tape,
+        domain: Option<Aabb>,
+        given: Option<f64>,
+        span: Span,
+        what: &str,
+    ) -> Option<Lipschitz> {
+        if let Some(value) = given {
+            return Some(Lipschitz { value, given: true });
+        }
+        let est = self.estimate(tape, domain);
+        if !est.bound.is_finite() {
+            let where_ = if domain.is_some() { "within its `bounds`" } else { "over all of space" };
+            self.report(
+                Diagnostic::error(
+                    codes::UNBOUNDED_SLOPE,
+                    span,
+                    format!("{what} has no bound on its slope {where_}"),
+                    "its slope cannot be bounded",
+                )
+                .with_note("a field is marched in steps of its value over its largest slope")
+                .with_hint(if domain.is_some() {
+                    "state one with `lipschitz = …`, or keep `bounds` away from where it is infinitely steep"
+                } else {
+                    "give `bounds = [[x0, y0, z0], [x1, y1, z1]]`, or state the bound with `lipschitz = …`"
+                }),
+            );
+            return None;
+        }
+        // A constant has no slope; any positive bound marches it. Four significant
+        // digits, rounded up, keep it a bound and the dump readable.
+        let value = if est.bound > 0.0 { round_up(est.bound) } else { 1.0 };
+        if !(1.0 / STEEP..=STEEP).contains(&value) {
+            let shown = crate::sig::short(value);
+            self.report(
+                Diagnostic::warning(
+                    codes::STEEP_FIELD,
+                    span,
+                    format!("{what}'s slope is up to {shown}, far from a distance's 1"),
+                    format!("marched in steps of its value / {shown}"),
+                )
+                .with_note(
+                    "a field whose slope varies takes more steps than a distance; one that is a distance \
+                     scaled by k is exact divided by k",
+                )
+                .with_hint(format!("divide the body by {shown}, or state a bound you know with `lipschitz = …`")),
+            );
+        }
+        Some(Lipschitz { value, given: false })
+    }
+
+    /// The bound of the slope of `tape` over `domain`.
+    fn estimate(&self, tape: &Tape, domain: Option<Aabb>) -> Estimate {
+        let spheres = tape.shapes.iter().map(|s| ir::shape_sphere(s)).collect();
+        lipschitz(tape, domain, &SlopeDistances { spheres })
+    }
+
+    /// Where a displaced shape can reach and how far out its surface can move: the
+    /// shape's box grown until the displacement's least value there pushes no further
+    /// (`bounds`, when given, settles both). `None` after reporting no such box.
+    fn reach(
+        &mut self,
+        tape: &Tape,
+        child: &ir::Shape,
+        bounds: Option<Aabb>,
+        span: Span,
+    ) -> Option<(Option<Aabb>, f64)> {
+        if let Some(b) = bounds {
+            return Some((Some(b), 0.0));
+        }
+        let Some(base) = ir::shape_bounds(child) else {
+            // An unbounded shape stays unbounded; the displacement is bounded everywhere or not at all.
+            return Some((None, 0.0));
+        };
+        let mut reach = 0.0f64;
+        for _ in 0..8 {
+            let region = base.grow(reach);
+            let out = (-self.estimate(tape, Some(region)).range.lo).max(0.0);
+            if !out.is_finite() {
+                break;
+            }
+            if out <= reach * (1.0 + 1e-9) {
+                return Some((Some(region), reach));
+            }
+            reach = out * 1.05;
+        }
+        self.report(
+            Diagnostic::error(
+                codes::UNBOUNDED_SLOPE,
+                span,
+                "how far this displacement moves the surface has no bound",
+                "its least value keeps growing",
+            )
+            .with_hint("give `bounds = [[x0, y0, z0], [x1, y1, z1]]`"),
+        );
+        None
+    }
+}

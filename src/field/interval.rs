@@ -1,0 +1,508 @@
+//! Interval arithmetic over boxes of points (Moore 1966), and on top of it the
+//! [`Slope`]: a body's value and gradient as intervals over a box, whose largest
+//! gradient norm bounds the body's slope there.
+//!
+//! Intervals are in f64 and closed; an unknown or unbounded result is the whole line,
+//! never NaN (`0 · ∞` is 0: a factor that is exactly zero stays zero).
+
+use std::f64::consts::PI;
+use std::ops::{Add, Div, Mul, Sub};
+
+use super::tape::Scalar;
+use crate::geom::noise::{NOISE_RANGE, NOISE_SLOPE};
+use crate::ir::field::{Binary, Unary};
+
+/// A closed interval `[lo, hi]` (`lo ≤ hi`, either may be infinite).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Interval {
+    /// The lower end.
+    pub lo: f64,
+    /// The upper end.
+    pub hi: f64,
+}
+
+const DEG: f64 = PI / 180.0;
+
+/// `a · b` where a zero factor wins over an infinite one.
+fn mul0(a: f64, b: f64) -> f64 {
+    if a == 0.0 || b == 0.0 {
+        0.0
+    } else {
+        a * b
+    }
+}
+
+impl Interval {
+    /// The interval of one number.
+    pub fn point(x: f64) -> Interval {
+        Interval { lo: x, hi: x }
+    }
+
+    /// `[lo, hi]`, widened to the whole line if either end is NaN.
+    pub fn new(lo: f64, hi: f64) -> Interval {
+        if lo.is_nan() || hi.is_nan() {
+            Interval::ALL
+        } else {
+            Interval { lo: lo.min(hi), hi: hi.max(lo) }
+        }
+    }
+
+    /// Every number.
+    pub const ALL: Interval = Interval { lo: f64::NEG_INFINITY, hi: f64::INFINITY };
+
+    /// The truth values 0 and 1 both possible.
+    const MAYBE: Interval = Interval { lo: 0.0, hi: 1.0 };
+
+    /// The largest absolute value in it.
+    pub fn mag(self) -> f64 {
+        self.lo.abs().max(self.hi.abs())
+    }
+
+    /// The smallest interval holding both.
+    pub fn hull(self, o: Interval) -> Interval {
+        Interval { lo: self.lo.min(o.lo), hi: self.hi.max(o.hi) }
+    }
+
+    /// Whether it holds `x`.
+    pub fn contains(self, x: f64) -> bool {
+        self.lo <= x && x <= self.hi
+    }
+
+    fn truth(always: bool, never: bool) -> Interval {
+        if always {
+            Interval::point(1.0)
+        } else if never {
+            Interval::point(0.0)
+        } else {
+            Interval::MAYBE
+        }
+    }
+
+    /// A monotone non-decreasing function applied to both ends.
+    fn rising(self, f: impl Fn(f64) -> f64) -> Interval {
+        Interval::new(f(self.lo), f(self.hi))
+    }
+
+    /// The square.
+    pub fn sqr(self) -> Interval {
+        if self.contains(0.0) {
+            Interval::new(0.0, self.mag() * self.mag())
+        } else {
+            let (a, b) = (self.lo * self.lo, self.hi * self.hi);
+            Interval::new(a.min(b), a.max(b))
+        }
+    }
+
+    /// The sine of degrees: the ends' values, widened to ±1 where a crest lies within.
+    fn sin_deg(self) -> Interval {
+        // (NaN-safe: an unbounded width counts as wide.)
+        if self.hi - self.lo >= 360.0 || (self.hi - self.lo).is_nan() {
+            return Interval::new(-1.0, 1.0);
+        }
+        let (a, b) = ((self.lo * DEG).sin(), (self.hi * DEG).sin());
+        let (mut lo, mut hi) = (a.min(b), a.max(b));
+        // A crest at 90 + 360k, a trough at 270 + 360k.
+        let has = |at: f64| ((self.lo - at) / 360.0).ceil() * 360.0 + at <= self.hi;
+        if has(90.0) {
+            hi = 1.0;
+        }
+        if has(270.0) {
+            lo = -1.0;
+        }
+        Interval::new(lo, hi)
+    }
+
+    /// The cosine of degrees.
+    fn cos_deg(self) -> Interval {
+        Interval::new(self.lo + 90.0, self.hi + 90.0).sin_deg()
+    }
+
+    fn unary(f: Unary, x: Interval) -> Interval {
+        match f {
+            Unary::Neg => Interval::new(-x.hi, -x.lo),
+            Unary::Not => Interval::truth(x == Interval::point(0.0), !x.contains(0.0)),
+            Unary::Sin => x.sin_deg(),
+            Unary::Cos => x.cos_deg(),
+            Unary::Tan => {
+                // Rising between asymptotes at 90 + 180k.
+                let k = ((x.lo - 90.0) / 180.0).floor();
+                if x.hi - x.lo < 180.0 && x.hi < (k + 1.0) * 180.0 + 90.0 {
+                    x.rising(|t| (t * DEG).tan())
+                } else {
+                    Interval::ALL
+                }
+            }
+            Unary::Asin => x.rising(|t| t.clamp(-1.0, 1.0).asin() / DEG),
+            Unary::Acos => Interval::new(x.hi.clamp(-1.0, 1.0).acos() / DEG, x.lo.clamp(-1.0, 1.0).acos() / DEG),
+            Unary::Atan => x.rising(|t| t.atan() / DEG),
+            Unary::Sqrt => x.rising(|t| t.max(0.0).sqrt()),
+            Unary::Abs => {
+                if x.contains(0.0) {
+                    Interval::new(0.0, x.mag())
+                } else {
+                    Interval::new(x.lo.abs().min(x.hi.abs()), x.mag())
+                }
+            }
+            Unary::Floor => x.rising(f64::floor),
+            Unary::Ceil => x.rising(f64::ceil),
+            Unary::Round => x.rising(f64::round),
+            Unary::Sign => x.rising(|t| Unary::Sign.apply(t)),
+            Unary::Exp => x.rising(f64::exp),
+            Unary::Log => x.rising(|t| Unary::Log.apply(t)),
+            Unary::Length | Unary::Normalize => Interval::ALL,
+        }
+    }
+
+    fn binary(f: Binary, a: Interval, b: Interval) -> Interval {
+        match f {
+            Binary::Add => a.add(b),
+            Binary::Sub => a.sub(b),
+            Binary::Mul => a.mul(b),
+            Binary::Div => a.div(b),
+            Binary::Rem => {
+                let m = b.mag();
+                // Within one period of a constant positive divisor, a remainder is a shift.
+                if b.lo == b.hi && m > 0.0 && m.is_finite() && a.lo.is_finite() && a.hi.is_finite() {
+                    let k = (a.lo / m).trunc();
+                    if k == (a.hi / m).trunc() && (a.lo >= 0.0) == (a.hi >= 0.0) {
+                        return Interval::new(a.lo - k * m, a.hi - k * m);
+                    }
+                }
+                let lo = if a.lo >= 0.0 { 0.0 } else { -m };
+                let hi = if a.hi <= 0.0 { 0.0 } else { m };
+                Interval::new(lo, hi)
+            }
+            Binary::Lt => Interval::truth(a.hi < b.lo, a.lo >= b.hi),
+            Binary::Le => Interval::truth(a.hi <= b.lo, a.lo > b.hi),
+            Binary::Gt => Interval::truth(a.lo > b.hi, a.hi <= b.lo),
+            Binary::Ge => Interval::truth(a.lo >= b.hi, a.hi < b.lo),
+            Binary::Eq => Interval::truth(a.lo == a.hi && a == b, a.hi < b.lo || b.hi < a.lo),
+            Binary::Ne => Interval::truth(a.hi < b.lo || b.hi < a.lo, a.lo == a.hi && a == b),
+            Binary::And => Interval::truth(
+                !a.contains(0.0) && !b.contains(0.0),
+                a == Interval::point(0.0) || b == Interval::point(0.0),
+            ),
+            Binary::Or => Interval::truth(
+                !a.contains(0.0) || !b.contains(0.0),
+                a == Interval::point(0.0) && b == Interval::point(0.0),
+            ),
+            Binary::Min => Interval::new(a.lo.min(b.lo), a.hi.min(b.hi)),
+            Binary::Max => Interval::new(a.lo.max(b.lo), a.hi.max(b.hi)),
+            Binary::Pow => pow(a, b),
+            Binary::Atan2 => {
+                // Continuous, and monotone along each edge of a box that misses the cut
+                // (the negative x axis): the corners hold its extremes.
+                if a.contains(0.0) && b.lo <= 0.0 {
+                    return Interval::new(-180.0, 180.0);
+                }
+                let c =
+                    [(a.lo, b.lo), (a.lo, b.hi), (a.hi, b.lo), (a.hi, b.hi)].map(|(y, x)| Binary::Atan2.apply(y, x));
+                Interval::new(
+                    c.iter().copied().fold(f64::INFINITY, f64::min),
+                    c.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                )
+            }
+            Binary::Dot | Binary::Cross => Interval::ALL,
+        }
+    }
+}
+
+impl std::ops::Mul for Interval {
+    type Output = Interval;
+
+    /// The product.
+    fn mul(self, o: Interval) -> Interval {
+        let c = [mul0(self.lo, o.lo), mul0(self.lo, o.hi), mul0(self.hi, o.lo), mul0(self.hi, o.hi)];
+        Interval::new(
+            c.iter().copied().fold(f64::INFINITY, f64::min),
+            c.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        )
+    }
+}
+
+impl std::ops::Add for Interval {
+    type Output = Interval;
+
+    /// The sum.
+    fn add(self, o: Interval) -> Interval {
+        Interval::new(self.lo + o.lo, self.hi + o.hi)
+    }
+}
+
+impl std::ops::Sub for Interval {
+    type Output = Interval;
+
+    /// The difference.
+    fn sub(self, o: Interval) -> Interval {
+        Interval::new(self.lo - o.hi, self.hi - o.lo)
+    }
+}
+
+impl std::ops::Div for Interval {
+    type Output = Interval;
+
+    /// The quotient; the whole line when the divisor may be zero.
+    fn div(self, o: Interval) -> Interval {
+        if o.contains(0.0) {
+            return if self == Interval::point(0.0) { self } else { Interval::ALL };
+        }
+        self.mul(Interval::new(1.0 / o.hi, 1.0 / o.lo))
+    }
+}
+
+/// `pow(a, b)` over intervals: exact for a constant whole exponent and for a positive
+/// base; the whole line otherwise.
+fn pow(a: Interval, b: Interval) -> Interval {
+    if b.lo == b.hi && b.lo.fract() == 0.0 && b.lo.abs() < 1e9 {
+        let n = b.lo;
+        if n == 0.0 {
+            return Interval::point(1.0);
+        }
+        let p = |x: f64| Binary::Pow.apply(x, n);
+        if n > 0.0 && n % 2.0 == 0.0 {
+            return Interval::new(p(a.lo.abs().min(a.hi.abs()) * f64::from(!a.contains(0.0))), p(a.mag()));
+        }
+        if n > 0.0 {
+            return a.rising(p);
+        }
+        if a.contains(0.0) {
+            return Interval::ALL;
+        }
+        let (x, y) = (p(a.lo), p(a.hi));
+        return Interval::new(x.min(y), x.max(y));
+    }
+    if a.lo > 0.0 {
+        // x^y = e^(y ln x): monotone in each argument on each sign of ln x.
+        let ln = Interval::new(a.lo.ln(), a.hi.ln());
+        let e = ln.mul(b);
+        return Interval::new(e.lo.exp(), e.hi.exp());
+    }
+    Interval::ALL
+}
+
+impl Scalar for Interval {
+    type Point = [Interval; 3];
+
+    fn input(p: &[Interval; 3], axis: u8) -> Interval {
+        p[axis as usize]
+    }
+
+    fn constant(x: f64) -> Interval {
+        Interval::point(x)
+    }
+
+    fn unary(f: Unary, x: Interval) -> Interval {
+        Interval::unary(f, x)
+    }
+
+    fn binary(f: Binary, a: Interval, b: Interval) -> Interval {
+        Interval::binary(f, a, b)
+    }
+
+    fn select(c: Interval, a: Interval, b: Interval) -> Interval {
+        if !c.contains(0.0) {
+            a
+        } else if c == Interval::point(0.0) {
+            b
+        } else {
+            a.hull(b)
+        }
+    }
+
+    fn length(v: [Interval; 3]) -> Interval {
+        let s = v[0].sqr().add(v[1].sqr()).add(v[2].sqr());
+        Interval::new(s.lo.max(0.0).sqrt(), s.hi.max(0.0).sqrt())
+    }
+
+    fn noise(_: [Interval; 3], _: u32) -> Interval {
+        Interval::new(-NOISE_RANGE, NOISE_RANGE)
+    }
+}
+
+/// A body's value and gradient over a box, as intervals, and `n`, a bound of the
+/// gradient's norm by the rules of Lipschitz constants (a sum's slope is at most the
+/// sum of the slopes, a length's at most its vector's stretch, …). The gradient
+/// intervals alone lose the correlation between components (`length(p)` would get
+/// √3 instead of 1); the rules alone lose where a slope is small; each node keeps the
+/// smaller of the two bounds.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Slope {
+    /// The value.
+    pub v: Interval,
+    /// The gradient, by component.
+    pub g: [Interval; 3],
+    /// A bound of the gradient's norm.
+    pub n: f64,
+}
+
+impl Slope {
+    /// A value with gradient `g`, its norm bound the smaller of `n` and `g`'s.
+    fn new(v: Interval, g: [Interval; 3], n: f64) -> Slope {
+        let by_g = (g[0].mag().powi(2) + g[1].mag().powi(2) + g[2].mag().powi(2)).sqrt();
+        let n = if n.is_nan() { by_g } else { n.min(by_g) };
+        Slope { v, g, n: if n.is_nan() { f64::INFINITY } else { n } }
+    }
+
+    /// The bound of the gradient's norm.
+    pub fn norm(&self) -> f64 {
+        self.n
+    }
+
+    /// `f(x)` where `f`'s derivative lies in `d` over `x`.
+    fn chain(v: Interval, d: Interval, x: Slope) -> Slope {
+        Slope::new(v, x.g.map(|g| g.mul(d)), mul0(d.mag(), x.n))
+    }
+
+    /// The Jacobian's stretch bound for a vector of three slopes: its spectral norm is
+    /// at most the midpoint matrix's plus the radius matrix's Frobenius norm.
+    pub fn stretch(v: &[Slope; 3]) -> f64 {
+        let mid = |i: Interval| if i.lo.is_finite() && i.hi.is_finite() { 0.5 * (i.lo + i.hi) } else { 0.0 };
+        let rad = |i: Interval| if i.lo.is_finite() && i.hi.is_finite() { 0.5 * (i.hi - i.lo) } else { f64::INFINITY };
+        let rows = v.map(|s| glam::DVec3::new(mid(s.g[0]), mid(s.g[1]), mid(s.g[2])));
+        let m = glam::DMat3::from_cols(rows[0], rows[1], rows[2]).transpose();
+        let r2: f64 = v.iter().flat_map(|s| s.g.iter()).map(|&i| rad(i).powi(2)).sum();
+        let by_g = crate::ir::max_stretch(m) + r2.sqrt();
+        // Each row's norm bound gives a Frobenius bound too.
+        let by_n = (v[0].n.powi(2) + v[1].n.powi(2) + v[2].n.powi(2)).sqrt();
+        by_g.min(by_n)
+    }
+}
+
+impl Scalar for Slope {
+    type Point = [Interval; 3];
+
+    fn input(p: &[Interval; 3], axis: u8) -> Slope {
+        let mut g = [Interval::point(0.0); 3];
+        g[axis as usize] = Interval::point(1.0);
+        Slope { v: p[axis as usize], g, n: 1.0 }
+    }
+
+    fn constant(x: f64) -> Slope {
+        Slope { v: Interval::point(x), g: [Interval::point(0.0); 3], n: 0.0 }
+    }
+
+    fn unary(f: Unary, x: Slope) -> Slope {
+        let v = Interval::unary(f, x.v);
+        let one = Interval::point(1.0);
+        let d = match f {
+            Unary::Neg => Interval::point(-1.0),
+            Unary::Sin => x.v.cos_deg().mul(Interval::point(DEG)),
+            Unary::Cos => x.v.sin_deg().mul(Interval::point(-DEG)),
+            Unary::Tan => Interval::point(DEG).div(x.v.cos_deg().sqr()),
+            Unary::Asin => Interval::point(1.0 / DEG).div(Interval::unary(Unary::Sqrt, one.sub(x.v.sqr()))),
+            Unary::Acos => Interval::point(-1.0 / DEG).div(Interval::unary(Unary::Sqrt, one.sub(x.v.sqr()))),
+            Unary::Atan => Interval::point(1.0 / DEG).div(one.add(x.v.sqr())),
+            Unary::Sqrt => Interval::point(0.5).div(v),
+            Unary::Abs => {
+                if x.v.lo >= 0.0 {
+                    one
+                } else if x.v.hi <= 0.0 {
+                    Interval::point(-1.0)
+                } else {
+                    Interval::new(-1.0, 1.0)
+                }
+            }
+            Unary::Exp => v,
+            Unary::Log => one.div(x.v),
+            // A step's slope is zero between its jumps; a jump has no bound at all, and
+            // is marched as if it were not there (docs/fields.md says so).
+            Unary::Not | Unary::Floor | Unary::Ceil | Unary::Round | Unary::Sign => Interval::point(0.0),
+            Unary::Length | Unary::Normalize => Interval::ALL,
+        };
+        Slope::chain(v, d, x)
+    }
+
+    fn binary(f: Binary, a: Slope, b: Slope) -> Slope {
+        let v = Interval::binary(f, a.v, b.v);
+        let zero = [Interval::point(0.0); 3];
+        let comb = |ka: Interval, kb: Interval| {
+            let g = [0, 1, 2].map(|i| a.g[i].mul(ka).add(b.g[i].mul(kb)));
+            Slope::new(v, g, mul0(ka.mag(), a.n) + mul0(kb.mag(), b.n))
+        };
+        let one = Interval::point(1.0);
+        match f {
+            Binary::Add => comb(one, one),
+            Binary::Sub => comb(one, Interval::point(-1.0)),
+            Binary::Mul => comb(b.v, a.v),
+            Binary::Div => {
+                let inv = one.div(b.v);
+                comb(inv, a.v.mul(inv.sqr()).mul(Interval::point(-1.0)))
+            }
+            // Between jumps a remainder is its dividend shifted by whole divisors.
+            Binary::Rem if b.n == 0.0 => comb(one, Interval::point(0.0)),
+            Binary::Rem => Slope::new(v, [Interval::ALL; 3], f64::INFINITY),
+            Binary::Min | Binary::Max => {
+                let a_wins = if f == Binary::Min { a.v.hi <= b.v.lo } else { a.v.lo >= b.v.hi };
+                let b_wins = if f == Binary::Min { b.v.hi <= a.v.lo } else { b.v.lo >= a.v.hi };
+                if a_wins {
+                    Slope { v, ..a }
+                } else if b_wins {
+                    Slope { v, ..b }
+                } else {
+                    let g = [0, 1, 2].map(|i| a.g[i].hull(b.g[i]));
+                    Slope::new(v, g, a.n.max(b.n))
+                }
+            }
+            Binary::Pow => {
+                // d/da = b·a^(b−1); d/db = a^b·ln a (a > 0 only).
+                let da = b.v.mul(pow(a.v, b.v.sub(one)));
+                let db = if b.n == 0.0 {
+                    Interval::point(0.0)
+                } else if a.v.lo > 0.0 {
+                    v.mul(Interval::new(a.v.lo.ln(), a.v.hi.ln()))
+                } else {
+                    Interval::ALL
+                };
+                comb(da, db)
+            }
+            Binary::Atan2 => {
+                // atan2(y, x): ∂y = x / r², ∂x = −y / r², in degrees.
+                let r2 = a.v.sqr().add(b.v.sqr());
+                let k = Interval::point(1.0 / DEG).div(r2);
+                comb(b.v.mul(k), a.v.mul(k).mul(Interval::point(-1.0)))
+            }
+            Binary::Lt | Binary::Le | Binary::Gt | Binary::Ge | Binary::Eq | Binary::Ne | Binary::And | Binary::Or => {
+                Slope { v, g: zero, n: 0.0 }
+            }
+            Binary::Dot | Binary::Cross => Slope::new(Interval::ALL, [Interval::ALL; 3], f64::INFINITY),
+        }
+    }
+
+    fn select(c: Slope, a: Slope, b: Slope) -> Slope {
+        if !c.v.contains(0.0) {
+            a
+        } else if c.v == Interval::point(0.0) {
+            b
+        } else {
+            let g = [0, 1, 2].map(|i| a.g[i].hull(b.g[i]));
+            Slope::new(a.v.hull(b.v), g, a.n.max(b.n))
+        }
+    }
+
+    fn length(v: [Slope; 3]) -> Slope {
+        let value = Interval::length([v[0].v, v[1].v, v[2].v]);
+        // ∇|u| = Jᵀu/|u|: each component is at most its Jacobian column's norm.
+        let col = |i: usize| Interval::point((0..3).map(|k| v[k].g[i].mag().powi(2)).sum::<f64>().sqrt());
+        let g = if value.lo > 0.0 {
+            let inv = Interval::point(1.0).div(value);
+            [0, 1, 2].map(|i| {
+                let dot = v[0].v.mul(v[0].g[i]).add(v[1].v.mul(v[1].g[i])).add(v[2].v.mul(v[2].g[i]));
+                let g = dot.mul(inv);
+                let c = col(i);
+                Interval::new(g.lo.max(-c.hi), g.hi.min(c.hi))
+            })
+        } else {
+            [0, 1, 2].map(|i| {
+                let c = col(i);
+                Interval::new(-c.hi, c.hi)
+            })
+        };
+        Slope::new(value, g, Slope::stretch(&v))
+    }
+
+    fn noise(q: [Slope; 3], _: u32) -> Slope {
+        let s = NOISE_SLOPE * Slope::stretch(&q);
+        let col = |i: usize| NOISE_SLOPE * (0..3).map(|k| q[k].g[i].mag().powi(2)).sum::<f64>().sqrt();
+        Slope::new(Interval::new(-NOISE_RANGE, NOISE_RANGE), [0, 1, 2].map(|i| Interval::new(-col(i), col(i))), s)
+    }
+}

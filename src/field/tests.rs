@@ -1,0 +1,235 @@
+use std::sync::Arc;
+
+use glam::{DVec3, Vec3A};
+
+use super::*;
+use crate::geom::Aabb;
+use crate::ir::field::{Expr, Kind, Ty, Val};
+
+fn x(i: usize) -> Arc<Expr> {
+    Expr::new(Kind::Component(Expr::point(), i), Ty::Num)
+}
+
+fn n(v: f64) -> Arc<Expr> {
+    Expr::num(v)
+}
+
+fn un(f: Unary, a: Arc<Expr>) -> Arc<Expr> {
+    Expr::unary(f, a).unwrap()
+}
+
+fn bin(f: Binary, a: Arc<Expr>, b: Arc<Expr>) -> Arc<Expr> {
+    Expr::binary(f, a, b).unwrap()
+}
+
+/// `sin(k·x)·cos(k·y) + sin(k·y)·cos(k·z) + sin(k·z)·cos(k·x)`, degrees.
+fn gyroid(k: f64) -> Arc<Expr> {
+    let s = |i: usize| un(Unary::Sin, bin(Binary::Mul, n(k), x(i)));
+    let c = |i: usize| un(Unary::Cos, bin(Binary::Mul, n(k), x(i)));
+    let t = |i: usize, j: usize| bin(Binary::Mul, s(i), c(j));
+    bin(Binary::Add, bin(Binary::Add, t(0, 1), t(1, 2)), t(2, 0))
+}
+
+fn sphere() -> Arc<Expr> {
+    bin(Binary::Sub, un(Unary::Length, Expr::point()), n(1.0))
+}
+
+/// Every operation of the language in one body, each somewhere in its domain.
+fn everything() -> Vec<Arc<Expr>> {
+    let (a, b, c) = (x(0), x(1), x(2));
+    let mut out = vec![sphere(), gyroid(450.0)];
+    for f in [
+        Unary::Neg,
+        Unary::Sin,
+        Unary::Cos,
+        Unary::Tan,
+        Unary::Asin,
+        Unary::Acos,
+        Unary::Atan,
+        Unary::Sqrt,
+        Unary::Abs,
+        Unary::Floor,
+        Unary::Ceil,
+        Unary::Round,
+        Unary::Sign,
+        Unary::Exp,
+        Unary::Log,
+    ] {
+        out.push(un(f, bin(Binary::Mul, a.clone(), n(0.7))));
+    }
+    for f in [
+        Binary::Add,
+        Binary::Sub,
+        Binary::Mul,
+        Binary::Div,
+        Binary::Rem,
+        Binary::Min,
+        Binary::Max,
+        Binary::Pow,
+        Binary::Atan2,
+    ] {
+        out.push(bin(f, a.clone(), bin(Binary::Add, b.clone(), n(2.5))));
+    }
+    out.push(bin(Binary::Dot, Expr::point(), bin(Binary::Cross, Expr::point(), Expr::vec(DVec3::new(1.0, 2.0, 3.0)))));
+    out.push(Expr::new(
+        Kind::Select(bin(Binary::Lt, a.clone(), b.clone()), c.clone(), bin(Binary::Mul, c.clone(), n(2.0))),
+        Ty::Num,
+    ));
+    let norm = un(Unary::Normalize, Expr::point());
+    out.push(Expr::new(Kind::Component(norm, 1), Ty::Num));
+    out.push(Expr::new(Kind::Noise { at: Expr::point(), size: 0.7, seed: 4 }, Ty::Num));
+    out
+}
+
+/// Points in `[-2, 2]³`, deterministic.
+fn points(count: usize) -> Vec<DVec3> {
+    let mut s = 0x2545_f491_4f6c_dd1du64;
+    let mut r = || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        (s >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 2.0
+    };
+    (0..count).map(|_| DVec3::new(r(), r(), r())).collect()
+}
+
+fn none(_: &Arc<crate::ir::Shape>, _: DVec3) -> f64 {
+    0.0
+}
+
+/// The f32 tape computes what the f64 definition says, for every operation.
+#[test]
+fn tape_follows_the_definition() {
+    for e in everything() {
+        let tape = Tape::new(&e);
+        for p in points(300) {
+            let want = e.eval(p, &none);
+            let Val::Num(want) = want else { panic!() };
+            let got = tape.eval::<f32>(&p.as_vec3a(), &NoDistances) as f64;
+            let tol = 1e-3 * (1.0 + want.abs());
+            // A step function may round to its other side in f32 right at a jump.
+            let near_jump = (p.x * 0.7).fract().abs() < 1e-4 || (p.x * 0.7 - 0.5).fract().abs() < 1e-4;
+            assert!((got - want).abs() <= tol || near_jump, "{} at {p}: {got} vs {want}", e.source(200));
+        }
+    }
+}
+
+/// Dual numbers give the gradient: central differences of the f64 definition agree
+/// wherever the body is smooth.
+#[test]
+fn duals_give_the_gradient() {
+    for e in everything() {
+        let tape = Tape::new(&e);
+        for p in points(100) {
+            let d = tape.eval::<Dual>(&p.as_vec3a(), &NoDistances);
+            let h = 1e-5;
+            for a in 0..3 {
+                let mut step = DVec3::ZERO;
+                step[a] = h;
+                let (hi, lo) = (e.eval(p + step, &none).num(), e.eval(p - step, &none).num());
+                let fd = (hi - lo) / (2.0 * h);
+                let mid = e.eval(p, &none).num();
+                // Skip kinks and jumps: where the one-sided slopes disagree.
+                let (r, l) = ((hi - mid) / h, (mid - lo) / h);
+                if (r - l).abs() > 1e-2 * (1.0 + r.abs()) || !fd.is_finite() {
+                    continue;
+                }
+                let got = d.g[a] as f64;
+                assert!(
+                    (got - fd).abs() <= 2e-2 * (1.0 + fd.abs()),
+                    "{} at {p} axis {a}: {got} vs {fd}",
+                    e.source(200)
+                );
+            }
+        }
+    }
+}
+
+/// An interval over a box holds the body's value at every point of the box.
+#[test]
+fn intervals_hold_every_value() {
+    for e in everything() {
+        let tape = Tape::new(&e);
+        for (i, c) in points(60).into_iter().enumerate() {
+            let half = DVec3::splat([0.01, 0.2, 1.5][i % 3]);
+            let b = [0, 1, 2].map(|a| Interval::new(c[a] - half[a], c[a] + half[a]));
+            let iv = tape.eval::<Interval>(&b, &NoDistances);
+            for q in points(40) {
+                let p = c + q / 2.0 * half;
+                let v = e.eval(p, &none).num();
+                assert!(iv.lo - 1e-9 <= v && v <= iv.hi + 1e-9, "{} at {p}: {v} not in {iv:?}", e.source(200));
+            }
+        }
+    }
+}
+
+/// The slope bound is above every slope found by sampling, and close to it for the
+/// bodies a scene writes.
+#[test]
+fn slope_bounds_hold_and_are_tight() {
+    let b = Aabb { min: DVec3::splat(-1.6), max: DVec3::splat(1.6) };
+    let cases: [(Arc<Expr>, f64); 4] = [
+        (sphere(), 1.0),
+        (bin(Binary::Mul, n(4.0), sphere()), 4.0),
+        (bin(Binary::Mul, n(0.25), sphere()), 0.25),
+        (un(Unary::Abs, gyroid(450.0)), 0.0),
+    ];
+    for (e, exact) in cases {
+        let tape = Tape::new(&e);
+        let est = lipschitz(&tape, Some(b), &NoDistances);
+        let sampled = points(20_000)
+            .into_iter()
+            .map(|p| tape.eval::<Dual>(&(p * 0.8).as_vec3a(), &NoDistances).g.length() as f64)
+            .fold(0.0, f64::max);
+        assert!(est.bound >= sampled * (1.0 - 1e-4), "{}: bound {} below a slope {sampled}", e.source(80), est.bound);
+        if exact > 0.0 {
+            assert!((est.bound - exact).abs() < 1e-9, "{}: {} is not {exact}", e.source(80), est.bound);
+        } else {
+            assert!(est.bound < sampled * 1.4, "{}: bound {} far above {sampled}", e.source(80), est.bound);
+        }
+    }
+}
+
+/// Over all of space a body whose form bounds its slope gets a finite bound; one
+/// whose slope grows without end gets none.
+#[test]
+fn unbounded_domains() {
+    let g = lipschitz(&Tape::new(&gyroid(450.0)), None, &NoDistances);
+    assert!(g.bound.is_finite() && g.bound > 13.0, "{g:?}");
+    let s = lipschitz(&Tape::new(&sphere()), None, &NoDistances);
+    assert!((s.bound - 1.0).abs() < 1e-12, "{s:?}");
+    let sq = lipschitz(&Tape::new(&bin(Binary::Mul, x(0), x(0))), None, &NoDistances);
+    assert!(sq.bound.is_infinite(), "{sq:?}");
+}
+
+/// Common subexpressions are computed once and registers are reused.
+#[test]
+fn tapes_share_and_reuse() {
+    let s = sphere();
+    let twice = bin(Binary::Mul, s.clone(), bin(Binary::Add, s.clone(), n(0.0)));
+    let tape = Tape::new(&twice);
+    let lengths = tape.ops.iter().filter(|(op, _)| matches!(op, Op::Length(_))).count();
+    assert_eq!(lengths, 1, "one length for both uses");
+    let g = Tape::new(&gyroid(450.0));
+    assert!(g.regs < 10, "{} registers for the gyroid", g.regs);
+    let v = g.eval::<f32>(&Vec3A::new(0.1, 0.2, 0.3), &NoDistances);
+    assert!((v as f64 - gyroid(450.0).eval(DVec3::new(0.1, 0.2, 0.3), &none).num()).abs() < 1e-5);
+}
+
+/// The inlined sine and cosine are f32-accurate over the angles fields use.
+#[test]
+fn fast_trig_is_accurate() {
+    let (mut worst, mut libm) = (0.0f64, 0.0f64);
+    for i in -200_000..200_000 {
+        let x = i as f32 * 0.0173;
+        let r = (x as f64).to_radians();
+        worst = worst.max((sin_deg(x) as f64 - r.sin()).abs()).max((cos_deg(x) as f64 - r.cos()).abs());
+        let (s, c) = ((x * RAD).sin() as f64, (x * RAD).cos() as f64);
+        libm = libm.max((s - r.sin()).abs()).max((c - r.cos()).abs());
+    }
+    // Both lose what f32 loses scaling a large angle; neither loses much more.
+    assert!(worst < 2.0 * libm + 1e-7, "{worst} against libm's {libm}");
+    assert_eq!(sin_deg(0.0), 0.0);
+    assert_eq!(cos_deg(0.0), 1.0);
+    assert!((sin_deg(90.0) - 1.0).abs() < 1e-7 && sin_deg(180.0).abs() < 1e-6);
+}

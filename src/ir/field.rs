@@ -1,0 +1,609 @@
+//! Field expressions: the bodies of `p => …` literals, functions of the point `p` with
+//! everything that does not depend on it already folded to a number.
+//!
+//! An expression is a tree of `Arc`-shared nodes (a name used twice in a body is one
+//! node reached twice); its meaning is fixed here, in f64, by [`Expr::eval`], which the
+//! back-ends' f32 evaluators (`crate::field`) are tested against.
+
+use std::fmt::Write as _;
+use std::sync::Arc;
+
+use glam::DVec3;
+
+use super::Shape;
+use crate::sig::num;
+
+/// What a field expression evaluates to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Ty {
+    /// A number.
+    Num,
+    /// A vector.
+    Vec3,
+    /// A truth value (a comparison), only ever a condition.
+    Bool,
+}
+
+impl Ty {
+    /// The language's name for it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Ty::Num => "num",
+            Ty::Vec3 => "vec3",
+            Ty::Bool => "bool",
+        }
+    }
+}
+
+/// One node of a field expression.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Expr {
+    /// What it computes.
+    pub kind: Kind,
+    /// Its type, fixed by its operands'.
+    pub ty: Ty,
+}
+
+/// Functions of one operand.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Unary {
+    /// `-x` of a number or vector.
+    Neg,
+    /// `not b`.
+    Not,
+    /// Sine of degrees.
+    Sin,
+    /// Cosine of degrees.
+    Cos,
+    /// Tangent of degrees.
+    Tan,
+    /// Arcsine in degrees; its operand is clamped to [−1, 1].
+    Asin,
+    /// Arccosine in degrees; its operand is clamped to [−1, 1].
+    Acos,
+    /// Arctangent in degrees.
+    Atan,
+    /// Square root; of 0 below 0.
+    Sqrt,
+    /// Absolute value.
+    Abs,
+    /// Largest whole number not above.
+    Floor,
+    /// Smallest whole number not below.
+    Ceil,
+    /// Nearest whole number, halves away from zero.
+    Round,
+    /// −1, 0 or 1.
+    Sign,
+    /// e to the power.
+    Exp,
+    /// Natural logarithm; of the smallest positive f32 at or below 0.
+    Log,
+    /// Length of a vector.
+    Length,
+    /// A vector scaled to length 1 (the zero vector stays zero).
+    Normalize,
+}
+
+/// Functions of two operands.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Binary {
+    /// `+` of numbers or vectors.
+    Add,
+    /// `-` of numbers or vectors.
+    Sub,
+    /// `*`: numbers, a vector and a number, or two vectors by component.
+    Mul,
+    /// `/`: as `*`.
+    Div,
+    /// `%`: as `/`, the remainder with the sign of the dividend.
+    Rem,
+    /// `<` of numbers.
+    Lt,
+    /// `<=` of numbers.
+    Le,
+    /// `>` of numbers.
+    Gt,
+    /// `>=` of numbers.
+    Ge,
+    /// `==` of numbers or truth values.
+    Eq,
+    /// `!=` of numbers or truth values.
+    Ne,
+    /// `and`.
+    And,
+    /// `or`.
+    Or,
+    /// The smaller number.
+    Min,
+    /// The larger number.
+    Max,
+    /// `pow(x, y)`; of `|x|` when `x` is negative and `y` not whole.
+    Pow,
+    /// `atan2(y, x)` in degrees.
+    Atan2,
+    /// Dot product.
+    Dot,
+    /// Cross product.
+    Cross,
+}
+
+/// What a node computes.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Kind {
+    /// The point `p`.
+    Point,
+    /// A number known before rendering.
+    Num(f64),
+    /// A vector known before rendering.
+    Vec(DVec3),
+    /// One component (0, 1, 2 for x, y, z) of a vector.
+    Component(Arc<Expr>, usize),
+    /// A vector of three numbers.
+    Vector([Arc<Expr>; 3]),
+    /// A function of one operand.
+    Unary(Unary, Arc<Expr>),
+    /// A function of two operands.
+    Binary(Binary, Arc<Expr>, Arc<Expr>),
+    /// `if c then a else b`, both of one type.
+    Select(Arc<Expr>, Arc<Expr>, Arc<Expr>),
+    /// `dist(shape, q)`: the shape's signed distance bound at the point `q`.
+    Dist(Arc<Shape>, Arc<Expr>),
+    /// `noise3(q, size, seed)`: the `noise` pattern's gradient noise at `q / size`.
+    Noise {
+        /// Where.
+        at: Arc<Expr>,
+        /// The feature size, > 0.
+        size: f64,
+        /// The seed.
+        seed: u32,
+    },
+}
+
+impl Unary {
+    /// The function's name (`-` and `not` as operators).
+    pub fn name(self) -> &'static str {
+        match self {
+            Unary::Neg => "-",
+            Unary::Not => "not",
+            Unary::Sin => "sin",
+            Unary::Cos => "cos",
+            Unary::Tan => "tan",
+            Unary::Asin => "asin",
+            Unary::Acos => "acos",
+            Unary::Atan => "atan",
+            Unary::Sqrt => "sqrt",
+            Unary::Abs => "abs",
+            Unary::Floor => "floor",
+            Unary::Ceil => "ceil",
+            Unary::Round => "round",
+            Unary::Sign => "sign",
+            Unary::Exp => "exp",
+            Unary::Log => "log",
+            Unary::Length => "length",
+            Unary::Normalize => "normalize",
+        }
+    }
+
+    /// The result's type for an operand of type `x`; `None` if it takes no such operand.
+    pub fn ty(self, x: Ty) -> Option<Ty> {
+        match (self, x) {
+            (Unary::Neg, Ty::Num | Ty::Vec3) => Some(x),
+            (Unary::Not, Ty::Bool) => Some(Ty::Bool),
+            (Unary::Length, Ty::Vec3) => Some(Ty::Num),
+            (Unary::Normalize, Ty::Vec3) => Some(Ty::Vec3),
+            (Unary::Neg | Unary::Not | Unary::Length | Unary::Normalize, _) => None,
+            (_, Ty::Num) => Some(Ty::Num),
+            _ => None,
+        }
+    }
+
+    /// The function at `x`, in f64 (the definition the evaluators follow).
+    pub fn apply(self, x: f64) -> f64 {
+        match self {
+            Unary::Neg => -x,
+            Unary::Not => f64::from(x == 0.0),
+            Unary::Sin => x.to_radians().sin(),
+            Unary::Cos => x.to_radians().cos(),
+            Unary::Tan => x.to_radians().tan(),
+            Unary::Asin => x.clamp(-1.0, 1.0).asin().to_degrees(),
+            Unary::Acos => x.clamp(-1.0, 1.0).acos().to_degrees(),
+            Unary::Atan => x.atan().to_degrees(),
+            Unary::Sqrt => x.max(0.0).sqrt(),
+            Unary::Abs => x.abs(),
+            Unary::Floor => x.floor(),
+            Unary::Ceil => x.ceil(),
+            Unary::Round => x.round(),
+            Unary::Sign => {
+                if x == 0.0 {
+                    0.0
+                } else {
+                    x.signum()
+                }
+            }
+            Unary::Exp => x.exp(),
+            Unary::Log => x.max(f64::from(f32::MIN_POSITIVE)).ln(),
+            // Vector functions are applied by `Expr::eval`.
+            Unary::Length | Unary::Normalize => f64::NAN,
+        }
+    }
+}
+
+impl Binary {
+    /// The operator as written, or the function's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Binary::Add => "+",
+            Binary::Sub => "-",
+            Binary::Mul => "*",
+            Binary::Div => "/",
+            Binary::Rem => "%",
+            Binary::Lt => "<",
+            Binary::Le => "<=",
+            Binary::Gt => ">",
+            Binary::Ge => ">=",
+            Binary::Eq => "==",
+            Binary::Ne => "!=",
+            Binary::And => "and",
+            Binary::Or => "or",
+            Binary::Min => "min",
+            Binary::Max => "max",
+            Binary::Pow => "pow",
+            Binary::Atan2 => "atan2",
+            Binary::Dot => "dot",
+            Binary::Cross => "cross",
+        }
+    }
+
+    /// Whether it is written as a function call rather than between its operands.
+    pub fn is_call(self) -> bool {
+        matches!(self, Binary::Min | Binary::Max | Binary::Pow | Binary::Atan2 | Binary::Dot | Binary::Cross)
+    }
+
+    /// The result's type for operands of types `a` and `b`; `None` if it takes no such pair.
+    pub fn ty(self, a: Ty, b: Ty) -> Option<Ty> {
+        use Ty::{Bool, Num, Vec3};
+        match (self, a, b) {
+            (Binary::Add | Binary::Sub, Num, Num) => Some(Num),
+            (Binary::Add | Binary::Sub, Vec3, Vec3) => Some(Vec3),
+            (Binary::Mul | Binary::Div | Binary::Rem, Num, Num) => Some(Num),
+            (Binary::Mul | Binary::Div | Binary::Rem, Vec3, Vec3 | Num) => Some(Vec3),
+            (Binary::Mul, Num, Vec3) => Some(Vec3),
+            (Binary::Lt | Binary::Le | Binary::Gt | Binary::Ge, Num, Num) => Some(Bool),
+            (Binary::Eq | Binary::Ne, Num, Num) | (Binary::Eq | Binary::Ne, Bool, Bool) => Some(Bool),
+            (Binary::And | Binary::Or, Bool, Bool) => Some(Bool),
+            (Binary::Min | Binary::Max | Binary::Pow | Binary::Atan2, Num, Num) => Some(Num),
+            (Binary::Dot, Vec3, Vec3) => Some(Num),
+            (Binary::Cross, Vec3, Vec3) => Some(Vec3),
+            _ => None,
+        }
+    }
+
+    /// The function of two numbers, in f64 (truth values are 1 and 0).
+    pub fn apply(self, x: f64, y: f64) -> f64 {
+        match self {
+            Binary::Add => x + y,
+            Binary::Sub => x - y,
+            Binary::Mul => x * y,
+            Binary::Div => x / y,
+            Binary::Rem => x % y,
+            Binary::Lt => f64::from(x < y),
+            Binary::Le => f64::from(x <= y),
+            Binary::Gt => f64::from(x > y),
+            Binary::Ge => f64::from(x >= y),
+            Binary::Eq => f64::from(x == y),
+            Binary::Ne => f64::from(x != y),
+            Binary::And => f64::from(x != 0.0 && y != 0.0),
+            Binary::Or => f64::from(x != 0.0 || y != 0.0),
+            Binary::Min => x.min(y),
+            Binary::Max => x.max(y),
+            Binary::Pow => {
+                if x < 0.0 && y.fract() != 0.0 {
+                    x.abs().powf(y)
+                } else {
+                    x.powf(y)
+                }
+            }
+            // `atan2(y, x)`: the first operand is y.
+            Binary::Atan2 => (x + 0.0).atan2(y).to_degrees(),
+            // Vector functions are applied by `Expr::eval`.
+            Binary::Dot | Binary::Cross => f64::NAN,
+        }
+    }
+}
+
+/// The value of an expression at a point, in f64: a number (truth values as 1 and 0)
+/// or a vector.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Val {
+    /// A number or truth value.
+    Num(f64),
+    /// A vector.
+    Vec(DVec3),
+}
+
+impl Val {
+    /// The number (a vector's x).
+    pub fn num(self) -> f64 {
+        match self {
+            Val::Num(x) => x,
+            Val::Vec(v) => v.x,
+        }
+    }
+
+    /// The vector (a number splatted).
+    pub fn vec(self) -> DVec3 {
+        match self {
+            Val::Num(x) => DVec3::splat(x),
+            Val::Vec(v) => v,
+        }
+    }
+}
+
+impl Expr {
+    /// A node of `kind` whose type is `ty`.
+    pub fn new(kind: Kind, ty: Ty) -> Arc<Expr> {
+        Arc::new(Expr { kind, ty })
+    }
+
+    /// The point `p`.
+    pub fn point() -> Arc<Expr> {
+        Expr::new(Kind::Point, Ty::Vec3)
+    }
+
+    /// A number.
+    pub fn num(x: f64) -> Arc<Expr> {
+        Expr::new(Kind::Num(x), Ty::Num)
+    }
+
+    /// A vector.
+    pub fn vec(v: DVec3) -> Arc<Expr> {
+        Expr::new(Kind::Vec(v), Ty::Vec3)
+    }
+
+    /// `f(x)`; `None` if `f` takes no operand of `x`'s type.
+    pub fn unary(f: Unary, x: Arc<Expr>) -> Option<Arc<Expr>> {
+        let ty = f.ty(x.ty)?;
+        Some(Expr::new(Kind::Unary(f, x), ty))
+    }
+
+    /// `f(a, b)`; `None` if `f` takes no operands of these types.
+    pub fn binary(f: Binary, a: Arc<Expr>, b: Arc<Expr>) -> Option<Arc<Expr>> {
+        let ty = f.ty(a.ty, b.ty)?;
+        Some(Expr::new(Kind::Binary(f, a, b), ty))
+    }
+
+    /// The operands, in order.
+    pub fn operands(&self) -> Vec<&Arc<Expr>> {
+        match &self.kind {
+            Kind::Point | Kind::Num(_) | Kind::Vec(_) => vec![],
+            Kind::Component(x, _) | Kind::Unary(_, x) | Kind::Dist(_, x) | Kind::Noise { at: x, .. } => vec![x],
+            Kind::Vector(xs) => xs.iter().collect(),
+            Kind::Binary(_, a, b) => vec![a, b],
+            Kind::Select(c, a, b) => vec![c, a, b],
+        }
+    }
+
+    /// Whether the value depends on the point (else it is a constant the checker folded).
+    pub fn uses_point(&self) -> bool {
+        match &self.kind {
+            Kind::Point => true,
+            Kind::Num(_) | Kind::Vec(_) => false,
+            _ => self.operands().iter().any(|x| x.uses_point()),
+        }
+    }
+
+    /// Distinct nodes (shared ones once): the work of one evaluation.
+    pub fn size(self: &Arc<Expr>) -> usize {
+        let mut seen = std::collections::HashSet::new();
+        let mut stack = vec![self];
+        while let Some(e) = stack.pop() {
+            if seen.insert(Arc::as_ptr(e)) {
+                stack.extend(e.operands());
+            }
+        }
+        seen.len()
+    }
+
+    /// The shapes `dist` reads, in first-use order, each once.
+    pub fn shapes(self: &Arc<Expr>) -> Vec<Arc<Shape>> {
+        let mut out: Vec<Arc<Shape>> = Vec::new();
+        let mut seen = std::collections::HashSet::new();
+        let mut stack = vec![self];
+        while let Some(e) = stack.pop() {
+            if !seen.insert(Arc::as_ptr(e)) {
+                continue;
+            }
+            if let Kind::Dist(s, _) = &e.kind {
+                if !out.iter().any(|o| Arc::ptr_eq(o, s)) {
+                    out.push(s.clone());
+                }
+            }
+            // Reversed, so operands are visited left to right.
+            stack.extend(e.operands().into_iter().rev());
+        }
+        out
+    }
+
+    /// The value at `p`, in f64, with `dist(shape, q)` given by `dist` (by the shape's
+    /// index in [`shapes`](Self::shapes)).
+    pub fn eval(&self, p: DVec3, dist: &dyn Fn(&Arc<Shape>, DVec3) -> f64) -> Val {
+        let n = |e: &Arc<Expr>| e.eval(p, dist).num();
+        let v = |e: &Arc<Expr>| e.eval(p, dist).vec();
+        match &self.kind {
+            Kind::Point => Val::Vec(p),
+            Kind::Num(x) => Val::Num(*x),
+            Kind::Vec(x) => Val::Vec(*x),
+            Kind::Component(x, i) => Val::Num(v(x)[*i]),
+            Kind::Vector(xs) => Val::Vec(DVec3::new(n(&xs[0]), n(&xs[1]), n(&xs[2]))),
+            Kind::Unary(Unary::Length, x) => Val::Num(v(x).length()),
+            Kind::Unary(Unary::Normalize, x) => Val::Vec(v(x).normalize_or_zero()),
+            Kind::Unary(f, x) if x.ty == Ty::Vec3 => Val::Vec(v(x).to_array().map(|c| f.apply(c)).into()),
+            Kind::Unary(f, x) => Val::Num(f.apply(n(x))),
+            Kind::Binary(Binary::Dot, a, b) => Val::Num(v(a).dot(v(b))),
+            Kind::Binary(Binary::Cross, a, b) => Val::Vec(v(a).cross(v(b))),
+            Kind::Binary(f, a, b) if self.ty == Ty::Vec3 => {
+                let (a, b) = (v(a), v(b));
+                Val::Vec(DVec3::new(f.apply(a.x, b.x), f.apply(a.y, b.y), f.apply(a.z, b.z)))
+            }
+            Kind::Binary(f, a, b) => Val::Num(f.apply(n(a), n(b))),
+            Kind::Select(c, a, b) => {
+                if n(c) != 0.0 {
+                    a.eval(p, dist)
+                } else {
+                    b.eval(p, dist)
+                }
+            }
+            Kind::Dist(s, q) => Val::Num(dist(s, v(q))),
+            Kind::Noise { at, size, seed } => Val::Num(crate::geom::noise(v(at) / *size, *seed)),
+        }
+    }
+
+    /// The expression as scn source, with `p` for the point and `shape#i` for the
+    /// `i`-th shape `dist` reads ([`shapes`](Self::shapes)); cut short past `limit` bytes.
+    pub fn source(self: &Arc<Expr>, limit: usize) -> String {
+        let shapes = self.shapes();
+        let mut out = String::new();
+        write_expr(&mut out, self, 0, &shapes, limit);
+        if out.len() > limit {
+            let mut cut = limit;
+            while !out.is_char_boundary(cut) {
+                cut -= 1;
+            }
+            out.truncate(cut);
+            out.push('…');
+        }
+        out
+    }
+}
+
+/// Binding strength of a node as written: higher binds tighter.
+fn precedence(e: &Expr) -> u8 {
+    match &e.kind {
+        Kind::Select(..) => 1,
+        Kind::Binary(Binary::Or, ..) => 2,
+        Kind::Binary(Binary::And, ..) => 3,
+        Kind::Unary(Unary::Not, _) => 4,
+        Kind::Binary(Binary::Lt | Binary::Le | Binary::Gt | Binary::Ge | Binary::Eq | Binary::Ne, ..) => 5,
+        Kind::Binary(Binary::Add | Binary::Sub, ..) => 6,
+        Kind::Binary(Binary::Mul | Binary::Div | Binary::Rem, ..) => 7,
+        Kind::Unary(Unary::Neg, _) => 8,
+        Kind::Num(x) if *x < 0.0 => 8,
+        _ => 10,
+    }
+}
+
+fn write_expr(out: &mut String, e: &Arc<Expr>, outer: u8, shapes: &[Arc<Shape>], limit: usize) {
+    if out.len() > limit {
+        return;
+    }
+    let prec = precedence(e);
+    let paren = prec < outer;
+    if paren {
+        out.push('(');
+    }
+    let args = |out: &mut String, xs: &[&Arc<Expr>]| {
+        for (i, x) in xs.iter().enumerate() {
+            if i > 0 {
+                out.push_str(", ");
+            }
+            write_expr(out, x, 0, shapes, limit);
+        }
+    };
+    match &e.kind {
+        Kind::Point => out.push('p'),
+        Kind::Num(x) => out.push_str(&num(*x)),
+        Kind::Vec(v) => out.push_str(&crate::sig::vec(*v)),
+        Kind::Component(x, i) => {
+            write_expr(out, x, 10, shapes, limit);
+            out.push_str([".x", ".y", ".z"][*i]);
+            // (A negative number's component needs its parentheses: `(-1).x`.)
+        }
+        Kind::Vector(xs) => {
+            out.push('[');
+            args(out, &[&xs[0], &xs[1], &xs[2]]);
+            out.push(']');
+        }
+        Kind::Unary(Unary::Neg, x) => {
+            out.push('-');
+            write_expr(out, x, 8, shapes, limit);
+        }
+        Kind::Unary(Unary::Not, x) => {
+            out.push_str("not ");
+            write_expr(out, x, 5, shapes, limit);
+        }
+        Kind::Unary(f, x) => {
+            let _ = write!(out, "{}(", f.name());
+            args(out, &[x]);
+            out.push(')');
+        }
+        Kind::Binary(f, a, b) if f.is_call() => {
+            let _ = write!(out, "{}(", f.name());
+            args(out, &[a, b]);
+            out.push(')');
+        }
+        Kind::Binary(f, a, b) => {
+            // Left-associative: the right operand of an equal-precedence operator needs parentheses.
+            write_expr(out, a, prec, shapes, limit);
+            let _ = write!(out, " {} ", f.name());
+            write_expr(out, b, prec + 1, shapes, limit);
+        }
+        Kind::Select(c, a, b) => {
+            out.push_str("if ");
+            write_expr(out, c, 0, shapes, limit);
+            out.push_str(" then ");
+            write_expr(out, a, 0, shapes, limit);
+            out.push_str(" else ");
+            write_expr(out, b, 1, shapes, limit);
+        }
+        Kind::Dist(s, q) => {
+            let i = shapes.iter().position(|o| Arc::ptr_eq(o, s)).unwrap_or(0);
+            let _ = write!(out, "dist(shape#{i}, ");
+            write_expr(out, q, 0, shapes, limit);
+            out.push(')');
+        }
+        Kind::Noise { at, size, seed } => {
+            out.push_str("noise3(");
+            write_expr(out, at, 0, shapes, limit);
+            let _ = write!(out, ", {}, {seed})", num(*size));
+        }
+    }
+    if paren {
+        out.push(')');
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn x() -> Arc<Expr> {
+        Expr::new(Kind::Component(Expr::point(), 0), Ty::Num)
+    }
+
+    #[test]
+    fn source_is_readable_and_parenthesised_where_needed() {
+        let sum = Expr::binary(Binary::Add, x(), Expr::num(1.0)).unwrap();
+        let prod = Expr::binary(Binary::Mul, sum.clone(), Expr::num(2.0)).unwrap();
+        assert_eq!(prod.source(100), "(p.x + 1) * 2");
+        let diff = Expr::binary(Binary::Sub, x(), Expr::binary(Binary::Sub, x(), Expr::num(1.0)).unwrap()).unwrap();
+        assert_eq!(diff.source(100), "p.x - (p.x - 1)");
+        let s = Expr::unary(Unary::Sin, prod).unwrap();
+        assert_eq!(s.source(100), "sin((p.x + 1) * 2)");
+        assert_eq!(s.source(5), "sin((…");
+    }
+
+    #[test]
+    fn eval_follows_the_language() {
+        let p = DVec3::new(3.0, 4.0, 0.0);
+        let len = Expr::unary(Unary::Length, Expr::point()).unwrap();
+        let none = |_: &Arc<Shape>, _: DVec3| 0.0;
+        assert_eq!(len.eval(p, &none), Val::Num(5.0));
+        let s = Expr::unary(Unary::Sin, Expr::num(90.0)).unwrap();
+        assert_eq!(s.eval(p, &none), Val::Num(1.0), "degrees");
+        let root = Expr::unary(Unary::Sqrt, Expr::num(-4.0)).unwrap();
+        assert_eq!(root.eval(p, &none), Val::Num(0.0), "total: sqrt of a negative is 0");
+        let shared = Expr::binary(Binary::Mul, len.clone(), len.clone()).unwrap();
+        assert_eq!(shared.size(), 3, "a shared node counts once");
+    }
+}
