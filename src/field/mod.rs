@@ -1,7 +1,7 @@
 //! Evaluating field bodies: a body ([`crate::ir::field::Expr`]) is compiled once to a
 //! [`Tape`], which every scalar type runs: `f32` to march, [`Dual`] for a hit's value
 //! and gradient, [`Interval`] to rule out a stretch of a ray, and [`Slope`] for the
-//! bound of a body's slope over a box ([`lipschitz`]), which the checker states and the
+//! bound of a body's slope over a box ([`lipschitz()`]), which the checker states and the
 //! march divides by.
 //!
 //! Every operation's meaning is [`Unary::apply`] / [`Binary::apply`] in f64; each scalar
