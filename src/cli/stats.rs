@@ -48,6 +48,13 @@ pub(crate) fn stats_text(c: &Counters, g: &World, map: &SourceMap, lower_s: f64,
         mem.closure_bytes,
         mem.top_bvh_bytes,
     );
+    if c.segment_bounds > 0 {
+        out.push_str(&format!(
+            "  fields          {} bounds along stretches of rays ({:.1} per ray), for segment tracing\n",
+            c.segment_bounds,
+            c.segment_bounds as f64 / rays
+        ));
+    }
     if !mem.meshes.is_empty() {
         let tri = mem.triangles();
         let bytes = mem.mesh_bytes();

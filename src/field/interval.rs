@@ -23,6 +23,17 @@ pub struct Interval {
 
 const DEG: f64 = PI / 180.0;
 
+/// `x` rounded to the nearest whole number, without a libm call (`f64::round` is one on
+/// baseline x86-64): adding and taking off 1.5·2⁵² rounds, for `|x|` below 2⁵¹.
+fn round(x: f64) -> f64 {
+    const MAGIC: f64 = 6_755_399_441_055_744.0;
+    if x.abs() < 2e15 {
+        (x + MAGIC) - MAGIC
+    } else {
+        x
+    }
+}
+
 /// `a · b` where a zero factor wins over an infinite one.
 fn mul0(a: f64, b: f64) -> f64 {
     if a == 0.0 || b == 0.0 {
@@ -52,6 +63,20 @@ impl Interval {
 
     /// The truth values 0 and 1 both possible.
     const MAYBE: Interval = Interval { lo: 0.0, hi: 1.0 };
+
+    /// Its middle (0 when an end is infinite).
+    pub fn mid(self) -> f64 {
+        if self.lo.is_finite() && self.hi.is_finite() {
+            0.5 * (self.lo + self.hi)
+        } else {
+            0.0
+        }
+    }
+
+    /// Half its width.
+    pub fn radius(self) -> f64 {
+        0.5 * (self.hi - self.lo)
+    }
 
     /// The largest absolute value in it.
     pub fn mag(self) -> f64 {
@@ -95,21 +120,29 @@ impl Interval {
 
     /// The sine of degrees: the ends' values, widened to ±1 where a crest lies within.
     fn sin_deg(self) -> Interval {
-        // (NaN-safe: an unbounded width counts as wide.)
-        if self.hi - self.lo >= 360.0 || (self.hi - self.lo).is_nan() {
+        let width = self.hi - self.lo;
+        // (NaN-safe: an unbounded width counts as wide; so does a huge angle, whose
+        // turns f64 cannot count.)
+        if !(width < 360.0 && self.lo.abs() < 1e15) {
             return Interval::new(-1.0, 1.0);
         }
-        let (a, b) = ((self.lo * DEG).sin(), (self.hi * DEG).sin());
-        let (mut lo, mut hi) = (a.min(b), a.max(b));
-        // A crest at 90 + 360k, a trough at 270 + 360k.
-        let has = |at: f64| ((self.lo - at) / 360.0).ceil() * 360.0 + at <= self.hi;
-        if has(90.0) {
-            hi = 1.0;
+        // Whole turns off exactly, then crests at 90° and 450°, troughs at −90° and 270°.
+        let lo = self.lo - 360.0 * round(self.lo / 360.0);
+        let hi = lo + width;
+        // The ends by the f32 polynomials, widened by more than their error (f32's
+        // rounding of an angle up to 540°, about 1e-6).
+        const PAD: f64 = 4e-6;
+        let (a, b) = (crate::field::sin_deg(lo as f32) as f64, crate::field::sin_deg(hi as f32) as f64);
+        let mut top = (a.max(b) + PAD).min(1.0);
+        let mut bottom = (a.min(b) - PAD).max(-1.0);
+        let within = |x: f64| lo <= x && x <= hi;
+        if within(90.0) || within(450.0) {
+            top = 1.0;
         }
-        if has(270.0) {
-            lo = -1.0;
+        if within(-90.0) || within(270.0) {
+            bottom = -1.0;
         }
-        Interval::new(lo, hi)
+        Interval { lo: bottom, hi: top }
     }
 
     /// The cosine of degrees.
@@ -325,22 +358,55 @@ impl Scalar for Interval {
 /// intervals alone lose the correlation between components (`length(p)` would get
 /// √3 instead of 1); the rules alone lose where a slope is small; each node keeps the
 /// smaller of the two bounds.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Slope {
+///
+/// Generic over how many derivatives it carries: [`Slope`] the gradient (three), for the
+/// bound of a body's slope over a box; [`Dir`] the derivative along one direction, for
+/// the bound along a stretch of a ray.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Jet<const N: usize> {
     /// The value.
     pub v: Interval,
-    /// The gradient, by component.
-    pub g: [Interval; 3],
-    /// A bound of the gradient's norm.
+    /// The derivatives, by seed direction.
+    pub g: [Interval; N],
+    /// A bound of the derivatives' norm.
     pub n: f64,
 }
 
-impl Slope {
-    /// A value with gradient `g`, its norm bound the smaller of `n` and `g`'s.
-    fn new(v: Interval, g: [Interval; 3], n: f64) -> Slope {
-        let by_g = (g[0].mag().powi(2) + g[1].mag().powi(2) + g[2].mag().powi(2)).sqrt();
+/// Value and gradient.
+pub type Slope = Jet<3>;
+
+/// Value and derivative along a direction.
+pub type Dir = Jet<1>;
+
+impl<const N: usize> Default for Jet<N> {
+    fn default() -> Jet<N> {
+        Jet { v: Interval::default(), g: [Interval::default(); N], n: 0.0 }
+    }
+}
+
+/// Where a [`Jet`] is evaluated: a box, and the derivatives of the point's coordinates
+/// with respect to the seeds (the identity for a gradient, a ray's direction for `Dir`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Region<const N: usize> {
+    /// The box.
+    pub at: [Interval; 3],
+    /// `seed[axis][j]`: how coordinate `axis` moves along seed `j`.
+    pub seed: [[f64; N]; 3],
+}
+
+impl Region<3> {
+    /// A box, for the gradient.
+    pub fn gradient(at: [Interval; 3]) -> Region<3> {
+        Region { at, seed: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]] }
+    }
+}
+
+impl<const N: usize> Jet<N> {
+    /// A value with derivatives `g`, its norm bound the smaller of `n` and `g`'s.
+    fn new(v: Interval, g: [Interval; N], n: f64) -> Jet<N> {
+        let by_g = g.iter().map(|d| d.mag().powi(2)).sum::<f64>().sqrt();
         let n = if n.is_nan() { by_g } else { n.min(by_g) };
-        Slope { v, g, n: if n.is_nan() { f64::INFINITY } else { n } }
+        Jet { v, g, n: if n.is_nan() { f64::INFINITY } else { n } }
     }
 
     /// The bound of the gradient's norm.
@@ -349,39 +415,50 @@ impl Slope {
     }
 
     /// `f(x)` where `f`'s derivative lies in `d` over `x`.
-    fn chain(v: Interval, d: Interval, x: Slope) -> Slope {
-        Slope::new(v, x.g.map(|g| g.mul(d)), mul0(d.mag(), x.n))
+    fn chain(v: Interval, d: Interval, x: Jet<N>) -> Jet<N> {
+        Jet::new(v, x.g.map(|g| g.mul(d)), mul0(d.mag(), x.n))
+    }
+
+    /// Column `i` of the Jacobian of three jets, its norm as a bound.
+    fn column(v: &[Jet<N>; 3], i: usize) -> f64 {
+        (0..3).map(|k| v[k].g[i].mag().powi(2)).sum::<f64>().sqrt()
     }
 
     /// The Jacobian's stretch bound for a vector of three slopes: its spectral norm is
     /// at most the midpoint matrix's plus the radius matrix's Frobenius norm.
-    pub fn stretch(v: &[Slope; 3]) -> f64 {
-        let mid = |i: Interval| if i.lo.is_finite() && i.hi.is_finite() { 0.5 * (i.lo + i.hi) } else { 0.0 };
-        let rad = |i: Interval| if i.lo.is_finite() && i.hi.is_finite() { 0.5 * (i.hi - i.lo) } else { f64::INFINITY };
-        let rows = v.map(|s| glam::DVec3::new(mid(s.g[0]), mid(s.g[1]), mid(s.g[2])));
-        let m = glam::DMat3::from_cols(rows[0], rows[1], rows[2]).transpose();
-        let r2: f64 = v.iter().flat_map(|s| s.g.iter()).map(|&i| rad(i).powi(2)).sum();
-        let by_g = crate::ir::max_stretch(m) + r2.sqrt();
+    /// (With one seed the Jacobian is a column, whose norm is its spectral norm.)
+    pub fn stretch(v: &[Jet<N>; 3]) -> f64 {
+        let by_g = if N == 3 {
+            let mid = |i: Interval| if i.lo.is_finite() && i.hi.is_finite() { 0.5 * (i.lo + i.hi) } else { 0.0 };
+            let rad =
+                |i: Interval| if i.lo.is_finite() && i.hi.is_finite() { 0.5 * (i.hi - i.lo) } else { f64::INFINITY };
+            let row = |s: &Jet<N>| glam::DVec3::new(mid(s.g[0]), mid(s.g[1]), mid(s.g[2]));
+            let m = glam::DMat3::from_cols(row(&v[0]), row(&v[1]), row(&v[2])).transpose();
+            let r2: f64 = v.iter().flat_map(|s| s.g.iter()).map(|&i| rad(i).powi(2)).sum();
+            crate::ir::max_stretch(m) + r2.sqrt()
+        } else {
+            (0..N).map(|i| Jet::column(v, i).powi(2)).sum::<f64>().sqrt()
+        };
         // Each row's norm bound gives a Frobenius bound too.
         let by_n = (v[0].n.powi(2) + v[1].n.powi(2) + v[2].n.powi(2)).sqrt();
         by_g.min(by_n)
     }
 }
 
-impl Scalar for Slope {
-    type Point = [Interval; 3];
+impl<const N: usize> Scalar for Jet<N> {
+    type Point = Region<N>;
 
-    fn input(p: &[Interval; 3], axis: u8) -> Slope {
-        let mut g = [Interval::point(0.0); 3];
-        g[axis as usize] = Interval::point(1.0);
-        Slope { v: p[axis as usize], g, n: 1.0 }
+    fn input(p: &Region<N>, axis: u8) -> Jet<N> {
+        let seed = p.seed[axis as usize];
+        let n = seed.iter().map(|x| x * x).sum::<f64>().sqrt();
+        Jet { v: p.at[axis as usize], g: seed.map(Interval::point), n }
     }
 
-    fn constant(x: f64) -> Slope {
-        Slope { v: Interval::point(x), g: [Interval::point(0.0); 3], n: 0.0 }
+    fn constant(x: f64) -> Jet<N> {
+        Jet { v: Interval::point(x), g: [Interval::point(0.0); N], n: 0.0 }
     }
 
-    fn unary(f: Unary, x: Slope) -> Slope {
+    fn unary(f: Unary, x: Jet<N>) -> Jet<N> {
         let v = Interval::unary(f, x.v);
         let one = Interval::point(1.0);
         let d = match f {
@@ -409,15 +486,15 @@ impl Scalar for Slope {
             Unary::Not | Unary::Floor | Unary::Ceil | Unary::Round | Unary::Sign => Interval::point(0.0),
             Unary::Length | Unary::Normalize => Interval::ALL,
         };
-        Slope::chain(v, d, x)
+        Jet::chain(v, d, x)
     }
 
-    fn binary(f: Binary, a: Slope, b: Slope) -> Slope {
+    fn binary(f: Binary, a: Jet<N>, b: Jet<N>) -> Jet<N> {
         let v = Interval::binary(f, a.v, b.v);
-        let zero = [Interval::point(0.0); 3];
+        let zero = [Interval::point(0.0); N];
         let comb = |ka: Interval, kb: Interval| {
-            let g = [0, 1, 2].map(|i| a.g[i].mul(ka).add(b.g[i].mul(kb)));
-            Slope::new(v, g, mul0(ka.mag(), a.n) + mul0(kb.mag(), b.n))
+            let g = std::array::from_fn(|i| a.g[i].mul(ka).add(b.g[i].mul(kb)));
+            Jet::new(v, g, mul0(ka.mag(), a.n) + mul0(kb.mag(), b.n))
         };
         let one = Interval::point(1.0);
         match f {
@@ -430,17 +507,17 @@ impl Scalar for Slope {
             }
             // Between jumps a remainder is its dividend shifted by whole divisors.
             Binary::Rem if b.n == 0.0 => comb(one, Interval::point(0.0)),
-            Binary::Rem => Slope::new(v, [Interval::ALL; 3], f64::INFINITY),
+            Binary::Rem => Jet::new(v, [Interval::ALL; N], f64::INFINITY),
             Binary::Min | Binary::Max => {
                 let a_wins = if f == Binary::Min { a.v.hi <= b.v.lo } else { a.v.lo >= b.v.hi };
                 let b_wins = if f == Binary::Min { b.v.hi <= a.v.lo } else { b.v.lo >= a.v.hi };
                 if a_wins {
-                    Slope { v, ..a }
+                    Jet { v, ..a }
                 } else if b_wins {
-                    Slope { v, ..b }
+                    Jet { v, ..b }
                 } else {
-                    let g = [0, 1, 2].map(|i| a.g[i].hull(b.g[i]));
-                    Slope::new(v, g, a.n.max(b.n))
+                    let g = std::array::from_fn(|i| a.g[i].hull(b.g[i]));
+                    Jet::new(v, g, a.n.max(b.n))
                 }
             }
             Binary::Pow => {
@@ -462,47 +539,49 @@ impl Scalar for Slope {
                 comb(b.v.mul(k), a.v.mul(k).mul(Interval::point(-1.0)))
             }
             Binary::Lt | Binary::Le | Binary::Gt | Binary::Ge | Binary::Eq | Binary::Ne | Binary::And | Binary::Or => {
-                Slope { v, g: zero, n: 0.0 }
+                Jet { v, g: zero, n: 0.0 }
             }
-            Binary::Dot | Binary::Cross => Slope::new(Interval::ALL, [Interval::ALL; 3], f64::INFINITY),
+            Binary::Dot | Binary::Cross => Jet::new(Interval::ALL, [Interval::ALL; N], f64::INFINITY),
         }
     }
 
-    fn select(c: Slope, a: Slope, b: Slope) -> Slope {
+    fn select(c: Jet<N>, a: Jet<N>, b: Jet<N>) -> Jet<N> {
         if !c.v.contains(0.0) {
             a
         } else if c.v == Interval::point(0.0) {
             b
         } else {
-            let g = [0, 1, 2].map(|i| a.g[i].hull(b.g[i]));
-            Slope::new(a.v.hull(b.v), g, a.n.max(b.n))
+            let g = std::array::from_fn(|i| a.g[i].hull(b.g[i]));
+            Jet::new(a.v.hull(b.v), g, a.n.max(b.n))
         }
     }
 
-    fn length(v: [Slope; 3]) -> Slope {
+    fn length(v: [Jet<N>; 3]) -> Jet<N> {
         let value = Interval::length([v[0].v, v[1].v, v[2].v]);
         // ∇|u| = Jᵀu/|u|: each component is at most its Jacobian column's norm.
-        let col = |i: usize| Interval::point((0..3).map(|k| v[k].g[i].mag().powi(2)).sum::<f64>().sqrt());
         let g = if value.lo > 0.0 {
             let inv = Interval::point(1.0).div(value);
-            [0, 1, 2].map(|i| {
+            std::array::from_fn(|i| {
                 let dot = v[0].v.mul(v[0].g[i]).add(v[1].v.mul(v[1].g[i])).add(v[2].v.mul(v[2].g[i]));
                 let g = dot.mul(inv);
-                let c = col(i);
-                Interval::new(g.lo.max(-c.hi), g.hi.min(c.hi))
+                let c = Jet::column(&v, i);
+                Interval::new(g.lo.max(-c), g.hi.min(c))
             })
         } else {
-            [0, 1, 2].map(|i| {
-                let c = col(i);
-                Interval::new(-c.hi, c.hi)
+            std::array::from_fn(|i| {
+                let c = Jet::column(&v, i);
+                Interval::new(-c, c)
             })
         };
-        Slope::new(value, g, Slope::stretch(&v))
+        Jet::new(value, g, Jet::stretch(&v))
     }
 
-    fn noise(q: [Slope; 3], _: u32) -> Slope {
-        let s = NOISE_SLOPE * Slope::stretch(&q);
-        let col = |i: usize| NOISE_SLOPE * (0..3).map(|k| q[k].g[i].mag().powi(2)).sum::<f64>().sqrt();
-        Slope::new(Interval::new(-NOISE_RANGE, NOISE_RANGE), [0, 1, 2].map(|i| Interval::new(-col(i), col(i))), s)
+    fn noise(q: [Jet<N>; 3], _: u32) -> Jet<N> {
+        let s = NOISE_SLOPE * Jet::stretch(&q);
+        let g = std::array::from_fn(|i| {
+            let c = NOISE_SLOPE * Jet::column(&q, i);
+            Interval::new(-c, c)
+        });
+        Jet::new(Interval::new(-NOISE_RANGE, NOISE_RANGE), g, s)
     }
 }

@@ -11,7 +11,7 @@ use std::collections::BinaryHeap;
 
 use glam::DVec3;
 
-use super::interval::{Interval, Slope};
+use super::interval::{Interval, Region, Slope};
 use super::tape::{Distances, Tape};
 use crate::geom::Aabb;
 use crate::ir::field::Ty;
@@ -57,7 +57,7 @@ impl Ord for Cell {
 
 /// The slope bound and value range of `tape` over the box `lo..hi`.
 fn over(tape: &Tape, lo: DVec3, hi: DVec3, dist: &(dyn Distances<Slope> + Sync)) -> (f64, Interval) {
-    let p = [0, 1, 2].map(|i| Interval::new(lo[i], hi[i]));
+    let p = Region::gradient([0, 1, 2].map(|i| Interval::new(lo[i], hi[i])));
     if tape.ty() == Ty::Vec3 {
         let v = tape.eval3::<Slope>(&p, dist);
         (Slope::stretch(&v), v[0].v.hull(v[1].v).hull(v[2].v))
@@ -164,14 +164,7 @@ impl Distances<Slope> for SlopeDistances {
             }
             None => Interval::ALL,
         };
-        Slope { v, g, n: Slope::stretch(&q) }.tighten()
-    }
-}
-
-impl Slope {
-    /// The norm bound no larger than its gradient intervals allow.
-    fn tighten(self) -> Slope {
-        let by_g = (self.g[0].mag().powi(2) + self.g[1].mag().powi(2) + self.g[2].mag().powi(2)).sqrt();
-        Slope { n: self.n.min(by_g), ..self }
+        let by_g = g.iter().map(|d| d.mag().powi(2)).sum::<f64>().sqrt();
+        Slope { v, g, n: Slope::stretch(&q).min(by_g) }
     }
 }

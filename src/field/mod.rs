@@ -7,11 +7,13 @@
 //! Every operation's meaning is [`Unary::apply`] / [`Binary::apply`] in f64; each scalar
 //! type follows it (tested against it at random points).
 
+mod flat;
 mod interval;
 mod lipschitz;
 mod tape;
 
-pub use interval::{Interval, Slope};
+pub use flat::Flat;
+pub use interval::{Dir, Interval, Jet, Region, Slope};
 pub use lipschitz::{lipschitz, Estimate, SlopeDistances};
 pub use tape::{Distances, NoDistances, Op, Reg, Scalar, Tape};
 
@@ -137,30 +139,33 @@ fn octant(r: f32) -> (f32, f32) {
     (s, c)
 }
 
-/// The sine of `r` degrees in [−180, 180], exact at the quarter turns. Branch-free
-/// (folds by `abs`, the octant chosen by a 0-or-1 factor): a field's angles are as
-/// good as random, and a mispredicted branch costs more than both polynomials.
+/// Sine and cosine of degrees from one reduction: the angle less its nearest quarter
+/// turn, whose octant polynomials give both, swapped and signed by the quarter.
 #[inline]
-fn sin_reduced(r: f32) -> f32 {
-    // sin is symmetric about 90°: fold [0, 180] onto [0, 90].
-    let m = 90.0 - (90.0 - r.abs()).abs();
-    // Beyond 45° from a zero it is a cosine.
-    let beyond = f32::from(u8::from(m > 45.0));
-    let (s, c) = octant(m - beyond * (2.0 * m - 90.0));
-    (s + beyond * (c - s)).copysign(r)
+pub fn sincos_deg(x: f32) -> (f32, f32) {
+    const MAGIC: f32 = 12_582_912.0;
+    let r = reduce_deg(x);
+    let q = (r * (1.0 / 90.0) + MAGIC) - MAGIC;
+    let (s, c) = octant(r - 90.0 * q);
+    // The quarter, 0 to 3 (−1 and −2 are 3 and 2).
+    let j = (q as i32) & 3;
+    let swap = f32::from(u8::from(j & 1 == 1));
+    let (a, b) = (s + swap * (c - s), c + swap * (s - c));
+    let sin_sign = if j >= 2 { -1.0 } else { 1.0 };
+    let cos_sign = if j == 1 || j == 2 { -1.0 } else { 1.0 };
+    (a * sin_sign, b * cos_sign)
 }
 
 /// Sine of degrees.
 #[inline]
 pub fn sin_deg(x: f32) -> f32 {
-    sin_reduced(reduce_deg(x))
+    sincos_deg(x).0
 }
 
-/// Cosine of degrees: the sine a quarter turn on.
+/// Cosine of degrees.
 #[inline]
 pub fn cos_deg(x: f32) -> f32 {
-    let r = reduce_deg(x) + 90.0;
-    sin_reduced(r - 360.0 * f32::from(u8::from(r > 180.0)))
+    sincos_deg(x).1
 }
 
 /// A number with its gradient with respect to the point: forward-mode differentiation,

@@ -114,6 +114,20 @@ fn tape_follows_the_definition() {
     }
 }
 
+/// The flat f32 tape computes what the tape computes, bit for bit.
+#[test]
+fn flat_tapes_equal_tapes() {
+    for e in everything() {
+        let tape = Tape::new(&e);
+        let flat = Flat::new(&tape).expect("a small tape flattens");
+        for p in points(200) {
+            let p = p.as_vec3a();
+            let (a, b) = (tape.eval::<f32>(&p, &NoDistances), flat.eval(p, &NoDistances));
+            assert!(a == b || (a.is_nan() && b.is_nan()), "{}: {a} vs {b}", e.source(200));
+        }
+    }
+}
+
 /// Dual numbers give the gradient: central differences of the f64 definition agree
 /// wherever the body is smooth.
 #[test]
@@ -229,6 +243,12 @@ fn fast_trig_is_accurate() {
     }
     // Both lose what f32 loses scaling a large angle; neither loses much more.
     assert!(worst < 2.0 * libm + 1e-7, "{worst} against libm's {libm}");
+    for i in -20_000..20_000 {
+        let x = i as f32 * 0.0731;
+        let (s, c) = sincos_deg(x);
+        assert!((s - sin_deg(x)).abs() < 3e-7 && (c - cos_deg(x)).abs() < 3e-7, "{x}: {s}, {c}");
+    }
+    assert_eq!(sincos_deg(0.0), (0.0, 1.0));
     assert_eq!(sin_deg(0.0), 0.0);
     assert_eq!(cos_deg(0.0), 1.0);
     assert!((sin_deg(90.0) - 1.0).abs() < 1e-7 && sin_deg(180.0).abs() < 1e-6);

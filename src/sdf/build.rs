@@ -70,6 +70,19 @@ impl Surf {
     }
 }
 
+/// An object's lowered root: its closures, and what a ray can march by instead of the
+/// closure (a union part by part, a field by segments).
+pub struct Root {
+    /// The distance bound.
+    pub dist: Sdf,
+    /// The surface closure.
+    pub surf: SurfSdf,
+    /// A union's parts.
+    pub parts: Option<RayParts>,
+    /// A field's body.
+    pub field: Option<field::RayField>,
+}
+
 /// Builds closures and counts the bytes they capture.
 pub struct Builder<'a> {
     /// Material interning.
@@ -82,6 +95,9 @@ pub struct Builder<'a> {
     /// The union built last through a hierarchy (its node's address, hierarchy, parts
     /// and blend radius), for [`build_root`](Self::build_root).
     last_union: Option<LastUnion>,
+    /// The field built last (its node's address and body), for
+    /// [`build_root`](Self::build_root).
+    last_field: Option<(usize, field::Body)>,
     /// Render space from the frame the node being built is in: operators that work in
     /// their own units restart `xf` at the identity, and a pattern still needs the
     /// whole map to its object's space.
@@ -125,13 +141,14 @@ const ARC_HEADER: usize = 16;
 impl<'a> Builder<'a> {
     /// A builder interning materials into `materials`.
     pub fn new(materials: &'a mut MaterialTable) -> Builder<'a> {
-        Builder { materials, bytes: 0, prune: true, last_union: None, frame: DAffine3::IDENTITY }
+        Builder { materials, bytes: 0, prune: true, last_union: None, last_field: None, frame: DAffine3::IDENTITY }
     }
 
     /// [`build`](Self::build), and when the shape is a union of bounded parts (under
     /// transforms and paint) that a ray can march part by part, what it needs for that.
-    pub fn build_root(&mut self, shape: &Shape, xf: DAffine3, mat: u32) -> (Sdf, SurfSdf, Option<RayParts>) {
+    pub fn build_root(&mut self, shape: &Shape, xf: DAffine3, mat: u32) -> Root {
         self.last_union = None;
+        self.last_field = None;
         let (d, m) = self.build(shape, xf, mat);
         let mut node = shape;
         let mut acc = xf;
@@ -161,7 +178,23 @@ impl<'a> Builder<'a> {
             }
             _ => None,
         };
-        (d, m, parts)
+        let field = match (&node.kind, self.last_field.take()) {
+            (ShapeKind::Field { bounds, lipschitz, .. }, Some((addr, body)))
+                if addr == node as *const Shape as usize =>
+            {
+                let inv = acc.inverse();
+                let inv = Affine3A::from_mat3_translation(inv.matrix3.as_mat3(), inv.translation.as_vec3());
+                let stretch = if acc.matrix3 == DMat3::IDENTITY { 1.0 } else { min_singular_value(acc.matrix3) };
+                Some(field::RayField {
+                    inv,
+                    scale: (stretch / lipschitz.value) as f32,
+                    body,
+                    bounds: bounds.map(|b| (b.min.as_vec3a(), b.max.as_vec3a())),
+                })
+            }
+            _ => None,
+        };
+        Root { dist: d, surf: m, parts, field }
     }
 
     fn sdf<F: Fn(Vec3A) -> f32 + Send + Sync + 'static>(&mut self, f: F) -> Sdf {
@@ -337,6 +370,7 @@ impl<'a> Builder<'a> {
             }
             ShapeKind::Field { body, bounds, lipschitz } => {
                 let body = self.body(body, mat);
+                self.last_field = Some((shape as *const Shape as usize, body.clone()));
                 let (k, cut) = (1.0 / lipschitz.value as f32, bounds.as_ref().map(BoxCut::new));
                 let b = body.clone();
                 (

@@ -8,7 +8,7 @@ use std::sync::Arc;
 use glam::Vec3A;
 
 use super::build::{Sdf, Surf, SurfSdf};
-use crate::field::{Distances, Dual, Tape};
+use crate::field::{Dir, Distances, Dual, Flat, Interval, Region, Tape};
 use crate::geom::Aabb;
 
 /// The shapes a body's `dist` calls read, as the back-end's closures.
@@ -38,14 +38,18 @@ impl Distances<Dual> for Shapes {
 /// A compiled body with what its `dist` calls read.
 #[derive(Clone)]
 pub struct Body {
-    tape: Arc<Tape>,
-    shapes: Shapes,
+    /// The compiled body.
+    pub tape: Arc<Tape>,
+    /// The same, flattened for f32, when it fits.
+    flat: Option<Arc<Flat>>,
+    /// What its `dist` calls read.
+    pub shapes: Shapes,
 }
 
 impl Body {
     /// The body of `tape`, its shapes lowered to `shapes`.
     pub fn new(tape: Tape, shapes: Shapes) -> Body {
-        Body { tape: Arc::new(tape), shapes }
+        Body { flat: Flat::new(&tape).map(Arc::new), tape: Arc::new(tape), shapes }
     }
 
     /// Bytes it holds: its instructions and the closures' pointers.
@@ -57,7 +61,10 @@ impl Body {
     /// The number at `p`.
     #[inline]
     pub fn num(&self, p: Vec3A) -> f32 {
-        let v = self.tape.eval::<f32>(&p, &self.shapes);
+        let v = match &self.flat {
+            Some(f) => f.eval(p, &self.shapes),
+            None => self.tape.eval::<f32>(&p, &self.shapes),
+        };
         // A body undefined at a point (∞ − ∞) is taken as far outside, never as a hit.
         if v.is_nan() {
             f32::MAX
@@ -79,7 +86,10 @@ impl Body {
     /// The vector at `p`.
     #[inline]
     pub fn vec(&self, p: Vec3A) -> Vec3A {
-        Vec3A::from_array(self.tape.eval3::<f32>(&p, &self.shapes))
+        match &self.flat {
+            Some(f) => f.eval3(p, &self.shapes),
+            None => Vec3A::from_array(self.tape.eval3::<f32>(&p, &self.shapes)),
+        }
     }
 
     /// The vector at `p`, each component with its gradient (the map's Jacobian by rows).
@@ -140,5 +150,153 @@ pub fn cut_surf(b: &Option<BoxCut>, p: Vec3A, s: Surf) -> Surf {
     match b {
         Some(b) => b.surf(p, s.mat).max(s),
         None => s,
+    }
+}
+
+impl Distances<Dir> for Shapes {
+    /// A shape's distance over a stretch of a ray: within the stretch's half-diagonal
+    /// of its value at the middle, changing no faster than the point moves (a distance
+    /// bound is 1-Lipschitz).
+    fn dist(&self, i: u32, q: [Dir; 3]) -> Dir {
+        let mid = Vec3A::new(q[0].v.mid() as f32, q[1].v.mid() as f32, q[2].v.mid() as f32);
+        let r = (q.iter().map(|c| c.v.radius().powi(2)).sum::<f64>()).sqrt();
+        let d = self.dist[i as usize](mid) as f64;
+        let s = Dir::stretch(&q);
+        Dir { v: Interval::new(d - r, d + r), g: [Interval::new(-s, s)], n: s }
+    }
+}
+
+/// A field at the root of an object, marched by segment tracing (Galin et al., 2020):
+/// along a stretch of the ray, the bound of the body's derivative *along the ray*
+/// (interval arithmetic over the stretch's box, [`Dir`]) replaces the bound of its
+/// slope over the whole box. Near a surface that bound is close to the derivative
+/// itself, so a step lands close to the surface rather than a slope-ratio short of it;
+/// far from one, a stretch with no surface is crossed in one step.
+#[derive(Clone)]
+pub struct RayField {
+    /// Render space to the field's frame.
+    pub inv: glam::Affine3A,
+    /// Render-space distance per unit of the body's value: the frame's smallest
+    /// stretch over the field's slope bound (the closure's scale, so a hit is judged
+    /// as the closure judges it).
+    pub scale: f32,
+    /// The body.
+    pub body: Body,
+    /// The box it is cut to, in its frame.
+    pub bounds: Option<(Vec3A, Vec3A)>,
+}
+
+/// The first stretch a derivative bound is asked for, as a share of what is left of
+/// the ray's span within the field.
+const FIRST_SEGMENT: f32 = 0.125;
+
+/// Plain sphere-tracing steps before segments.
+const PLAIN_STEPS: u32 = 128;
+
+impl RayField {
+    /// The first hit along `ray` within `[t0, t1]`, and the threshold there.
+    pub fn march(
+        &self,
+        ray: &crate::trace::Ray,
+        (t0, t1): (f32, f32),
+        params: super::MarchParams,
+        c: &mut crate::trace::Counters,
+        evals: &mut u64,
+    ) -> Option<(f32, f32)> {
+        let o = self.inv.transform_point3a(ray.origin);
+        let d = self.inv.transform_vector3a(ray.dir);
+        let (mut t, end) = match self.bounds {
+            Some((lo, hi)) => {
+                // The slab test in the field's frame: outside the box is empty.
+                let inv_d = d.recip();
+                let (a, b) = ((lo - o) * inv_d, (hi - o) * inv_d);
+                let near = a.min(b).max_element().max(t0);
+                let far = a.max(b).min_element().min(t1);
+                // (NaN from a ray along a face: nothing to march.)
+                if near > far || near.is_nan() || far.is_nan() {
+                    return None;
+                }
+                (near, far)
+            }
+            None => (t0, t1),
+        };
+        let base = ray.origin.length();
+        let mut steps = 0u32;
+        // Plain sphere tracing first: most rays meet the surface in a few of its cheap
+        // steps. One that crawls (grazing, or where the body is shallow beside its
+        // steepest parts) goes on by segments, whose bound follows the body along it.
+        while steps < PLAIN_STEPS.min(params.max_steps) {
+            let v = self.body.num(o + d * t);
+            *evals += 1;
+            steps += 1;
+            let threshold = super::march::threshold(params.epsilon, base, t);
+            if v * self.scale < threshold {
+                return Some((t, threshold));
+            }
+            t += v * self.scale;
+            if t > end {
+                return None;
+            }
+        }
+        if steps >= params.max_steps {
+            c.budget_misses += 1;
+            return None;
+        }
+        let mut seg = (end - t) * FIRST_SEGMENT;
+        loop {
+            let v = self.body.num(o + d * t);
+            *evals += 1;
+            steps += 1;
+            let threshold = super::march::threshold(params.epsilon, base, t);
+            if v * self.scale < threshold {
+                return Some((t, threshold));
+            }
+            if steps >= params.max_steps {
+                c.budget_misses += 1;
+                return None;
+            }
+            let stop = (t + seg).min(end);
+            let lambda = self.along(o, d, t, stop);
+            c.segment_bounds += 1;
+            // Sphere-trace within the stretch with its bound: no surface before t + v/λ.
+            let mut v = v;
+            let mut inner = 0;
+            loop {
+                let step = v / lambda;
+                if t + step >= stop || step.is_nan() {
+                    // Nothing in the stretch: go to its end, and try a longer one.
+                    t = stop;
+                    seg *= 2.0;
+                    break;
+                }
+                t += step;
+                inner += 1;
+                if inner == 4 {
+                    // The bound is loose for what is left: a shorter stretch, a new bound.
+                    seg = (stop - t) * 0.5;
+                    break;
+                }
+                v = self.body.num(o + d * t);
+                *evals += 1;
+                steps += 1;
+                let threshold = super::march::threshold(params.epsilon, base, t);
+                if v * self.scale < threshold {
+                    return Some((t, threshold));
+                }
+            }
+            if t >= end {
+                return None;
+            }
+        }
+    }
+
+    /// A bound of the body's rate of change along `o + t·d` for `t` in `[a, b]`.
+    fn along(&self, o: Vec3A, d: Vec3A, a: f32, b: f32) -> f32 {
+        let (p, q) = (o + d * a, o + d * b);
+        let at = [0, 1, 2].map(|i| Interval::new(p[i].min(q[i]) as f64, p[i].max(q[i]) as f64));
+        let region = Region { at, seed: [[d.x as f64], [d.y as f64], [d.z as f64]] };
+        let j = self.body.tape.eval::<Dir>(&region, &self.body.shapes);
+        // A little above, for the f32 rounding of the point's value; never zero.
+        ((j.g[0].mag() * (1.0 + 1e-4)) as f32).max(f32::MIN_POSITIVE)
     }
 }

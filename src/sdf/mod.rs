@@ -15,7 +15,7 @@ pub mod union;
 use glam::{DAffine3, Vec3A};
 
 pub use crate::ir::min_singular_value;
-pub use build::{Builder, Sdf, Surf, SurfSdf};
+pub use build::{Builder, Root, Sdf, Surf, SurfSdf};
 pub use march::MarchParams;
 
 use crate::ir;
@@ -32,13 +32,16 @@ pub struct SdfObject {
     convex: bool,
     /// A union at the root, marched part by part ([`union::RayParts`]).
     parts: Option<union::RayParts>,
+    /// A field at the root, marched by segments ([`field::RayField`]); boxed, as
+    /// most objects have none.
+    field: Option<Box<field::RayField>>,
 }
 
 impl SdfObject {
     /// Lowers a shape seen through `xf` (render from world) into closures.
     pub fn new(shape: &ir::Shape, xf: DAffine3, builder: &mut Builder<'_>) -> SdfObject {
-        let (dist, mat, parts) = builder.build_root(shape, xf, 0);
-        SdfObject { dist, mat, parts, convex: shape.is_convex() }
+        let root = builder.build_root(shape, xf, 0);
+        SdfObject { dist: root.dist, mat: root.surf, parts: root.parts, field: root.field.map(Box::new), convex: shape.is_convex() }
     }
 
     /// Marches the ray over `[t0, t1]`; on a hit, its distance and the threshold there
@@ -57,6 +60,9 @@ impl SdfObject {
     ) -> Option<(f32, f32)> {
         if inside {
             return march::march_out(&*self.dist, ray, t0, t1, params, c, evals);
+        }
+        if let Some(field) = &self.field {
+            return field.march(ray, (t0, t1), params, c, evals);
         }
         match &self.parts {
             Some(parts) => parts.march(ray, (t0, t1), params, c, evals),

@@ -24,6 +24,8 @@ pub struct Counters {
     pub max_evals_per_ray: u64,
     /// Marches that ran out of steps before deciding (counted as misses).
     pub budget_misses: u64,
+    /// Bounds of a field's rate of change along a stretch of a ray (segment tracing).
+    pub segment_bounds: u64,
     /// BVH nodes visited (a node a packet visits counts once for each ray the walk
     /// carries into it: every wanted ray from its first active one, see
     /// [`Bvh::each_packet`](crate::accel::Bvh::each_packet)).
@@ -54,6 +56,7 @@ impl Counters {
         self.leaf_evals += o.leaf_evals;
         self.max_evals_per_ray = self.max_evals_per_ray.max(o.max_evals_per_ray);
         self.budget_misses += o.budget_misses;
+        self.segment_bounds += o.segment_bounds;
         self.node_visits += o.node_visits;
         self.triangle_tests += o.triangle_tests;
         self.pruned_rays += o.pruned_rays;

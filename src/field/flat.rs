@@ -1,0 +1,242 @@
+//! The f32 tape flattened for the march's inner loop: one instruction per operation,
+//! a constant operand carried inline for the common arithmetic, registers in a fixed
+//! array indexed through a mask (so no bounds check), one `match` to dispatch. It
+//! computes exactly what [`Tape::run`] computes on `f32` (tested on every operation).
+
+use glam::Vec3A;
+
+use super::tape::{Distances, Op, Tape};
+use super::{cos_deg, sin_deg, sincos_deg};
+use crate::ir::field::{Binary, Unary};
+
+/// Registers of a flat tape; a tape needing more runs as a [`Tape`].
+pub const FLAT_REGS: usize = 64;
+
+/// Registers of a small flat tape (most bodies): less to clear per evaluation.
+const SMALL_REGS: usize = 16;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Code {
+    Input(u8),
+    Const,
+    Unary(Unary),
+    Binary(Binary),
+    AddC,
+    SubC,
+    CSub,
+    MulC,
+    DivC,
+    CDiv,
+    MinC,
+    MaxC,
+    Select,
+    Length,
+    Dist,
+    Noise,
+    /// Sine into `out` and cosine into register `b`, of one angle.
+    SinCos,
+    /// A copy of register `a`.
+    Copy,
+}
+
+/// One instruction: `out = code(a, b, c)`, or with the constant `k`.
+#[derive(Clone, Copy, Debug)]
+struct Ins {
+    code: Code,
+    out: u16,
+    a: u16,
+    b: u16,
+    c: u16,
+    k: f32,
+}
+
+/// Makes a sine and a cosine of one angle one instruction: the sine's computes both,
+/// the cosine into a register of its own that the cosine's place then copies from
+/// (the angle's register must hold the same value at both).
+fn fuse_sincos(ins: &mut [Ins], extra: &mut usize) {
+    for i in 0..ins.len() {
+        let (code, a) = (ins[i].code, ins[i].a);
+        let partner = match code {
+            Code::Unary(Unary::Sin) => Code::Unary(Unary::Cos),
+            Code::Unary(Unary::Cos) => Code::Unary(Unary::Sin),
+            _ => continue,
+        };
+        // The first partner reading the angle before anything overwrites it.
+        let mut found = None;
+        for (j, next) in ins.iter().enumerate().skip(i) {
+            if j > i && next.code == partner && next.a == a {
+                found = Some(j);
+                break;
+            }
+            if next.out == a {
+                break;
+            }
+        }
+        let Some(j) = found else { continue };
+        let spare = *extra as u16;
+        *extra += 1;
+        let mine = ins[i].out;
+        ins[i] = if code == Code::Unary(Unary::Sin) {
+            Ins { code: Code::SinCos, out: mine, a, b: spare, c: 0, k: 0.0 }
+        } else {
+            Ins { code: Code::SinCos, out: spare, a, b: mine, c: 0, k: 0.0 }
+        };
+        ins[j] = Ins { code: Code::Copy, out: ins[j].out, a: spare, b: 0, c: 0, k: 0.0 };
+    }
+}
+
+/// A tape flattened for f32.
+#[derive(Clone, Debug)]
+pub struct Flat {
+    ins: Vec<Ins>,
+    out: [u16; 3],
+    /// Whether its registers fit [`SMALL_REGS`].
+    small: bool,
+}
+
+impl Flat {
+    /// `tape` flattened, or `None` if it needs more than [`FLAT_REGS`] registers.
+    pub fn new(tape: &Tape) -> Option<Flat> {
+        let mut extra = tape.regs;
+        let mut ins = Vec::with_capacity(tape.ops.len());
+        let mut constant = |ins: &mut Vec<Ins>, k: f64| {
+            let r = extra as u16;
+            extra += 1;
+            ins.push(Ins { code: Code::Const, out: r, a: 0, b: 0, c: 0, k: k as f32 });
+            r
+        };
+        for &(op, out) in &tape.ops {
+            let out = out as u16;
+            let i = |code, a: u32, b: u32, c: u32, k: f64| Ins {
+                code,
+                out,
+                a: a as u16,
+                b: b as u16,
+                c: c as u16,
+                k: k as f32,
+            };
+            let next = match op {
+                Op::Input(a) => i(Code::Input(a), 0, 0, 0, 0.0),
+                Op::Const(k) => i(Code::Const, 0, 0, 0, k),
+                Op::Unary(f, a) => i(Code::Unary(f), a, 0, 0, 0.0),
+                Op::Binary(f, a, b) => i(Code::Binary(f), a, b, 0, 0.0),
+                Op::BinaryRc(f, a, k) => match f {
+                    Binary::Add => i(Code::AddC, a, 0, 0, k),
+                    Binary::Sub => i(Code::SubC, a, 0, 0, k),
+                    Binary::Mul => i(Code::MulC, a, 0, 0, k),
+                    Binary::Div => i(Code::DivC, a, 0, 0, k),
+                    Binary::Min => i(Code::MinC, a, 0, 0, k),
+                    Binary::Max => i(Code::MaxC, a, 0, 0, k),
+                    _ => {
+                        let r = constant(&mut ins, k);
+                        i(Code::Binary(f), a, r as u32, 0, 0.0)
+                    }
+                },
+                Op::BinaryLc(f, k, b) => match f {
+                    Binary::Add => i(Code::AddC, b, 0, 0, k),
+                    Binary::Sub => i(Code::CSub, b, 0, 0, k),
+                    Binary::Mul => i(Code::MulC, b, 0, 0, k),
+                    Binary::Div => i(Code::CDiv, b, 0, 0, k),
+                    Binary::Min => i(Code::MinC, b, 0, 0, k),
+                    Binary::Max => i(Code::MaxC, b, 0, 0, k),
+                    _ => {
+                        let r = constant(&mut ins, k);
+                        i(Code::Binary(f), r as u32, b, 0, 0.0)
+                    }
+                },
+                Op::Select(c, a, b) => i(Code::Select, a, b, c, 0.0),
+                Op::Length(v) => i(Code::Length, v[0], v[1], v[2], 0.0),
+                Op::Dist(s, q) => {
+                    Ins { code: Code::Dist, out, a: q[0] as u16, b: q[1] as u16, c: q[2] as u16, k: f32::from_bits(s) }
+                }
+                Op::Noise(s, q) => {
+                    Ins { code: Code::Noise, out, a: q[0] as u16, b: q[1] as u16, c: q[2] as u16, k: f32::from_bits(s) }
+                }
+            };
+            ins.push(next);
+        }
+        fuse_sincos(&mut ins, &mut extra);
+        if extra > FLAT_REGS {
+            return None;
+        }
+        let o = |i: usize| tape.out[i.min(tape.out.len() - 1)] as u16;
+        Some(Flat { ins, out: [o(0), o(1), o(2)], small: extra <= SMALL_REGS })
+    }
+
+    /// Runs the tape at `p`; `out` reads what it wants from the registers (returning
+    /// them all would copy them).
+    #[inline]
+    fn run<R>(&self, p: Vec3A, dist: &dyn Distances<f32>, out: impl FnOnce(&dyn Fn(u16) -> f32) -> R) -> R {
+        if self.small {
+            let r = self.run_n::<SMALL_REGS>(p, dist);
+            out(&|i| r[i as usize & (SMALL_REGS - 1)])
+        } else {
+            let r = self.run_n::<FLAT_REGS>(p, dist);
+            out(&|i| r[i as usize & (FLAT_REGS - 1)])
+        }
+    }
+
+    /// [`run`](Self::run) with `N` registers (a power of two the tape fits).
+    #[inline(always)]
+    fn run_n<const N: usize>(&self, p: Vec3A, dist: &dyn Distances<f32>) -> [f32; N] {
+        let mask = N as u16 - 1;
+        let mut r = [0.0f32; N];
+        for ins in &self.ins {
+            let x = |i: u16| r[(i & mask) as usize];
+            let (a, k) = (x(ins.a), ins.k);
+            let v = match ins.code {
+                Code::Input(axis) => p[axis as usize],
+                Code::Const => k,
+                Code::AddC => a + k,
+                Code::SubC => a - k,
+                Code::CSub => k - a,
+                Code::MulC => a * k,
+                Code::DivC => a / k,
+                Code::CDiv => k / a,
+                Code::MinC => a.min(k),
+                Code::MaxC => a.max(k),
+                Code::Unary(Unary::Sin) => sin_deg(a),
+                Code::Unary(Unary::Cos) => cos_deg(a),
+                Code::SinCos => {
+                    let (s, c) = sincos_deg(a);
+                    r[(ins.b & mask) as usize] = c;
+                    s
+                }
+                Code::Copy => a,
+                Code::Unary(Unary::Abs) => a.abs(),
+                Code::Unary(Unary::Neg) => -a,
+                Code::Unary(f) => <f32 as super::Scalar>::unary(f, a),
+                Code::Binary(Binary::Add) => a + x(ins.b),
+                Code::Binary(Binary::Sub) => a - x(ins.b),
+                Code::Binary(Binary::Mul) => a * x(ins.b),
+                Code::Binary(Binary::Min) => a.min(x(ins.b)),
+                Code::Binary(Binary::Max) => a.max(x(ins.b)),
+                Code::Binary(f) => <f32 as super::Scalar>::binary(f, a, x(ins.b)),
+                Code::Select => {
+                    if x(ins.c) != 0.0 {
+                        a
+                    } else {
+                        x(ins.b)
+                    }
+                }
+                Code::Length => (a * a + x(ins.b) * x(ins.b) + x(ins.c) * x(ins.c)).sqrt(),
+                Code::Dist => dist.dist(k.to_bits(), [a, x(ins.b), x(ins.c)]),
+                Code::Noise => <f32 as super::Scalar>::noise([a, x(ins.b), x(ins.c)], k.to_bits()),
+            };
+            r[(ins.out & mask) as usize] = v;
+        }
+        r
+    }
+
+    /// The number at `p`.
+    #[inline]
+    pub fn eval(&self, p: Vec3A, dist: &dyn Distances<f32>) -> f32 {
+        self.run(p, dist, |r| r(self.out[0]))
+    }
+
+    /// The vector at `p`.
+    #[inline]
+    pub fn eval3(&self, p: Vec3A, dist: &dyn Distances<f32>) -> Vec3A {
+        self.run(p, dist, |r| Vec3A::new(r(self.out[0]), r(self.out[1]), r(self.out[2])))
+    }
+}
