@@ -41,7 +41,13 @@ impl SdfObject {
     /// Lowers a shape seen through `xf` (render from world) into closures.
     pub fn new(shape: &ir::Shape, xf: DAffine3, builder: &mut Builder<'_>) -> SdfObject {
         let root = builder.build_root(shape, xf, 0);
-        SdfObject { dist: root.dist, mat: root.surf, parts: root.parts, field: root.field.map(Box::new), convex: shape.is_convex() }
+        SdfObject {
+            dist: root.dist,
+            mat: root.surf,
+            parts: root.parts,
+            field: root.field.map(Box::new),
+            convex: shape.is_convex(),
+        }
     }
 
     /// Marches the ray over `[t0, t1]`; on a hit, its distance and the threshold there
