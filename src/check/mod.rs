@@ -316,6 +316,24 @@ impl Ctx<'_> {
     fn stmt(&mut self, stmt: &ast::Stmt) {
         match &stmt.kind {
             ast::StmtKind::Error => {}
+            ast::StmtKind::Let { name, params, value } if matches!(value.kind, ast::ExprKind::Field { .. }) => {
+                self.report(
+                    Diagnostic::error(
+                        codes::MISPLACED_FIELD,
+                        value.span,
+                        "a field literal cannot be stored in a `let` or returned from a function",
+                        "a field literal",
+                    )
+                    .with_note("`p => …` is an argument of `field`, `warp` or `displace` only")
+                    .with_hint("write the body as a function of the point, `let f(p) = …`, and pass `p => f(p)`"),
+                );
+                // Bound as poison, so its uses are not reported again as unknown names.
+                if params.is_none() {
+                    self.bind(name, Bound::Value(Value::Error));
+                } else {
+                    self.define_function(name, params.as_deref().unwrap_or_default(), value);
+                }
+            }
             ast::StmtKind::Let { name, params: None, value } => {
                 let v = self.expr(value);
                 self.lets.entry(name.span).or_insert_with(|| (name.name.clone(), false));

@@ -206,7 +206,7 @@ pub fn collect(
                             "this unbounded object is left out of the export",
                             "it has no finite surface",
                         )
-                        .with_note("a mesh file holds closed solids; a `plane` has no finite surface to write"),
+                        .with_note("a mesh file holds closed solids; a `plane` or a `field` without `bounds` has no finite surface to write"),
                     );
                     continue;
                 }

@@ -277,7 +277,7 @@ fn short(x: f64) -> String {
 fn unbounded(span: Span) -> Diagnostic {
     Diagnostic::error(codes::LOWERING, span, "cannot tessellate an unbounded shape", "this shape has no finite extent")
         .with_note("an isosurface needs finite bounds; only a bare `plane` is meshed as a large square")
-        .with_hint("try intersecting it with a `box` to bound it")
+        .with_hint("give a `field` its `bounds = [[x0, y0, z0], [x1, y1, z1]]`, or intersect the shape with a `box`")
 }
 
 /// Where an isosurface's cell size came from, so a failure can say what to change.

@@ -62,18 +62,11 @@ where
     I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
     P: Parser<'t, I, Expr, Extra<'t, 's>> + Clone,
 {
-    // `p => body` is a field literal: an argument form only, so a comprehension's
-    // `for x in xs => body` never reads as one.
-    let field = ident()
-        .then_ignore(just(Token::Arrow))
-        .then(expr.clone())
-        .map_with(|(param, body), e| Expr {
-            kind: ExprKind::Field { param, body: Box::new(body) },
-            span: Span::from(e.span()),
-        })
-        .labelled("field literal");
-    let arg =
-        ident().then_ignore(just(Token::Eq)).or_not().then(field.or(expr)).map(|(name, value)| Arg { name, value });
+    let arg = ident()
+        .then_ignore(just(Token::Eq))
+        .or_not()
+        .then(field_literal(expr.clone()).or(expr))
+        .map(|(name, value)| Arg { name, value });
     arg.separated_by(just(Token::Comma))
         .allow_trailing()
         .collect::<Vec<_>>()
@@ -86,6 +79,24 @@ where
             // One error argument tells the checker not to report arity on a list it never saw.
             |span| vec![Arg { name: None, value: error_expr(span) }],
         )))
+}
+
+/// `p => body`, a field literal. It is parsed only as an argument and as a `let`'s value
+/// (where the checker refuses it with a clear error), never as an operand, so a
+/// comprehension's `for x in xs => body` never reads as one.
+fn field_literal<'t, 's: 't, I, P>(expr: P) -> impl Parser<'t, I, Expr, Extra<'t, 's>> + Clone
+where
+    I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
+    P: Parser<'t, I, Expr, Extra<'t, 's>> + Clone,
+{
+    ident()
+        .then_ignore(just(Token::Arrow))
+        .then(expr)
+        .map_with(|(param, body), e| Expr {
+            kind: ExprKind::Field { param, body: Box::new(body) },
+            span: Span::from(e.span()),
+        })
+        .labelled("field literal")
 }
 
 /// What follows an atom: `[index]` or `.component`.
@@ -340,7 +351,7 @@ where
             .ignore_then(ident())
             .then(params.or_not())
             .then_ignore(just(Token::Eq))
-            .then(e.clone())
+            .then(field_literal(e.clone()).or(e.clone()))
             .map(|((name, params), value)| StmtKind::Let { name, params, value })
             .labelled("let statement")
             .as_context();

@@ -36,6 +36,7 @@ conformance! {
     every_primitive_hit_is_outside_in_and_finite => primitive_hits_are_outside_in_and_finite,
     glass_far_from_the_origin_renders_the_same => crate::glass::glass_far_from_the_origin_renders_the_same,
     thin_glass_walls_are_crossed_cleanly => crate::glass::thin_glass_walls_are_crossed_cleanly,
+    fields_cover_what_their_shapes_cover => crate::fields::fields_cover_what_their_shapes_cover,
 }
 
 /// Every object of `tests/data/primitives.scn` is hit by some ray aimed inside its

@@ -8,6 +8,7 @@ mod deploy;
 mod derived;
 mod effects;
 mod export;
+mod fields;
 mod fmt;
 mod glass;
 mod golden;
