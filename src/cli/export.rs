@@ -11,6 +11,7 @@ use clap::ValueEnum;
 use scnc::export::formats::{self, Format};
 use scnc::export::report::MeshReport;
 use scnc::export::{Frame, Up};
+use scnc::mesh::Detail;
 use scnc::source::FsLoader;
 use scnc::study::tolerance::Tolerance;
 
@@ -113,6 +114,8 @@ pub(crate) struct ExportArgs {
     message_format: MessageFormat,
 }
 
+/// How many times a `--tolerance` export refines a pinched isosurface (×1.3 each).
+const REFINEMENTS: usize = 3;
 /// A scale from 1e-12 to 1e12, which keeps a renderable scene finite in f32.
 fn parse_scale(s: &str) -> Result<f64, String> {
     let x: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
@@ -182,7 +185,7 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
         return ExitCode::from(1);
     }
     let started = Instant::now();
-    let detail = match args.tolerance {
+    let detail: Detail = match args.tolerance {
         Some(tol) => {
             let detail = scnc::study::tolerance::mesh_detail(scene, tol);
             let _ = writeln!(std::io::stderr(), "tolerance {tol}: picked detail {}", detail.rings());
@@ -198,8 +201,34 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
     };
     let frame = Frame { up, scale: args.scale };
     let skip = args.skip_unbounded || format.for_printing();
-    let export = match pool.install(|| scnc::export::collect(scene, detail, frame, args.memory_limit, skip, &FsLoader))
-    {
+    let collect =
+        |detail| pool.install(|| scnc::export::collect(scene, detail, frame, args.memory_limit, skip, &FsLoader));
+    let mut result = collect(detail);
+    // A tolerance promises a mesh good enough to use: where an isosurface is pinched or
+    // lost volume (a part thinner than the cell), refine, a few times at most.
+    let mut detail = detail;
+    if args.tolerance.is_some() {
+        for _ in 0..REFINEMENTS {
+            let Ok(e) = &result else { break };
+            let thin = [scnc::diag::codes::PINCHED_EDGES, scnc::diag::codes::LOST_VOLUME];
+            if !e.warnings.iter().any(|w| thin.contains(&w.code)) {
+                break;
+            }
+            let finer = Detail::N((detail.rings() as f64 * 1.3).ceil() as u32);
+            let _ = writeln!(
+                std::io::stderr(),
+                "detail {} is coarser than parts of an isosurface: refining to detail {}",
+                detail.rings(),
+                finer.rings()
+            );
+            match collect(finer) {
+                // A finer grid over the cell limit keeps the pinched mesh and its warning.
+                Err(_) => break,
+                ok => (result, detail) = (ok, finer),
+            }
+        }
+    }
+    let export = match result {
         Ok(e) => {
             super::report_in(&compiled.map, &e.warnings, args.message_format);
             e

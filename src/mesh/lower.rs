@@ -3,7 +3,7 @@
 //! isosurface, a plane as a square reaching the far limit). Failures are diagnostics
 //! that point at the source.
 
-use glam::{DAffine3, DVec3};
+use glam::{DAffine3, DVec3, Vec3A};
 use rayon::prelude::*;
 
 use super::{isosurface, obj, octree, parts, Detail, IsoAccuracy, MeshJob, Normals};
@@ -388,6 +388,7 @@ fn isosurface_object(
     let warnings = lost_parts(&lost, solid.len(), span, cell, across, from)
         .into_iter()
         .chain(pinched(surface.pinched, span, cell, across, from))
+        .chain(if lost.is_empty() { lost_volume(&mesh, &*dist, &bounds, span, cell, across, from) } else { None })
         .collect();
     let farthest = mesh.positions.par_iter().map(|p| f64::from(dist(p.as_vec3a()).abs())).reduce(|| 0.0, f64::max);
     Ok(MeshJob {
@@ -431,6 +432,84 @@ fn lost_parts(
             d.with_hint(format!("try `--detail {}` or a `--tolerance` below {}", short(rings), approx(needed / 2.0)))
         }
     })
+}
+
+/// Samples of the shape's box that measure its volume for [`lost_volume`].
+const VOLUME_SAMPLES: u32 = 1 << 16;
+
+/// The warning for an isosurface that lost (or gained) much of its shape's volume; `None`
+/// when the mesh's volume is within a tenth, plus four standard errors, of the volume
+/// measured by sampling the shape at stratified points of its box. This is what finds a
+/// field's sheet thinner than the cell, which no CSG part names: the grid misses it, so
+/// the mesh has no surface there and the part-based check has nothing to point at.
+fn lost_volume(
+    mesh: &TriMesh,
+    dist: &(dyn Fn(Vec3A) -> f32 + Sync),
+    bounds: &ir::Aabb,
+    span: Span,
+    cell: f64,
+    across: f64,
+    from: CellFrom,
+) -> Option<Diagnostic> {
+    let size = bounds.max - bounds.min;
+    let box_volume = size.x * size.y * size.z;
+    if box_volume.is_nan() || box_volume <= 0.0 || box_volume.is_infinite() {
+        return None;
+    }
+    // Jittered points of a 2^16-point lattice along a Weyl sequence: the same on every run.
+    let inside = (0..VOLUME_SAMPLES)
+        .into_par_iter()
+        .filter(|&i| {
+            let i = f64::from(i) + 0.5;
+            let u = glam::DVec3::new(
+                i * 0.754_877_666_246_692_7,
+                i * 0.569_840_290_998_053_3,
+                i / f64::from(VOLUME_SAMPLES),
+            );
+            let u = u - u.floor();
+            dist((bounds.min + u * size).as_vec3a()) < 0.0
+        })
+        .count() as f64;
+    let n = f64::from(VOLUME_SAMPLES);
+    let fraction = inside / n;
+    let sampled = fraction * box_volume;
+    let error = (fraction * (1.0 - fraction) / n).sqrt() * box_volume;
+    let meshed = mesh.signed_volume();
+    if (meshed - sampled).abs() <= 0.1 * sampled + 4.0 * error {
+        return None;
+    }
+    let d = Diagnostic::warning(
+        codes::LOST_VOLUME,
+        span,
+        format!("the mesh holds {} of the shape's volume", percent(meshed / sampled)),
+        format!(
+            "meshed at cell {}: volume {} where samples of the shape find {}",
+            approx(cell),
+            approx(meshed),
+            approx(sampled)
+        ),
+    )
+    .with_note(
+        "parts thinner than the cell (a thin shell, a field's sheet) fall between the grid's points and are left out",
+    );
+    Some(match from {
+        CellFrom::Scene => d.with_hint(format!("try `cell = {}` or less", approx(cell / 2.0))),
+        CellFrom::Detail => d.with_hint(format!(
+            "try `--detail {}` or more, or a `--tolerance` below {}",
+            short(detail_for(across, cell / 2.0)),
+            approx(cell / 4.0)
+        )),
+    })
+}
+
+/// A ratio as a percentage people read: whole percents, or one decimal below 10 %.
+fn percent(r: f64) -> String {
+    let p = r * 100.0;
+    if p.abs() < 10.0 {
+        format!("{p:.1} %")
+    } else {
+        format!("{p:.0} %")
+    }
 }
 
 /// The warning for `edges` of an isosurface at `cell` left on four triangles; `None`

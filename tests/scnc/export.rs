@@ -326,3 +326,34 @@ fn stats_report_each_object_closed_and_scale_multiplies_lengths() {
     // A side-2 box scaled by 10: 8000 cubic units, wherever it is turned.
     assert!(lines[2].contains("12 triangles, watertight and manifold, 0 degenerate dropped, volume 8000.000"), "{err}");
 }
+
+/// `--tolerance` refines an isosurface that is pinched or lost volume at the detail it
+/// first picks (a gyroid sheet thinner than that cell), and says so: the export ends
+/// watertight, without the warnings, with the volume sampling finds.
+#[test]
+fn a_tolerance_export_refines_a_sheet_thinner_than_its_cell() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = dir.path().join("sheet.scn");
+    std::fs::write(
+        &scene,
+        "let g(p) = sin(450 * p.x) * cos(450 * p.y) + sin(450 * p.y) * cos(450 * p.z) + sin(450 * p.z) * cos(450 * p.x)\n\
+         object field(p => max(abs(g(p)) - 0.3, length(p) - 0.8) / 16, bounds = [[-0.8, -0.8, -0.8], [0.8, 0.8, 0.8]])\n\
+         light ambient(1)\n",
+    )
+    .expect("writing the scene");
+    let out = dir.path().join("sheet.stl");
+    let run = scnc(&[
+        "export",
+        scene.to_str().expect("utf-8"),
+        "-o",
+        out.to_str().expect("utf-8"),
+        "--tolerance",
+        "0.05",
+        "--stats",
+    ]);
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(0), "{err}");
+    assert!(err.contains("picked detail 7") && err.contains("refining to detail"), "{err}");
+    assert!(!err.contains("W0804") && !err.contains("W0802"), "{err}");
+    assert!(err.contains("watertight and manifold"), "{err}");
+}

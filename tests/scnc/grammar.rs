@@ -63,6 +63,9 @@ fn grammar_knows_exactly_the_compilers_words() {
         "keyword.operator.arithmetic.scn",
         "entity.name.function.scn",
         "variable.parameter.scn",
+        "variable.parameter.field.scn",
+        "keyword.operator.arrow.field.scn",
+        "variable.other.property.component.scn",
     ] {
         assert!(all.iter().any(|(s, _)| s == scope), "no rule has scope {scope}");
     }

@@ -3,24 +3,35 @@
 
 use std::fmt::Write as _;
 
-use super::{Builtin, Ctor, Kind, BUILTINS, CONSTANTS};
+use super::{Builtin, Ctor, BUILTINS, CONSTANTS};
 use crate::sig::{Default, Ty};
 
-/// Whether a builtin belongs in a section.
-type Holds = fn(&Builtin) -> bool;
-
-/// The sections of the reference, each with the builtins it holds.
-const SECTIONS: &[(&str, Holds)] = &[
-    ("Primitives", |b| matches!(b.ctor, Ctor::Primitive(_))),
-    ("Operators and modifiers", |b| matches!(b.ctor, Ctor::Csg(_) | Ctor::Modifier(_))),
-    ("Materials, colours and patterns", |b| matches!(b.ctor, Ctor::Material | Ctor::Rgb | Ctor::Pattern(_))),
-    ("Lights", |b| matches!(b.ctor, Ctor::Light(_))),
-    ("Numbers, vectors and lists", |b| {
-        matches!(b.ctor, Ctor::Math(_) | Ctor::Numeric(_) | Ctor::Vector(_) | Ctor::Extreme(_) | Ctor::Len)
-    }),
-    ("Mesh generators (after `mesh`)", |b| b.kind() == Kind::MeshGenerator),
-    ("Statements", |b| matches!(b.kind(), Kind::Camera | Kind::Render)),
+/// The sections of the reference, in order.
+const SECTIONS: [&str; 8] = [
+    "Primitives",
+    "Operators and modifiers",
+    "Fields",
+    "Materials, colours and patterns",
+    "Lights",
+    "Numbers, vectors and lists",
+    "Mesh generators (after `mesh`)",
+    "Statements",
 ];
+
+/// The section a builtin is listed in: a match over every kind of builtin, so a new
+/// kind cannot be left out of the reference.
+fn section(b: &Builtin) -> usize {
+    match b.ctor {
+        Ctor::Primitive(_) => 0,
+        Ctor::Csg(_) | Ctor::Modifier(_) => 1,
+        Ctor::Field(_) | Ctor::Dist | Ctor::Noise3 => 2,
+        Ctor::Material | Ctor::Rgb | Ctor::Pattern(_) => 3,
+        Ctor::Light(_) => 4,
+        Ctor::Math(_) | Ctor::Numeric(_) | Ctor::Vector(_) | Ctor::Extreme(_) | Ctor::Len => 5,
+        Ctor::Generator(_) => 6,
+        Ctor::Camera | Ctor::Render => 7,
+    }
+}
 
 /// The reference in Markdown.
 pub fn reference() -> String {
@@ -29,9 +40,9 @@ pub fn reference() -> String {
          Written from the compiler's own table (`UPDATE_EXPECT=1 cargo test reference` rewrites it), so the values \
          listed are the values checked. Angles are in degrees.\n",
     );
-    for (title, holds) in SECTIONS {
+    for (i, title) in SECTIONS.iter().enumerate() {
         let _ = write!(out, "\n## {title}\n");
-        for b in BUILTINS.iter().filter(|b| holds(b)) {
+        for b in BUILTINS.iter().filter(|b| section(b) == i) {
             let _ = write!(out, "\n### `{}`\n\n{}", b.signature(), sentence(b.doc));
             if let Some(ty) = b.variadic {
                 let _ = write!(out, " Takes any number of `{ty}` arguments first (a list stands for its elements).");
