@@ -382,6 +382,8 @@ pub mod codes {
     pub const PINCHED_EDGES: &str = "W0802";
     /// An unbounded object left out of an export.
     pub const SKIPPED_UNBOUNDED: &str = "W0803";
+    /// An object with no triangles, left out of an export.
+    pub const SKIPPED_EMPTY: &str = "W0805";
     /// An isosurface whose volume is far from the volume its shape's samples measure.
     pub const LOST_VOLUME: &str = "W0804";
 }

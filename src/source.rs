@@ -7,10 +7,54 @@ use crate::span::Span;
 /// Largest source file.
 pub const MAX_FILE_BYTES: usize = 4 * 1024 * 1024;
 
+/// Largest mesh file (`mesh file(…)`): scanned models run to hundreds of megabytes.
+pub const MAX_MESH_FILE_BYTES: u64 = 2 << 30;
+
 /// Reads included files; the CLI reads the disk, tests may serve files from memory.
 pub trait Loader {
     /// The text of the file at `path`.
     fn read(&self, path: &Path) -> std::io::Result<String>;
+
+    /// The bytes of a data file (a mesh) at `path`, of at most `limit` bytes; from the
+    /// disk unless a loader serves its own.
+    fn read_bytes(&self, path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
+        read_regular_file(path, limit)
+    }
+}
+
+/// Reads a regular file of at most `limit` bytes, checking the limit while reading (a
+/// file may grow after it was measured). A directory, device, pipe or socket is refused
+/// before it is opened: `/dev/zero` would never end and opening a pipe blocks until a
+/// writer comes.
+pub fn read_regular_file(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
+    use std::io::Read as _;
+    let meta = std::fs::metadata(path)?;
+    if meta.is_dir() {
+        return Err(std::io::Error::other("it is a directory"));
+    }
+    if !meta.is_file() {
+        return Err(std::io::Error::other("it is not a regular file (a device, pipe or socket)"));
+    }
+    let too_large = || std::io::Error::other(format!("it is larger than the {} limit", size_name(limit)));
+    if meta.len() > limit {
+        return Err(too_large());
+    }
+    let mut bytes = Vec::new();
+    bytes.try_reserve_exact(meta.len() as usize).map_err(|_| std::io::Error::other("not enough memory to read it"))?;
+    std::fs::File::open(path)?.take(limit + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit {
+        return Err(too_large());
+    }
+    Ok(bytes)
+}
+
+/// A byte count as a limit is named: `4 MiB`, `2 GiB`.
+fn size_name(bytes: u64) -> String {
+    if bytes >= 1 << 30 && bytes.is_multiple_of(1 << 30) {
+        format!("{} GiB", bytes >> 30)
+    } else {
+        format!("{} MiB", bytes >> 20)
+    }
 }
 
 /// Reads files from the file system.
@@ -18,28 +62,9 @@ pub trait Loader {
 pub struct FsLoader;
 
 impl Loader for FsLoader {
-    /// Reads a regular file of at most [`MAX_FILE_BYTES`], checking the limit while
-    /// reading (a file may grow after it was measured). A directory, device, pipe or
-    /// socket is refused before it is opened: `/dev/zero` would never end and opening a
-    /// pipe blocks until a writer comes.
+    /// Reads a regular file of at most [`MAX_FILE_BYTES`] (see [`read_regular_file`]).
     fn read(&self, path: &Path) -> std::io::Result<String> {
-        use std::io::Read as _;
-        let meta = std::fs::metadata(path)?;
-        if meta.is_dir() {
-            return Err(std::io::Error::other("it is a directory"));
-        }
-        if !meta.is_file() {
-            return Err(std::io::Error::other("it is not a regular file (a device, pipe or socket)"));
-        }
-        let too_large = || std::io::Error::other(format!("it is larger than the {} MiB limit", MAX_FILE_BYTES >> 20));
-        if meta.len() > MAX_FILE_BYTES as u64 {
-            return Err(too_large());
-        }
-        let mut bytes = Vec::with_capacity(meta.len() as usize);
-        std::fs::File::open(path)?.take(MAX_FILE_BYTES as u64 + 1).read_to_end(&mut bytes)?;
-        if bytes.len() > MAX_FILE_BYTES {
-            return Err(too_large());
-        }
+        let bytes = read_regular_file(path, MAX_FILE_BYTES as u64)?;
         String::from_utf8(bytes).map_err(|_| std::io::Error::other("it is not valid UTF-8"))
     }
 }

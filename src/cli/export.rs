@@ -238,6 +238,15 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
             return ExitCode::from(1);
         }
     };
+    if export.parts.is_empty() {
+        // A file with no solid in it is of no use to a slicer or viewer, and some refuse it.
+        let _ = writeln!(
+            std::io::stderr(),
+            "error: no object of `{}` has a surface to write (see the warnings above); nothing written",
+            args.file.display()
+        );
+        return ExitCode::from(1);
+    }
     let units = args.units.unwrap_or(Units::Mm).three_mf();
     let mtl_name = mtl.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
     let mut bytes = 0u64;

@@ -3,11 +3,10 @@
 //!
 //! Objects are meshed exactly as `render --geometry mesh` meshes them (the same
 //! generators and isosurfaces, at the same detail), but in world coordinates rather
-//! than camera-relative ones. scnc is left-handed (x right, y up, z forward), while STL,
-//! OBJ, PLY, 3MF and glTF are read as right-handed, so positions are mirrored into the
-//! output frame (`--up y`: `(x, y, −z)`; `--up z`: `(x, z, y)`) and every triangle's
-//! winding is reversed with them: a part keeps its shape (it is not mirrored in a slicer)
-//! and its triangles stay wound outward.
+//! than camera-relative ones, mapped into the file's right-handed frame by
+//! [`crate::geom::axes`] (the mapping `mesh file(…)` reads back with): `--up y`:
+//! `(x, y, −z)`; `--up z`: `(x, z, y)`, every triangle's winding reversed with them, so a
+//! part keeps its shape (it is not mirrored in a slicer) and stays wound outward.
 
 pub mod formats;
 pub mod report;
@@ -21,14 +20,7 @@ use crate::source::Loader;
 use crate::span::Span;
 use crate::trace::MaterialTable;
 
-/// Which output axis is up.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Up {
-    /// Y up, as in glTF, OBJ and PLY viewers (and scnc).
-    Y,
-    /// Z up, as slicers and CAD tools expect.
-    Z,
-}
+pub use crate::geom::axes::Up;
 
 /// How scene coordinates become the file's.
 #[derive(Clone, Copy, Debug)]
@@ -43,11 +35,7 @@ impl Frame {
     /// A scene point in the file's right-handed frame (a reflection of scnc's
     /// left-handed one, see the module's comment).
     pub fn place(&self, p: DVec3) -> DVec3 {
-        let q = match self.up {
-            Up::Y => DVec3::new(p.x, p.y, -p.z),
-            Up::Z => DVec3::new(p.x, p.z, p.y),
-        };
-        q * self.scale
+        crate::geom::axes::to_file(p, self.up) * self.scale
     }
 }
 
@@ -96,6 +84,8 @@ pub struct Part {
     pub smooth: bool,
     /// Triangles dropped because they had no area.
     pub degenerate: usize,
+    /// Of those, the ones with area in f64 that f32 coordinates took away.
+    pub rounded_away: usize,
 }
 
 impl Part {
@@ -220,7 +210,33 @@ pub fn collect(
     budget.confirm()?;
     let warnings =
         skipped.into_iter().chain(jobs.iter_mut().flat_map(|(job, _)| std::mem::take(&mut job.warnings))).collect();
-    let parts = jobs.into_iter().enumerate().map(|(n, (job, span))| part(n, job, span, frame)).collect();
+    let mut warnings: Vec<Diagnostic> = warnings;
+    let mut parts = Vec::with_capacity(jobs.len());
+    for (n, (job, span)) in jobs.into_iter().enumerate() {
+        let p = part(n, job, span, frame);
+        if let Some(coarse) = too_coarse_for_f32(&p.mesh) {
+            return Err(collapsed(span, coarse));
+        }
+        if !p.mesh.triangles.is_empty() {
+            parts.push(p);
+        } else if p.rounded_away > 0 {
+            return Err(collapsed(
+                span,
+                format!("all {} of its triangles have no area in 32-bit coordinates", p.degenerate),
+            ));
+        } else {
+            // An empty object is an invalid object to lib3mf and PrusaSlicer.
+            warnings.push(
+                Diagnostic::warning(
+                    codes::SKIPPED_EMPTY,
+                    span,
+                    "this object has no triangles and is left out",
+                    "an empty mesh",
+                )
+                .with_note("a mesh file's objects must have triangles: validators and slicers refuse empty ones"),
+            );
+        }
+    }
     let colours = materials.materials.iter().map(|m| Colour(m.color.as_dvec3().to_array())).collect();
     Ok(Export { parts, colours, warnings })
 }
@@ -230,12 +246,16 @@ fn part(n: usize, job: mesh::MeshJob, span: Span, frame: Frame) -> Part {
     let positions: Vec<DVec3> = job.mesh.positions.iter().map(|&p| frame.place(job.xf.transform_point3(p))).collect();
     // The reflection into the file's frame turns every triangle inside out; a transform
     // that mirrors (negative determinant) turns it back.
-    let flip = job.xf.matrix3.determinant() > 0.0;
-    let (mut triangles, mut materials, mut degenerate) = (Vec::new(), Vec::new(), 0);
+    let flip = crate::geom::axes::REVERSES_WINDING != (job.xf.matrix3.determinant() < 0.0);
+    let (mut triangles, mut materials, mut degenerate, mut rounded_away) = (Vec::new(), Vec::new(), 0, 0);
     for (t, &[a, b, c]) in job.mesh.triangles.iter().enumerate() {
-        // Repeated corners included: they give a zero cross product too.
-        let [pa, pb, pc] = [a, b, c].map(|i| positions[i as usize]);
+        // Judged on the f32 corners every format writes (a triangle with area in f64
+        // can lose it in f32 far from the origin); repeated corners give a zero cross
+        // product too.
+        let [pa, pb, pc] = [a, b, c].map(|i| positions[i as usize].as_vec3());
         if (pb - pa).cross(pc - pa).length_squared() == 0.0 {
+            let [qa, qb, qc] = [a, b, c].map(|i| positions[i as usize]);
+            rounded_away += usize::from((qb - qa).cross(qc - qa).length_squared() > 0.0);
             degenerate += 1;
             continue;
         }
@@ -249,7 +269,39 @@ fn part(n: usize, job: mesh::MeshJob, span: Span, frame: Frame) -> Part {
         materials,
         smooth: job.normals != mesh::Normals::Flat,
         degenerate,
+        rounded_away,
     }
+}
+
+/// How many f32 steps an object must span on every axis: rounding then moves a vertex
+/// by at most a hundredth of the object's extent.
+const MIN_F32_STEPS: f64 = 50.0;
+
+/// Why f32 coordinates cannot hold `mesh` where it stands, if they cannot: an axis
+/// along which it spans fewer than [`MIN_F32_STEPS`] steps of f32 at its coordinates
+/// (a 0.01 sphere at 1e6, where f32 steps by 0.0625, is written as a flat disk).
+fn too_coarse_for_f32(mesh: &crate::geom::TriMesh) -> Option<String> {
+    let (lo, hi) =
+        mesh.positions.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    (0..3).find_map(|k| {
+        let extent = hi[k] - lo[k];
+        let step = lo[k].abs().max(hi[k].abs()) * f64::from(f32::EPSILON);
+        (extent > 0.0 && extent < MIN_F32_STEPS * step).then(|| {
+            format!(
+                "it is {} across its {} axis in the file, where 32-bit coordinates step by {}",
+                mesh::lower::approx(extent),
+                ["x", "y", "z"][k],
+                mesh::lower::approx(step)
+            )
+        })
+    })
+}
+
+/// An object f32 coordinates cannot hold where it stands, for `why`.
+fn collapsed(span: Span, why: String) -> Diagnostic {
+    Diagnostic::error(codes::LOWERING, span, "this object cannot be written where it stands", why)
+        .with_note("mesh files store positions as 32-bit floats, whose step grows with the distance from the origin")
+        .with_hint("move the scene nearer the origin, or scale the object up")
 }
 
 fn unbounded(span: Span) -> Diagnostic {

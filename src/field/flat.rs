@@ -95,7 +95,7 @@ pub struct Flat {
 }
 
 impl Flat {
-    /// `tape` flattened, or `None` if it needs more than [`FLAT_REGS`] registers.
+    /// `tape` flattened, or `None` if it needs more than `FLAT_REGS` registers.
     pub fn new(tape: &Tape) -> Option<Flat> {
         let mut extra = tape.regs;
         let mut ins = Vec::with_capacity(tape.ops.len());

@@ -1,6 +1,7 @@
 //! Plain geometry in f64 that every stage shares: axis-aligned boxes, indexed triangle
 //! meshes and the parametric generators that make them.
 
+pub mod axes;
 pub mod noise;
 pub mod tessellate;
 

@@ -249,7 +249,7 @@ fn detail_for(across: f64, cell: f64) -> f64 {
 }
 
 /// A positive length to three significant digits, as people read it.
-fn approx(x: f64) -> String {
+pub(crate) fn approx(x: f64) -> String {
     let scale = 10f64.powi((3 - x.abs().log10().ceil() as i32).clamp(0, 12));
     short((x * scale).round() / scale)
 }
@@ -582,7 +582,7 @@ pub fn explicit(
             return Ok(job);
         }
         MeshSource::File { path, written } => {
-            let text = loader.read(path).map_err(|e| {
+            let bytes = loader.read_bytes(path, crate::source::MAX_MESH_FILE_BYTES).map_err(|e| {
                 Diagnostic::error(
                     codes::LOWERING,
                     m.span,
@@ -591,7 +591,7 @@ pub fn explicit(
                 )
                 .with_note(format!("looked for {}", path.display()))
             })?;
-            obj::parse(&text).map_err(|e| {
+            obj::parse(&bytes).map_err(|e| {
                 let place = if e.line > 0 { format!("{written}:{}", e.line) } else { written.clone() };
                 Diagnostic::error(
                     codes::LOWERING,

@@ -79,13 +79,14 @@ fn the_default_detail_loses_the_chord_volume_and_no_more() {
 fn obj_reads_back_through_scncs_reader_with_its_colours() {
     let dir = tempfile::tempdir().expect("temp dir");
     let bytes = export("tests/data/export/unit.scn", dir.path(), "unit.obj", &["--detail", "28"]);
+    let mesh = scnc::mesh::obj::parse(&bytes).expect("scnc reads it");
     let text = String::from_utf8(bytes).expect("text");
-    let mesh = scnc::mesh::obj::parse(&text).expect("scnc reads it");
     let tris: Vec<[DVec3; 3]> = mesh.triangles.iter().map(|t| t.map(|i| mesh.positions[i as usize])).collect();
-    let (v, lo, hi) = measure(&tris);
+    let (v, lo, _) = measure(&tris);
+    // Read back into scnc's space, wound outward: the volume is positive and the
+    // sphere's far side is at x = −3.
     assert!((v - 8.0 - SPHERE).abs() < 0.01 * SPHERE, "volume {v}");
-    // Y up, right-handed: z mirrored, the box's top at y = 1 + √3 at most.
-    assert!(close(lo, DVec3::new(-3.0, -1.0, -1.8), 0.1) || lo.x == -3.0, "bounds {lo}..{hi}");
+    assert!((lo.x + 3.0).abs() < 1e-6, "bounds from {lo}");
     assert!(text.contains("mtllib unit.mtl\no object_1\n") && text.contains("\no object_2\n"));
     let mtl = std::fs::read_to_string(dir.path().join("unit.mtl")).expect("the MTL beside it");
     let kd: Vec<&str> = mtl.lines().filter(|l| l.starts_with("Kd ")).collect();
@@ -356,4 +357,116 @@ fn a_tolerance_export_refines_a_sheet_thinner_than_its_cell() {
     assert!(err.contains("picked detail 7") && err.contains("refining to detail"), "{err}");
     assert!(!err.contains("W0804") && !err.contains("W0802"), "{err}");
     assert!(err.contains("watertight and manifold"), "{err}");
+}
+
+/// A model exported to OBJ and read back with `mesh file(…)` lands where it was, not
+/// mirrored: an asymmetric arrangement of boxes (which tell left from right, and front
+/// from back) renders the same, pixel for pixel, as the scene itself as meshes.
+#[test]
+fn an_exported_obj_reads_back_where_it_was() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let common = "camera(position = [1.4, 2, -3.6], look_at = [0.5, 0.5, 0.5])\n\
+                  render(width = 96, height = 96)\n\
+                  light ambient(0.3)\nlight point(0.7) at [4, 6, -3]\n\
+                  let m = material(color = rgb(200, 150, 60), specular = 30)\n";
+    let scene = dir.path().join("l.scn");
+    std::fs::write(
+        &scene,
+        format!(
+            "{common}object box(1, 0.25, 0.25) at [0.5, 0, 0] with m\n\
+             object box(0.25, 1, 0.25) at [-0.25, 0.75, 0] with m\n\
+             object box(0.25, 0.25, 0.6) rotate [0, 20, 0] at [1.2, 0.5, 1] with m\n"
+        ),
+    )
+    .expect("writing the scene");
+    let obj = dir.path().join("l.obj");
+    let run = scnc(&["export", scene.to_str().expect("utf-8"), "-o", obj.to_str().expect("utf-8")]);
+    assert_eq!(run.status.code(), Some(0), "{}", String::from_utf8_lossy(&run.stderr));
+    let back = dir.path().join("back.scn");
+    std::fs::write(&back, format!("{common}object mesh file(\"l.obj\") with m\n")).expect("writing");
+    let render = |scene: &Path, out: &str, extra: &[&str]| {
+        let png = dir.path().join(out);
+        let mut args = vec!["render", scene.to_str().expect("utf-8"), "-o", png.to_str().expect("utf-8")];
+        args.extend_from_slice(extra);
+        let run = scnc(&args);
+        assert_eq!(run.status.code(), Some(0), "{}", String::from_utf8_lossy(&run.stderr));
+        image::open(&png).expect("a PNG").to_rgb8()
+    };
+    let meshed = render(&scene, "meshed.png", &["--geometry", "mesh"]);
+    let read_back = render(&back, "back.png", &[]);
+    let off = meshed.pixels().zip(read_back.pixels()).filter(|(a, b)| a != b).count();
+    assert_eq!(off, 0, "{off} pixels differ between the scene as meshes and its OBJ read back");
+    let background = meshed.pixels().filter(|p| **p == meshed[(0, 0)]).count();
+    assert!(background < 96 * 96 * 9 / 10, "the boxes fill a tenth of the view");
+}
+
+/// Writes `files` (name, bytes) into a new temporary directory.
+fn files(list: &[(&str, &[u8])]) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().expect("temp dir");
+    for (name, bytes) in list {
+        std::fs::write(dir.path().join(name), bytes).expect("writing");
+    }
+    dir
+}
+
+/// The reproducers of what validators and slicers refused: an object with no triangle
+/// of any area is left out with W0805 (it was written as an invalid empty object); an
+/// object f32 cannot hold where it stands (a 0.01 sphere at 1e6, written as a flat disk
+/// of volume 0) is an error with nothing written; so is a scene with nothing to write.
+#[test]
+fn exports_hold_only_what_a_file_can() {
+    let dir = files(&[
+        ("flat.obj", b"v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n"),
+        ("empty.scn", b"object mesh file(\"flat.obj\")\nobject box(1) at [3, 0, 0]\nlight ambient(1)\n"),
+        ("far.scn", b"object sphere(0.01) at [0, 0, 1e6]\nlight ambient(1)\n"),
+        ("plane.scn", b"object plane()\nlight ambient(1)\n"),
+    ]);
+    let path = |n: &str| dir.path().join(n).to_str().expect("utf-8").to_string();
+    let run = scnc(&["export", &path("empty.scn"), "-o", &path("empty.3mf"), "--stats"]);
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(0), "{err}");
+    assert!(err.contains("W0805") && err.contains("1 objects, 12 triangles"), "{err}");
+    for (scene, says) in [("far.scn", "cannot be written where it stands"), ("plane.scn", "nothing written")] {
+        let out = path(&format!("{scene}.stl"));
+        let run = scnc(&["export", &path(scene), "-o", &out]);
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(1), "{scene}: {err}");
+        assert!(err.contains(says), "{scene}: {err}");
+        assert!(!Path::new(&out).exists(), "{scene}: a file was written");
+    }
+}
+
+/// Mesh files have their own limit (2 GiB), not a scene file's 4 MiB: a 6 MB OBJ loads.
+#[test]
+fn mesh_files_larger_than_a_scene_file_load() {
+    let mut obj = String::from("# a strip of 100,000 triangles\n");
+    let n = 50_000;
+    for i in 0..=n {
+        let x = i as f64 / n as f64;
+        obj.push_str(&format!("v {x:.9} 0.000000000 0.000000000\nv {x:.9} 0.100000000 0.000000000\n"));
+    }
+    for i in 0..n {
+        let (a, b) = (2 * i + 1, 2 * i + 3);
+        obj.push_str(&format!("f {a} {b} {}\nf {} {b} {}\n", a + 1, a + 1, b + 1));
+    }
+    assert!(obj.len() > 5 << 20, "the file is {} bytes", obj.len());
+    let dir = files(&[
+        ("big.obj", obj.as_bytes()),
+        ("big.scn", b"camera(position = [0.5, 0.05, -1], look_at = [0.5, 0.05, 0])\nobject mesh file(\"big.obj\")\nlight ambient(1)\n"),
+    ]);
+    let png = dir.path().join("big.png");
+    let run = scnc(&[
+        "render",
+        dir.path().join("big.scn").to_str().expect("utf-8"),
+        "-o",
+        png.to_str().expect("utf-8"),
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--stats",
+    ]);
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(0), "{err}");
+    assert!(err.contains("100000 triangles"), "{err}");
 }
