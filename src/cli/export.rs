@@ -15,7 +15,7 @@ use scnc::mesh::Detail;
 use scnc::source::FsLoader;
 use scnc::study::tolerance::Tolerance;
 
-use super::files::{cannot_write, check_output_as, write_atomic};
+use super::files::{cannot_write, check_output_as, overwritten_input, write_atomic};
 use super::render::{parse_bytes, parse_detail};
 use super::{compile, report, usage_error, worker_pool, MessageFormat};
 
@@ -180,6 +180,21 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
     }
     let Some(scene) = compiled.scene.take() else { return ExitCode::from(1) };
     let scene = &scene;
+    let meshes = scene.objects.iter().filter_map(|o| match &o.geometry {
+        scnc::ir::Geometry::Mesh(m) => match &m.source {
+            scnc::ir::MeshSource::File { path, .. } => Some(path.as_path()),
+            _ => None,
+        },
+        scnc::ir::Geometry::Shape(_) => None,
+    });
+    let sources = compiled.map.files().map(|(_, f)| f.path.as_path());
+    if let Some(input) = overwritten_input(&args.output, sources.chain(meshes)) {
+        return usage_error(&format!(
+            "`{}` is an input of the scene ({}); name another output",
+            args.output.display(),
+            input.display()
+        ));
+    }
     if scene.objects.is_empty() {
         let _ = writeln!(std::io::stderr(), "error: `{}` has no objects to export", args.file.display());
         return ExitCode::from(1);

@@ -470,3 +470,17 @@ fn mesh_files_larger_than_a_scene_file_load() {
     assert_eq!(run.status.code(), Some(0), "{err}");
     assert!(err.contains("100000 triangles"), "{err}");
 }
+
+/// An export never overwrites its inputs: an output naming the scene's mesh file (by
+/// any spelling of its path) is a usage error, and the file is untouched.
+#[test]
+fn an_export_never_overwrites_its_inputs() {
+    let tet = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+    let dir = files(&[("tet.obj", tet), ("tet.scn", b"object mesh file(\"tet.obj\")\nlight ambient(1)\n")]);
+    let scene = dir.path().join("tet.scn");
+    let dotted = dir.path().join(".").join("tet.obj");
+    let run = scnc(&["export", scene.to_str().expect("utf-8"), "-o", dotted.to_str().expect("utf-8")]);
+    assert_eq!(run.status.code(), Some(2), "{}", String::from_utf8_lossy(&run.stderr));
+    assert!(String::from_utf8_lossy(&run.stderr).contains("is an input of the scene"));
+    assert_eq!(std::fs::read(dir.path().join("tet.obj")).expect("still there"), tet);
+}
