@@ -25,9 +25,13 @@ use super::octree::{key, unkey, Grid};
 use super::qef::Qef;
 use crate::geom::TriMesh;
 
-/// Most finest cells one isosurface may refine. A cell takes about 200 bytes at the peak
-/// of extraction (its key, its share of corner values and crossings, its sheets and
-/// their triangles), so this bounds an isosurface's working memory near 1 GB.
+/// Bytes a finest cell takes at the peak of extraction (its key, its share of corner
+/// values and crossings, its sheets and their triangles): a memory budget allows its
+/// bytes over this many cells.
+pub const CELL_BYTES: u64 = 200;
+
+/// Most finest cells one isosurface may refine when no budget says otherwise (about 1 GB
+/// of working memory).
 pub const MAX_CELLS: usize = 4_000_000;
 
 /// Why an isosurface could not be made.
@@ -76,14 +80,26 @@ pub struct Surface {
     pub pinched: usize,
 }
 
-/// Extracts the zero set of `f` on `grid`.
+/// Extracts the zero set of `f` on `grid`, refining at most [`MAX_CELLS`] cells.
 pub fn extract(f: &(dyn Fn(Vec3A) -> f32 + Sync), grid: &Grid) -> Result<Surface, IsoError> {
+    extract_within(f, grid, MAX_CELLS)
+}
+
+/// Extracts the zero set of `f` on `grid`, refining at most `max_cells` cells.
+pub fn extract_within(f: &(dyn Fn(Vec3A) -> f32 + Sync), grid: &Grid, max_cells: usize) -> Result<Surface, IsoError> {
     let too_many = |cells: f64| IsoError::TooManyCells {
         cells,
         // A surface's cell count goes with the inverse square of the cell.
-        min_cell: grid.cell * (cells / MAX_CELLS as f64).sqrt(),
+        min_cell: grid.cell * (cells / max_cells as f64).sqrt(),
     };
-    let mut cells = grid.surface_cells(f, MAX_CELLS).map_err(too_many)?;
+    let mut cells = grid.surface_cells(f, max_cells).map_err(too_many)?;
+    // Ask for the working memory's address space before using it: a cap (ulimit -v) or a
+    // strict overcommit policy refuses here, as a too-fine grid, not by aborting midway.
+    let mut probe: Vec<u8> = Vec::new();
+    if probe.try_reserve_exact(cells.len().saturating_mul(CELL_BYTES as usize)).is_err() {
+        return Err(too_many(max_cells as f64 * 2.0));
+    }
+    drop(probe);
     let (corners, values, edges, rings) = loop {
         let corners = corner_values(f, grid, &cells);
         // Each cell's eight corners, looked up once (the table is large: lookups miss
@@ -106,7 +122,7 @@ pub fn extract(f: &(dyn Fn(Vec3A) -> f32 + Sync), grid: &Grid) -> Result<Surface
         missing.dedup();
         cells.extend(missing);
         cells.par_sort_unstable();
-        if cells.len() > MAX_CELLS {
+        if cells.len() > max_cells {
             return Err(too_many(cells.len() as f64));
         }
     };

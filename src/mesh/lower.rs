@@ -118,8 +118,15 @@ pub fn tessellate(
             let bounds = ir::shape_bounds(node).ok_or_else(|| unbounded(node.span))?.transform(&xf);
             let cell = detail_cell((bounds.max - bounds.min).length(), detail.rings() as f64);
             // Sampled in render space, so the vertices need no further placing.
-            let iso =
-                Iso { grid: xf, place: DAffine3::IDENTITY, material, cell, smooth: false, from: CellFrom::Detail };
+            let iso = Iso {
+                grid: xf,
+                place: DAffine3::IDENTITY,
+                material,
+                cell,
+                smooth: false,
+                from: CellFrom::Detail,
+                max_cells: budget.cells_allowed(),
+            };
             let job = isosurface_object(node, iso, node.span, materials)?;
             budget.spend(job.mesh.triangles.len() as u64, shape.span)?;
             Ok(job)
@@ -167,6 +174,13 @@ impl Budget {
             unconfirmed: 0,
             largest: None,
         }
+    }
+
+    /// Cells an isosurface may refine now: the bytes left at
+    /// [`isosurface::CELL_BYTES`] a cell. Its working memory is freed once its mesh is
+    /// made, so only the mesh is spent from the budget.
+    pub fn cells_allowed(&self) -> usize {
+        usize::try_from(self.bytes / isosurface::CELL_BYTES).unwrap_or(usize::MAX).max(1)
     }
 
     /// Asks the system for the bytes spent since the last question, and gives them back:
@@ -254,6 +268,15 @@ pub(crate) fn approx(x: f64) -> String {
     short((x * scale).round() / scale)
 }
 
+/// A byte count as people read it: GiB or MiB.
+fn bytes_name(b: u64) -> String {
+    if b >= 1 << 30 {
+        format!("{:.1} GiB", b as f64 / (1u64 << 30) as f64)
+    } else {
+        format!("{} MiB", b >> 20)
+    }
+}
+
 /// A count as people say it: millions above a million, powers of ten above a billion.
 fn millions(n: f64) -> String {
     if n >= 1e9 {
@@ -303,6 +326,9 @@ struct Iso {
     smooth: bool,
     /// What set `cell`, for the hint of a failure.
     from: CellFrom,
+    /// Most cells it may refine: what the memory budget has left, at
+    /// [`isosurface::CELL_BYTES`] a cell.
+    max_cells: usize,
 }
 
 /// An isosurface of `shape` sampled and placed as `iso` says, each triangle taking the
@@ -314,7 +340,7 @@ fn isosurface_object(
     span: Span,
     materials: &mut MaterialTable,
 ) -> Result<MeshJob, Diagnostic> {
-    let Iso { grid, place, material, cell, smooth, from } = iso;
+    let Iso { grid, place, material, cell, smooth, from, max_cells } = iso;
     let bounds = ir::shape_bounds(shape).ok_or_else(|| unbounded(shape.span))?.transform(&grid);
     // A cell as large as the shape samples a few points around it: the mesh would be a
     // sliver or nothing, so it is refused like a grid that finds no surface.
@@ -340,7 +366,12 @@ fn isosurface_object(
             "isosurface grid is too fine",
             format!("cell {} would refine about {} cells near the surface", ir::dump_num(cell), millions(cells)),
         )
-        .with_note(format!("an isosurface may refine at most {} cells", isosurface::MAX_CELLS));
+        .with_note(format!(
+            "an isosurface may refine at most {} cells: the memory limit's {} at {} bytes a cell",
+            millions(max_cells as f64),
+            bytes_name(max_cells as u64 * isosurface::CELL_BYTES),
+            isosurface::CELL_BYTES
+        ));
         match from {
             CellFrom::Scene => {
                 d.with_hint(format!("try `cell = {}` or more", ir::dump_num((min_cell * 1.001 * 1e6).ceil() / 1e6)))
@@ -354,10 +385,10 @@ fn isosurface_object(
         // key and the cell limit.
         let cells = 6.0 * side * side;
         let for_keys = cell * side / (1u64 << octree::MAX_LEVELS) as f64;
-        let for_limit = cell * (cells / isosurface::MAX_CELLS as f64).sqrt();
+        let for_limit = cell * (cells / max_cells as f64).sqrt();
         too_fine(cells, for_keys.max(for_limit))
     })?;
-    let surface = isosurface::extract(&*dist, &lattice).map_err(|e| match e {
+    let surface = isosurface::extract_within(&*dist, &lattice, max_cells).map_err(|e| match e {
         isosurface::IsoError::TooManyCells { cells, min_cell } => too_fine(cells, min_cell),
         isosurface::IsoError::NoSurface => {
             let d = Diagnostic::error(
@@ -576,6 +607,7 @@ pub fn explicit(
                 cell: *cell,
                 smooth: m.smooth,
                 from: CellFrom::Scene,
+                max_cells: budget.cells_allowed(),
             };
             let job = isosurface_object(shape, iso, m.span, materials)?;
             budget.spend(job.mesh.triangles.len() as u64, m.span)?;
