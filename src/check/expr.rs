@@ -250,9 +250,11 @@ impl Ctx<'_> {
     /// A list of `values` if they share one type, else `None` after reporting the first
     /// element that differs.
     pub(super) fn uniform_list(&mut self, values: Vec<(Value, Span)>) -> Option<Value> {
-        if let Some((first, first_span)) = values.first() {
+        // Judged against the first element that is not an empty list, which fits any.
+        let typed = values.iter().find(|(v, _)| !matches!(v, Value::List(l) if l.is_empty())).or(values.first());
+        if let Some((first, first_span)) = typed {
             let name = |v: &Value| v.ty_name();
-            for (v, s) in &values[1..] {
+            for (v, s) in &values {
                 if !v.same_type(first) {
                     self.report(
                         Diagnostic::error(
@@ -473,26 +475,37 @@ impl Ctx<'_> {
     }
 }
 
-/// Equality of values that `==` compares; `None` for values it does not.
-fn equal(a: &Value, b: &Value) -> Option<bool> {
-    Some(match (a, b) {
+/// Equality of values that `==` compares; `None` for values it does not. Each pair of
+/// values looked at costs a step of `steps`; past `limit` it stops with `Err` (a list
+/// that shares itself, `[a, a]` forty levels deep, has 2⁴⁰ elements). A list compared
+/// with itself is equal without a look inside (values are immutable, and never NaN).
+fn equal(a: &Value, b: &Value, steps: &mut u64, limit: u64) -> Result<Option<bool>, ()> {
+    *steps += 1;
+    if *steps > limit {
+        return Err(());
+    }
+    Ok(Some(match (a, b) {
         (Value::Num(x), Value::Num(y)) => x == y,
         (Value::Bool(x), Value::Bool(y)) => x == y,
         (Value::Str(x), Value::Str(y)) => x == y,
         (Value::Vec3(x), Value::Vec3(y)) | (Value::Color(x), Value::Color(y)) => x == y,
         (Value::List(x), Value::List(y)) => {
+            if Rc::ptr_eq(x, y) {
+                return Ok(Some(true));
+            }
             if x.len() != y.len() {
-                return Some(false);
+                return Ok(Some(false));
             }
             for (p, q) in x.iter().zip(y.iter()) {
-                if !equal(p, q)? {
-                    return Some(false);
+                match equal(p, q, steps, limit)? {
+                    Some(true) => {}
+                    other => return Ok(other.map(|_| false)),
                 }
             }
             true
         }
-        _ => return None,
-    })
+        _ => return Ok(None),
+    }))
 }
 
 impl Ctx<'_> {
@@ -534,8 +547,25 @@ impl Ctx<'_> {
     }
 
     fn equality(&mut self, op: BinOp, a: &Value, a_span: Span, b: &Value, b_span: Span, span: Span) -> Value {
-        let same =
-            if a.same_type(b) || matches!((a, b), (Value::List(_), Value::List(_))) { equal(a, b) } else { None };
+        let same = if a.same_type(b) || matches!((a, b), (Value::List(_), Value::List(_))) {
+            // Counted against the fuel like every other step of evaluation.
+            let mut steps = 0;
+            let limit = self.fuel.min(u64::MAX - 1);
+            match equal(a, b, &mut steps, limit) {
+                Ok(eq) => {
+                    if !self.burn(steps, span) {
+                        return Value::Error;
+                    }
+                    eq
+                }
+                Err(()) => {
+                    self.burn(limit + 1, span);
+                    return Value::Error;
+                }
+            }
+        } else {
+            None
+        };
         match same {
             Some(eq) => Value::Bool(eq == (op == BinOp::Eq)),
             None => {

@@ -588,8 +588,23 @@ pub fn check_indexed(
     Some((scene, diags, index.unwrap_or_default()))
 }
 
-/// The unit vector along `v`, or `None` for a zero or non-finite vector.
+/// The unit vector along `v`, or `None` for a zero or non-finite vector. Scaled by its
+/// largest component first, as `hypot` does, so `[1e200, 1e200, 0]` (whose `x·x`
+/// overflows) and `[1e-200, 0, 0]` (whose `x·x` underflows) have directions.
 pub(crate) fn direction(v: DVec3) -> Option<DVec3> {
-    let n = v.try_normalize()?;
+    let big = v.abs().max_element();
+    if !big.is_finite() || big == 0.0 {
+        return None;
+    }
+    let n = (v / big).try_normalize()?;
     n.is_finite().then_some(n)
+}
+
+/// The length of `v` without overflow or underflow in its squares (as `hypot`).
+pub(crate) fn length(v: DVec3) -> f64 {
+    let big = v.abs().max_element();
+    if big == 0.0 || !big.is_finite() {
+        return big;
+    }
+    big * (v / big).length()
 }

@@ -100,7 +100,8 @@ impl Value {
     }
 
     /// Whether two values have the same type as users read it ([`Value::ty_name`]),
-    /// without formatting either.
+    /// without formatting either. The empty list is a list of any element type, so
+    /// `if c then [sphere(1)] else []` and `[[1], []]` are well typed.
     pub fn same_type(&self, other: &Value) -> bool {
         fn key(v: &Value) -> (Option<Ty>, Option<Ty>) {
             let num = |t: Option<Ty>| if t == Some(Ty::Int) { Some(Ty::Num) } else { t };
@@ -109,7 +110,10 @@ impl Value {
                 v => (num(v.ty()), None),
             }
         }
-        key(self) == key(other)
+        match (key(self), key(other)) {
+            ((Some(Ty::List), None), (Some(Ty::List), _)) | ((Some(Ty::List), _), (Some(Ty::List), None)) => true,
+            (a, b) => a == b,
+        }
     }
 
     /// A vector's three numbers as a list, as `for` and list parameters read `[x, y, z]`.

@@ -6,7 +6,8 @@ use logos::Logos;
 
 /// One token. Bad input becomes one of the error variants; the lexer never fails.
 #[derive(Logos, Clone, Debug, PartialEq)]
-#[logos(skip r"[ \t\r\n\f]+")]
+// A byte-order mark (Windows Notepad starts files with one) is skipped like whitespace.
+#[logos(skip r"[ \t\r\n\f\u{feff}]+")]
 pub enum Token<'src> {
     /// `let`
     #[token("let")]
@@ -161,7 +162,8 @@ pub enum Token<'src> {
     BlockComment(bool),
     /// A number with trailing letters or an exponent without digits, e.g. `12ab`, `1e`.
     #[regex(r"[0-9]+(\.[0-9]+)?([eE][+-]?)?[A-Za-z_][A-Za-z0-9_]*|[0-9]+(\.[0-9]+)?[eE][+-]?")]
-    #[regex(r"[0-9]+\.[0-9]+\.[0-9.]*")]
+    // A second dot followed by a digit (`1.2.3`); `0.0..3` is a number and a range.
+    #[regex(r"[0-9]+\.[0-9]+\.[0-9][0-9.]*")]
     BadNumber(&'src str),
     /// A `#` not followed by exactly six hex digits.
     #[regex(r"#[0-9A-Za-z_]*")]

@@ -113,3 +113,23 @@ fn an_address_space_cap_is_an_error_not_an_abort() {
     assert!(stderr.contains("big.scn:2:8"), "{stderr}");
     assert!(!out.exists(), "nothing written");
 }
+
+/// `==` walks values and spends fuel for it: a list that shares itself forty levels
+/// deep (2⁴⁰ elements) compared with itself is equal at once (the same list), and
+/// compared with an equal copy built apart it runs out of fuel with E0706 instead of
+/// running for hours.
+#[test]
+fn equality_of_self_sharing_lists_is_counted() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut text = String::from("let a0 = [1, 1]\nlet b0 = [1, 1]\n");
+    for i in 1..=40 {
+        text.push_str(&format!("let a{i} = [a{p}, a{p}]\nlet b{i} = [b{p}, b{p}]\n", p = i - 1));
+    }
+    let tail = "object sphere(if same then 1 else 2) at [0, 0, 5]\nlight ambient(1)\n";
+    let itself = dir.path().join("itself.scn");
+    std::fs::write(&itself, format!("{text}let same = a40 == a40 and b40 == b40\n{tail}")).expect("write");
+    assert_eq!(error_codes(&itself), Vec::<&str>::new());
+    let apart = dir.path().join("apart.scn");
+    std::fs::write(&apart, format!("{text}let same = a40 == b40\n{tail}")).expect("write");
+    assert_eq!(error_codes(&apart), vec!["E0706"]);
+}

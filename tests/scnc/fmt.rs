@@ -104,3 +104,91 @@ fn shipped_examples_are_formatted() {
     }
     finish(failures);
 }
+
+/// `text` with every gap between tokens widened (two more spaces, or a trailing space
+/// before a line break) and glued tokens pulled apart, and, with `reals`, every integer
+/// written as a real (`3` as `3.0`): what a person might type, meaning the same.
+fn respaced(text: &str, reals: bool) -> String {
+    let mut out = String::new();
+    let mut end = 0;
+    for (tok, span) in syntax::lex(text, 0) {
+        let (start, stop) = (span.start as usize, span.end as usize);
+        let gap = &text[end..start];
+        if gap.contains('\n') {
+            out.push(' ');
+            out.push_str(gap);
+        } else {
+            out.push_str("  ");
+            out.push_str(gap);
+        }
+        let word = &text[start..stop];
+        match tok {
+            Token::Number(_) if reals && word.bytes().all(|b| b.is_ascii_digit()) => {
+                out.push_str(word);
+                out.push_str(".0");
+            }
+            _ => out.push_str(word),
+        }
+        end = stop;
+    }
+    out.push_str(&text[end..]);
+    out
+}
+
+/// A formatter must never change what a file means: every corpus file respaced formats
+/// to the same layout as the file itself, and with its integers written as reals it
+/// still formats, idempotently, to a file that means the same. (`for i in 0.0 .. 3`
+/// used to format to `0.0..3`, which did not lex.)
+#[test]
+fn respaced_files_format_to_the_same_layout_and_meaning() {
+    let mut failures = Vec::new();
+    let mut checked = 0;
+    for dir in [
+        "examples/seed",
+        "examples/features",
+        "examples/animation",
+        "tests/data/ir",
+        "tests/data/fmt",
+        "benches/scenes",
+    ] {
+        for path in cases(dir) {
+            let text = std::fs::read_to_string(&path).expect("reading the case");
+            let Ok(canonical) = scnc::fmt::format(&text) else { continue };
+            checked += 1;
+            let name = path.display();
+            match scnc::fmt::format(&respaced(&text, false)) {
+                Ok(f) if f == canonical => {}
+                Ok(f) => failures.push(format!(
+                    "{name}: respaced, it formats differently:\n{}",
+                    crate::support::diff(&canonical, &f)
+                )),
+                Err(_) => failures.push(format!("{name}: respaced, it does not format")),
+            }
+            let reals = respaced(&text, true);
+            match scnc::fmt::format(&reals) {
+                Ok(once) => {
+                    if scnc::fmt::format(&once).ok().as_deref() != Some(once.as_str()) {
+                        failures.push(format!("{name}: with reals, formatting is not idempotent"));
+                    }
+                    if meaning(&path, once.clone()) != meaning(&path, text.clone()) {
+                        failures.push(format!("{name}: with reals and formatted, it means something else:\n{once}"));
+                    }
+                }
+                Err(_) => failures.push(format!("{name}: with reals, it does not format")),
+            }
+        }
+    }
+    assert!(checked >= 60, "checked {checked}");
+    finish(failures);
+}
+
+/// A scene saved with a byte-order mark (Windows Notepad) compiles as without one, and
+/// `fmt` writes it without the mark.
+#[test]
+fn a_byte_order_mark_is_skipped() {
+    let plain = "light ambient(1)\nobject sphere(1) at [0, 0, 5]\n";
+    let marked = format!("\u{feff}{plain}");
+    let scene = crate::support::scene(&marked);
+    assert_eq!(scene.objects.len(), 1);
+    assert_eq!(scnc::fmt::format(&marked).expect("formats"), plain);
+}

@@ -328,7 +328,7 @@ impl Ctx<'_> {
                     Value::Vec3(u.cross(w))
                 }
             }
-            VecFn::Length => Value::Num(OneVector::from_args(a).v.length()),
+            VecFn::Length => Value::Num(crate::check::length(OneVector::from_args(a).v)),
             // The range refused zero; one too small to scale is refused the same way.
             VecFn::Normalize => match direction(OneVector::from_args(a).v) {
                 Some(n) => Value::Vec3(n),
