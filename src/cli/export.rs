@@ -8,6 +8,7 @@ use std::time::Instant;
 
 use clap::ValueEnum;
 
+use scnc::diag::codes;
 use scnc::export::formats::{self, Format};
 use scnc::export::report::MeshReport;
 use scnc::export::{Frame, Up};
@@ -114,6 +115,10 @@ pub(crate) struct ExportArgs {
     message_format: MessageFormat,
 }
 
+/// Warnings about how a scene renders, which an export leaves out.
+const RENDER_ONLY: [&str; 5] =
+    [codes::NO_LIGHTS, codes::USELESS_LIGHT, codes::BEHIND_CAMERA, codes::NO_EFFECT, codes::STEEP_FIELD];
+
 /// How many times a `--tolerance` export refines a pinched isosurface (×1.3 each).
 const REFINEMENTS: usize = 3;
 /// A scale from 1e-12 to 1e12, which keeps a renderable scene finite in f32.
@@ -175,6 +180,9 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
         Err(e) => return usage_error(&e),
     };
     let Some(mut compiled) = compile(&args.file, args.message_format) else { return ExitCode::from(1) };
+    // What only a render sees (lights, the camera's view, a field's marching cost) is
+    // not the export's business.
+    compiled.diagnostics.retain(|d| d.is_error() || !RENDER_ONLY.contains(&d.code));
     if report(&compiled, args.message_format) {
         return ExitCode::from(1);
     }

@@ -484,3 +484,20 @@ fn an_export_never_overwrites_its_inputs() {
     assert!(String::from_utf8_lossy(&run.stderr).contains("is an input of the scene"));
     assert_eq!(std::fs::read(dir.path().join("tet.obj")).expect("still there"), tet);
 }
+
+/// An export says nothing about how the scene would render: no lights (W0002) or a
+/// steep field (W0007) are not its business; what concerns the file still is.
+#[test]
+fn an_export_leaves_out_render_only_warnings() {
+    let dir = files(&[(
+        "s.scn",
+        b"object field(p => 4 * (length(p) - 1), bounds = [[-1.1, -1.1, -1.1], [1.1, 1.1, 1.1]])\nlet unused = 1\n",
+    )]);
+    let scene = dir.path().join("s.scn");
+    let out = dir.path().join("s.stl");
+    let run = scnc(&["export", scene.to_str().expect("utf-8"), "-o", out.to_str().expect("utf-8")]);
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(0), "{err}");
+    assert!(!err.contains("W0002") && !err.contains("W0007"), "{err}");
+    assert!(err.contains("W0001"), "{err}");
+}
