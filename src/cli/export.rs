@@ -342,8 +342,14 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
 }
 
 /// Where an OBJ export's MTL file goes: beside it, same stem.
+/// The MTL file beside an OBJ: its name with `.mtl`, whitespace and characters outside
+/// printable ASCII made `_`, because `mtllib` names are whitespace-separated and readers
+/// differ on anything else.
 fn mtl_path(output: &Path) -> PathBuf {
-    output.with_extension("mtl")
+    let with = output.with_extension("mtl");
+    let Some(name) = with.file_name() else { return with };
+    let safe: String = name.to_string_lossy().chars().map(|c| if c.is_ascii_graphic() { c } else { '_' }).collect();
+    with.with_file_name(safe)
 }
 
 /// A writer counting the bytes through it, for the summary line.

@@ -98,12 +98,22 @@ fn material_name(m: u32) -> String {
 fn obj(export: &Export, mtl: &str, w: &mut dyn Write) -> io::Result<()> {
     writeln!(w, "# scnc export: {} objects, {} triangles", export.parts.len(), export.triangle_count())?;
     writeln!(w, "mtllib {mtl}")?;
-    let mut base = 1u64;
+    // Vertex and normal numbers run on across objects; a smooth part writes one normal
+    // per vertex, so its faces use the same number for both (`f a//a …`).
+    let (mut base, mut normals) = (1u64, 1u64);
     for p in &export.parts {
         writeln!(w, "o {}", p.name)?;
         for v in &p.mesh.positions {
             let [x, y, z] = f32s(*v);
             writeln!(w, "v {x} {y} {z}")?;
+        }
+        if p.smooth {
+            for n in p.vertex_normals() {
+                // Rounding leaves components like 3e-18 where 0 is meant; f32 prints them
+                // out in full, so they are written as 0.
+                let [x, y, z] = f32s(n.to_array().map(|c| if c.abs() < 1e-7 { 0.0 } else { c }).into());
+                writeln!(w, "vn {x} {y} {z}")?;
+            }
         }
         let mut current = None;
         for (t, tri) in p.mesh.triangles.iter().enumerate() {
@@ -112,9 +122,17 @@ fn obj(export: &Export, mtl: &str, w: &mut dyn Write) -> io::Result<()> {
                 writeln!(w, "usemtl {}", material_name(p.materials[t]))?;
             }
             let [a, b, c] = tri.map(|i| base + i as u64);
-            writeln!(w, "f {a} {b} {c}")?;
+            if p.smooth {
+                let [na, nb, nc] = tri.map(|i| normals + i as u64);
+                writeln!(w, "f {a}//{na} {b}//{nb} {c}//{nc}")?;
+            } else {
+                writeln!(w, "f {a} {b} {c}")?;
+            }
         }
         base += p.mesh.positions.len() as u64;
+        if p.smooth {
+            normals += p.mesh.positions.len() as u64;
+        }
     }
     Ok(())
 }
