@@ -330,6 +330,8 @@ pub mod codes {
     pub const OUT_OF_REACH: &str = "E0403";
     /// A field whose slope has no bound the checker can find.
     pub const UNBOUNDED_SLOPE: &str = "E0404";
+    /// A domain operation (`twist`, `bend`, `polar`) of a shape with no finite extent.
+    pub const NEEDS_BOUNDED: &str = "E0405";
     /// `camera` or `render` given twice.
     pub const DUPLICATE_STATEMENT: &str = "E0500";
     /// `object` of something that is not a shape or mesh.
@@ -376,6 +378,8 @@ pub mod codes {
     pub const NO_EFFECT: &str = "W0006";
     /// A field far from a distance (its slope bound far from 1): it is marched slowly.
     pub const STEEP_FIELD: &str = "W0007";
+    /// A `polar` shape reaching out of its sector: the distance is only a bound there.
+    pub const CROSSES_SECTOR: &str = "W0008";
     /// Parts of a shape too small for its isosurface's cell, left out of the mesh.
     pub const LOST_PARTS: &str = "W0801";
     /// Isosurface edges left on four triangles where parts are thinner than the cell.

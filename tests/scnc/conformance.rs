@@ -37,6 +37,7 @@ conformance! {
     glass_far_from_the_origin_renders_the_same => crate::glass::glass_far_from_the_origin_renders_the_same,
     thin_glass_walls_are_crossed_cleanly => crate::glass::thin_glass_walls_are_crossed_cleanly,
     fields_cover_what_their_shapes_cover => crate::fields::fields_cover_what_their_shapes_cover,
+    domain_operations_cover_what_they_describe => crate::fields::domain_operations_cover_what_they_describe,
 }
 
 /// Every object of `tests/data/primitives.scn` is hit by some ray aimed inside its

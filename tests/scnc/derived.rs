@@ -102,6 +102,8 @@ fn literal(p: &Param, rng: &mut Rng) -> Option<String> {
         Ty::Mesh => "mesh box(1)".into(),
         Ty::List => "[1, 2]".into(),
         Ty::Linear => "0.5".into(),
+        // `symmetric`'s axes; any other string parameter is a mesh file's path.
+        Ty::Str if p.name == "axes" => ["\"x\"", "\"xz\"", "\"xyz\""][rng.below(3)].into(),
         Ty::Str => "\"tests/data/models/gem.obj\"".into(),
         Ty::FieldNum => FIELDS[rng.below(FIELDS.len())].to_string(),
         Ty::FieldVec => MAPS[rng.below(MAPS.len())].to_string(),

@@ -49,7 +49,8 @@ fn call(b: &Builtin) -> String {
         b.params
             .iter()
             .filter(|p| p.default == scnc::check::builtins::Default::Required)
-            .map(|p| argument(p.ty).to_string()),
+            // `symmetric`'s axes are a string that is not a path.
+            .map(|p| if p.name == "axes" { "\"xz\"".to_string() } else { argument(p.ty).to_string() }),
     );
     if b.params.iter().any(|p| p.ty == Ty::Bounds) {
         args.push(format!("bounds = {}", argument(Ty::Bounds)));

@@ -92,6 +92,11 @@ pub enum FieldFn {
     Field,
     Warp,
     Displace,
+    Twist,
+    Bend,
+    Elongate,
+    Symmetric,
+    Polar,
 }
 
 /// The patterns.

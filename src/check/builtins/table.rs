@@ -5,6 +5,7 @@
 use std::sync::LazyLock;
 
 use super::{Builtin, Ctor, Extreme, FieldFn, Gen, LightFn, MathFn, Modifier, NumFn, PatternFn, Ty, VecFn};
+use crate::check::construct::domain::{BendArgs, ElongateArgs, PolarArgs, SymmetricArgs, TwistArgs};
 use crate::check::construct::fields::{DisplaceArgs, DistArgs, FieldArgs, Noise3Args, WarpArgs};
 use crate::check::construct::maths::{
     Atan2Args, ClampArgs, HsvArgs, ListArgs, MixArgs, NumberArgs, PairArgs, PowArgs, RangeArgs, VectorArgs,
@@ -116,6 +117,42 @@ static REST: &[Builtin] = &[
         DisplaceArgs::PARAMS,
         Ty::Shape,
         "the shape's distance plus `f(p)`: bumps, ripples, noise on its surface",
+    ),
+    // Domain operations (warps with their maps and bounds written for you).
+    f(
+        "twist",
+        Ctor::Field(FieldFn::Twist),
+        TwistArgs::PARAMS,
+        Ty::Shape,
+        "the shape twisted about `y`: the slice at height `y` turned `degrees_per_unit * y` as `rotate [0, a, 0]` turns",
+    ),
+    f(
+        "bend",
+        Ctor::Field(FieldFn::Bend),
+        BendArgs::PARAMS,
+        Ty::Shape,
+        "the shape's `y` axis bent towards `+x` by `degrees_per_unit` per unit of height",
+    ),
+    f(
+        "elongate",
+        Ctor::Field(FieldFn::Elongate),
+        ElongateArgs::PARAMS,
+        Ty::Shape,
+        "the shape cut at its centre planes and pulled apart by a slab `2 * by` thick (exact)",
+    ),
+    f(
+        "symmetric",
+        Ctor::Field(FieldFn::Symmetric),
+        SymmetricArgs::PARAMS,
+        Ty::Shape,
+        "the shape's half on the positive side of each of `axes` mirrored onto the negative side (exact)",
+    ),
+    f(
+        "polar",
+        Ctor::Field(FieldFn::Polar),
+        PolarArgs::PARAMS,
+        Ty::Shape,
+        "`count` copies of the shape about `y`, `360 / count` degrees apart, the shape itself the one on `+x`",
     ),
     f("dist", Ctor::Dist, DistArgs::PARAMS, Ty::Num, "inside a field's body, the shape's signed distance at `q`"),
     f(

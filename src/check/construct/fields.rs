@@ -108,8 +108,8 @@ impl Ctx<'_> {
                     return None;
                 };
                 let bounds = self.bounds(bounds, a.span_of("bounds"))?;
-                let tape = self.tape(&lit.body, lit.span)?;
-                let l = self.slope(&tape, bounds, given, lit.span, "this field")?;
+                let tape = self.field_tape(&lit.body, lit.span)?;
+                let l = self.field_slope(&tape, bounds, given, lit.span, "this field")?;
                 Some(ShapeKind::Field { body: lit.body.clone(), bounds, lipschitz: l })
             }
             FieldFn::Warp => {
@@ -119,10 +119,11 @@ impl Ctx<'_> {
                     return None;
                 };
                 let bounds = self.bounds(bounds, a.span_of("bounds"))?;
-                let tape = self.tape(&lit.body, lit.span)?;
-                let l = self.slope(&tape, bounds, given, lit.span, "this warp")?;
+                let tape = self.field_tape(&lit.body, lit.span)?;
+                let l = self.field_slope(&tape, bounds, given, lit.span, "this warp")?;
                 Some(ShapeKind::Warp { child, map: lit.body.clone(), bounds, lipschitz: l })
             }
+            FieldFn::Twist | FieldFn::Bend | FieldFn::Elongate | FieldFn::Symmetric | FieldFn::Polar => None,
             FieldFn::Displace => {
                 let DisplaceArgs { shape: Value::Shape(child), f: Value::Field(lit), bounds, lipschitz: given } =
                     DisplaceArgs::from_args(a)
@@ -130,9 +131,9 @@ impl Ctx<'_> {
                     return None;
                 };
                 let bounds = self.bounds(bounds, a.span_of("bounds"))?;
-                let tape = self.tape(&lit.body, lit.span)?;
+                let tape = self.field_tape(&lit.body, lit.span)?;
                 let (region, reach) = self.reach(&tape, &child, bounds, lit.span)?;
-                let l = self.slope(&tape, region, given, lit.span, "this displacement")?;
+                let l = self.field_slope(&tape, region, given, lit.span, "this displacement")?;
                 // A displacement's slope adds to the shape's 1: only the sum is far from 1.
                 Some(ShapeKind::Displace { child, by: lit.body.clone(), bounds, lipschitz: l, reach })
             }
@@ -204,7 +205,7 @@ impl Ctx<'_> {
     }
 
     /// The body compiled, or `None` after reporting one too large.
-    fn tape(&mut self, body: &Arc<Expr>, span: Span) -> Option<Tape> {
+    pub(in crate::check) fn field_tape(&mut self, body: &Arc<Expr>, span: Span) -> Option<Tape> {
         let tape = Tape::new(body);
         if tape.ops.len() > MAX_FIELD_OPS {
             self.report(
@@ -223,7 +224,7 @@ impl Ctx<'_> {
 
     /// What the body's slope is bounded by: `given`, or estimated over `domain`;
     /// `None` after reporting that no bound was found. `what` names the field.
-    fn slope(
+    pub(in crate::check) fn field_slope(
         &mut self,
         tape: &Tape,
         domain: Option<Aabb>,

@@ -3,6 +3,7 @@
 //! plain values (materials, colours, lights, numbers). Each family declares its
 //! builtins' parameters with [`params!`](crate::params) and reads them as typed fields.
 
+pub(super) mod domain;
 pub(super) mod fields;
 pub(super) mod maths;
 pub(super) mod meshes;
@@ -199,8 +200,12 @@ impl Ctx<'_> {
                 let kind = self.modifier(m, &a);
                 self.shape(kind, a.call)
             }
-            Ctor::Field(f) => {
+            Ctor::Field(f @ (builtins::FieldFn::Field | builtins::FieldFn::Warp | builtins::FieldFn::Displace)) => {
                 let kind = self.field_shape(f, &a);
+                self.shape(kind, a.call)
+            }
+            Ctor::Field(f) => {
+                let kind = self.domain_shape(f, &a, a.call);
                 self.shape(kind, a.call)
             }
             Ctor::Dist => self.dist(&a),
