@@ -50,6 +50,8 @@ pub enum Ty {
     FieldVec,
     /// A box, `[[x0, y0, z0], [x1, y1, z1]]`.
     Bounds,
+    /// A 2D profile (`circle`, `rect`, `polygon`), for `extrude` and `revolve`.
+    Profile,
 }
 
 impl fmt::Display for Ty {
@@ -73,6 +75,7 @@ impl fmt::Display for Ty {
             Ty::FieldNum => "p => num",
             Ty::FieldVec => "p => vec3",
             Ty::Bounds => "[vec3, vec3]",
+            Ty::Profile => "profile",
         };
         f.write_str(s)
     }

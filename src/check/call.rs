@@ -580,6 +580,7 @@ fn admits(ty: Ty, v: &Value) -> bool {
         Ty::FieldVec => matches!(v, Value::Field(f) if f.body.ty == crate::ir::field::Ty::Vec3),
         // Its two corners are checked by the builtin, which can say which is wrong.
         Ty::Bounds => matches!(v, Value::List(_)),
+        Ty::Profile => matches!(v, Value::Profile(_)),
     }
 }
 

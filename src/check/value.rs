@@ -49,6 +49,8 @@ pub enum Value {
     Sym(Arc<ir::field::Expr>),
     /// A field literal `p => …`, its body evaluated.
     Field(Rc<FieldLit>),
+    /// A 2D profile.
+    Profile(Arc<crate::check::construct::profiles::Profile>),
     /// Poison.
     Error,
 }
@@ -76,6 +78,7 @@ impl Value {
             },
             Value::Field(f) if f.body.ty == ir::field::Ty::Vec3 => Ty::FieldVec,
             Value::Field(_) => Ty::FieldNum,
+            Value::Profile(_) => Ty::Profile,
             Value::Error => return None,
         })
     }

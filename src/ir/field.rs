@@ -405,6 +405,39 @@ impl Expr {
         seen.len()
     }
 
+    /// This expression with the point replaced by `q` (an expression of the new point):
+    /// `f(p)` becomes `f(q(p))`. Shared nodes stay shared.
+    pub fn substitute(self: &Arc<Expr>, q: &Arc<Expr>) -> Arc<Expr> {
+        fn walk(
+            e: &Arc<Expr>,
+            q: &Arc<Expr>,
+            memo: &mut std::collections::HashMap<*const Expr, Arc<Expr>>,
+        ) -> Arc<Expr> {
+            if !e.uses_point() {
+                return e.clone();
+            }
+            if let Some(done) = memo.get(&Arc::as_ptr(e)) {
+                return done.clone();
+            }
+            let mut w = |x: &Arc<Expr>| walk(x, q, memo);
+            let kind = match &e.kind {
+                Kind::Point => return q.clone(),
+                Kind::Num(_) | Kind::Vec(_) => return e.clone(),
+                Kind::Component(x, k) => Kind::Component(w(x), *k),
+                Kind::Vector([a, b, c]) => Kind::Vector([w(a), w(b), w(c)]),
+                Kind::Unary(f, x) => Kind::Unary(*f, w(x)),
+                Kind::Binary(f, a, b) => Kind::Binary(*f, w(a), w(b)),
+                Kind::Select(c, a, b) => Kind::Select(w(c), w(a), w(b)),
+                Kind::Dist(s, at) => Kind::Dist(s.clone(), w(at)),
+                Kind::Noise { at, size, seed } => Kind::Noise { at: w(at), size: *size, seed: *seed },
+            };
+            let out = Expr::new(kind, e.ty);
+            memo.insert(Arc::as_ptr(e), out.clone());
+            out
+        }
+        walk(self, q, &mut std::collections::HashMap::new())
+    }
+
     /// The shapes `dist` reads, in first-use order, each once.
     pub fn shapes(self: &Arc<Expr>) -> Vec<Arc<Shape>> {
         let mut out: Vec<Arc<Shape>> = Vec::new();

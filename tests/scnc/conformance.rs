@@ -38,6 +38,7 @@ conformance! {
     thin_glass_walls_are_crossed_cleanly => crate::glass::thin_glass_walls_are_crossed_cleanly,
     fields_cover_what_their_shapes_cover => crate::fields::fields_cover_what_their_shapes_cover,
     domain_operations_cover_what_they_describe => crate::fields::domain_operations_cover_what_they_describe,
+    sweeps_cover_what_they_describe => crate::fields::sweeps_cover_what_they_describe,
 }
 
 /// Every object of `tests/data/primitives.scn` is hit by some ray aimed inside its

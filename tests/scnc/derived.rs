@@ -71,6 +71,15 @@ const MAPS: &[&str] = &[
     "p => p * [1, 1.5, 0.8] + [0.1, 0, 0]",
 ];
 
+/// Profiles a sweep is given: a disc off the axis, a rectangle across it, a concave
+/// polygon (an L) and a triangle.
+const PROFILES: &[&str] = &[
+    "circle(0.3)",
+    "rect(0.4, 0.3)",
+    "polygon([[0.1, -0.5], [0.7, -0.5], [0.7, -0.2], [0.35, -0.2], [0.35, 0.5], [0.1, 0.5]])",
+    "polygon([[0.2, 0], [0.8, -0.3], [0.5, 0.6]])",
+];
+
 /// Transforms a sampled shape is seen through.
 const PLACEMENTS: &[&str] = &["", "rotate [25, 40, 10]", "scale [1.5, 0.6, 1] rotate [10, 0, 30]", "scale 0.7"];
 
@@ -108,6 +117,7 @@ fn literal(p: &Param, rng: &mut Rng) -> Option<String> {
         Ty::FieldNum => FIELDS[rng.below(FIELDS.len())].to_string(),
         Ty::FieldVec => MAPS[rng.below(MAPS.len())].to_string(),
         Ty::Bounds => "[[-0.9, -0.8, -0.7], [0.8, 0.9, 1]]".into(),
+        Ty::Profile => PROFILES[rng.below(PROFILES.len())].to_string(),
     })
 }
 

@@ -285,3 +285,30 @@ pub fn domain_operations_cover_what_they_describe(mode: Mode) {
         assert_eq!(off, 0, "{mode:?}: {op} and {shape} disagree on {off} pixels away from the silhouette");
     }
 }
+
+/// Sweeps cover what the solids they describe cover, in every mode: a rectangle
+/// extruded is a box (`u`, `v` as `x`, `z`; along `y`), a disc extruded a cylinder, a
+/// disc revolved a sphere, a rectangle off the axis revolved a tube, and an L extruded
+/// the L of two boxes (a concave polygon's exact distance).
+pub fn sweeps_cover_what_they_describe(mode: Mode) {
+    let reach = if mode == Mode::Sdf { 1 } else { 2 };
+    let cases = [
+        ("box(0.7, 0.4, 0.3) rotate [20, 30, 0]", "extrude(rect(0.7, 0.3), 0.4) rotate [20, 30, 0]"),
+        ("cylinder(0.6, 0.5) rotate [30, 0, 0]", "extrude(circle(0.6), 0.5) rotate [30, 0, 0]"),
+        ("sphere(0.8)", "revolve(circle(0.8))"),
+        (
+            "subtract(cylinder(0.9, 0.5), cylinder(0.5, 0.6)) rotate [-40, 0, 0]",
+            "revolve(polygon([[0.5, -0.5], [0.9, -0.5], [0.9, 0.5], [0.5, 0.5]])) rotate [-40, 0, 0]",
+        ),
+        (
+            "union(box(0.8, 0.2, 0.2) at [0, 0, -0.6], box(0.2, 0.2, 0.8) at [-0.6, 0, 0]) rotate [-50, 0, 0]",
+            "extrude(polygon([[-0.8, -0.8], [0.8, -0.8], [0.8, -0.4], [-0.4, -0.4], [-0.4, 0.8], [-0.8, 0.8]]), 0.2) rotate [-50, 0, 0]",
+        ),
+    ];
+    for (shape, sweep) in cases {
+        let (a, b) = (covered(shape, mode), covered(sweep, mode));
+        assert!(a.iter().filter(|&&c| c).count() > 30, "{mode:?}: {shape} covers too little to compare");
+        let off = disagreements_off_edges(&a, &b, reach);
+        assert_eq!(off, 0, "{mode:?}: {sweep} and {shape} disagree on {off} pixels away from the silhouette");
+    }
+}

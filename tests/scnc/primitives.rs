@@ -29,6 +29,7 @@ fn argument(ty: Ty) -> &'static str {
         Ty::FieldNum => "p => length(p) - 0.5",
         Ty::FieldVec => "p => p * [1, 1.5, 1]",
         Ty::Bounds => "[[-1, -1, -1], [1, 1, 1]]",
+        Ty::Profile => "rect(0.4, 0.3)",
     }
 }
 
@@ -50,7 +51,11 @@ fn call(b: &Builtin) -> String {
             .iter()
             .filter(|p| p.default == scnc::check::builtins::Default::Required)
             // `symmetric`'s axes are a string that is not a path.
-            .map(|p| if p.name == "axes" { "\"xz\"".to_string() } else { argument(p.ty).to_string() }),
+            .map(|p| match p.name {
+                "axes" => "\"xz\"".to_string(),
+                "points" => "[[0.1, 0], [0.6, 0], [0.3, 0.5]]".to_string(),
+                _ => argument(p.ty).to_string(),
+            }),
     );
     if b.params.iter().any(|p| p.ty == Ty::Bounds) {
         args.push(format!("bounds = {}", argument(Ty::Bounds)));

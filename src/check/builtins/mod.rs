@@ -46,6 +46,8 @@ pub enum Ctor {
     Modifier(Modifier),
     /// A shape from a field literal.
     Field(FieldFn),
+    /// A 2D profile, or a sweep of one into a shape.
+    Profile(ProfileFn),
     /// `dist(shape, q)`, inside a field's body.
     Dist,
     /// `noise3(q, size, seed)`.
@@ -97,6 +99,17 @@ pub enum FieldFn {
     Elongate,
     Symmetric,
     Polar,
+}
+
+/// The profiles and sweeps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(missing_docs, reason = "each variant is the builtin of the same name, documented in BUILTINS")]
+pub enum ProfileFn {
+    Circle,
+    Rect,
+    Polygon,
+    Extrude,
+    Revolve,
 }
 
 /// The patterns.
@@ -217,6 +230,7 @@ impl Builtin {
             | Ctor::Vector(_)
             | Ctor::Extreme(_)
             | Ctor::Field(_)
+            | Ctor::Profile(_)
             | Ctor::Dist
             | Ctor::Noise3
             | Ctor::Len => Kind::Function,

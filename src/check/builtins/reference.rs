@@ -7,10 +7,11 @@ use super::{Builtin, Ctor, BUILTINS, CONSTANTS};
 use crate::sig::{Default, Ty};
 
 /// The sections of the reference, in order.
-const SECTIONS: [&str; 8] = [
+const SECTIONS: [&str; 9] = [
     "Primitives",
     "Operators and modifiers",
     "Fields",
+    "Profiles and sweeps",
     "Materials, colours and patterns",
     "Lights",
     "Numbers, vectors and lists",
@@ -25,11 +26,12 @@ fn section(b: &Builtin) -> usize {
         Ctor::Primitive(_) => 0,
         Ctor::Csg(_) | Ctor::Modifier(_) => 1,
         Ctor::Field(_) | Ctor::Dist | Ctor::Noise3 => 2,
-        Ctor::Material | Ctor::Rgb | Ctor::Pattern(_) => 3,
-        Ctor::Light(_) => 4,
-        Ctor::Math(_) | Ctor::Numeric(_) | Ctor::Vector(_) | Ctor::Extreme(_) | Ctor::Len => 5,
-        Ctor::Generator(_) => 6,
-        Ctor::Camera | Ctor::Render => 7,
+        Ctor::Profile(_) => 3,
+        Ctor::Material | Ctor::Rgb | Ctor::Pattern(_) => 4,
+        Ctor::Light(_) => 5,
+        Ctor::Math(_) | Ctor::Numeric(_) | Ctor::Vector(_) | Ctor::Extreme(_) | Ctor::Len => 6,
+        Ctor::Generator(_) => 7,
+        Ctor::Camera | Ctor::Render => 8,
     }
 }
 

@@ -4,7 +4,7 @@
 
 use std::sync::LazyLock;
 
-use super::{Builtin, Ctor, Extreme, FieldFn, Gen, LightFn, MathFn, Modifier, NumFn, PatternFn, Ty, VecFn};
+use super::{Builtin, Ctor, Extreme, FieldFn, Gen, LightFn, MathFn, Modifier, NumFn, PatternFn, ProfileFn, Ty, VecFn};
 use crate::check::construct::domain::{BendArgs, ElongateArgs, PolarArgs, SymmetricArgs, TwistArgs};
 use crate::check::construct::fields::{DisplaceArgs, DistArgs, FieldArgs, Noise3Args, WarpArgs};
 use crate::check::construct::maths::{
@@ -13,6 +13,7 @@ use crate::check::construct::maths::{
 use crate::check::construct::meshes::{
     BoxMeshArgs, CylinderMeshArgs, FileArgs, IcoSphereArgs, IsosurfaceArgs, PlaneMeshArgs, TorusMeshArgs, UvSphereArgs,
 };
+use crate::check::construct::profiles::{CircleArgs, ExtrudeArgs, PolygonArgs, RectArgs, RevolveArgs};
 use crate::check::construct::shapes::{CsgArgs, RepeatArgs, RoundArgs, ShellArgs};
 use crate::check::construct::values::{
     AmbientArgs, CheckerArgs, DirectionalArgs, GradientArgs, MaterialArgs, NoiseArgs, PointArgs, RgbArgs, StripesArgs,
@@ -153,6 +154,30 @@ static REST: &[Builtin] = &[
         PolarArgs::PARAMS,
         Ty::Shape,
         "`count` copies of the shape about `y`, `360 / count` degrees apart, the shape itself the one on `+x`",
+    ),
+    // Profiles and sweeps.
+    f("circle", Ctor::Profile(ProfileFn::Circle), CircleArgs::PARAMS, Ty::Profile, "a disc of radius `r` about the origin of the `[u, v]` plane"),
+    f("rect", Ctor::Profile(ProfileFn::Rect), RectArgs::PARAMS, Ty::Profile, "a rectangle `2 * half_u` by `2 * half_v` about the origin of the `[u, v]` plane"),
+    f(
+        "polygon",
+        Ctor::Profile(ProfileFn::Polygon),
+        PolygonArgs::PARAMS,
+        Ty::Profile,
+        "a simple polygon through `points`, either winding, with an exact signed distance",
+    ),
+    f(
+        "extrude",
+        Ctor::Profile(ProfileFn::Extrude),
+        ExtrudeArgs::PARAMS,
+        Ty::Shape,
+        "the profile's `[u, v]` as `x` and `z`, extruded along `y` from `-half_height` to `half_height` (POV-Ray's prism)",
+    ),
+    f(
+        "revolve",
+        Ctor::Profile(ProfileFn::Revolve),
+        RevolveArgs::PARAMS,
+        Ty::Shape,
+        "the profile's `[u, v]` as radius and height, revolved about `y` (POV-Ray's lathe); parts at `u < 0` are clipped",
     ),
     f("dist", Ctor::Dist, DistArgs::PARAMS, Ty::Num, "inside a field's body, the shape's signed distance at `q`"),
     f(

@@ -7,6 +7,7 @@ pub(super) mod domain;
 pub(super) mod fields;
 pub(super) mod maths;
 pub(super) mod meshes;
+pub(crate) mod profiles;
 pub(super) mod shapes;
 pub(super) mod values;
 
@@ -208,6 +209,7 @@ impl Ctx<'_> {
                 let kind = self.domain_shape(f, &a, a.call);
                 self.shape(kind, a.call)
             }
+            Ctor::Profile(f) => self.profile(f, &a),
             Ctor::Dist => self.dist(&a),
             Ctor::Noise3 => self.noise3(&a),
             Ctor::Material => self.material(&a),

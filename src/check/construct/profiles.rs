@@ -1,0 +1,310 @@
+//! 2D profiles and the sweeps that make solids of them: `circle`, `rect` and `polygon`
+//! (exact signed distances in the `[u, v]` plane), `extrude` (POV-Ray's `prism`: `u`, `v`
+//! are the solid's `x` and `z`, extruded along `y`) and `revolve` (POV-Ray's `lathe`: `u`,
+//! `v` are the radius and the height, revolved about `y`). A profile is a field
+//! expression of the point `[u, v, 0]`; a sweep substitutes the solid's point into it
+//! and is a `field` with bound 1, exact where the profile is.
+
+use std::sync::Arc;
+
+use glam::{DVec2, DVec3};
+
+use crate::check::builtins::ProfileFn;
+use crate::check::expr::BoundArgs;
+use crate::check::{Ctx, Value};
+use crate::diag::{codes, Diagnostic};
+use crate::geom::Aabb;
+use crate::ir::field::{Binary, Expr, Kind, Ty, Unary};
+use crate::ir::{Lipschitz, ShapeKind};
+use crate::sig::Range;
+use crate::span::Span;
+
+/// A 2D shape: its signed distance as an expression of the point `[u, v, 0]`, and its box.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Profile {
+    /// The signed distance, exact.
+    pub body: Arc<Expr>,
+    /// Smallest corner `[u, v]`.
+    pub min: DVec2,
+    /// Largest corner `[u, v]`.
+    pub max: DVec2,
+}
+
+crate::params! {
+    /// `circle(r)`.
+    pub struct CircleArgs {
+        /// the radius
+        r: f64 as Num = required, Range::POSITIVE;
+    }
+}
+
+crate::params! {
+    /// `rect(half_u, half_v)`.
+    pub struct RectArgs {
+        /// half the width along `u`
+        half_u: f64 as Num = required, Range::POSITIVE;
+        /// half the height along `v`
+        half_v: f64 as Num = required, Range::POSITIVE;
+    }
+}
+
+crate::params! {
+    /// `polygon(points)`.
+    pub struct PolygonArgs {
+        /// the corners `[[u, v], …]` in order, either winding; the last joins the first
+        points: Value as List = required;
+    }
+}
+
+crate::params! {
+    /// `extrude(profile, half_height)`.
+    pub struct ExtrudeArgs {
+        /// the profile: its `u` and `v` are the solid's `x` and `z`
+        profile: Value as Profile = required;
+        /// the solid runs from `y = -half_height` to `y = half_height`
+        half_height: f64 as Num = required, Range::POSITIVE;
+    }
+}
+
+crate::params! {
+    /// `revolve(profile)`.
+    pub struct RevolveArgs {
+        /// the profile: its `u` is the distance from the `y` axis, its `v` the height
+        profile: Value as Profile = required;
+    }
+}
+
+/// Most corners of one polygon (its distance takes a few operations per edge).
+pub const MAX_POLYGON_POINTS: usize = 1000;
+
+fn un(f: Unary, x: &Arc<Expr>) -> Arc<Expr> {
+    Expr::unary(f, x.clone()).unwrap_or_else(|| Expr::num(f64::NAN))
+}
+
+fn bin(f: Binary, a: &Arc<Expr>, b: &Arc<Expr>) -> Arc<Expr> {
+    Expr::binary(f, a.clone(), b.clone()).unwrap_or_else(|| Expr::num(f64::NAN))
+}
+
+fn comp(p: &Arc<Expr>, k: usize) -> Arc<Expr> {
+    Expr::new(Kind::Component(p.clone(), k), Ty::Num)
+}
+
+fn vec2(a: Arc<Expr>, b: Arc<Expr>) -> Arc<Expr> {
+    Expr::new(Kind::Vector([a, b, Expr::num(0.0)]), Ty::Vec3)
+}
+
+fn num(x: f64) -> Arc<Expr> {
+    Expr::num(x)
+}
+
+/// `min(max(a, b), 0) + |[max(a, 0), max(b, 0)]|`: the exact distance of the
+/// intersection of two slabs' distances `a` and `b` taken along orthogonal directions.
+fn corner(a: &Arc<Expr>, b: &Arc<Expr>) -> Arc<Expr> {
+    let zero = num(0.0);
+    let inside = bin(Binary::Min, &bin(Binary::Max, a, b), &zero);
+    let outside = un(Unary::Length, &vec2(bin(Binary::Max, a, &zero), bin(Binary::Max, b, &zero)));
+    bin(Binary::Add, &inside, &outside)
+}
+
+/// Whether segments `a0 a1` and `b0 b1` cross or touch.
+fn segments_meet(a0: DVec2, a1: DVec2, b0: DVec2, b1: DVec2) -> bool {
+    let side = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
+    let on = |p: DVec2, q: DVec2, r: DVec2| r.cmpge(p.min(q)).all() && r.cmple(p.max(q)).all();
+    let (d1, d2) = (side(b0, b1, a0), side(b0, b1, a1));
+    let (d3, d4) = (side(a0, a1, b0), side(a0, a1, b1));
+    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0)) && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0)) {
+        return true;
+    }
+    (d1 == 0.0 && on(b0, b1, a0))
+        || (d2 == 0.0 && on(b0, b1, a1))
+        || (d3 == 0.0 && on(a0, a1, b0))
+        || (d4 == 0.0 && on(a0, a1, b1))
+}
+
+impl Ctx<'_> {
+    /// A profile builtin's value (a profile, or a sweep's shape), or poison after reporting.
+    pub(in crate::check) fn profile(&mut self, f: ProfileFn, a: &BoundArgs) -> Value {
+        let p = Expr::point();
+        let (u, v) = (comp(&p, 0), comp(&p, 1));
+        let made = match f {
+            ProfileFn::Circle => {
+                let CircleArgs { r } = CircleArgs::from_args(a);
+                let body = bin(Binary::Sub, &un(Unary::Length, &p), &num(r));
+                Some(Profile { body, min: DVec2::splat(-r), max: DVec2::splat(r) })
+            }
+            ProfileFn::Rect => {
+                let RectArgs { half_u, half_v } = RectArgs::from_args(a);
+                let qu = bin(Binary::Sub, &un(Unary::Abs, &u), &num(half_u));
+                let qv = bin(Binary::Sub, &un(Unary::Abs, &v), &num(half_v));
+                let h = DVec2::new(half_u, half_v);
+                Some(Profile { body: corner(&qu, &qv), min: -h, max: h })
+            }
+            ProfileFn::Polygon => {
+                let PolygonArgs { points } = PolygonArgs::from_args(a);
+                self.polygon(&points, a.span_of("points")).map(|(body, min, max)| Profile { body, min, max })
+            }
+            ProfileFn::Extrude | ProfileFn::Revolve => {
+                return match self.sweep(f, a) {
+                    Some(kind) => self.shape(Some(kind), a.call),
+                    None => Value::Error,
+                };
+            }
+        };
+        made.map_or(Value::Error, |p| Value::Profile(Arc::new(p)))
+    }
+
+    /// `extrude` or `revolve` as a field of the solid's point, or `None` after reporting.
+    fn sweep(&mut self, f: ProfileFn, a: &BoundArgs) -> Option<ShapeKind> {
+        let p = Expr::point();
+        let (x, y, z) = (comp(&p, 0), comp(&p, 1), comp(&p, 2));
+        let exact = Lipschitz { value: 1.0, given: false };
+        match f {
+            ProfileFn::Extrude => {
+                let ExtrudeArgs { profile: Value::Profile(profile), half_height: h } = ExtrudeArgs::from_args(a) else {
+                    return None;
+                };
+                let d2 = profile.body.substitute(&vec2(x, z));
+                let dy = bin(Binary::Sub, &un(Unary::Abs, &y), &num(h));
+                let bounds = Aabb {
+                    min: DVec3::new(profile.min.x, -h, profile.min.y),
+                    max: DVec3::new(profile.max.x, h, profile.max.y),
+                };
+                Some(ShapeKind::Field { body: corner(&d2, &dy), bounds: Some(bounds), lipschitz: exact })
+            }
+            ProfileFn::Revolve => {
+                let RevolveArgs { profile: Value::Profile(profile) } = RevolveArgs::from_args(a) else {
+                    return None;
+                };
+                if profile.max.x <= 0.0 {
+                    self.report(
+                        Diagnostic::error(
+                            codes::OUT_OF_RANGE,
+                            a.span_of("profile"),
+                            "this profile has nothing to revolve",
+                            format!("it lies at u ≤ 0 (up to u = {})", crate::sig::short(profile.max.x)),
+                        )
+                        .with_note("`revolve` turns the part of a profile at u > 0 (the radius) about the y axis")
+                        .with_hint("move the profile to positive u"),
+                    );
+                    return None;
+                }
+                // The radius is never negative: a part of the profile at u < 0 is never
+                // reached (it is clipped), and the distance stays a bound.
+                let radius = un(Unary::Length, &Expr::new(Kind::Vector([x, num(0.0), z]), Ty::Vec3));
+                let body = profile.body.substitute(&vec2(radius, y));
+                let r = profile.max.x;
+                let bounds = Aabb { min: DVec3::new(-r, profile.min.y, -r), max: DVec3::new(r, profile.max.y, r) };
+                Some(ShapeKind::Field { body, bounds: Some(bounds), lipschitz: exact })
+            }
+            ProfileFn::Circle | ProfileFn::Rect | ProfileFn::Polygon => None,
+        }
+    }
+
+    /// A simple polygon's exact signed distance (Quilez's: the nearest edge, the sign by
+    /// the crossing count) and box, or `None` after reporting a bad polygon.
+    fn polygon(&mut self, points: &Value, span: Span) -> Option<(Arc<Expr>, DVec2, DVec2)> {
+        let bad = |this: &mut Self, what: String, label: &str| {
+            this.report(
+                Diagnostic::error(codes::OUT_OF_RANGE, span, what, label)
+                    .with_note("a polygon is three or more corners `[u, v]`, its edges meeting only at their ends"),
+            );
+            None
+        };
+        let Value::List(items) = points else { return None };
+        let mut corners = Vec::with_capacity(items.len());
+        for (i, item) in items.iter().enumerate() {
+            let xy = match item {
+                Value::List(c) if c.len() == 2 => match (&c[0], &c[1]) {
+                    (Value::Num(u), Value::Num(v)) if u.is_finite() && v.is_finite() => Some(DVec2::new(*u, *v)),
+                    _ => None,
+                },
+                Value::Error => return None,
+                _ => None,
+            };
+            let Some(xy) = xy else {
+                return bad(self, format!("corner {} is not a point `[u, v]`", i + 1), "every corner is two numbers");
+            };
+            corners.push(xy);
+        }
+        let n = corners.len();
+        if n < 3 {
+            return bad(self, format!("a polygon needs 3 corners, this has {n}"), "too few corners");
+        }
+        if n > MAX_POLYGON_POINTS {
+            return bad(self, format!("a polygon may have at most {MAX_POLYGON_POINTS} corners"), "too many corners");
+        }
+        let edge = |i: usize| (corners[i], corners[(i + 1) % n]);
+        if let Some(i) = (0..n).find(|&i| edge(i).0 == edge(i).1) {
+            let what = format!("edge {} has no length: corners {} and {} are equal", i + 1, i + 1, (i + 1) % n + 1);
+            return bad(self, what, "a repeated corner");
+        }
+        for i in 0..n {
+            let (a0, a1) = edge(i);
+            for j in i + 1..n {
+                // Neighbouring edges share a corner; they may only meet there.
+                let adjacent = j == i + 1 || (i == 0 && j == n - 1);
+                let (b0, b1) = edge(j);
+                let meet = if adjacent {
+                    let shared = if j == i + 1 { a1 } else { a0 };
+                    let (other_a, other_b) = if j == i + 1 { (a0, b1) } else { (a1, b0) };
+                    // Folded back on itself: the two edges overlap beyond the shared corner.
+                    (other_a - shared).perp_dot(other_b - shared) == 0.0
+                        && (other_a - shared).dot(other_b - shared) > 0.0
+                } else {
+                    segments_meet(a0, a1, b0, b1)
+                };
+                if meet {
+                    return bad(
+                        self,
+                        format!("edges {} and {} of the polygon cross", i + 1, j + 1),
+                        "a polygon's edges may meet only at shared corners",
+                    );
+                }
+            }
+        }
+        let area: f64 = (0..n).map(|i| corners[i].perp_dot(corners[(i + 1) % n])).sum::<f64>() / 2.0;
+        if area == 0.0 {
+            return bad(self, "the polygon has no area".into(), "its corners lie on a line");
+        }
+        let p = Expr::point();
+        let (u, v) = (comp(&p, 0), comp(&p, 1));
+        let zero = num(0.0);
+        let (mut d2, mut sign): (Option<Arc<Expr>>, Arc<Expr>) = (None, num(1.0));
+        for i in 0..n {
+            let (vi, vj) = (corners[i], corners[(i + n - 1) % n]);
+            let e = vj - vi;
+            // w = p − vi; b = w − e·clamp(w·e / e·e, 0, 1); the squared distance b·b.
+            let (wu, wv) = (bin(Binary::Sub, &u, &num(vi.x)), bin(Binary::Sub, &v, &num(vi.y)));
+            let t = bin(
+                Binary::Div,
+                &bin(Binary::Add, &bin(Binary::Mul, &wu, &num(e.x)), &bin(Binary::Mul, &wv, &num(e.y))),
+                &num(e.dot(e)),
+            );
+            let t = bin(Binary::Min, &bin(Binary::Max, &t, &zero), &num(1.0));
+            let (bu, bv) = (
+                bin(Binary::Sub, &wu, &bin(Binary::Mul, &t, &num(e.x))),
+                bin(Binary::Sub, &wv, &bin(Binary::Mul, &t, &num(e.y))),
+            );
+            let bb = bin(Binary::Add, &bin(Binary::Mul, &bu, &bu), &bin(Binary::Mul, &bv, &bv));
+            d2 = Some(match d2 {
+                Some(d) => bin(Binary::Min, &d, &bb),
+                None => bb,
+            });
+            // The edge crosses the horizontal ray from p: the sign flips.
+            let c1 = bin(Binary::Ge, &v, &num(vi.y));
+            let c2 = bin(Binary::Lt, &v, &num(vj.y));
+            let c3 = bin(Binary::Gt, &bin(Binary::Mul, &num(e.x), &wv), &bin(Binary::Mul, &num(e.y), &wu));
+            let all = bin(Binary::And, &bin(Binary::And, &c1, &c2), &c3);
+            let none =
+                bin(Binary::And, &bin(Binary::And, &un(Unary::Not, &c1), &un(Unary::Not, &c2)), &un(Unary::Not, &c3));
+            let flip = bin(Binary::Or, &all, &none);
+            let factor = Expr::new(Kind::Select(flip, num(-1.0), num(1.0)), Ty::Num);
+            sign = bin(Binary::Mul, &sign, &factor);
+        }
+        let d = un(Unary::Sqrt, &d2.unwrap_or_else(|| num(0.0)));
+        let body = bin(Binary::Mul, &sign, &d);
+        let min = corners.iter().fold(DVec2::INFINITY, |m, c| m.min(*c));
+        let max = corners.iter().fold(DVec2::NEG_INFINITY, |m, c| m.max(*c));
+        Some((body, min, max))
+    }
+}
