@@ -134,10 +134,15 @@ impl Ctx<'_> {
         };
         let found = arg.value.ty_name();
         let expected: Vec<String> = all.iter().map(|o| format!("`{}`", o.params[0].ty)).collect();
+        // `a or b`, `a, b or c`.
+        let listed = match expected.split_last() {
+            Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
+            _ => expected.join(""),
+        };
         let mut d = Diagnostic::error(
             codes::TYPE_MISMATCH,
             arg.span,
-            format!("expected {}, found `{found}`", expected.join(" or ")),
+            format!("expected {listed}, found `{found}`"),
             format!("this is a `{found}`"),
         );
         for o in all {

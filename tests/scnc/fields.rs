@@ -288,7 +288,8 @@ pub fn domain_operations_cover_what_they_describe(mode: Mode) {
 
 /// Sweeps cover what the solids they describe cover, in every mode: a rectangle
 /// extruded is a box (`u`, `v` as `x`, `z`; along `y`), a disc extruded a cylinder, a
-/// disc revolved a sphere, a rectangle off the axis revolved a tube, and an L extruded
+/// disc revolved a sphere, a rectangle off the axis revolved a tube, a disc's outline
+/// (`shell`) extruded a pipe, a disc grown by `round` a wider cylinder, and an L extruded
 /// the L of two boxes (a concave polygon's exact distance).
 pub fn sweeps_cover_what_they_describe(mode: Mode) {
     let reach = if mode == Mode::Sdf { 1 } else { 2 };
@@ -296,6 +297,11 @@ pub fn sweeps_cover_what_they_describe(mode: Mode) {
         ("box(0.7, 0.4, 0.3) rotate [20, 30, 0]", "extrude(rect(0.7, 0.3), 0.4) rotate [20, 30, 0]"),
         ("cylinder(0.6, 0.5) rotate [30, 0, 0]", "extrude(circle(0.6), 0.5) rotate [30, 0, 0]"),
         ("sphere(0.8)", "revolve(circle(0.8))"),
+        (
+            "subtract(cylinder(0.7, 0.5), cylinder(0.5, 0.6)) rotate [-40, 0, 0]",
+            "extrude(shell(circle(0.6), 0.2), 0.5) rotate [-40, 0, 0]",
+        ),
+        ("cylinder(0.8, 0.3) rotate [-30, 0, 0]", "extrude(round(circle(0.5), 0.3), 0.3) rotate [-30, 0, 0]"),
         (
             "subtract(cylinder(0.9, 0.5), cylinder(0.5, 0.6)) rotate [-40, 0, 0]",
             "revolve(polygon([[0.5, -0.5], [0.9, -0.5], [0.9, 0.5], [0.5, 0.5]])) rotate [-40, 0, 0]",

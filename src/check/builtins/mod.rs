@@ -108,6 +108,8 @@ pub enum ProfileFn {
     Circle,
     Rect,
     Polygon,
+    Round,
+    Shell,
     Extrude,
     Revolve,
 }
@@ -309,8 +311,12 @@ mod tests {
                 assert_ne!(a.ctor, b.ctor, "`{}` and `{}` share a constructor", a.name, b.name);
                 if a.name == b.name && a.kind() == b.kind() {
                     let (x, y) = (a.params[0].ty, b.params[0].ty);
-                    let distinct =
-                        [x, y].contains(&Ty::Shape) && x != y && a.variadic.is_none() && b.variadic.is_none();
+                    // Shapes, profiles and numbers are values no parameter of another takes.
+                    let kinds = [Ty::Shape, Ty::Profile];
+                    let distinct = (kinds.contains(&x) || kinds.contains(&y))
+                        && x != y
+                        && a.variadic.is_none()
+                        && b.variadic.is_none();
                     assert!(distinct, "`{}` is listed twice and its overloads cannot be told apart", a.name);
                 }
             }

@@ -13,7 +13,9 @@ use crate::check::construct::maths::{
 use crate::check::construct::meshes::{
     BoxMeshArgs, CylinderMeshArgs, FileArgs, IcoSphereArgs, IsosurfaceArgs, PlaneMeshArgs, TorusMeshArgs, UvSphereArgs,
 };
-use crate::check::construct::profiles::{CircleArgs, ExtrudeArgs, PolygonArgs, RectArgs, RevolveArgs};
+use crate::check::construct::profiles::{
+    CircleArgs, ExtrudeArgs, PolygonArgs, RectArgs, RevolveArgs, RoundProfileArgs, ShellProfileArgs,
+};
 use crate::check::construct::shapes::{CsgArgs, RepeatArgs, RoundArgs, ShellArgs};
 use crate::check::construct::values::{
     AmbientArgs, CheckerArgs, DirectionalArgs, GradientArgs, MaterialArgs, NoiseArgs, PointArgs, RgbArgs, StripesArgs,
@@ -164,6 +166,20 @@ static REST: &[Builtin] = &[
         PolygonArgs::PARAMS,
         Ty::Profile,
         "a simple polygon through `points`, either winding, with an exact signed distance",
+    ),
+    f(
+        "round",
+        Ctor::Profile(ProfileFn::Round),
+        RoundProfileArgs::PARAMS,
+        Ty::Profile,
+        "rounds a profile's corners by growing it by `r`",
+    ),
+    f(
+        "shell",
+        Ctor::Profile(ProfileFn::Shell),
+        ShellProfileArgs::PARAMS,
+        Ty::Profile,
+        "a profile's outline, `thickness` wide, centred on its edge",
     ),
     f(
         "extrude",

@@ -74,6 +74,26 @@ crate::params! {
     }
 }
 
+crate::params! {
+    /// `round(profile, r)`.
+    pub struct RoundProfileArgs {
+        /// the profile to round
+        profile: Value as Profile = required;
+        /// how far the profile grows, rounding its corners by as much
+        r: f64 as Num = required, Range::NONNEG;
+    }
+}
+
+crate::params! {
+    /// `shell(profile, thickness)`.
+    pub struct ShellProfileArgs {
+        /// the profile to hollow into an outline
+        profile: Value as Profile = required;
+        /// the outline's thickness, centred on the edge
+        thickness: f64 as Num = required, Range::POSITIVE;
+    }
+}
+
 /// Most corners of one polygon (its distance takes a few operations per edge).
 pub const MAX_POLYGON_POINTS: usize = 1000;
 
@@ -143,6 +163,21 @@ impl Ctx<'_> {
                 let PolygonArgs { points } = PolygonArgs::from_args(a);
                 self.polygon(&points, a.span_of("points")).map(|(body, min, max)| Profile { body, min, max })
             }
+            ProfileFn::Round => {
+                let RoundProfileArgs { profile: Value::Profile(inner), r } = RoundProfileArgs::from_args(a) else {
+                    return Value::Error;
+                };
+                let body = bin(Binary::Sub, &inner.body, &num(r));
+                Some(Profile { body, min: inner.min - r, max: inner.max + r })
+            }
+            ProfileFn::Shell => {
+                let ShellProfileArgs { profile: Value::Profile(inner), thickness: t } = ShellProfileArgs::from_args(a)
+                else {
+                    return Value::Error;
+                };
+                let body = bin(Binary::Sub, &un(Unary::Abs, &inner.body), &num(t / 2.0));
+                Some(Profile { body, min: inner.min - t / 2.0, max: inner.max + t / 2.0 })
+            }
             ProfileFn::Extrude | ProfileFn::Revolve => {
                 return match self.sweep(f, a) {
                     Some(kind) => self.shape(Some(kind), a.call),
@@ -196,7 +231,7 @@ impl Ctx<'_> {
                 let bounds = Aabb { min: DVec3::new(-r, profile.min.y, -r), max: DVec3::new(r, profile.max.y, r) };
                 Some(ShapeKind::Field { body, bounds: Some(bounds), lipschitz: exact })
             }
-            ProfileFn::Circle | ProfileFn::Rect | ProfileFn::Polygon => None,
+            ProfileFn::Circle | ProfileFn::Rect | ProfileFn::Polygon | ProfileFn::Round | ProfileFn::Shell => None,
         }
     }
 
