@@ -71,16 +71,19 @@ crate::params! {
 /// Most copies a `polar` measures one by one when its shape crosses its sector.
 const MAX_EXACT_COPIES: u32 = 64;
 
-/// Expression builders; every use below is well typed, so a refusal is a bug.
-fn un(f: Unary, x: &Arc<Expr>) -> Arc<Expr> {
+/// Expression builders for maps and bodies written here (also by `profiles`); every use
+/// is well typed, so a refusal would be a bug, shown as NaN rather than a panic.
+pub(super) fn un(f: Unary, x: &Arc<Expr>) -> Arc<Expr> {
     Expr::unary(f, x.clone()).unwrap_or_else(|| Expr::num(f64::NAN))
 }
 
-fn bin(f: Binary, a: &Arc<Expr>, b: &Arc<Expr>) -> Arc<Expr> {
+/// `f(a, b)`, see [`un`].
+pub(super) fn bin(f: Binary, a: &Arc<Expr>, b: &Arc<Expr>) -> Arc<Expr> {
     Expr::binary(f, a.clone(), b.clone()).unwrap_or_else(|| Expr::num(f64::NAN))
 }
 
-fn component(p: &Arc<Expr>, k: usize) -> Arc<Expr> {
+/// Component `k` of a vector expression.
+pub(super) fn component(p: &Arc<Expr>, k: usize) -> Arc<Expr> {
     Expr::new(Kind::Component(p.clone(), k), Ty::Num)
 }
 

@@ -9,6 +9,7 @@ use std::sync::Arc;
 
 use glam::{DVec2, DVec3};
 
+use super::domain::{bin, component, un};
 use crate::check::builtins::ProfileFn;
 use crate::check::expr::BoundArgs;
 use crate::check::{Ctx, Value};
@@ -97,18 +98,6 @@ crate::params! {
 /// Most corners of one polygon (its distance takes a few operations per edge).
 pub const MAX_POLYGON_POINTS: usize = 1000;
 
-fn un(f: Unary, x: &Arc<Expr>) -> Arc<Expr> {
-    Expr::unary(f, x.clone()).unwrap_or_else(|| Expr::num(f64::NAN))
-}
-
-fn bin(f: Binary, a: &Arc<Expr>, b: &Arc<Expr>) -> Arc<Expr> {
-    Expr::binary(f, a.clone(), b.clone()).unwrap_or_else(|| Expr::num(f64::NAN))
-}
-
-fn comp(p: &Arc<Expr>, k: usize) -> Arc<Expr> {
-    Expr::new(Kind::Component(p.clone(), k), Ty::Num)
-}
-
 fn vec2(a: Arc<Expr>, b: Arc<Expr>) -> Arc<Expr> {
     Expr::new(Kind::Vector([a, b, Expr::num(0.0)]), Ty::Vec3)
 }
@@ -145,7 +134,7 @@ impl Ctx<'_> {
     /// A profile builtin's value (a profile, or a sweep's shape), or poison after reporting.
     pub(in crate::check) fn profile(&mut self, f: ProfileFn, a: &BoundArgs) -> Value {
         let p = Expr::point();
-        let (u, v) = (comp(&p, 0), comp(&p, 1));
+        let (u, v) = (component(&p, 0), component(&p, 1));
         let made = match f {
             ProfileFn::Circle => {
                 let CircleArgs { r } = CircleArgs::from_args(a);
@@ -191,7 +180,7 @@ impl Ctx<'_> {
     /// `extrude` or `revolve` as a field of the solid's point, or `None` after reporting.
     fn sweep(&mut self, f: ProfileFn, a: &BoundArgs) -> Option<ShapeKind> {
         let p = Expr::point();
-        let (x, y, z) = (comp(&p, 0), comp(&p, 1), comp(&p, 2));
+        let (x, y, z) = (component(&p, 0), component(&p, 1), component(&p, 2));
         let exact = Lipschitz { value: 1.0, given: false };
         match f {
             ProfileFn::Extrude => {
@@ -302,7 +291,7 @@ impl Ctx<'_> {
             return bad(self, "the polygon has no area".into(), "its corners lie on a line");
         }
         let p = Expr::point();
-        let (u, v) = (comp(&p, 0), comp(&p, 1));
+        let (u, v) = (component(&p, 0), component(&p, 1));
         let zero = num(0.0);
         let (mut d2, mut sign): (Option<Arc<Expr>>, Arc<Expr>) = (None, num(1.0));
         for i in 0..n {
