@@ -50,7 +50,7 @@ pub enum Value {
     /// A field literal `p => …`, its body evaluated.
     Field(Rc<FieldLit>),
     /// A 2D profile.
-    Profile(Arc<crate::check::construct::profiles::Profile>),
+    Profile(Arc<Profile>),
     /// Poison.
     Error,
 }
@@ -150,4 +150,15 @@ impl Value {
     pub fn is_error(&self) -> bool {
         matches!(self, Value::Error)
     }
+}
+
+/// A 2D shape: its signed distance as an expression of the point `[u, v, 0]`, and its box.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Profile {
+    /// The signed distance, exact.
+    pub body: Arc<ir::field::Expr>,
+    /// Smallest corner `[u, v]`.
+    pub min: glam::DVec2,
+    /// Largest corner `[u, v]`.
+    pub max: glam::DVec2,
 }

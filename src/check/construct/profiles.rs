@@ -12,6 +12,7 @@ use glam::{DVec2, DVec3};
 use super::domain::{bin, component, un};
 use crate::check::builtins::ProfileFn;
 use crate::check::expr::BoundArgs;
+use crate::check::value::Profile;
 use crate::check::{Ctx, Value};
 use crate::diag::{codes, Diagnostic};
 use crate::geom::Aabb;
@@ -19,17 +20,6 @@ use crate::ir::field::{Binary, Expr, Kind, Ty, Unary};
 use crate::ir::{Lipschitz, ShapeKind};
 use crate::sig::Range;
 use crate::span::Span;
-
-/// A 2D shape: its signed distance as an expression of the point `[u, v, 0]`, and its box.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Profile {
-    /// The signed distance, exact.
-    pub body: Arc<Expr>,
-    /// Smallest corner `[u, v]`.
-    pub min: DVec2,
-    /// Largest corner `[u, v]`.
-    pub max: DVec2,
-}
 
 crate::params! {
     /// `circle(r)`.
