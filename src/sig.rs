@@ -292,8 +292,12 @@ impl Param {
 }
 
 /// Formats a number with at most 12 decimals, trailing zeros trimmed and `-0` as `0`,
-/// so dumps do not change with the last bits of a rotation matrix.
+/// so dumps do not change with the last bits of a rotation matrix; from 1e16 on (where
+/// f64 no longer holds every whole number) in exponent form, not 300 digits.
 pub fn num(x: f64) -> String {
+    if x.is_finite() && x.abs() >= 1e16 {
+        return format!("{x:e}");
+    }
     let s = format!("{x:.12}");
     let s = s.trim_end_matches('0').trim_end_matches('.');
     if s == "-0" {

@@ -460,6 +460,19 @@ impl Ctx<'_> {
     fn int_operand(&mut self, v: &Value, span: Span, what: &str) -> Option<i64> {
         match v {
             Value::Num(x) if x.fract() == 0.0 && x.abs() <= 1e15 => Some(*x as i64),
+            Value::Num(x) if x.fract() == 0.0 => {
+                // Past 2^53 not every whole number exists as a number: say so, not "whole".
+                self.report(
+                    Diagnostic::error(
+                        codes::NOT_INTEGER,
+                        span,
+                        format!("{what} is too large"),
+                        format!("this is {}", ir::dump_num(*x)),
+                    )
+                    .with_note("loop bounds must lie within ±1e15: past 2^53 (about 9e15) numbers skip whole values"),
+                );
+                None
+            }
             Value::Num(x) => {
                 self.report(
                     Diagnostic::error(

@@ -205,7 +205,10 @@ impl Ctx<'_> {
             }
             PatternFn::Gradient => {
                 let GradientArgs { a: pa, b: pb, from, to } = GradientArgs::from_args(a);
-                let kind = if crate::check::direction(to - from).is_none() {
+                let kind = if !(to - from).is_finite() {
+                    self.range_error(a.span_of("to"), "to", "a point within 1e308 of `from`", dump_vec(to));
+                    None
+                } else if crate::check::direction(to - from).is_none() {
                     self.range_error(a.span_of("to"), "to", "a point other than `from`", dump_vec(to));
                     None
                 } else {
