@@ -242,7 +242,7 @@ impl Ctx<'_> {
         let num = |v: &Value| matches!(v, Value::Num(_)) || matches!(v, Value::Sym(e) if e.ty == FTy::Num);
         if values.len() == 3 && values.iter().all(|(v, _)| num(v)) {
             let c = |i: usize| values[i].0.as_field().unwrap_or_else(|| crate::ir::field::Expr::num(0.0));
-            return Value::Sym(super::field::vector([c(0), c(1), c(2)]));
+            return Value::Sym(crate::ir::field::Expr::vector([c(0), c(1), c(2)]));
         }
         self.uniform_list(values).unwrap_or(Value::Error)
     }

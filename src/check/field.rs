@@ -343,8 +343,3 @@ fn component(e: &Arc<Expr>, i: usize) -> Arc<Expr> {
         _ => Expr::new(Kind::Component(e.clone(), i), Ty::Num),
     }
 }
-
-/// The vector `[x, y, z]` of three numbers, some depending on the point.
-pub(super) fn vector(xs: [Arc<Expr>; 3]) -> Arc<Expr> {
-    Expr::new(Kind::Vector(xs), Ty::Vec3)
-}

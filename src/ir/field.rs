@@ -361,6 +361,16 @@ impl Expr {
         Expr::new(Kind::Vec(v), Ty::Vec3)
     }
 
+    /// The vector `[x, y, z]` of three number expressions.
+    pub fn vector(xs: [Arc<Expr>; 3]) -> Arc<Expr> {
+        Expr::new(Kind::Vector(xs), Ty::Vec3)
+    }
+
+    /// Component `k` (0, 1, 2 for x, y, z) of a vector expression.
+    pub fn component(v: &Arc<Expr>, k: usize) -> Arc<Expr> {
+        Expr::new(Kind::Component(v.clone(), k), Ty::Num)
+    }
+
     /// `f(x)`; `None` if `f` takes no operand of `x`'s type.
     pub fn unary(f: Unary, x: Arc<Expr>) -> Option<Arc<Expr>> {
         let ty = f.ty(x.ty)?;

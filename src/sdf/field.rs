@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use glam::Vec3A;
 
-use super::build::{Sdf, Surf, SurfSdf};
+use super::surf::{Sdf, Surf, SurfSdf};
 use crate::field::{Dir, Distances, Dual, Flat, Interval, Region, Tape};
 use crate::geom::Aabb;
 

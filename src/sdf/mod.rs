@@ -10,13 +10,15 @@ mod build;
 mod field;
 pub mod march;
 pub mod prim;
+mod surf;
 pub mod union;
 
 use glam::{DAffine3, Vec3A};
 
 pub use crate::ir::min_singular_value;
-pub use build::{Builder, Root, Sdf, Surf, SurfSdf};
+pub use build::{Builder, Root};
 pub use march::MarchParams;
+pub use surf::{Sdf, Surf, SurfSdf};
 
 use crate::ir;
 use crate::trace::{Counters, Hit, Packet, Ray};

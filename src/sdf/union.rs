@@ -22,8 +22,8 @@
 
 use glam::{Vec3A, Vec4};
 
-use super::build::Surf;
 use super::prim;
+use super::surf::Surf;
 use crate::accel::{sphere_interval, Aabb, Bvh, Child, Rays4, ROBUST};
 
 /// The field of no part at all: nothing there.

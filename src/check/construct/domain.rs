@@ -82,15 +82,6 @@ pub(super) fn bin(f: Binary, a: &Arc<Expr>, b: &Arc<Expr>) -> Arc<Expr> {
     Expr::binary(f, a.clone(), b.clone()).unwrap_or_else(|| Expr::num(f64::NAN))
 }
 
-/// Component `k` of a vector expression.
-pub(super) fn component(p: &Arc<Expr>, k: usize) -> Arc<Expr> {
-    Expr::new(Kind::Component(p.clone(), k), Ty::Num)
-}
-
-fn vector(c: [Arc<Expr>; 3]) -> Arc<Expr> {
-    Expr::new(Kind::Vector(c), Ty::Vec3)
-}
-
 /// `[a·cos θ − b·sin θ, a·sin θ + b·cos θ]`: `(a, b)` turned by `θ` degrees.
 fn turn(a: &Arc<Expr>, b: &Arc<Expr>, theta: &Arc<Expr>) -> (Arc<Expr>, Arc<Expr>) {
     let (c, s) = (un(Unary::Cos, theta), un(Unary::Sin, theta));
@@ -110,7 +101,7 @@ impl Ctx<'_> {
     /// A domain operation, or `None` after reporting.
     pub(in crate::check) fn domain_shape(&mut self, f: FieldFn, a: &BoundArgs, span: Span) -> Option<ShapeKind> {
         let p = Expr::point();
-        let (x, y, z) = (component(&p, 0), component(&p, 1), component(&p, 2));
+        let (x, y, z) = (Expr::component(&p, 0), Expr::component(&p, 1), Expr::component(&p, 2));
         let exact = Lipschitz { value: 1.0, given: false };
         match f {
             FieldFn::Twist => {
@@ -123,7 +114,7 @@ impl Ctx<'_> {
                 // −x sin a + z cos a), so back is the other way).
                 let theta = bin(Binary::Mul, &Expr::num(k), &y);
                 let (qx, qz) = turn(&x, &z, &theta);
-                let map = vector([qx, y.clone(), qz]);
+                let map = Expr::vector([qx, y.clone(), qz]);
                 let r = radius_about_y(&b);
                 let bounds = Aabb { min: DVec3::new(-r, b.min.y, -r), max: DVec3::new(r, b.max.y, r) };
                 self.warp(child, map, bounds, span, "this twist")
@@ -137,7 +128,7 @@ impl Ctx<'_> {
                 // y axis, seen where q.x = 0, lies at x = y·tan(k·y): towards +x.
                 let theta = bin(Binary::Mul, &Expr::num(k), &y);
                 let (qx, qy) = turn(&x, &y, &theta);
-                let map = vector([qx, qy, z.clone()]);
+                let map = Expr::vector([qx, qy, z.clone()]);
                 // A turn about the origin keeps the distance from it.
                 let r = b.min.abs().max(b.max.abs()).length();
                 self.warp(child, map, Aabb { min: DVec3::splat(-r), max: DVec3::splat(r) }, span, "this bend")
@@ -149,12 +140,12 @@ impl Ctx<'_> {
                 // q = p − clamp(p, −h, h): the shape's halves moved apart by the slab,
                 // exact outside (Quilez's elongation) and 1-Lipschitz everywhere.
                 let q = [0, 1, 2].map(|k| {
-                    let c = component(&p, k);
+                    let c = Expr::component(&p, k);
                     let clamped = bin(Binary::Max, &bin(Binary::Min, &c, &Expr::num(h[k])), &Expr::num(-h[k]));
                     bin(Binary::Sub, &c, &clamped)
                 });
                 let bounds = ir::shape_bounds(&child).map(|b| Aabb { min: b.min - h, max: b.max + h });
-                Some(ShapeKind::Warp { child, map: vector(q), bounds, lipschitz: exact })
+                Some(ShapeKind::Warp { child, map: Expr::vector(q), bounds, lipschitz: exact })
             }
             FieldFn::Symmetric => {
                 let SymmetricArgs { shape: Value::Shape(child), axes } = SymmetricArgs::from_args(a) else {
@@ -162,7 +153,7 @@ impl Ctx<'_> {
                 };
                 let mirrored = self.axes(&axes, a.span_of("axes"))?;
                 let q = [0, 1, 2].map(|k| {
-                    let c = component(&p, k);
+                    let c = Expr::component(&p, k);
                     if mirrored[k] {
                         un(Unary::Abs, &c)
                     } else {
@@ -177,7 +168,7 @@ impl Ctx<'_> {
                     }
                     Aabb { min: lo, max: hi }
                 });
-                Some(ShapeKind::Warp { child, map: vector(q), bounds, lipschitz: exact })
+                Some(ShapeKind::Warp { child, map: Expr::vector(q), bounds, lipschitz: exact })
             }
             FieldFn::Polar => {
                 let PolarArgs { shape: Value::Shape(child), count } = PolarArgs::from_args(a) else {
@@ -192,7 +183,7 @@ impl Ctx<'_> {
                         // Every copy measured, the nearest taken: exact, `count` times the work.
                         let copies = (0..count).map(|j| {
                             let (qx, qz) = turn(&x, &z, &Expr::num(-w * f64::from(j)));
-                            Expr::new(Kind::Dist(child.clone(), vector([qx, y.clone(), qz])), Ty::Num)
+                            Expr::new(Kind::Dist(child.clone(), Expr::vector([qx, y.clone(), qz])), Ty::Num)
                         });
                         let body = copies.reduce(|a, b| bin(Binary::Min, &a, &b)).unwrap_or_else(|| Expr::num(1.0));
                         return Some(ShapeKind::Field { body, bounds: Some(bounds), lipschitz: exact });
@@ -219,7 +210,7 @@ impl Ctx<'_> {
                 let step = un(Unary::Round, &bin(Binary::Div, &angle, &Expr::num(w)));
                 let back = bin(Binary::Mul, &step, &Expr::num(-w));
                 let (qx, qz) = turn(&x, &z, &back);
-                let map = vector([qx, y.clone(), qz]);
+                let map = Expr::vector([qx, y.clone(), qz]);
                 Some(ShapeKind::Warp { child, map, bounds: Some(bounds), lipschitz: exact })
             }
             FieldFn::Field | FieldFn::Warp | FieldFn::Displace => None,

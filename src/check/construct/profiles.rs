@@ -9,7 +9,7 @@ use std::sync::Arc;
 
 use glam::{DVec2, DVec3};
 
-use super::domain::{bin, component, un};
+use super::domain::{bin, un};
 use crate::check::builtins::ProfileFn;
 use crate::check::expr::BoundArgs;
 use crate::check::value::Profile;
@@ -89,7 +89,7 @@ crate::params! {
 pub const MAX_POLYGON_POINTS: usize = 1000;
 
 fn vec2(a: Arc<Expr>, b: Arc<Expr>) -> Arc<Expr> {
-    Expr::new(Kind::Vector([a, b, Expr::num(0.0)]), Ty::Vec3)
+    Expr::vector([a, b, Expr::num(0.0)])
 }
 
 fn num(x: f64) -> Arc<Expr> {
@@ -124,7 +124,7 @@ impl Ctx<'_> {
     /// A profile builtin's value (a profile, or a sweep's shape), or poison after reporting.
     pub(in crate::check) fn profile(&mut self, f: ProfileFn, a: &BoundArgs) -> Value {
         let p = Expr::point();
-        let (u, v) = (component(&p, 0), component(&p, 1));
+        let (u, v) = (Expr::component(&p, 0), Expr::component(&p, 1));
         let made = match f {
             ProfileFn::Circle => {
                 let CircleArgs { r } = CircleArgs::from_args(a);
@@ -170,7 +170,7 @@ impl Ctx<'_> {
     /// `extrude` or `revolve` as a field of the solid's point, or `None` after reporting.
     fn sweep(&mut self, f: ProfileFn, a: &BoundArgs) -> Option<ShapeKind> {
         let p = Expr::point();
-        let (x, y, z) = (component(&p, 0), component(&p, 1), component(&p, 2));
+        let (x, y, z) = (Expr::component(&p, 0), Expr::component(&p, 1), Expr::component(&p, 2));
         let exact = Lipschitz { value: 1.0, given: false };
         match f {
             ProfileFn::Extrude => {
@@ -204,7 +204,7 @@ impl Ctx<'_> {
                 }
                 // The radius is never negative: a part of the profile at u < 0 is never
                 // reached (it is clipped), and the distance stays a bound.
-                let radius = un(Unary::Length, &Expr::new(Kind::Vector([x, num(0.0), z]), Ty::Vec3));
+                let radius = un(Unary::Length, &Expr::vector([x, num(0.0), z]));
                 let body = profile.body.substitute(&vec2(radius, y));
                 let r = profile.max.x;
                 let bounds = Aabb { min: DVec3::new(-r, profile.min.y, -r), max: DVec3::new(r, profile.max.y, r) };
@@ -281,7 +281,7 @@ impl Ctx<'_> {
             return bad(self, "the polygon has no area".into(), "its corners lie on a line");
         }
         let p = Expr::point();
-        let (u, v) = (component(&p, 0), component(&p, 1));
+        let (u, v) = (Expr::component(&p, 0), Expr::component(&p, 1));
         let zero = num(0.0);
         let (mut d2, mut sign): (Option<Arc<Expr>>, Arc<Expr>) = (None, num(1.0));
         for i in 0..n {
