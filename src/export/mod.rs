@@ -289,9 +289,9 @@ fn too_coarse_for_f32(mesh: &crate::geom::TriMesh) -> Option<String> {
         (extent > 0.0 && extent < MIN_F32_STEPS * step).then(|| {
             format!(
                 "it is {} across its {} axis in the file, where 32-bit coordinates step by {}",
-                mesh::lower::approx(extent),
+                mesh::approx(extent),
                 ["x", "y", "z"][k],
-                mesh::lower::approx(step)
+                mesh::approx(step)
             )
         })
     })

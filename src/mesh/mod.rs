@@ -8,6 +8,8 @@
 //! A plane shape becomes a finite square reaching `max_distance` around the camera.
 
 mod detail;
+mod iso_job;
+pub(crate) use iso_job::approx;
 pub mod isosurface;
 pub mod lower;
 pub mod obj;

@@ -1,0 +1,328 @@
+//! An isosurface made into a mesh job: the cell a detail level stands for, the
+//! extraction within the memory budget, each triangle's material, and the warnings of
+//! what the grid lost (parts, pinched edges, volume), each with the cell that keeps it.
+
+use glam::{DAffine3, Vec3A};
+use rayon::prelude::*;
+
+use super::{isosurface, octree, parts, IsoAccuracy, MeshJob, Normals};
+use crate::diag::{codes, Diagnostic};
+use crate::geom::TriMesh;
+use crate::ir::{self, Shape};
+use crate::sdf::Builder;
+use crate::span::Span;
+use crate::trace::MaterialTable;
+
+/// The cell of an isosurface made at `rings` of detail: a 1/(4·rings) fraction of the
+/// shape's bounding diameter `across`.
+pub(super) fn detail_cell(across: f64, rings: f64) -> f64 {
+    across / (4.0 * rings)
+}
+
+/// The lowest detail whose cell ([`detail_cell`]) is at most `cell`.
+fn detail_for(across: f64, cell: f64) -> f64 {
+    (across / (4.0 * cell)).ceil()
+}
+
+/// A positive length to three significant digits, as people read it.
+pub(crate) fn approx(x: f64) -> String {
+    let scale = 10f64.powi((3 - x.abs().log10().ceil() as i32).clamp(0, 12));
+    short((x * scale).round() / scale)
+}
+
+/// A byte count as people read it: GiB or MiB.
+fn bytes_name(b: u64) -> String {
+    if b >= 1 << 30 {
+        format!("{:.1} GiB", b as f64 / (1u64 << 30) as f64)
+    } else {
+        format!("{} MiB", b >> 20)
+    }
+}
+
+/// A count as people say it: millions above a million, powers of ten above a billion.
+fn millions(n: f64) -> String {
+    if n >= 1e9 {
+        format!("{n:.1e}")
+    } else if n >= 1e6 {
+        format!("{:.1} million", n / 1e6)
+    } else {
+        format!("{}", n.round())
+    }
+}
+
+/// A size as people write it: exponent form when it is huge.
+fn short(x: f64) -> String {
+    if x.abs() >= 1e6 {
+        format!("{x:e}")
+    } else {
+        ir::dump_num(x)
+    }
+}
+
+pub(super) fn unbounded(span: Span) -> Diagnostic {
+    Diagnostic::error(codes::LOWERING, span, "cannot tessellate an unbounded shape", "this shape has no finite extent")
+        .with_note("an isosurface needs finite bounds; only a bare `plane` is meshed as a large square")
+        .with_hint("give a `field` its `bounds = [[x0, y0, z0], [x1, y1, z1]]`, or intersect the shape with a `box`")
+}
+
+/// Where an isosurface's cell size came from, so a failure can say what to change.
+#[derive(Clone, Copy)]
+pub(super) enum CellFrom {
+    /// `mesh isosurface(…, cell = …)`.
+    Scene,
+    /// `--detail` in mesh mode.
+    Detail,
+}
+
+/// How an isosurface is sampled and placed.
+pub(super) struct Iso {
+    /// Render from the grid's frame: where the grid is laid out.
+    pub(super) grid: DAffine3,
+    /// Render from the grid's frame, applied to the vertices.
+    pub(super) place: DAffine3,
+    /// Material of parts that have none.
+    pub(super) material: u32,
+    /// Cell size in the grid's units.
+    pub(super) cell: f64,
+    /// Interpolated normals.
+    pub(super) smooth: bool,
+    /// What set `cell`, for the hint of a failure.
+    pub(super) from: CellFrom,
+    /// Most cells it may refine: what the memory budget has left, at
+    /// [`isosurface::CELL_BYTES`] a cell.
+    pub(super) max_cells: usize,
+}
+
+/// An isosurface of `shape` sampled and placed as `iso` says, each triangle taking the
+/// material of the shape's nearest part. The distance closures are temporary: they are
+/// not part of the world's memory.
+pub(super) fn isosurface_object(
+    shape: &Shape,
+    iso: Iso,
+    span: Span,
+    materials: &mut MaterialTable,
+) -> Result<MeshJob, Diagnostic> {
+    let Iso { grid, place, material, cell, smooth, from, max_cells } = iso;
+    let bounds = ir::shape_bounds(shape).ok_or_else(|| unbounded(shape.span))?.transform(&grid);
+    // A cell as large as the shape samples a few points around it: the mesh would be a
+    // sliver or nothing, so it is refused like a grid that finds no surface.
+    let across = (bounds.max - bounds.min).length();
+    if cell >= across || cell.is_nan() {
+        let d = Diagnostic::error(
+            codes::LOWERING,
+            span,
+            "isosurface cell is as large as the shape",
+            format!("cell {} for a shape {} across", short(cell), short(across)),
+        )
+        .with_note("a cell must be smaller than the shape for the grid to see it");
+        return Err(match from {
+            CellFrom::Scene => d.with_hint(format!("try `cell = {}` or less", ir::dump_num(across / 20.0))),
+            CellFrom::Detail => d.with_hint("try a higher `--detail`"),
+        });
+    }
+    let (dist, mat) = Builder::new(materials).build(shape, grid, material);
+    let too_fine = |cells: f64, min_cell: f64| {
+        let d = Diagnostic::error(
+            codes::LOWERING,
+            span,
+            "isosurface grid is too fine",
+            format!("cell {} would refine about {} cells near the surface", ir::dump_num(cell), millions(cells)),
+        )
+        .with_note(format!(
+            "an isosurface may refine at most {} cells: the memory limit's {} at {} bytes a cell",
+            millions(max_cells as f64),
+            bytes_name(max_cells as u64 * isosurface::CELL_BYTES),
+            isosurface::CELL_BYTES
+        ));
+        match from {
+            CellFrom::Scene => {
+                d.with_hint(format!("try `cell = {}` or more", ir::dump_num((min_cell * 1.001 * 1e6).ceil() / 1e6)))
+            }
+            CellFrom::Detail => d.with_hint("try a lower `--detail`"),
+        }
+    };
+    let lattice = octree::Grid::new(bounds.min, bounds.max, cell).map_err(|side| {
+        // Too many cells on a side for a key: a closed surface across the grid crosses
+        // about as many cells as a cube's six faces, so the cell must grow for both the
+        // key and the cell limit.
+        let cells = 6.0 * side * side;
+        let for_keys = cell * side / (1u64 << octree::MAX_LEVELS) as f64;
+        let for_limit = cell * (cells / max_cells as f64).sqrt();
+        too_fine(cells, for_keys.max(for_limit))
+    })?;
+    let surface = isosurface::extract_within(&*dist, &lattice, max_cells).map_err(|e| match e {
+        isosurface::IsoError::TooManyCells { cells, min_cell } => too_fine(cells, min_cell),
+        isosurface::IsoError::NoSurface => {
+            let d = Diagnostic::error(
+                codes::LOWERING,
+                span,
+                "isosurface found no surface",
+                format!("no sign change on a grid of cell {}", ir::dump_num(cell)),
+            )
+            .with_note("the shape is thinner than a cell everywhere, so the mesh would be empty");
+            match from {
+                CellFrom::Scene => d.with_hint("try a smaller `cell`"),
+                CellFrom::Detail => d.with_hint("try a higher `--detail`"),
+            }
+        }
+    })?;
+    let mesh = surface.mesh;
+    let per_triangle = mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+            mat(((a + b + c) / 3.0).as_vec3a()).mat
+        })
+        .collect();
+    let mut solid = Vec::new();
+    parts::solid_parts(shape, grid, &mut solid);
+    let lost = parts::lost(&solid, &lattice, &*dist);
+    let warnings = lost_parts(&lost, solid.len(), span, cell, across, from)
+        .into_iter()
+        .chain(pinched(surface.pinched, span, cell, across, from))
+        .chain(if lost.is_empty() { lost_volume(&mesh, &*dist, &bounds, span, cell, across, from) } else { None })
+        .collect();
+    let farthest = mesh.positions.par_iter().map(|p| f64::from(dist(p.as_vec3a()).abs())).reduce(|| 0.0, f64::max);
+    Ok(MeshJob {
+        mesh,
+        xf: place,
+        material,
+        per_triangle: Some(per_triangle),
+        normals: if smooth { Normals::Vertex } else { Normals::Flat },
+        convex: false,
+        warnings,
+        isosurface: Some(IsoAccuracy { cell, farthest }),
+    })
+}
+
+/// The warning for parts an isosurface at `cell` lost, of `total` solid parts of a
+/// shape `across` wide; `None` when none was.
+fn lost_parts(
+    lost: &[&parts::Part],
+    total: usize,
+    span: Span,
+    cell: f64,
+    across: f64,
+    from: CellFrom,
+) -> Option<Diagnostic> {
+    let smallest = lost.iter().min_by(|a, b| a.across().total_cmp(&b.across()))?;
+    let plural = if lost.len() == 1 { "part was" } else { "parts were" };
+    // A grid point lies inside any part at least twice the cell across.
+    let needed = smallest.across() / 2.0;
+    let d = Diagnostic::warning(
+        codes::LOST_PARTS,
+        span,
+        format!("{} of {total} {plural} not meshed: smaller than the isosurface cell", lost.len()),
+        format!("meshed at cell {}", approx(cell)),
+    )
+    .with_label(smallest.span, format!("the smallest lost part, {} across, is made here", approx(smallest.across())))
+    .with_note("no grid point lies inside these parts, so the mesh has no surface there");
+    Some(match from {
+        CellFrom::Scene => d.with_hint(format!("try `cell = {}` or less", approx(needed))),
+        CellFrom::Detail => {
+            let rings = detail_for(across, needed);
+            d.with_hint(format!("try `--detail {}` or a `--tolerance` below {}", short(rings), approx(needed / 2.0)))
+        }
+    })
+}
+
+/// Samples of the shape's box that measure its volume for [`lost_volume`].
+const VOLUME_SAMPLES: u32 = 1 << 16;
+
+/// The warning for an isosurface that lost (or gained) much of its shape's volume; `None`
+/// when the mesh's volume is within a tenth, plus four standard errors, of the volume
+/// measured by sampling the shape at stratified points of its box. This is what finds a
+/// field's sheet thinner than the cell, which no CSG part names: the grid misses it, so
+/// the mesh has no surface there and the part-based check has nothing to point at.
+fn lost_volume(
+    mesh: &TriMesh,
+    dist: &(dyn Fn(Vec3A) -> f32 + Sync),
+    bounds: &ir::Aabb,
+    span: Span,
+    cell: f64,
+    across: f64,
+    from: CellFrom,
+) -> Option<Diagnostic> {
+    let size = bounds.max - bounds.min;
+    let box_volume = size.x * size.y * size.z;
+    if box_volume.is_nan() || box_volume <= 0.0 || box_volume.is_infinite() {
+        return None;
+    }
+    // Jittered points of a 2^16-point lattice along a Weyl sequence: the same on every run.
+    let inside = (0..VOLUME_SAMPLES)
+        .into_par_iter()
+        .filter(|&i| {
+            let i = f64::from(i) + 0.5;
+            let u = glam::DVec3::new(
+                i * 0.754_877_666_246_692_7,
+                i * 0.569_840_290_998_053_3,
+                i / f64::from(VOLUME_SAMPLES),
+            );
+            let u = u - u.floor();
+            dist((bounds.min + u * size).as_vec3a()) < 0.0
+        })
+        .count() as f64;
+    let n = f64::from(VOLUME_SAMPLES);
+    let fraction = inside / n;
+    let sampled = fraction * box_volume;
+    let error = (fraction * (1.0 - fraction) / n).sqrt() * box_volume;
+    let meshed = mesh.signed_volume();
+    if (meshed - sampled).abs() <= 0.1 * sampled + 4.0 * error {
+        return None;
+    }
+    let d = Diagnostic::warning(
+        codes::LOST_VOLUME,
+        span,
+        format!("the mesh holds {} of the shape's volume", percent(meshed / sampled)),
+        format!(
+            "meshed at cell {}: volume {} where samples of the shape find {}",
+            approx(cell),
+            approx(meshed),
+            approx(sampled)
+        ),
+    )
+    .with_note(
+        "parts thinner than the cell (a thin shell, a field's sheet) fall between the grid's points and are left out",
+    );
+    Some(match from {
+        CellFrom::Scene => d.with_hint(format!("try `cell = {}` or less", approx(cell / 2.0))),
+        CellFrom::Detail => d.with_hint(format!(
+            "try `--detail {}` or more, or a `--tolerance` below {}",
+            short(detail_for(across, cell / 2.0)),
+            approx(cell / 4.0)
+        )),
+    })
+}
+
+/// A ratio as a percentage people read: whole percents, or one decimal below 10 %.
+fn percent(r: f64) -> String {
+    let p = r * 100.0;
+    if p.abs() < 10.0 {
+        format!("{p:.1} %")
+    } else {
+        format!("{p:.0} %")
+    }
+}
+
+/// The warning for `edges` of an isosurface at `cell` left on four triangles; `None`
+/// when there are none.
+fn pinched(edges: usize, span: Span, cell: f64, across: f64, from: CellFrom) -> Option<Diagnostic> {
+    if edges == 0 {
+        return None;
+    }
+    let plural = if edges == 1 { "edge lies" } else { "edges lie" };
+    let d = Diagnostic::warning(
+        codes::PINCHED_EDGES,
+        span,
+        format!("{edges} isosurface {plural} on four triangles: parts are thinner than the cell"),
+        format!("meshed at cell {}", approx(cell)),
+    )
+    .with_note(
+        "the mesh is closed, but not manifold at those edges; tools that need a manifold (slicers) may refuse it",
+    );
+    Some(match from {
+        CellFrom::Scene => d.with_hint(format!("try `cell = {}` or less", approx(cell / 2.0))),
+        CellFrom::Detail => d.with_hint(format!("try `--detail {}` or more", short(detail_for(across, cell / 2.0)))),
+    })
+}
