@@ -433,14 +433,7 @@ impl Ctx<'_> {
                 Value::List(Rc::new(x.iter().chain(y.iter()).cloned().collect()))
             }
             _ => {
-                let mut d = Diagnostic::error(
-                    codes::BAD_OPERANDS,
-                    span,
-                    format!("cannot apply `{}` to `{}` and `{}`", op.symbol(), a.ty_name(), b.ty_name()),
-                    format!("`{}` {} `{}` is not defined", a.ty_name(), op.symbol(), b.ty_name()),
-                )
-                .with_label(a_span, a.this_is())
-                .with_label(b_span, b.this_is());
+                let mut d = bad_operands(op, (&a, a_span), (&b, b_span), span);
                 if matches!((&a, &b), (Value::Shape(_), Value::Shape(_))) {
                     let hint = match op {
                         BinOp::Add => "try `union(a, b)` to combine shapes",
@@ -473,6 +466,23 @@ impl Ctx<'_> {
                 .with_note(format!("lists may hold at most {MAX_LIST} elements")),
         );
     }
+}
+
+/// "cannot apply `op` to `A` and `B`", each operand labelled with its type.
+pub(super) fn bad_operands(
+    op: BinOp,
+    (a, a_span): (&Value, Span),
+    (b, b_span): (&Value, Span),
+    span: Span,
+) -> Diagnostic {
+    Diagnostic::error(
+        codes::BAD_OPERANDS,
+        span,
+        format!("cannot apply `{}` to `{}` and `{}`", op.symbol(), a.ty_name(), b.ty_name()),
+        format!("`{}` {} `{}` is not defined", a.ty_name(), op.symbol(), b.ty_name()),
+    )
+    .with_label(a_span, a.this_is())
+    .with_label(b_span, b.this_is())
 }
 
 /// Equality of values that `==` compares; `None` for values it does not. Each pair of

@@ -12,7 +12,7 @@ use std::rc::Rc;
 use std::sync::Arc;
 
 use super::builtins::{Builtin, Ctor, Extreme, MathFn, NumFn, VecFn};
-use super::expr::BoundArgs;
+use super::expr::{bad_operands, BoundArgs};
 use super::value::FieldLit;
 use super::{index, Bound, Ctx, Value};
 use crate::diag::{codes, Diagnostic};
@@ -169,14 +169,7 @@ impl Ctx<'_> {
         Some(match node {
             Some(e) => Value::Sym(e),
             None => {
-                let mut d = Diagnostic::error(
-                    codes::BAD_OPERANDS,
-                    span,
-                    format!("cannot apply `{}` to `{}` and `{}`", op.symbol(), a.ty_name(), b.ty_name()),
-                    format!("`{}` {} `{}` is not defined", a.ty_name(), op.symbol(), b.ty_name()),
-                )
-                .with_label(a_span, a.this_is())
-                .with_label(b_span, b.this_is());
+                let mut d = bad_operands(op, (a, a_span), (b, b_span), span);
                 if x.is_none() || y.is_none() {
                     d = d.with_note("only numbers, vectors and truth values can depend on a field's point");
                 }
