@@ -6,6 +6,7 @@
 //! - `files`: output written whole or not at all.
 //! - `fmt`: `scnc fmt`.
 //! - `export`: the scene as a mesh file.
+//! - `studio`: the web page that edits a scene and renders it as you type.
 
 mod encode;
 mod export;
@@ -16,6 +17,7 @@ mod merge;
 mod progress;
 mod render;
 mod stats;
+mod studio;
 mod sweep;
 mod watch;
 
@@ -77,6 +79,9 @@ enum Command {
     Sweep(SweepArgs),
     /// Run a Language Server Protocol server on stdin/stdout, for editors.
     Lsp,
+    /// Edit a scene in the browser and watch it render as you type: a local web server
+    /// (127.0.0.1 unless `--host` says otherwise) serving one page for one file.
+    Studio(studio::StudioArgs),
     /// Format files in place in the canonical layout (comments and blank lines kept).
     Fmt {
         /// The scene files.
@@ -199,6 +204,7 @@ fn run(cli: Cli) -> ExitCode {
         Command::Watch(args) => watch::watch_cmd(args),
         Command::Sweep(args) => sweep::sweep_cmd(args),
         Command::Export(args) => export::export_cmd(args),
+        Command::Studio(args) => studio::studio_cmd(args),
         Command::Merge(args) => merge::merge_cmd(args),
         Command::Encode(args) => encode::encode_cmd(args),
         Command::Fmt { files, check } => fmt::fmt_cmd(&files, check),

@@ -1,6 +1,7 @@
 //! The single integration-test binary: every test module links into it.
 
 mod animation;
+mod browser;
 mod budget;
 mod cli;
 mod conformance;
@@ -25,6 +26,7 @@ mod readme;
 mod render;
 mod skip;
 mod stability;
+mod studio;
 mod support;
 mod tiles;
 mod watch;

@@ -1,0 +1,324 @@
+// scnc studio: the page. The editor is CodeMirror (editor.js, global ScnEditor); the
+// server answers checks, renders (a binary stream, see readMessages) and saves.
+"use strict";
+
+const $ = (id) => document.getElementById(id);
+const canvas = $("preview");
+const ctx = canvas.getContext("2d");
+/** The coarse pass, kept to fill the canvas until the full frame's bands replace it. */
+const coarse = document.createElement("canvas");
+
+const state = {
+  view: { yaw: 0, pitch: 0, zoom: 1, panx: 0, pany: 0 },
+  backend: "sdf",
+  rung: null,
+  frame: 0,
+  frames: 1,
+  fps: 24,
+  playing: false,
+  render: null, // the AbortController of the render in flight
+  checkSeq: 0,
+  lastText: "",
+};
+
+let editor = null;
+
+function query(extra) {
+  const v = state.view;
+  const p = new URLSearchParams({
+    yaw: v.yaw, pitch: v.pitch, zoom: v.zoom, panx: v.panx, pany: v.pany,
+    backend: state.backend, frame: state.frame, ...extra,
+  });
+  if (state.rung !== null) p.set("rung", state.rung);
+  return p.toString();
+}
+
+async function post(path, body) {
+  const r = await fetch(path, { method: "POST", body, headers: { "Content-Type": "text/plain;charset=utf-8" } });
+  if (!r.ok) throw new Error(await r.text());
+  return r;
+}
+
+// --- diagnostics ---------------------------------------------------------------------
+
+function showDiagnostics(list) {
+  ScnEditor.showDiagnostics(editor, list);
+  const ul = $("diagnostics");
+  ul.replaceChildren(...list.map((d) => {
+    const li = document.createElement("li");
+    li.className = d.severity;
+    const code = document.createElement("span");
+    code.className = "code";
+    code.textContent = `${d.severity}[${d.code}]`;
+    li.append(code, d.message);
+    li.onclick = () => { editor.dispatch({ selection: { anchor: d.from, head: d.to }, scrollIntoView: true }); editor.focus(); };
+    return li;
+  }));
+}
+
+async function check(text) {
+  const seq = ++state.checkSeq;
+  try {
+    const r = await (await post("/api/check", text)).json();
+    if (seq === state.checkSeq) showDiagnostics(r.diagnostics);
+  } catch (e) { /* the server is gone: the status line says so on the next render */ }
+}
+
+// --- rendering -----------------------------------------------------------------------
+
+/** Calls `on(kind, payload)` for each message of the render stream: a kind byte, a
+ * little-endian u32 length and the payload. */
+async function readMessages(response, on) {
+  const reader = response.body.getReader();
+  let buf = new Uint8Array(0);
+  for (;;) {
+    const { done, value } = await reader.read();
+    if (done) return;
+    const joined = new Uint8Array(buf.length + value.length);
+    joined.set(buf); joined.set(value, buf.length);
+    buf = joined;
+    let at = 0;
+    while (buf.length - at >= 5) {
+      const len = new DataView(buf.buffer, buf.byteOffset + at + 1, 4).getUint32(0, true);
+      if (buf.length - at - 5 < len) break;
+      on(String.fromCharCode(buf[at]), buf.subarray(at + 5, at + 5 + len));
+      at += 5 + len;
+    }
+    buf = buf.slice(at);
+  }
+}
+
+const text = new TextDecoder();
+const json = (bytes) => JSON.parse(text.decode(bytes));
+
+function drawBand(target, bytes) {
+  const dv = new DataView(bytes.buffer, bytes.byteOffset, 12);
+  const y0 = dv.getUint32(0, true), rows = dv.getUint32(4, true), width = dv.getUint32(8, true);
+  const rgb = bytes.subarray(12);
+  const img = target.createImageData(width, rows);
+  for (let i = 0, j = 0; i < rgb.length; i += 3, j += 4) {
+    img.data[j] = rgb[i]; img.data[j + 1] = rgb[i + 1]; img.data[j + 2] = rgb[i + 2]; img.data[j + 3] = 255;
+  }
+  target.putImageData(img, 0, y0);
+}
+
+async function render(sourceText, opts = {}) {
+  if (state.render) state.render.abort();
+  const controller = new AbortController();
+  state.render = controller;
+  const started = performance.now();
+  let level = null;
+  let firstImageMs = null;
+  canvas.dataset.busy = "1";
+  $("note").textContent = "";
+  try {
+    const r = await fetch(`/api/render?${query({ coarse: opts.coarse ?? 4 })}`, {
+      method: "POST", body: sourceText, signal: controller.signal,
+    });
+    if (!r.ok) throw new Error(await r.text());
+    await readMessages(r, (kind, payload) => {
+      if (controller.signal.aborted) return;
+      switch (kind) {
+        case "M": {
+          const m = json(payload);
+          level = m.level;
+          setAnimation(m.frames, m.fps, m.frame);
+          if (m.level === "coarse") {
+            coarse.width = m.width; coarse.height = m.height;
+          } else {
+            // Resizing clears the canvas: the coarse image fills it until bands arrive.
+            if (canvas.width !== m.width || canvas.height !== m.height) { canvas.width = m.width; canvas.height = m.height; }
+            if (coarse.width > 1) { ctx.imageSmoothingEnabled = false; ctx.drawImage(coarse, 0, 0, m.width, m.height); }
+          }
+          break;
+        }
+        case "B":
+          if (level === "coarse") {
+            drawBand(coarse.getContext("2d"), payload);
+            if (canvas.width < coarse.width * 2) { canvas.width = coarse.width * 4; canvas.height = coarse.height * 4; }
+            ctx.imageSmoothingEnabled = false;
+            ctx.drawImage(coarse, 0, 0, canvas.width, canvas.height);
+          } else {
+            drawBand(ctx, payload);
+          }
+          if (firstImageMs === null) {
+            firstImageMs = performance.now() - started;
+            canvas.dataset.firstImageMs = firstImageMs.toFixed(1);
+          }
+          break;
+        case "S": {
+          const s = json(payload);
+          const total = performance.now() - started;
+          canvas.dataset.fullMs = total.toFixed(1);
+          canvas.dataset.renders = String(Number(canvas.dataset.renders || 0) + 1);
+          $("status").textContent =
+            `${s.setting}: first image ${firstImageMs.toFixed(0)} ms after the edit, full frame ${total.toFixed(0)} ms ` +
+            `(lower ${s.lower_ms.toFixed(0)} ms, trace ${s.full_ms.toFixed(0)} ms, ${s.rays} rays)`;
+          $("effects").textContent = s.effects;
+          $("stats").textContent = s.text;
+          break;
+        }
+        case "A": {
+          const a = json(payload);
+          $("accuracy-result").textContent =
+            `rung ${a.rung + 1} of ${a.rungs}: ${a.ms.toFixed(0)} ms, ${a.differing_percent.toFixed(2)} % of pixels off by more than ` +
+            `${a.threshold}/255 and RMSE ${a.rmse.toFixed(4)} against the finest rung (${a.reference_ms.toFixed(0)} ms)`;
+          break;
+        }
+        case "N": $("note").textContent = json(payload).note; break;
+        case "E": showDiagnostics(json(payload)); $("status").textContent = "not rendered: the scene has errors (the last image stays)"; break;
+        case "X": break;
+      }
+    });
+    if (!controller.signal.aborted) {
+      // Hooks for tests and automation: renders finished, and whether one is running.
+      canvas.dataset.finished = String(Number(canvas.dataset.finished || 0) + 1);
+      canvas.dataset.busy = "0";
+      if (state.playing) scheduleNextFrame();
+    }
+  } catch (e) {
+    if (e.name !== "AbortError") $("status").textContent = `render failed: ${e.message}`;
+  }
+}
+
+// --- the edit loop -------------------------------------------------------------------
+
+function edited(newText) {
+  state.lastText = newText;
+  check(newText);
+  render(newText);
+}
+
+async function save() {
+  try {
+    await post("/api/save", ScnEditor.textOf(editor));
+    $("saved").textContent = `saved ${new Date().toLocaleTimeString()}`;
+  } catch (e) { $("saved").textContent = `not saved: ${e.message}`; }
+}
+
+async function format() {
+  const r = await (await post("/api/format", ScnEditor.textOf(editor))).json();
+  if (r.text !== undefined) ScnEditor.replaceText(editor, r.text); else showDiagnostics(r.diagnostics);
+}
+
+async function writeCamera() {
+  const r = await (await post(`/api/camera?${query({})}`, ScnEditor.textOf(editor))).json();
+  if (r.text === undefined) { showDiagnostics(r.diagnostics); return; }
+  state.view = { yaw: 0, pitch: 0, zoom: 1, panx: 0, pany: 0 };
+  ScnEditor.replaceText(editor, r.text);
+}
+
+async function exportAs(format) {
+  try {
+    const r = await post(`/api/export?format=${format}`, ScnEditor.textOf(editor));
+    const name = (r.headers.get("Content-Disposition") || "").match(/filename="([^"]+)"/)?.[1] || `scene.${format}`;
+    const a = document.createElement("a");
+    a.href = URL.createObjectURL(await r.blob());
+    a.download = name;
+    document.body.append(a); a.click(); a.remove();
+    $("note").textContent = `exported ${name}`;
+  } catch (e) { $("note").textContent = `export failed: ${e.message}`; }
+}
+
+// --- camera --------------------------------------------------------------------------
+
+function viewChanged() { render(ScnEditor.textOf(editor)); }
+
+let drag = null;
+canvas.addEventListener("pointerdown", (e) => {
+  drag = { x: e.clientX, y: e.clientY, pan: e.shiftKey };
+  canvas.setPointerCapture(e.pointerId);
+  canvas.classList.add("dragging");
+});
+canvas.addEventListener("pointermove", (e) => {
+  if (!drag) return;
+  const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
+  drag.x = e.clientX; drag.y = e.clientY;
+  const size = canvas.getBoundingClientRect();
+  if (drag.pan) {
+    state.view.panx -= dx / size.width * state.view.zoom;
+    state.view.pany += dy / size.height * state.view.zoom;
+  } else {
+    state.view.yaw += dx * 0.4;
+    state.view.pitch = Math.max(-180, Math.min(180, state.view.pitch + dy * 0.4));
+  }
+  viewChanged();
+});
+const endDrag = () => { drag = null; canvas.classList.remove("dragging"); };
+canvas.addEventListener("pointerup", endDrag);
+canvas.addEventListener("pointercancel", endDrag);
+canvas.addEventListener("wheel", (e) => {
+  e.preventDefault();
+  state.view.zoom = Math.max(0.01, Math.min(100, state.view.zoom * Math.exp(e.deltaY * 0.001)));
+  viewChanged();
+}, { passive: false });
+
+// --- animation -----------------------------------------------------------------------
+
+function setAnimation(frames, fps, frame) {
+  state.frames = frames; state.fps = fps;
+  $("animation").hidden = frames <= 1;
+  $("frame").max = Math.max(0, frames - 1);
+  $("frame").value = frame;
+  $("frame-label").textContent = `frame ${frame} of ${frames} (${fps} fps)`;
+}
+
+let playTimer = null;
+function scheduleNextFrame() {
+  clearTimeout(playTimer);
+  playTimer = setTimeout(() => {
+    if (!state.playing) return;
+    state.frame = (state.frame + 1) % state.frames;
+    render(ScnEditor.textOf(editor), { coarse: 1 });
+  }, 1000 / state.fps);
+}
+
+$("play").onclick = () => {
+  state.playing = !state.playing;
+  $("play").textContent = state.playing ? "⏸" : "▶";
+  if (state.playing) scheduleNextFrame();
+};
+$("frame").oninput = () => { state.frame = Number($("frame").value); viewChanged(); };
+
+// --- controls ------------------------------------------------------------------------
+
+$("save").onclick = save;
+$("format").onclick = format;
+$("write-camera").onclick = writeCamera;
+$("reset-view").onclick = () => { state.view = { yaw: 0, pitch: 0, zoom: 1, panx: 0, pany: 0 }; viewChanged(); };
+for (const f of ["stl", "3mf", "glb"]) $(`export-${f}`).onclick = () => exportAs(f);
+$("backend").onchange = () => { state.backend = $("backend").value; viewChanged(); };
+function rungChanged() {
+  const on = $("accuracy-on").checked;
+  $("accuracy").disabled = !on;
+  state.rung = on ? Number($("accuracy").value) : null;
+  $("rung").textContent = on ? `rung ${state.rung + 1} of 6` : "";
+  if (!on) $("accuracy-result").textContent = "";
+  viewChanged();
+}
+$("accuracy-on").onchange = rungChanged;
+$("accuracy").oninput = rungChanged;
+
+// --- start ---------------------------------------------------------------------------
+
+(async () => {
+  const file = await (await fetch("/api/file")).json();
+  $("file").textContent = file.path;
+  document.title = `${file.name} — scnc studio`;
+  editor = ScnEditor.create($("editor"), file.text, {
+    change: edited,
+    save,
+    format,
+    hover: async (pos) => (await post(`/api/hover?pos=${pos}`, ScnEditor.textOf(editor))).json(),
+    complete: async (pos) => (await post(`/api/complete?pos=${pos}`, ScnEditor.textOf(editor))).json(),
+  });
+  window.scnStudio = { editor, state, ScnEditor };
+  edited(file.text);
+  // The file on disk is the truth: an edit made elsewhere replaces the page's text.
+  const events = new EventSource("/api/events");
+  events.addEventListener("file", (e) => {
+    const t = JSON.parse(e.data).text;
+    if (t !== ScnEditor.textOf(editor)) ScnEditor.replaceText(editor, t);
+  });
+  events.addEventListener("include", () => edited(ScnEditor.textOf(editor)));
+})();

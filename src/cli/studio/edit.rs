@@ -1,0 +1,277 @@
+//! The editor's questions, answered by the same code `scnc check`, the language server,
+//! `scnc fmt` and `scnc export` run: diagnostics, hover, completion, formatting, saving,
+//! the camera line, and mesh downloads.
+//!
+//! The page counts text positions in UTF-16 code units (JavaScript strings); the compiler
+//! in bytes. Every position crosses [`to_byte`] or [`to_utf16`].
+
+use scnc::diag::{Diagnostic, Severity};
+use scnc::export::formats::Format;
+use scnc::lsp::analysis::{Analysis, CandidateKind};
+use scnc::source::{FileId, SourceMap};
+
+use super::http::Reply;
+use super::preview::View;
+use super::Studio;
+
+/// The byte offset of UTF-16 position `pos` in `text` (clamped to its end).
+pub(crate) fn to_byte(text: &str, pos: u32) -> u32 {
+    let mut units = 0u32;
+    for (i, c) in text.char_indices() {
+        if units >= pos {
+            return i as u32;
+        }
+        units += c.len_utf16() as u32;
+    }
+    text.len() as u32
+}
+
+/// The UTF-16 position of byte offset `byte` in `text`.
+pub(crate) fn to_utf16(text: &str, byte: usize) -> usize {
+    let byte = byte.min(text.len());
+    text.char_indices().take_while(|(i, _)| *i < byte).map(|(_, c)| c.len_utf16()).sum()
+}
+
+/// The file on disk.
+pub(crate) fn file(studio: &Studio) -> Reply {
+    match studio.files.text() {
+        Ok(text) => Reply::json(&serde_json::json!({
+            "text": text,
+            "name": studio.files.root.file_name().map(|n| n.to_string_lossy().into_owned()),
+            "path": studio.files.root.display().to_string(),
+        })),
+        Err(e) => Reply::text(500, &e),
+    }
+}
+
+fn analyse(studio: &Studio, text: String) -> Analysis {
+    let loader = studio.files.loader();
+    Analysis::new(&studio.files.root, text, &loader, &|| false).expect("an analysis that is never cancelled completes")
+}
+
+/// Diagnostics as the page shows them: a span in the editor's text (a diagnostic in an
+/// include points at the start, its place named in the message), and the message with
+/// its notes and help as `scnc check` prints them.
+pub(crate) fn diagnostics_json(map: &SourceMap, diagnostics: &[Diagnostic]) -> serde_json::Value {
+    let root = &map.file(FileId(0)).text;
+    let list: Vec<_> = diagnostics
+        .iter()
+        .map(|d| {
+            let (id, range) = map.local_range(d.span());
+            // The primary label says what is wrong at the span, which an editor's squiggle
+            // cannot show beside the message.
+            let mut message = match d.labels.first().map(|l| l.message.as_str()) {
+                Some(label) if !label.is_empty() => format!("{} ({label})", d.message),
+                _ => d.message.clone(),
+            };
+            let (from, to) = if id == FileId(0) {
+                (to_utf16(root, range.start), to_utf16(root, range.end))
+            } else {
+                let (line, col) = map.line_col(id, range.start);
+                message = format!("{}:{line}:{col}: {message}", map.file(id).name);
+                (0, 0)
+            };
+            for note in &d.notes {
+                message.push_str(&format!("\nnote: {note}"));
+            }
+            for hint in &d.hints {
+                message.push_str(&format!("\nhelp: {hint}"));
+            }
+            serde_json::json!({
+                "from": from, "to": to, "code": d.code, "message": message,
+                "severity": match d.severity { Severity::Error => "error", Severity::Warning => "warning" },
+            })
+        })
+        .collect();
+    serde_json::Value::Array(list)
+}
+
+/// `scnc check` of the editor's text; the files it read are watched from now on.
+pub(crate) fn check(studio: &Studio, text: String) -> Reply {
+    let a = analyse(studio, text);
+    studio.files.watch(a.map.files().map(|(_, f)| f.path.clone()).collect());
+    Reply::json(&serde_json::json!({ "diagnostics": diagnostics_json(&a.map, &a.diagnostics) }))
+}
+
+/// The hover text at UTF-16 position `pos`.
+pub(crate) fn hover(studio: &Studio, text: String, pos: u32) -> Reply {
+    let at = to_byte(&text, pos);
+    let a = analyse(studio, text);
+    let answer = a.hover(at).map(|(span, doc)| {
+        let root = a.text();
+        serde_json::json!({
+            "from": to_utf16(root, span.start as usize), "to": to_utf16(root, span.end as usize), "text": doc,
+        })
+    });
+    Reply::json(&answer.unwrap_or(serde_json::Value::Null))
+}
+
+/// Completion at UTF-16 position `pos`.
+pub(crate) fn complete(studio: &Studio, text: String, pos: u32) -> Reply {
+    let at = to_byte(&text, pos);
+    let a = analyse(studio, text);
+    let items: Vec<_> = a
+        .complete(at)
+        .into_iter()
+        .map(|c| {
+            // CodeMirror's names for the icons.
+            let kind = match c.kind {
+                CandidateKind::Argument => "property",
+                CandidateKind::Variable => "variable",
+                CandidateKind::Function | CandidateKind::Builtin => "function",
+                CandidateKind::Constant => "constant",
+                CandidateKind::Keyword => "keyword",
+            };
+            serde_json::json!({ "label": c.label, "detail": c.detail, "doc": c.doc, "kind": kind })
+        })
+        .collect();
+    Reply::json(&serde_json::Value::Array(items))
+}
+
+/// `scnc fmt` of the text: the formatted text, or the syntax errors that stop it.
+pub(crate) fn format(text: String) -> Reply {
+    match scnc::fmt::format(&text) {
+        Ok(formatted) => Reply::json(&serde_json::json!({ "text": formatted })),
+        Err(diagnostics) => {
+            let mut map = SourceMap::new();
+            let _ = map.add("scene", std::path::Path::new("scene"), text);
+            Reply::json(&serde_json::json!({ "diagnostics": diagnostics_json(&map, &diagnostics) }))
+        }
+    }
+}
+
+/// Writes the text to the file, whole or not at all, as `fmt` and `render` write.
+pub(crate) fn save(studio: &Studio, text: String) -> Reply {
+    match studio.files.save(text) {
+        Ok(()) => Reply::json(&serde_json::json!({ "saved": studio.files.root.display().to_string() })),
+        Err(e) => Reply::text(500, &crate::cli::files::cannot_write(&studio.files.root, &e)),
+    }
+}
+
+/// The text with its camera statement (or a new one) set to the page's view, formatted.
+pub(crate) fn camera_line(studio: &Studio, text: String, view: &View) -> Reply {
+    let loader = studio.files.loader();
+    let root = studio.files.root.clone();
+    let compiled = scnc::with_big_stack(|| scnc::compile_source("scene", &root, text.clone(), &loader));
+    let Some(scene) = &compiled.scene else {
+        return Reply::json(&serde_json::json!({
+            "diagnostics": diagnostics_json(&compiled.map, &compiled.diagnostics),
+        }));
+    };
+    let c = view.apply(&scene.camera);
+    let v = |p: glam::DVec3| format!("[{}, {}, {}]", short(p.x), short(p.y), short(p.z));
+    let mut line = format!("camera(position = {}, look_at = {}", v(c.position), v(c.look_at));
+    if (c.up.normalize() - glam::DVec3::Y).length() > 1e-9 {
+        line.push_str(&format!(", up = {}", v(c.up)));
+    }
+    if (c.fov - scnc::ir::SEED_FOV).abs() > 1e-9 {
+        line.push_str(&format!(", fov = {}", short(c.fov)));
+    }
+    line.push(')');
+    let in_root = scene.camera.span.map(|s| compiled.map.local_range(s)).filter(|(id, _)| *id == FileId(0));
+    let edited = match in_root {
+        Some((_, range)) => format!("{}{line}{}", &text[..range.start], &text[range.end..]),
+        None => insert_before_first_statement(&text, &line),
+    };
+    // The formatter lays the line out as the rest of the file; if it cannot (it can
+    // only fail on a syntax error, and the text compiled), the text is kept as edited.
+    let formatted = scnc::fmt::format(&edited).unwrap_or(edited);
+    Reply::json(&serde_json::json!({ "text": formatted }))
+}
+
+/// A number short enough to read, exact to 1e-4.
+fn short(x: f64) -> String {
+    let s = format!("{:.4}", x);
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" {
+        "0".into()
+    } else {
+        s.into()
+    }
+}
+
+/// `line` before the first line that is not a comment, blank or an `include`.
+fn insert_before_first_statement(text: &str, line: &str) -> String {
+    let mut at = 0;
+    for l in text.split_inclusive('\n') {
+        let t = l.trim();
+        if !(t.is_empty() || t.starts_with("//") || t.starts_with("include")) {
+            break;
+        }
+        at += l.len();
+    }
+    let sep = if at > 0 && !text[..at].ends_with('\n') { "\n" } else { "" };
+    format!("{}{sep}{line}\n{}", &text[..at], &text[at..])
+}
+
+/// The scene as a mesh file to download, as `scnc export` writes it with its defaults
+/// (detail high; z up for STL and 3MF, which are for printing, y up otherwise).
+pub(crate) fn export(studio: &Studio, text: String, format: &str) -> Reply {
+    use scnc::export::{Frame, Up};
+    let (format, mime, ext) = match format {
+        "stl" => (Format::Stl, "model/stl", "stl"),
+        "3mf" => (Format::ThreeMf, "model/3mf", "3mf"),
+        "glb" => (Format::Glb, "model/gltf-binary", "glb"),
+        "ply" => (Format::Ply, "application/octet-stream", "ply"),
+        other => return Reply::text(400, &format!("`{other}`: the studio exports stl, 3mf, glb or ply")),
+    };
+    let loader = studio.files.loader();
+    let root = studio.files.root.clone();
+    let compiled = scnc::with_big_stack(|| scnc::compile_source("scene", &root, text, &loader));
+    let Some(scene) = &compiled.scene else {
+        return Reply::text(422, "the scene has errors: fix them to export");
+    };
+    if scene.objects.is_empty() {
+        return Reply::text(422, "the scene has no objects to export");
+    }
+    let printing = matches!(format, Format::Stl | Format::ThreeMf);
+    let frame = Frame { up: if printing { Up::Z } else { Up::Y }, scale: 1.0 };
+    let limit = scnc::mesh::lower::DEFAULT_MEMORY_LIMIT;
+    let collected = studio
+        .preview
+        .pool
+        .install(|| scnc::export::collect(scene, scnc::mesh::Detail::High, frame, limit, printing, &loader));
+    let export = match collected {
+        Ok(e) if !e.parts.is_empty() => e,
+        Ok(_) => return Reply::text(422, "no object of the scene has a surface to write"),
+        Err(d) => return Reply::text(422, &format!("error[{}]: {}", d.code, d.message)),
+    };
+    let mut bytes = Vec::new();
+    if let Err(e) = format.write(&export, "millimeter", "", &mut bytes) {
+        return Reply::text(500, &format!("cannot write the {ext}: {e}"));
+    }
+    let stem = studio.files.root.file_stem().map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
+    let stem: String =
+        stem.chars().map(|c| if c.is_ascii_alphanumeric() || "-_.".contains(c) { c } else { '_' }).collect();
+    Reply::download(mime, format!("{stem}.{ext}"), bytes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn positions_cross_between_utf16_and_bytes() {
+        let t = "a€b😀c";
+        // a=1 unit/1 byte, €=1 unit/3 bytes, b, 😀=2 units/4 bytes, c.
+        assert_eq!(to_byte(t, 0), 0);
+        assert_eq!(to_byte(t, 2), 4);
+        assert_eq!(to_byte(t, 5), 9);
+        assert_eq!(to_byte(t, 99), t.len() as u32);
+        assert_eq!(to_utf16(t, 4), 2);
+        assert_eq!(to_utf16(t, 9), 5);
+        assert_eq!(to_utf16(t, t.len()), 6);
+    }
+
+    #[test]
+    fn a_new_camera_line_goes_after_the_includes() {
+        let t = "// scene\ninclude \"l.scn\"\n\nobject sphere(1)\n";
+        assert_eq!(
+            insert_before_first_statement(t, "camera()"),
+            "// scene\ninclude \"l.scn\"\n\ncamera()\nobject sphere(1)\n"
+        );
+        assert_eq!(insert_before_first_statement("", "camera()"), "camera()\n");
+        assert_eq!(short(-0.00001), "0");
+        assert_eq!(short(2.5), "2.5");
+    }
+}

@@ -1,0 +1,190 @@
+//! `scnc studio`: a local web page that edits one scene and renders it as you type.
+//!
+//! - this file: the command, the server loop and the rules every request passes first
+//!   (its `Host` and `Origin` are the server's own, its body is bounded, its path is one
+//!   of a fixed set: nothing is served from the disk by name);
+//! - [`http`]: requests and responses, streamed ones included;
+//! - [`edit`]: the editor's questions (check, hover, completion, format, save, the
+//!   camera line) and export;
+//! - [`preview`]: renders, coarse first then the full frame in bands, the newest
+//!   request winning;
+//! - [`files`]: the one file it edits, the includes below its directory, and the
+//!   watcher that tells the page when they change on disk.
+
+mod edit;
+mod files;
+mod http;
+mod preview;
+
+use std::io::Write;
+use std::net::{IpAddr, SocketAddr};
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
+
+use http::{Reply, Req};
+
+use super::usage_error;
+
+#[derive(clap::Args)]
+pub(crate) struct StudioArgs {
+    /// The scene file to edit (created, empty, when it does not exist yet).
+    file: PathBuf,
+    /// The port to listen on; 0 picks a free one.
+    #[arg(long, default_value = "7117")]
+    port: u16,
+    /// The address to listen on. Anything but a loopback address lets other machines
+    /// edit and render this file: say so explicitly.
+    #[arg(long, default_value = "127.0.0.1")]
+    host: IpAddr,
+    /// Worker threads for rendering (default: one per core).
+    #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024))]
+    threads: Option<u16>,
+    /// Write the port listened on to this file (for tests and scripts with `--port 0`).
+    #[arg(long, hide = true)]
+    port_file: Option<PathBuf>,
+}
+
+/// Requests handled at once; more wait for a free slot (a page makes at most a few).
+const MAX_IN_FLIGHT: usize = 16;
+
+/// What every request handler shares.
+pub(crate) struct Studio {
+    /// The file, its directory and the watcher's subscribers.
+    files: files::Files,
+    /// `Host` header values that name this server.
+    hosts: Vec<String>,
+    /// Renders: the newest wins.
+    preview: preview::Previews,
+}
+
+pub(crate) fn studio_cmd(args: StudioArgs) -> ExitCode {
+    let files = match files::Files::open(&args.file) {
+        Ok(f) => f,
+        Err(e) => return usage_error(&e),
+    };
+    let pool = match super::worker_pool(args.threads) {
+        Ok(p) => p,
+        Err(e) => return usage_error(&e),
+    };
+    let server = match tiny_http::Server::http(SocketAddr::new(args.host, args.port)) {
+        Ok(s) => s,
+        Err(e) => {
+            return usage_error(&format!(
+                "cannot listen on {}: {e}{}",
+                SocketAddr::new(args.host, args.port),
+                if args.port != 0 { " (try another --port, or --port 0 for any free one)" } else { "" }
+            ))
+        }
+    };
+    let Some(addr) = server.server_addr().to_ip() else {
+        return usage_error("the server has no IP address");
+    };
+    if !args.host.is_loopback() {
+        let _ = writeln!(
+            std::io::stderr(),
+            "warning: listening on {}: anyone who can reach this machine can read, change and render `{}`",
+            args.host,
+            args.file.display()
+        );
+    }
+    let studio = Arc::new(Studio { hosts: own_hosts(addr), files, preview: preview::Previews::new(pool) });
+    studio.files.start_watching(&studio);
+    let url = format!("http://{}/", display_addr(addr));
+    if let Some(path) = &args.port_file {
+        if let Err(e) = super::files::write_text(path, &format!("{}\n", addr.port())) {
+            return usage_error(&super::files::cannot_write(path, &e));
+        }
+    }
+    let _ = writeln!(std::io::stderr(), "scnc studio: editing {} at {url} (Ctrl-C ends it)", args.file.display());
+    serve(&server, &studio);
+    ExitCode::SUCCESS
+}
+
+/// The address as a URL writes it (an IPv6 one in brackets).
+fn display_addr(addr: SocketAddr) -> String {
+    match addr {
+        SocketAddr::V4(a) => a.to_string(),
+        SocketAddr::V6(a) => format!("[{}]:{}", a.ip(), a.port()),
+    }
+}
+
+/// The `Host` values a browser sends to this server: its address, and `localhost` when
+/// it listens on loopback. A page served from any other name (a DNS-rebinding attack
+/// points one at 127.0.0.1) is refused.
+fn own_hosts(addr: SocketAddr) -> Vec<String> {
+    let port = addr.port();
+    let mut hosts = vec![display_addr(addr)];
+    if addr.ip().is_loopback() {
+        hosts.push(format!("localhost:{port}"));
+    }
+    if addr.ip().is_unspecified() {
+        hosts.push(format!("127.0.0.1:{port}"));
+        hosts.push(format!("localhost:{port}"));
+    }
+    hosts
+}
+
+fn serve(server: &tiny_http::Server, studio: &Arc<Studio>) {
+    let in_flight = Arc::new(AtomicUsize::new(0));
+    for request in server.incoming_requests() {
+        // A page makes a handful of requests at a time; past the limit new ones wait,
+        // which bounds threads whatever a client sends.
+        while in_flight.load(Ordering::Acquire) >= MAX_IN_FLIGHT {
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+        in_flight.fetch_add(1, Ordering::AcqRel);
+        let studio = Arc::clone(studio);
+        let count = Arc::clone(&in_flight);
+        let spawned = std::thread::Builder::new().name("studio-request".into()).spawn(move || {
+            // A handler that panics loses its request, never the server.
+            let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| handle(&studio, request)));
+            count.fetch_sub(1, Ordering::AcqRel);
+        });
+        if spawned.is_err() {
+            in_flight.fetch_sub(1, Ordering::AcqRel);
+        }
+    }
+}
+
+/// The assets of the page, compiled into the binary.
+const INDEX_HTML: &str = include_str!("assets/index.html");
+const STUDIO_JS: &str = include_str!("assets/studio.js");
+const STUDIO_CSS: &str = include_str!("assets/studio.css");
+/// CodeMirror 6, bundled by `studio/` (`npm ci && npm run build`).
+const EDITOR_JS: &str = include_str!("assets/editor.js");
+
+fn handle(studio: &Arc<Studio>, request: tiny_http::Request) {
+    let mut req = Req::new(request);
+    if let Err(why) = req.same_origin(&studio.hosts) {
+        return req.reply(Reply::text(403, &why));
+    }
+    let method = req.method();
+    let path = req.path().to_string();
+    let reply = match (method.as_str(), path.as_str()) {
+        ("GET", "/") => Reply::asset("text/html; charset=utf-8", INDEX_HTML),
+        ("GET", "/assets/studio.js") => Reply::asset("text/javascript; charset=utf-8", STUDIO_JS),
+        ("GET", "/assets/studio.css") => Reply::asset("text/css; charset=utf-8", STUDIO_CSS),
+        ("GET", "/assets/editor.js") => Reply::asset("text/javascript; charset=utf-8", EDITOR_JS),
+        ("GET", "/api/file") => edit::file(studio),
+        ("GET", "/api/events") => return studio.files.subscribe(req),
+        ("POST", "/api/render") => return preview::render(studio, req),
+        ("POST", path) if path.starts_with("/api/") => match req.body() {
+            Ok(text) => match path {
+                "/api/check" => edit::check(studio, text),
+                "/api/hover" => edit::hover(studio, text, req.query_u32("pos")),
+                "/api/complete" => edit::complete(studio, text, req.query_u32("pos")),
+                "/api/format" => edit::format(text),
+                "/api/save" => edit::save(studio, text),
+                "/api/camera" => edit::camera_line(studio, text, &preview::View::from_query(&req)),
+                "/api/export" => edit::export(studio, text, req.query("format").unwrap_or("stl")),
+                _ => Reply::text(404, "no such page"),
+            },
+            Err(reply) => reply,
+        },
+        ("GET" | "HEAD", _) => Reply::text(404, "no such page"),
+        _ => Reply::text(405, "method not allowed"),
+    };
+    req.reply(reply);
+}

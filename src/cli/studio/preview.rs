@@ -1,0 +1,393 @@
+//! Renders for the page: a coarse image first, then the full frame in bands of rows as
+//! they finish, streamed; a newer request stops an older one between bands. With an
+//! accuracy rung, the same view rendered at the finest rung is the reference the error
+//! is measured against (`scnc sweep`'s ladder, felt under the hand).
+//!
+//! The stream is a sequence of messages (see [`super::http::Stream::message`]):
+//! `M` the image about to come (JSON), `B` a band of it (`y0`, `rows`, `width` as u32
+//! and RGB bytes), `S` the render's statistics, `A` the accuracy against the finest rung,
+//! `N` a note, `E` diagnostics that stopped it, `X` overtaken by a newer request.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+use glam::DQuat;
+
+use scnc::mesh::Detail;
+use scnc::render::{Image, Region};
+use scnc::trace::Counters;
+use scnc::world::Mode;
+
+use super::edit::diagnostics_json;
+use super::files::lock;
+use super::http::{Req, Stream};
+use super::Studio;
+
+/// The hit thresholds of the accuracy slider, coarse to fine (the last is the reference).
+const SDF_RUNGS: [f64; 6] = [1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 1e-5];
+/// Mesh detail (rings) of the accuracy slider, coarse to fine.
+const MESH_RUNGS: [u32; 6] = [4, 7, 14, 28, 56, 112];
+/// Largest full frame the page renders; a larger scene is previewed at this many pixels.
+const MAX_PIXELS: u64 = 1 << 20;
+/// Rows per band of the full frame (a multiple of the tracer's 4-row strips).
+const BAND_ROWS: u32 = 16;
+/// Longest full frame the studio starts, as estimated from the coarse one: past it the
+/// preview stays coarse and says so.
+const MAX_FULL_SECONDS: f64 = 30.0;
+/// A pixel "differs" from the reference past this many steps of 255 in any channel.
+const DIFF_THRESHOLD: u8 = 16;
+
+/// The renders of one server.
+pub(crate) struct Previews {
+    /// Render workers.
+    pub(crate) pool: rayon::ThreadPool,
+    /// The newest render request: an older one stops at its next band.
+    newest: AtomicU64,
+    /// One render at a time.
+    running: Mutex<()>,
+    /// The last reference render: its key and image.
+    reference: Mutex<Option<(u64, Image, f64)>>,
+}
+
+impl Previews {
+    pub(crate) fn new(pool: rayon::ThreadPool) -> Previews {
+        Previews { pool, newest: AtomicU64::new(0), running: Mutex::new(()), reference: Mutex::new(None) }
+    }
+}
+
+/// The page's view: an orbit, zoom and pan about the scene camera's `look_at`, which
+/// never touches the file.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct View {
+    /// Degrees about the camera's up axis.
+    yaw: f64,
+    /// Degrees up or down, kept off the poles.
+    pitch: f64,
+    /// Distance factor (1: the scene's).
+    zoom: f64,
+    /// Pan along the image's right and up, in units of the distance to `look_at`.
+    pan: [f64; 2],
+}
+
+impl Default for View {
+    /// The scene's own camera.
+    fn default() -> View {
+        View { yaw: 0.0, pitch: 0.0, zoom: 1.0, pan: [0.0; 2] }
+    }
+}
+
+impl View {
+    /// The view in a request's query (`yaw`, `pitch`, `zoom`, `panx`, `pany`).
+    pub(crate) fn from_query(req: &Req) -> View {
+        let zoom = req.query_f64("zoom").filter(|z| *z > 1e-3 && *z < 1e3).unwrap_or(1.0);
+        let clamp = |k: &str| req.query_f64(k).unwrap_or(0.0).clamp(-1e3, 1e3);
+        View { yaw: clamp("yaw"), pitch: clamp("pitch"), zoom, pan: [clamp("panx"), clamp("pany")] }
+    }
+
+    /// `camera` seen from this view.
+    pub(crate) fn apply(&self, camera: &scnc::ir::Camera) -> scnc::ir::Camera {
+        let mut c = camera.clone();
+        if *self == View::default() {
+            return c;
+        }
+        let up = c.up.normalize();
+        let offset = c.position - c.look_at;
+        let distance = offset.length();
+        let forward = -offset / distance;
+        // The frame's own axes (left-handed, as render::frame builds them).
+        let right = up.cross(forward).normalize();
+        let screen_up = forward.cross(right).normalize();
+        let look_at = c.look_at + (right * self.pan[0] + screen_up * self.pan[1]) * distance;
+        let turned = DQuat::from_axis_angle(up, self.yaw.to_radians()) * offset;
+        // Pitch about the turned right axis, stopping a degree short of the up axis so
+        // the view never looks along it.
+        let axis = up.cross(-turned).normalize();
+        let elevation = (turned.normalize().dot(up)).clamp(-1.0, 1.0).asin().to_degrees();
+        let pitch = (elevation + self.pitch).clamp(-89.0, 89.0) - elevation;
+        let turned = DQuat::from_axis_angle(axis, -pitch.to_radians()) * turned;
+        c.look_at = look_at;
+        c.position = look_at + turned * self.zoom;
+        c
+    }
+}
+
+/// A render request: its stream answered until done, overtaken, or the page gone.
+pub(crate) fn render(studio: &Arc<Studio>, mut req: Req) {
+    let text = match req.body() {
+        Ok(t) => t,
+        Err(reply) => return req.reply(reply),
+    };
+    let ask = Ask {
+        view: View::from_query(&req),
+        coarse: req.query_u32("coarse").clamp(1, 16),
+        mesh: req.query("backend") == Some("mesh"),
+        rung: req.query("rung").and_then(|r| r.parse::<usize>().ok()).filter(|r| *r < SDF_RUNGS.len()),
+        frame: req.query_u32("frame"),
+    };
+    let previews = &studio.preview;
+    let id = previews.newest.fetch_add(1, Ordering::AcqRel) + 1;
+    let Some(mut out) = req.stream("application/octet-stream") else { return };
+    let _one = lock(&previews.running);
+    let current = || previews.newest.load(Ordering::Acquire) == id;
+    if !current() {
+        let _ = out.message(b'X', b"{}");
+        return;
+    }
+    // Failing to write means the page is gone (or moved on): stop either way.
+    let _ = run(studio, &text, &ask, &mut out, &current);
+}
+
+/// What the page asked for.
+struct Ask {
+    view: View,
+    /// The coarse pass's reduction (4: a quarter of each side); 1 skips it.
+    coarse: u32,
+    mesh: bool,
+    /// The accuracy slider's rung, if the page shows it.
+    rung: Option<usize>,
+    frame: u32,
+}
+
+impl Ask {
+    /// The back-end at rung `r` (or the scene's own setting).
+    fn mode(&self, rung: Option<usize>) -> Mode {
+        match (self.mesh, rung) {
+            (true, Some(r)) => Mode::Mesh(Detail::N(MESH_RUNGS[r])),
+            (true, None) => Mode::Mesh(Detail::High),
+            (false, _) => Mode::Sdf,
+        }
+    }
+}
+
+fn json_message(out: &mut Stream, kind: u8, value: serde_json::Value) -> std::io::Result<()> {
+    out.message(kind, value.to_string().as_bytes())
+}
+
+fn run(studio: &Studio, text: &str, ask: &Ask, out: &mut Stream, current: &dyn Fn() -> bool) -> std::io::Result<()> {
+    let loader = studio.files.loader();
+    let root = studio.files.root.clone();
+    let mut compiled = scnc::with_big_stack(|| scnc::compile_source("scene", &root, text.to_string(), &loader));
+    let Some(first) = compiled.scene.take() else {
+        return json_message(out, b'E', diagnostics_json(&compiled.map, &compiled.diagnostics));
+    };
+    let declared = first.settings.clone();
+    let mut scene = if ask.frame > 0 && ask.frame < declared.frames {
+        let (scene, diagnostics) = scnc::with_big_stack(|| compiled.frame(ask.frame, &declared, &loader));
+        match scene {
+            Some(s) => s,
+            None => return json_message(out, b'E', diagnostics_json(&compiled.map, &diagnostics)),
+        }
+    } else {
+        first
+    };
+    scene.camera = ask.view.apply(&scene.camera);
+    let s = &mut scene.settings;
+    let (full_w, full_h) = (s.width, s.height);
+    let pixels = full_w as u64 * full_h as u64;
+    if pixels > MAX_PIXELS {
+        let k = (MAX_PIXELS as f64 / pixels as f64).sqrt();
+        s.width = ((full_w as f64 * k) as u32).max(1);
+        s.height = ((full_h as f64 * k) as u32).max(1);
+        let note = format!(
+            "previewed at {}×{} of the scene's {full_w}×{full_h} (`scnc render` makes the full size)",
+            s.width, s.height
+        );
+        json_message(out, b'N', serde_json::json!({ "note": note }))?;
+    }
+    if let (false, Some(r)) = (ask.mesh, ask.rung) {
+        s.epsilon = SDF_RUNGS[r];
+    }
+    let mode = ask.mode(ask.rung);
+    let started = Instant::now();
+    let effects = scnc::render::effects::derive(&scene);
+    let limit = scnc::mesh::lower::DEFAULT_MEMORY_LIMIT;
+    let lowered = studio.preview.pool.install(|| scnc::world::prepare_within(&scene, effects, mode, &loader, limit));
+    let (frame, world) = match lowered {
+        Ok(l) => l,
+        Err(d) => return json_message(out, b'E', diagnostics_json(&compiled.map, &[d])),
+    };
+    let lower_s = started.elapsed().as_secs_f64();
+    let meta = |level: &str, width: u32, height: u32| {
+        serde_json::json!({
+            "level": level, "width": width, "height": height,
+            "frames": declared.frames, "fps": declared.fps, "frame": ask.frame.min(declared.frames - 1),
+            "warnings": diagnostics_json(&compiled.map, &world.warnings),
+        })
+    };
+    // The coarse pass: the same frame with fewer pixels.
+    let mut trace_s = 0.0;
+    if ask.coarse > 1 {
+        let mut small = frame.clone();
+        small.width = (frame.width / ask.coarse).max(1);
+        small.height = (frame.height / ask.coarse).max(1);
+        json_message(out, b'M', meta("coarse", small.width, small.height))?;
+        let t = Instant::now();
+        let (image, _) = studio.preview.pool.install(|| scnc::render::render(&world, &small, &|| {}));
+        trace_s = t.elapsed().as_secs_f64();
+        send_band(out, 0, &image)?;
+        let estimate = trace_s * (ask.coarse * ask.coarse) as f64;
+        if estimate > MAX_FULL_SECONDS {
+            let note = format!(
+                "the full frame would take about {estimate:.0} s: showing the coarse preview; `scnc render` makes it"
+            );
+            return json_message(out, b'N', serde_json::json!({ "note": note }));
+        }
+    }
+    if !current() {
+        return out.message(b'X', b"{}");
+    }
+    json_message(out, b'M', meta("full", frame.width, frame.height))?;
+    let t = Instant::now();
+    let mut counters = Counters::default();
+    let mut whole = Vec::with_capacity(frame.width as usize * frame.height as usize * 3);
+    let mut y0 = 0;
+    while y0 < frame.height {
+        if !current() {
+            return out.message(b'X', b"{}");
+        }
+        let y1 = (y0 + BAND_ROWS).min(frame.height);
+        let region = Region { x0: 0, y0, x1: frame.width, y1 };
+        let (band, c) = studio.preview.pool.install(|| scnc::render::render_region(&world, &frame, region, &|| {}));
+        counters.add(&c);
+        send_band(out, y0, &band)?;
+        whole.extend_from_slice(&band.pixels);
+        y0 = y1;
+    }
+    let full_s = t.elapsed().as_secs_f64();
+    let stats = crate::cli::stats::stats_text(&counters, &world, &compiled.map, lower_s, full_s);
+    json_message(
+        out,
+        b'S',
+        serde_json::json!({
+            "text": stats, "effects": frame.effects.to_string(), "lower_ms": lower_s * 1e3,
+            "coarse_ms": trace_s * 1e3, "full_ms": full_s * 1e3, "rays": counters.rays(),
+            "setting": setting_label(ask, &scene),
+        }),
+    )?;
+    if let Some(rung) = ask.rung {
+        let image = Image { width: frame.width, height: frame.height, depth: frame.bit_depth, pixels: whole };
+        accuracy(studio, text, ask, rung, &scene, &image, lower_s + full_s, out, current)?;
+    }
+    Ok(())
+}
+
+/// What the accuracy setting of this render was.
+fn setting_label(ask: &Ask, scene: &scnc::ir::Scene) -> String {
+    match ask.mode(ask.rung) {
+        Mode::Sdf => format!("SDF, hit threshold {:e}", scene.settings.epsilon),
+        Mode::Mesh(d) => format!("mesh, detail {}", d.rings()),
+    }
+}
+
+fn send_band(out: &mut Stream, y0: u32, image: &Image) -> std::io::Result<()> {
+    let mut payload = Vec::with_capacity(12 + image.pixels.len());
+    for n in [y0, image.height, image.width] {
+        payload.extend_from_slice(&n.to_le_bytes());
+    }
+    payload.extend_from_slice(&image.pixels);
+    out.message(b'B', &payload)
+}
+
+/// The error of `image` (at `rung`) against the finest rung of the same view, which is
+/// rendered once per scene text, view and size and kept.
+#[allow(clippy::too_many_arguments, reason = "one render's whole context")]
+fn accuracy(
+    studio: &Studio,
+    text: &str,
+    ask: &Ask,
+    rung: usize,
+    scene: &scnc::ir::Scene,
+    image: &Image,
+    seconds: f64,
+    out: &mut Stream,
+    current: &dyn Fn() -> bool,
+) -> std::io::Result<()> {
+    use std::hash::{Hash, Hasher};
+    let finest = SDF_RUNGS.len() - 1;
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    (text, ask.mesh, ask.frame, image.width, image.height).hash(&mut h);
+    [ask.view.yaw, ask.view.pitch, ask.view.zoom, ask.view.pan[0], ask.view.pan[1]].map(f64::to_bits).hash(&mut h);
+    let key = h.finish();
+    let cached =
+        lock(&studio.preview.reference).as_ref().filter(|(k, _, _)| *k == key).map(|(_, i, s)| (i.clone(), *s));
+    let (reference, reference_s) = match cached {
+        Some(r) => r,
+        None if rung == finest => (image.clone(), seconds),
+        None => {
+            if !current() {
+                return out.message(b'X', b"{}");
+            }
+            let mut scene = scene.clone();
+            if !ask.mesh {
+                scene.settings.epsilon = SDF_RUNGS[finest];
+            }
+            let t = Instant::now();
+            let loader = studio.files.loader();
+            let effects = scnc::render::effects::derive(&scene);
+            let limit = scnc::mesh::lower::DEFAULT_MEMORY_LIMIT;
+            let mode = ask.mode(Some(finest));
+            let rendered = studio.preview.pool.install(|| {
+                scnc::world::prepare_within(&scene, effects, mode, &loader, limit)
+                    .map(|(frame, world)| scnc::render::render(&world, &frame, &|| {}).0)
+            });
+            match rendered {
+                Ok(i) => (i, t.elapsed().as_secs_f64()),
+                Err(d) => {
+                    let note = format!("the finest rung cannot be made: {}", d.message);
+                    return json_message(out, b'N', serde_json::json!({ "note": note }));
+                }
+            }
+        }
+    };
+    *lock(&studio.preview.reference) = Some((key, reference.clone(), reference_s));
+    let differing = image
+        .pixels
+        .chunks_exact(3)
+        .zip(reference.pixels.chunks_exact(3))
+        .filter(|(a, b)| a.iter().zip(*b).any(|(x, y)| x.abs_diff(*y) > DIFF_THRESHOLD))
+        .count();
+    let total = (image.width as usize * image.height as usize).max(1);
+    json_message(
+        out,
+        b'A',
+        serde_json::json!({
+            "rung": rung, "rungs": SDF_RUNGS.len(), "ms": seconds * 1e3, "reference_ms": reference_s * 1e3,
+            "differing_percent": 100.0 * differing as f64 / total as f64,
+            "rmse": scnc::study::accuracy::rmse(image, &reference),
+            "threshold": DIFF_THRESHOLD,
+        }),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    fn camera() -> scnc::ir::Camera {
+        scnc::ir::Camera {
+            position: DVec3::new(0.0, 0.0, -5.0),
+            look_at: DVec3::ZERO,
+            up: DVec3::Y,
+            fov: 50.0,
+            span: None,
+        }
+    }
+
+    #[test]
+    fn the_view_orbits_about_look_at_and_never_reaches_the_pole() {
+        let c = camera();
+        assert_eq!(View::default().apply(&c).position, c.position);
+        let turned = View { yaw: 90.0, ..View::default() }.apply(&c);
+        assert!((turned.position.length() - 5.0).abs() < 1e-9, "{:?}", turned.position);
+        assert!(turned.position.z.abs() < 1e-9, "a quarter turn leaves the z axis: {:?}", turned.position);
+        let over = View { pitch: 500.0, ..View::default() }.apply(&c);
+        let elevation = over.position.normalize().dot(DVec3::Y).asin().to_degrees();
+        assert!((elevation - 89.0).abs() < 1e-6, "{elevation}");
+        let zoomed = View { zoom: 0.5, ..View::default() }.apply(&c);
+        assert!((zoomed.position.length() - 2.5).abs() < 1e-9);
+        let panned = View { pan: [0.1, 0.0], ..View::default() }.apply(&c);
+        assert!((panned.look_at - DVec3::new(0.5, 0.0, 0.0)).length() < 1e-9, "{:?}", panned.look_at);
+    }
+}
