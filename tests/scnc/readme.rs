@@ -79,6 +79,10 @@ fn every_readme_command_works_on_a_fresh_clone() {
         // `cargo run --release --` is the binary under test (already built).
         let line = command.replacen("cargo run --release --", "scnc", 1);
         assert!(line.starts_with("scnc "), "a README command the test cannot run: `{command}`");
+        if line.starts_with("scnc studio ") {
+            serves_its_page(&line, clone.path(), &path);
+            continue;
+        }
         let out = Command::new("sh")
             .args(["-c", &line])
             .current_dir(clone.path())
@@ -99,6 +103,38 @@ fn every_readme_command_works_on_a_fresh_clone() {
             assert!(written.exists(), "`{command}` did not write {}", written.display());
         }
     }
+}
+
+/// A server command (`scnc studio …`) runs until stopped: it must say where it listens,
+/// and answer there with its page.
+fn serves_its_page(line: &str, dir: &Path, path: &str) {
+    use std::io::{BufRead as _, Read as _, Write as _};
+    let words: Vec<&str> = line.split_whitespace().collect();
+    let mut child = Command::new(words[0])
+        .args(&words[1..])
+        .current_dir(dir)
+        .env("PATH", path)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("starting the studio");
+    let stderr = child.stderr.take().expect("its stderr");
+    let first = std::io::BufReader::new(stderr).lines().next().and_then(Result::ok).unwrap_or_default();
+    let served = first.split_whitespace().find_map(|w| w.strip_prefix("http://")).map(|a| a.trim_end_matches('/'));
+    let page = served.and_then(|addr| {
+        let mut s = std::net::TcpStream::connect(addr).ok()?;
+        s.set_read_timeout(Some(std::time::Duration::from_secs(20))).ok()?;
+        write!(s, "GET / HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\n\r\n").ok()?;
+        let mut reply = String::new();
+        s.read_to_string(&mut reply).ok()?;
+        Some(reply)
+    });
+    let _ = child.kill();
+    let _ = child.wait();
+    let page = page.unwrap_or_default();
+    assert!(
+        page.starts_with("HTTP/1.1 200") && page.contains("scnc studio"),
+        "`{line}` said `{first}` and served:\n{page}"
+    );
 }
 
 /// Relative links of a Markdown file (`[text](target)`, anchors dropped).

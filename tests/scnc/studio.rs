@@ -376,3 +376,73 @@ fn studio_survives_pages_that_leave_mid_render_and_renders_that_are_overtaken() 
     assert!(ends.iter().any(|e| e.ends_with('S')), "{ends:?}");
     assert_eq!(s.raw("GET", "/", &[], b"").0, 200);
 }
+
+/// The numbers in the README's "Studio" section: for each seed scene at its own size
+/// (1000×1000), the time from an edit to the first (quarter-size) image and to the full
+/// frame, as the page measures them, median of 7 edits. Run with
+/// `cargo test --release --test scnc -- --ignored --nocapture studio_latency`.
+#[test]
+#[ignore = "a measurement, not a test: run by hand for the README's table"]
+fn studio_latency_on_the_seed_scenes() {
+    if !have_tool("chromium") {
+        return;
+    }
+    let seeds = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/seed");
+    let mut b = Browser::launch();
+    let mut table = String::from("| scene | edit → first image (ms) | edit → full frame (ms) |\n|---|---|---|\n");
+    for n in 1..=7 {
+        let file = std::fs::read_dir(&seeds)
+            .unwrap()
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .find(|p| p.file_name().unwrap().to_string_lossy().starts_with(&format!("0{n}-")))
+            .unwrap();
+        let s = Server::start(&file);
+        b.open(&s.url());
+        b.wait_for(&format!("{FINISHED} >= 1 && {IDLE}"), Duration::from_secs(60));
+        let (mut first, mut full) = (Vec::new(), Vec::new());
+        for i in 0..7 {
+            let done = b.eval(FINISHED).as_u64().unwrap();
+            b.eval("(() => { const e = scnStudio.editor; e.focus(); e.dispatch({ selection: { anchor: e.state.doc.length } }); })()");
+            b.type_text(&format!("\n// edit {i}"));
+            b.wait_for(&format!("{FINISHED} > {done} && {IDLE}"), Duration::from_secs(60));
+            let mut ms =
+                |k: &str| b.eval(&format!("Number(document.querySelector('[data-testid=preview]').dataset.{k})"));
+            first.push(ms("firstImageMs").as_f64().unwrap());
+            full.push(ms("fullMs").as_f64().unwrap());
+        }
+        let median = |v: &mut Vec<f64>| {
+            v.sort_by(f64::total_cmp);
+            v[v.len() / 2]
+        };
+        let name = file.file_stem().unwrap().to_string_lossy().into_owned();
+        table.push_str(&format!("| {name} | {:.0} | {:.0} |\n", median(&mut first), median(&mut full)));
+    }
+    #[allow(clippy::print_stdout, reason = "the measurement's result")]
+    {
+        println!("{table}");
+    }
+}
+
+/// The README's picture of the studio (`docs/studio.png` is this, looked at and copied):
+/// the tour scene with the accuracy ladder on. Run with
+/// `cargo test --release --test scnc -- --ignored studio_screenshot`.
+#[test]
+#[ignore = "makes a picture for the README"]
+fn studio_screenshot_for_the_readme() {
+    if !have_tool("chromium") {
+        return;
+    }
+    let tour = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/tour.scn");
+    let s = Server::start(&tour);
+    let mut b = Browser::launch();
+    b.open(&s.url());
+    b.wait_for(&format!("{FINISHED} >= 1 && {IDLE}"), Duration::from_secs(60));
+    let done = b.eval(FINISHED).as_u64().unwrap();
+    b.click("[data-testid=accuracy-on]");
+    b.wait_for(&format!("{FINISHED} > {done} && {IDLE}"), Duration::from_secs(60));
+    b.wait_for(
+        "document.querySelector('[data-testid=accuracy-result]').textContent.length > 0",
+        Duration::from_secs(60),
+    );
+    b.screenshot(&artefacts().join("readme.png"));
+}

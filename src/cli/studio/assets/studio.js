@@ -91,6 +91,15 @@ async function readMessages(response, on) {
 const text = new TextDecoder();
 const json = (bytes) => JSON.parse(text.decode(bytes));
 
+/** Shows the canvas as large as the stage allows, at its image's aspect. */
+function fitCanvas() {
+  const w = canvas.width, h = canvas.height;
+  const k = Math.min($("stage").clientWidth / w, (window.innerHeight * 0.6) / h);
+  canvas.style.width = `${Math.floor(w * k)}px`;
+  canvas.style.height = `${Math.floor(h * k)}px`;
+}
+window.addEventListener("resize", fitCanvas);
+
 function drawBand(target, bytes) {
   const dv = new DataView(bytes.buffer, bytes.byteOffset, 12);
   const y0 = dv.getUint32(0, true), rows = dv.getUint32(4, true), width = dv.getUint32(8, true);
@@ -127,7 +136,9 @@ async function render(sourceText, opts = {}) {
             coarse.width = m.width; coarse.height = m.height;
           } else {
             // Resizing clears the canvas: the coarse image fills it until bands arrive.
-            if (canvas.width !== m.width || canvas.height !== m.height) { canvas.width = m.width; canvas.height = m.height; }
+            if (canvas.width !== m.width || canvas.height !== m.height) {
+              canvas.width = m.width; canvas.height = m.height; fitCanvas();
+            }
             if (coarse.width > 1) { ctx.imageSmoothingEnabled = false; ctx.drawImage(coarse, 0, 0, m.width, m.height); }
           }
           break;
@@ -135,7 +146,9 @@ async function render(sourceText, opts = {}) {
         case "B":
           if (level === "coarse") {
             drawBand(coarse.getContext("2d"), payload);
-            if (canvas.width < coarse.width * 2) { canvas.width = coarse.width * 4; canvas.height = coarse.height * 4; }
+            if (canvas.width < coarse.width * 2) {
+              canvas.width = coarse.width * 4; canvas.height = coarse.height * 4; fitCanvas();
+            }
             ctx.imageSmoothingEnabled = false;
             ctx.drawImage(coarse, 0, 0, canvas.width, canvas.height);
           } else {
