@@ -209,6 +209,38 @@ fn studio_streams_what_scnc_render_makes() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
 }
 
+/// The full frame of a render stream.
+fn full_frame(body: &[u8]) -> Vec<u8> {
+    let msgs = messages(body);
+    let full = msgs.iter().position(|(k, p)| *k == b'M' && String::from_utf8_lossy(p).contains("\"full\"")).unwrap();
+    msgs[full..].iter().filter(|(k, _)| *k == b'B').flat_map(|(_, p)| p[12..].to_vec()).collect()
+}
+
+#[test]
+fn studio_renders_the_frame_the_scrubber_asks_for() {
+    let orbit = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/animation/orbit.scn");
+    let s = Server::start(&orbit);
+    let text = std::fs::read_to_string(&orbit).unwrap();
+    let (_, first) = s.post("/api/render?coarse=1", &text);
+    let meta = messages(&first).into_iter().find(|(k, _)| *k == b'M').unwrap().1;
+    let meta: serde_json::Value = serde_json::from_slice(&meta).unwrap();
+    assert_eq!((meta["frames"].as_u64(), meta["fps"].as_f64()), (Some(48), Some(24.0)));
+    let (_, later) = s.post("/api/render?coarse=1&frame=12", &text);
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("f-##.png");
+    let out = Command::new(env!("CARGO_BIN_EXE_scnc"))
+        .arg("render")
+        .arg(&orbit)
+        .args(["--frames", "12..13", "-o"])
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let expected = image::open(dir.path().join("f-12.png")).unwrap().to_rgb8().into_raw();
+    assert_ne!(full_frame(&first), full_frame(&later), "frame 12 is frame 0");
+    assert_eq!(full_frame(&later), expected, "frame 12 differs from `scnc render --frames 12..13`");
+}
+
 #[test]
 fn studio_on_a_busy_port_is_a_usage_error() {
     let (_dir, scene) = seed_scene();
@@ -293,6 +325,22 @@ fn studio_in_a_browser() {
     assert_ne!(canvas_pixels(&mut b), fixed, "dragging did not change the view");
     assert_eq!(std::fs::read_to_string(&scene).unwrap(), original, "dragging wrote the file");
 
+    // View → camera writes the dragged view into the text as a camera line; the page's
+    // own view is reset, so the image stays (to the camera line's 4 decimals).
+    let dragged = canvas_pixels(&mut b);
+    let done = b.eval(FINISHED).as_u64().unwrap();
+    b.click("[data-testid=write-camera]");
+    b.wait_for("scnStudio.ScnEditor.textOf(scnStudio.editor).includes('camera(position = [')", limit);
+    b.wait_for(&format!("{FINISHED} > {done} && {IDLE}"), limit);
+    let written = canvas_pixels(&mut b);
+    let differing = written
+        .pixels()
+        .zip(dragged.pixels())
+        .filter(|(a, b)| a.0.iter().zip(b.0).any(|(x, y)| x.abs_diff(y) > 16))
+        .count();
+    assert!(differing * 100 < written.len() / 3, "{differing} pixels changed when the view became the camera line");
+    b.screenshot(&shots.join("5-camera-written.png"));
+
     // Ctrl-S saves the editor's text, whole, leaving no temporary file.
     b.eval("scnStudio.editor.focus()");
     b.ctrl('s');
@@ -310,7 +358,7 @@ fn studio_in_a_browser() {
         .collect();
     assert!(stray.is_empty(), "temporary files left: {stray:?}");
     b.wait_for("document.querySelector('[data-testid=saved]').textContent.startsWith('saved')", limit);
-    b.screenshot(&shots.join("5-saved.png"));
+    b.screenshot(&shots.join("6-saved.png"));
 
     // An edit made outside the page replaces the page's text.
     let outside = text.replace("sphere(0.4)", "sphere(0.3)");
@@ -337,7 +385,7 @@ fn studio_in_a_browser() {
     let mesh = stl_io::read_stl(&mut file).expect("a valid STL");
     assert!(mesh.faces.len() > 1000, "{} triangles", mesh.faces.len());
     mesh.validate().expect("an STL whose faces name its vertices");
-    b.screenshot(&shots.join("6-exported.png"));
+    b.screenshot(&shots.join("7-exported.png"));
 }
 
 #[test]
