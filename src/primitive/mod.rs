@@ -16,7 +16,12 @@ mod capsule;
 mod cone;
 mod cuboid;
 mod cylinder;
+mod ellipsoid;
+mod hex_prism;
+mod octahedron;
 mod plane;
+mod polytope;
+mod pyramid;
 mod sphere;
 mod torus;
 
@@ -29,7 +34,11 @@ pub use capsule::Capsule;
 pub use cone::Cone;
 pub use cuboid::Cuboid;
 pub use cylinder::Cylinder;
+pub use ellipsoid::Ellipsoid;
+pub use hex_prism::HexPrism;
+pub use octahedron::Octahedron;
 pub use plane::Plane;
+pub use pyramid::Pyramid;
 pub use sphere::Sphere;
 pub use torus::Torus;
 
@@ -221,6 +230,10 @@ primitives! {
     Capsule(Capsule),
     Cone(Cone),
     CappedCone(CappedCone),
+    Ellipsoid(Ellipsoid),
+    Octahedron(Octahedron),
+    Pyramid(Pyramid),
+    HexPrism(HexPrism),
 }
 
 /// Methods of [`Primitive`] that ask one [`Solid`] fact of whichever primitive it is.

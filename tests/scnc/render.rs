@@ -106,7 +106,7 @@ fn golden_images(mode: Mode, suffix: &str, filter: &dyn Fn(&Path) -> bool) {
 /// The cases with mesh goldens too: the seed scenes, and the features whose shading
 /// must agree across back-ends (light through glass meets meshes from both sides;
 /// patterns sit in the object's space however it is lowered; fields mesh through the
-/// isosurface mesher).
+/// isosurface mesher; the library's polyhedra have exact meshes).
 fn in_every_mode(p: &Path) -> bool {
     p.file_name().is_some_and(|n| {
         let n = n.to_string_lossy();
@@ -114,6 +114,7 @@ fn in_every_mode(p: &Path) -> bool {
             || n.starts_with("feature-glass.")
             || n.starts_with("feature-patterns.")
             || n.starts_with("feature-fields.")
+            || n.starts_with("feature-library.")
     })
 }
 

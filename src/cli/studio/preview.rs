@@ -105,7 +105,7 @@ impl View {
         let axis = up.cross(-turned).normalize();
         let elevation = (turned.normalize().dot(up)).clamp(-1.0, 1.0).asin().to_degrees();
         let pitch = (elevation + self.pitch).clamp(-89.0, 89.0) - elevation;
-        let turned = DQuat::from_axis_angle(axis, -pitch.to_radians()) * turned;
+        let turned = DQuat::from_axis_angle(axis, pitch.to_radians()) * turned;
         c.look_at = look_at;
         c.position = look_at + turned * self.zoom;
         c

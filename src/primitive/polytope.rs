@@ -1,0 +1,177 @@
+//! Convex polyhedra from their corners and faces: the exact signed distance and its
+//! gradient, and the exact mesh. Shared by `octahedron`, `pyramid` and `hex_prism`.
+//!
+//! Inside a convex solid the distance to the surface is the largest of the face planes'
+//! signed distances (exact). Outside, the nearest point lies on a face whose plane the
+//! point is in front of, so only those faces are searched: the point's projection if it
+//! falls inside the face, else the nearest point of the face's edges.
+
+use std::sync::Arc;
+
+use glam::{DVec3, Vec3A};
+
+use crate::geom::TriMesh;
+
+/// A convex polyhedron, in f32 for the closures and f64 for its mesh.
+#[derive(Debug)]
+pub(super) struct Polytope {
+    corners: Vec<DVec3>,
+    /// Each face's corners (indices), counter-clockwise seen from outside.
+    faces: Vec<Vec<u32>>,
+    /// Each face: its outward unit normal, its offset (`n·p = d` on it) and its corners.
+    planes: Vec<(Vec3A, f32, Vec<Vec3A>)>,
+}
+
+impl Polytope {
+    /// The polyhedron with these corners and faces (convex, holding the origin inside,
+    /// each face planar): faces are turned to wind counter-clockwise seen from outside.
+    pub(super) fn new(corners: Vec<DVec3>, mut faces: Vec<Vec<u32>>) -> Arc<Polytope> {
+        for f in &mut faces {
+            let [a, b, c] = [0, 1, 2].map(|i| corners[f[i] as usize]);
+            if (b - a).cross(c - a).dot(a) < 0.0 {
+                f.reverse();
+            }
+        }
+        let planes = faces
+            .iter()
+            .map(|f| {
+                let p = |i: usize| corners[f[i] as usize];
+                // Newell's normal: robust for any planar polygon.
+                let n = (0..f.len())
+                    .map(|i| {
+                        let (a, b) = (p(i), p((i + 1) % f.len()));
+                        DVec3::new((a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y))
+                    })
+                    .sum::<DVec3>()
+                    .normalize();
+                let d = n.dot(p(0));
+                (n.as_vec3a(), d as f32, (0..f.len()).map(|i| p(i).as_vec3a()).collect())
+            })
+            .collect();
+        Arc::new(Polytope { corners, faces, planes })
+    }
+
+    /// The face plane `p` is most in front of (or least behind), and by how much.
+    #[inline]
+    fn nearest_plane(&self, p: Vec3A) -> (usize, f32) {
+        let mut best = (0, f32::NEG_INFINITY);
+        for (i, (n, d, _)) in self.planes.iter().enumerate() {
+            let s = n.dot(p) - d;
+            if s > best.1 {
+                best = (i, s);
+            }
+        }
+        best
+    }
+
+    /// The nearest point of the surface to `p`, which is outside.
+    #[inline]
+    fn nearest_outside(&self, p: Vec3A) -> Vec3A {
+        let mut best = (f32::INFINITY, p);
+        for (n, d, corners) in &self.planes {
+            let s = n.dot(p) - d;
+            if s <= 0.0 {
+                continue;
+            }
+            let q = p - *n * s;
+            let k = corners.len();
+            let inside = (0..k).all(|i| {
+                let (a, b) = (corners[i], corners[(i + 1) % k]);
+                (b - a).cross(q - a).dot(*n) >= 0.0
+            });
+            let c = if inside {
+                q
+            } else {
+                (0..k)
+                    .map(|i| nearest_on_segment(p, corners[i], corners[(i + 1) % k]))
+                    .min_by(|a, b| a.distance_squared(p).total_cmp(&b.distance_squared(p)))
+                    .unwrap_or(q)
+            };
+            let d2 = c.distance_squared(p);
+            if d2 < best.0 {
+                best = (d2, c);
+            }
+        }
+        best.1
+    }
+
+    /// The exact signed distance.
+    #[inline]
+    pub(super) fn distance(&self, p: Vec3A) -> f32 {
+        let (_, s) = self.nearest_plane(p);
+        if s <= 0.0 {
+            s
+        } else {
+            p.distance(self.nearest_outside(p))
+        }
+    }
+
+    /// The gradient of [`distance`](Self::distance): the nearest face's normal inside
+    /// and on the surface, away from the nearest point outside.
+    #[inline]
+    pub(super) fn gradient(&self, p: Vec3A) -> Vec3A {
+        let (i, s) = self.nearest_plane(p);
+        let face = self.planes[i].0;
+        if s <= 0.0 {
+            return face;
+        }
+        (p - self.nearest_outside(p)).try_normalize().unwrap_or(face)
+    }
+
+    /// Triangles: each face as a fan (exact, as the faces are flat and convex).
+    pub(super) fn triangle_count(&self) -> u64 {
+        self.faces.iter().map(|f| f.len() as u64 - 2).sum()
+    }
+
+    /// The exact mesh, corners shared between faces.
+    pub(super) fn mesh(&self) -> TriMesh {
+        let triangles = self.faces.iter().flat_map(|f| (1..f.len() - 1).map(move |i| [f[0], f[i], f[i + 1]])).collect();
+        TriMesh { positions: self.corners.clone(), triangles }
+    }
+}
+
+#[inline]
+fn nearest_on_segment(p: Vec3A, a: Vec3A, b: Vec3A) -> Vec3A {
+    let ab = b - a;
+    let t = ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0);
+    a + ab * t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_cube_as_a_polytope_measures_as_a_box() {
+        let corners = (0..8)
+            .map(|i| {
+                DVec3::new((i & 1) as f64 * 2.0 - 1.0, (i >> 1 & 1) as f64 * 2.0 - 1.0, (i >> 2) as f64 * 2.0 - 1.0)
+            })
+            .collect();
+        let faces = vec![
+            vec![0, 4, 6, 2],
+            vec![1, 3, 7, 5],
+            vec![0, 1, 5, 4],
+            vec![2, 6, 7, 3],
+            vec![0, 2, 3, 1],
+            vec![4, 5, 7, 6],
+        ];
+        let cube = Polytope::new(corners, faces);
+        let boxed = |p: Vec3A| {
+            let q = p.abs() - Vec3A::ONE;
+            q.max(Vec3A::ZERO).length() + q.max_element().min(0.0)
+        };
+        for p in [
+            Vec3A::ZERO,
+            Vec3A::new(0.5, 0.2, -0.1),
+            Vec3A::new(3.0, 0.0, 0.0),
+            Vec3A::new(2.0, 2.0, 0.0),
+            Vec3A::new(-2.0, 3.0, 4.0),
+        ] {
+            assert!((cube.distance(p) - boxed(p)).abs() < 1e-5, "{p}: {} against {}", cube.distance(p), boxed(p));
+        }
+        assert_eq!(cube.gradient(Vec3A::new(2.0, 0.0, 0.0)), Vec3A::X);
+        assert_eq!(cube.triangle_count(), 12);
+        assert!((cube.mesh().signed_volume() - 8.0).abs() < 1e-12);
+    }
+}
