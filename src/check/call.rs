@@ -123,7 +123,7 @@ impl Ctx<'_> {
         let mut decider = None;
         for o in all {
             if let Some(arg) = first_arg(o, args) {
-                if arg.value.is_error() || admits(o.params[0].ty, &arg.value) {
+                if arg.value.is_error() || admits_part(o, &arg.value) {
                     return Some(o);
                 }
                 decider = decider.or(Some(arg));
@@ -133,7 +133,7 @@ impl Ctx<'_> {
             return Some(b);
         };
         let found = arg.value.ty_name();
-        let expected: Vec<String> = all.iter().map(|o| format!("`{}`", o.params[0].ty)).collect();
+        let expected: Vec<String> = all.iter().map(|o| format!("`{}`", deciding_ty(o))).collect();
         // `a or b`, `a, b or c`.
         let listed = match expected.split_last() {
             Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
@@ -589,9 +589,27 @@ fn admits(ty: Ty, v: &Value) -> bool {
     }
 }
 
-/// The argument an overload of `b` is chosen by: the one named like its first
-/// parameter, or else the first positional one.
+/// The type of the argument that picks overload `o`: its shapes' (or profiles') for a
+/// variadic one, else its first parameter's.
+fn deciding_ty(o: &Builtin) -> Ty {
+    o.variadic.unwrap_or(o.params[0].ty)
+}
+
+/// Whether `v` may be what picks overload `o`: a value of its type, or for a variadic
+/// one also a list of them (spread into its parts; an empty list picks the first overload).
+fn admits_part(o: &Builtin, v: &Value) -> bool {
+    match (o.variadic, v) {
+        (Some(_), Value::List(items)) => items.first().is_none_or(|x| admits_part(o, x)),
+        _ => admits(deciding_ty(o), v),
+    }
+}
+
+/// The argument that picks overload `o`: the first positional one of a variadic builtin,
+/// else the one its first parameter binds.
 fn first_arg<'a>(o: &Builtin, args: &'a [ArgVal]) -> Option<&'a ArgVal> {
+    if o.variadic.is_some() {
+        return args.iter().find(|a| a.name.is_none());
+    }
     let first = o.params[0].name;
     args.iter()
         .find(|a| a.name.as_ref().is_some_and(|n| n.name == first))

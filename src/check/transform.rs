@@ -67,8 +67,11 @@ impl Ctx<'_> {
                 ),
             };
         }
+        if let (Value::Profile(profile), false) = (&target, op == TransformOp::With) {
+            return self.transform_profile(op, profile, &arg, arg_span);
+        }
         if !matches!(target, Value::Shape(_) | Value::Mesh(_)) {
-            return bad_target(self, "transforms apply to shapes and meshes");
+            return bad_target(self, "transforms apply to shapes and meshes (and `at`, `rotate`, `scale` to profiles)");
         }
         if op == TransformOp::With {
             let Value::Material(m) = arg else {

@@ -71,13 +71,17 @@ const MAPS: &[&str] = &[
     "p => p * [1, 1.5, 0.8] + [0.1, 0, 0]",
 ];
 
-/// Profiles a sweep is given: a disc off the axis, a rectangle across it, a concave
-/// polygon (an L) and a triangle.
+/// Profiles a sweep is given: a disc, a rectangle across the axis, a concave polygon (an
+/// L) and a triangle; and profiles moved and combined: a plate with two holes, a smooth
+/// union of a disc and a turned bar, an intersection of a scaled rectangle and a disc.
 const PROFILES: &[&str] = &[
     "circle(0.3)",
     "rect(0.4, 0.3)",
     "polygon([[0.1, -0.5], [0.7, -0.5], [0.7, -0.2], [0.35, -0.2], [0.35, 0.5], [0.1, 0.5]])",
     "polygon([[0.2, 0], [0.8, -0.3], [0.5, 0.6]])",
+    "subtract(rect(0.6, 0.4) at [0.6, 0], circle(0.15) at [0.4, 0], circle(0.1) at [0.85, 0.1])",
+    "union(circle(0.25) at [0.3, 0], rect(0.1, 0.4) rotate 30 at [0.6, 0], smooth = 0.1)",
+    "intersect(rect(0.5, 0.3) scale 1.2 at [0.5, 0], circle(0.5) at [0.6, 0.1])",
 ];
 
 /// Transforms a sampled shape is seen through.

@@ -105,6 +105,7 @@ pub enum FieldFn {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[allow(missing_docs, reason = "each variant is the builtin of the same name, documented in BUILTINS")]
 pub enum ProfileFn {
+    Csg(CsgOp),
     Circle,
     Rect,
     Polygon,
@@ -313,10 +314,12 @@ mod tests {
                     let (x, y) = (a.params[0].ty, b.params[0].ty);
                     // Shapes, profiles and numbers are values no parameter of another takes.
                     let kinds = [Ty::Shape, Ty::Profile];
-                    let distinct = (kinds.contains(&x) || kinds.contains(&y))
-                        && x != y
-                        && a.variadic.is_none()
-                        && b.variadic.is_none();
+                    let distinct = match (a.variadic, b.variadic) {
+                        // Variadic overloads are told apart by the type of their parts.
+                        (Some(x), Some(y)) => kinds.contains(&x) && kinds.contains(&y) && x != y,
+                        (None, None) => (kinds.contains(&x) || kinds.contains(&y)) && x != y,
+                        _ => false,
+                    };
                     assert!(distinct, "`{}` is listed twice and its overloads cannot be told apart", a.name);
                 }
             }

@@ -158,6 +158,30 @@ static REST: &[Builtin] = &[
         "`count` copies of the shape about `y`, `360 / count` degrees apart, the shape itself the one on `+x`",
     ),
     // Profiles and sweeps.
+    variadic(
+        "union",
+        Ctor::Profile(ProfileFn::Csg(CsgOp::Union)),
+        Ty::Profile,
+        CsgArgs::PARAMS,
+        Ty::Profile,
+        "everything inside any of the profiles; `smooth` blends the seams",
+    ),
+    variadic(
+        "intersect",
+        Ctor::Profile(ProfileFn::Csg(CsgOp::Intersect)),
+        Ty::Profile,
+        CsgArgs::PARAMS,
+        Ty::Profile,
+        "only what is inside all of the profiles",
+    ),
+    variadic(
+        "subtract",
+        Ctor::Profile(ProfileFn::Csg(CsgOp::Subtract)),
+        Ty::Profile,
+        CsgArgs::PARAMS,
+        Ty::Profile,
+        "the first profile minus all the others (a hole through an extrusion)",
+    ),
     f("circle", Ctor::Profile(ProfileFn::Circle), CircleArgs::PARAMS, Ty::Profile, "a disc of radius `r` about the origin of the `[u, v]` plane"),
     f("rect", Ctor::Profile(ProfileFn::Rect), RectArgs::PARAMS, Ty::Profile, "a rectangle `2 * half_u` by `2 * half_v` about the origin of the `[u, v]` plane"),
     f(

@@ -11,15 +11,17 @@ use glam::{DVec2, DVec3};
 
 use super::domain::{bin, un};
 use crate::check::builtins::ProfileFn;
+use crate::check::construct::shapes::CsgArgs;
 use crate::check::expr::BoundArgs;
 use crate::check::value::Profile;
 use crate::check::{Ctx, Value};
 use crate::diag::{codes, Diagnostic};
 use crate::geom::Aabb;
 use crate::ir::field::{Binary, Expr, Kind, Ty, Unary};
-use crate::ir::{Lipschitz, ShapeKind};
+use crate::ir::{CsgOp, Lipschitz, ShapeKind};
 use crate::sig::Range;
 use crate::span::Span;
+use crate::syntax::ast::TransformOp;
 
 crate::params! {
     /// `circle(r)`.
@@ -126,6 +128,7 @@ impl Ctx<'_> {
         let p = Expr::point();
         let (u, v) = (Expr::component(&p, 0), Expr::component(&p, 1));
         let made = match f {
+            ProfileFn::Csg(op) => self.profile_csg(op, a),
             ProfileFn::Circle => {
                 let CircleArgs { r } = CircleArgs::from_args(a);
                 let body = bin(Binary::Sub, &un(Unary::Length, &p), &num(r));
@@ -165,6 +168,162 @@ impl Ctx<'_> {
             }
         };
         made.map_or(Value::Error, |p| Value::Profile(Arc::new(p)))
+    }
+
+    /// A profile moved in its plane: `at [u, v]`, `rotate degrees` (counter-clockwise,
+    /// from `u` towards `v`) or `scale k` (uniform, so the distance stays exact).
+    pub(in crate::check) fn transform_profile(
+        &mut self,
+        op: TransformOp,
+        profile: &Profile,
+        arg: &Value,
+        arg_span: Span,
+    ) -> Value {
+        let p = Expr::point();
+        let (u, v) = (Expr::component(&p, 0), Expr::component(&p, 1));
+        let corners = [
+            profile.min,
+            DVec2::new(profile.max.x, profile.min.y),
+            profile.max,
+            DVec2::new(profile.min.x, profile.max.y),
+        ];
+        let boxed = |pts: [DVec2; 4]| {
+            (pts.iter().fold(DVec2::INFINITY, |m, c| m.min(*c)), pts.iter().fold(DVec2::NEG_INFINITY, |m, c| m.max(*c)))
+        };
+        let two = match arg {
+            Value::List(items) if items.len() == 2 => match (&items[0], &items[1]) {
+                (Value::Num(a), Value::Num(b)) if a.is_finite() && b.is_finite() => Some(DVec2::new(*a, *b)),
+                _ => None,
+            },
+            _ => None,
+        };
+        let made = match (op, arg, two) {
+            (TransformOp::At, _, Some(d)) => {
+                let moved = vec2(bin(Binary::Sub, &u, &num(d.x)), bin(Binary::Sub, &v, &num(d.y)));
+                Some(Profile { body: profile.body.substitute(&moved), min: profile.min + d, max: profile.max + d })
+            }
+            (TransformOp::Rotate, Value::Num(deg), _) => {
+                let (sin, cos) = deg.to_radians().sin_cos();
+                // The point turned back by the angle, into the profile's own frame.
+                let back = vec2(
+                    bin(Binary::Add, &bin(Binary::Mul, &u, &num(cos)), &bin(Binary::Mul, &v, &num(sin))),
+                    bin(Binary::Sub, &bin(Binary::Mul, &v, &num(cos)), &bin(Binary::Mul, &u, &num(sin))),
+                );
+                let (min, max) = boxed(corners.map(|c| DVec2::new(c.x * cos - c.y * sin, c.x * sin + c.y * cos)));
+                Some(Profile { body: profile.body.substitute(&back), min, max })
+            }
+            (TransformOp::Scale, Value::Num(k), _) if *k > 0.0 && k.is_finite() => {
+                let shrunk = vec2(bin(Binary::Div, &u, &num(*k)), bin(Binary::Div, &v, &num(*k)));
+                let body = bin(Binary::Mul, &num(*k), &profile.body.substitute(&shrunk));
+                Some(Profile { body, min: profile.min * *k, max: profile.max * *k })
+            }
+            _ => None,
+        };
+        if let Some(made) = made {
+            return Value::Profile(Arc::new(made));
+        }
+        if let (TransformOp::Scale, Value::Num(k)) = (op, arg) {
+            self.report(
+                Diagnostic::error(
+                    codes::OUT_OF_RANGE,
+                    arg_span,
+                    "a profile's scale must be greater than 0",
+                    format!("this is {}", crate::sig::short(*k)),
+                )
+                .with_note("a zero scale shrinks the profile to nothing; mirroring is not supported"),
+            );
+            return Value::Error;
+        }
+        let (expected, note) = match op {
+            TransformOp::At => ("`[u, v]`", "a profile is placed in its plane by two numbers"),
+            TransformOp::Rotate => ("`num`", "a profile turns in its plane by one angle, in degrees"),
+            _ => ("`num`", "a profile scales uniformly, by one number, so its distance stays exact"),
+        };
+        self.report(
+            Diagnostic::error(
+                codes::TYPE_MISMATCH,
+                arg_span,
+                format!("expected {expected}, found `{}`", arg.ty_name()),
+                arg.this_is(),
+            )
+            .with_note(note),
+        );
+        Value::Error
+    }
+
+    /// `union`, `intersect` or `subtract` of profiles: the min or max of their distances
+    /// (Quilez's quadratic blend with `smooth`), a bound that is exact outside a union
+    /// and inside an intersection; `None` after reporting.
+    fn profile_csg(&mut self, op: CsgOp, a: &BoundArgs) -> Option<Profile> {
+        let name = match op {
+            CsgOp::Union => "union",
+            CsgOp::Intersect => "intersect",
+            CsgOp::Subtract => "subtract",
+        };
+        let parts: Vec<Arc<Profile>> =
+            a.rest.iter().filter_map(|(v, _)| if let Value::Profile(p) = v { Some(p.clone()) } else { None }).collect();
+        if parts.len() != a.rest.len() {
+            return None;
+        }
+        let Some((first, rest)) = parts.split_first() else {
+            self.report(
+                Diagnostic::error(codes::ARITY, a.call, format!("`{name}` needs at least one profile"), "none given")
+                    .with_hint(format!("try `{name}(circle(1), rect(0.5, 2))`")),
+            );
+            return None;
+        };
+        if parts.len() > MAX_POLYGON_POINTS {
+            self.report(
+                Diagnostic::error(codes::TOO_LARGE, a.call, format!("`{name}` of too many profiles"), "here")
+                    .with_note(format!("one operation may combine at most {MAX_POLYGON_POINTS} profiles")),
+            );
+            return None;
+        }
+        let CsgArgs { smooth: k } = CsgArgs::from_args(a);
+        // max(k − |a − b|, 0)² / 4k: how far the blend moves the seam (at most k/4).
+        let blend = |x: &Arc<Expr>, y: &Arc<Expr>| {
+            let gap = bin(Binary::Sub, &num(k), &un(Unary::Abs, &bin(Binary::Sub, x, y)));
+            let h = bin(Binary::Max, &gap, &num(0.0));
+            bin(Binary::Div, &bin(Binary::Mul, &h, &h), &num(4.0 * k))
+        };
+        let combine = |x: &Arc<Expr>, y: &Arc<Expr>, outer: Binary| {
+            let sharp = bin(outer, x, y);
+            match (k > 0.0, outer) {
+                (false, _) => sharp,
+                (true, Binary::Min) => bin(Binary::Sub, &sharp, &blend(x, y)),
+                (true, _) => bin(Binary::Add, &sharp, &blend(x, y)),
+            }
+        };
+        let (mut body, mut min, mut max) = (first.body.clone(), first.min, first.max);
+        for p in rest {
+            match op {
+                CsgOp::Union => {
+                    body = combine(&body, &p.body, Binary::Min);
+                    (min, max) = (min.min(p.min), max.max(p.max));
+                }
+                CsgOp::Intersect => {
+                    body = combine(&body, &p.body, Binary::Max);
+                    (min, max) = (min.max(p.min), max.min(p.max));
+                }
+                CsgOp::Subtract => body = combine(&body, &un(Unary::Neg, &p.body), Binary::Max),
+            }
+        }
+        if op == CsgOp::Union {
+            (min, max) = (min - k / 4.0, max + k / 4.0);
+        }
+        if min.cmpge(max).any() {
+            self.report(
+                Diagnostic::error(
+                    codes::OUT_OF_RANGE,
+                    a.call,
+                    "this intersection of profiles is empty",
+                    "their boxes do not overlap",
+                )
+                .with_note("`intersect` keeps only what is inside every profile"),
+            );
+            return None;
+        }
+        Some(Profile { body, min, max })
     }
 
     /// `extrude` or `revolve` as a field of the solid's point, or `None` after reporting.
@@ -210,7 +369,12 @@ impl Ctx<'_> {
                 let bounds = Aabb { min: DVec3::new(-r, profile.min.y, -r), max: DVec3::new(r, profile.max.y, r) };
                 Some(ShapeKind::Field { body, bounds: Some(bounds), lipschitz: exact })
             }
-            ProfileFn::Circle | ProfileFn::Rect | ProfileFn::Polygon | ProfileFn::Round | ProfileFn::Shell => None,
+            ProfileFn::Csg(_)
+            | ProfileFn::Circle
+            | ProfileFn::Rect
+            | ProfileFn::Polygon
+            | ProfileFn::Round
+            | ProfileFn::Shell => None,
         }
     }
 
