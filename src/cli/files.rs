@@ -1,7 +1,10 @@
 //! Output files written whole or not at all: to a temporary file beside the target,
 //! then renamed over it, keeping the mode of a file being replaced. A symbolic link at
 //! the output path is written through (its target is replaced, the link kept), as
-//! editors and `cp` do.
+//! editors and `cp` do. Also: SIGINT, SIGTERM and SIGHUP remove what is half-written and
+//! stop a child process; PNGs are written with text chunks (an animation's rate) and
+//! read back within the documented image limits; and the check that an output is not
+//! one of the inputs.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -10,18 +13,56 @@ use std::sync::Mutex;
 /// Temporary files being written, removed if the process is interrupted.
 static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
-/// On Ctrl-C (SIGINT): remove any temporary file being written and end the process at
-/// once with `code`, leaving every output as it was. Without this a render runs on and
-/// an interrupt during encoding leaves a `.scnc-*.tmp` file behind.
+/// A child process (`ffmpeg`) working for us, killed if the process is interrupted.
+static CHILD: Mutex<Option<std::process::Child>> = Mutex::new(None);
+
+/// On SIGINT (Ctrl-C), SIGTERM or SIGHUP — what `timeout`, `kill`, Slurm's time limits
+/// and Kubernetes send — remove any temporary file being written, stop the child
+/// process working for us, and end the process at once: with `code` on SIGINT, with
+/// 128 + the signal's number on the others, as a shell reports them. Every output is
+/// left as it was; without this a render runs on, and a signal during encoding leaves
+/// a `.scnc-*.tmp` file behind.
 pub(crate) fn stop_on_interrupt(code: i32) -> Result<(), String> {
-    ctrlc::set_handler(move || {
-        for path in PENDING.lock().map(|p| p.clone()).unwrap_or_default() {
-            let _ = std::fs::remove_file(path);
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP])
+        .map_err(|e| format!("cannot handle signals: {e}"))?;
+    std::thread::Builder::new()
+        .name("signals".into())
+        .spawn(move || {
+            if let Some(signal) = signals.forever().next() {
+                if let Some(child) = CHILD.lock().unwrap_or_else(|e| e.into_inner()).as_mut() {
+                    let _ = child.kill();
+                    let _ = child.wait();
+                }
+                for path in PENDING.lock().map(|p| p.clone()).unwrap_or_default() {
+                    let _ = std::fs::remove_file(path);
+                }
+                let code = if signal == SIGINT { code } else { 128 + signal };
+                #[allow(
+                    clippy::exit,
+                    reason = "the signal handler ends the process; the main thread may be mid-render"
+                )]
+                std::process::exit(code);
+            }
+        })
+        .map(|_| ())
+        .map_err(|e| format!("cannot handle signals: {e}"))
+}
+
+/// Runs `command` to its end as the child a signal stops (see [`stop_on_interrupt`]).
+pub(crate) fn run_child(command: &mut std::process::Command) -> std::io::Result<std::process::ExitStatus> {
+    let child = command.spawn()?;
+    *CHILD.lock().unwrap_or_else(|e| e.into_inner()) = Some(child);
+    loop {
+        let mut guard = CHILD.lock().unwrap_or_else(|e| e.into_inner());
+        let Some(child) = guard.as_mut() else { return Err(std::io::Error::other("the child was stopped")) };
+        if let Some(status) = child.try_wait()? {
+            *guard = None;
+            return Ok(status);
         }
-        #[allow(clippy::exit, reason = "the interrupt handler ends the process; the main thread may be mid-render")]
-        std::process::exit(code);
-    })
-    .map_err(|e| format!("cannot handle Ctrl-C: {e}"))
+        drop(guard);
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
 }
 
 /// Registers a temporary file for removal on interrupt while it lives.
@@ -110,7 +151,7 @@ pub(crate) fn cannot_write(path: &Path, e: &std::io::Error) -> String {
 }
 
 /// The directory a file is in (`.` for a bare file name).
-fn parent_dir(path: &Path) -> &Path {
+pub(crate) fn parent_dir(path: &Path) -> &Path {
     match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
@@ -120,7 +161,7 @@ fn parent_dir(path: &Path) -> &Path {
 /// The file a path finally names, following symbolic links (a dangling one names
 /// where its target would be); `path` itself when it is not a link. A loop of links
 /// stops after 40, like the kernel's limit.
-fn link_target(path: &Path) -> PathBuf {
+pub(crate) fn link_target(path: &Path) -> PathBuf {
     let mut p = path.to_path_buf();
     for _ in 0..40 {
         let Ok(next) = std::fs::read_link(&p) else { break };
@@ -168,29 +209,88 @@ pub(crate) fn write_text(path: &Path, text: &str) -> std::io::Result<()> {
     write_atomic(path, ".tmp", |w| w.write_all(text.as_bytes()))
 }
 
-/// Encodes a PNG whole or not at all.
 use scnc::render::BitDepth;
 
-pub(crate) fn write_png(path: &Path, image: &scnc::render::Image) -> std::io::Result<()> {
-    let colour = match image.depth {
-        BitDepth::Eight => image::ExtendedColorType::Rgb8,
-        BitDepth::Sixteen => image::ExtendedColorType::Rgb16,
-    };
-    encode_png(path, &image.pixels, image.width, image.height, colour)
+/// The PNG text keyword under which an animation's frames carry its frame rate, which
+/// `scnc encode` reads.
+pub(crate) const FPS_KEY: &str = "scnc:fps";
+
+/// Encodes a PNG whole or not at all, with `text` as tEXt chunks (keyword, text).
+pub(crate) fn write_png(path: &Path, image: &scnc::render::Image, text: &[(&str, String)]) -> std::io::Result<()> {
+    encode_png(path, &image.pixels, image.width, image.height, png::ColorType::Rgb, image.depth, text)
 }
 
-/// Encodes `pixels` of a `width × height` image as a PNG, whole or not at all.
+/// Encodes `pixels` of a `width × height` image (16-bit samples in the machine's
+/// order) as a PNG, whole or not at all.
 fn encode_png(
     path: &Path,
     pixels: &[u8],
     width: u32,
     height: u32,
-    colour: image::ExtendedColorType,
+    colour: png::ColorType,
+    depth: BitDepth,
+    text: &[(&str, String)],
 ) -> std::io::Result<()> {
-    use image::ImageEncoder;
     write_atomic(path, ".png.tmp", |w| {
-        image::codecs::png::PngEncoder::new(w).write_image(pixels, width, height, colour).map_err(std::io::Error::other)
+        let mut encoder = png::Encoder::new(w, width, height);
+        encoder.set_color(colour);
+        encoder.set_depth(match depth {
+            BitDepth::Eight => png::BitDepth::Eight,
+            BitDepth::Sixteen => png::BitDepth::Sixteen,
+        });
+        for (key, value) in text {
+            encoder.add_text_chunk((*key).to_string(), value.clone()).map_err(std::io::Error::other)?;
+        }
+        let mut writer = encoder.write_header().map_err(std::io::Error::other)?;
+        let mut stream = writer.stream_writer().map_err(std::io::Error::other)?;
+        match depth {
+            BitDepth::Eight => stream.write_all(pixels)?,
+            // PNG's samples are big-endian: converted a row's worth at a time.
+            BitDepth::Sixteen => {
+                for chunk in pixels.chunks(1 << 16) {
+                    let be: Vec<u8> =
+                        chunk.chunks_exact(2).flat_map(|s| u16::from_ne_bytes([s[0], s[1]]).to_be_bytes()).collect();
+                    stream.write_all(&be)?;
+                }
+            }
+        }
+        stream.finish().map_err(std::io::Error::other)
     })
+}
+
+/// Most bytes a decoded image may take: the largest image `render` writes (at the
+/// pixel limit, 16-bit RGBA), so every image scnc writes can be read back, and no more.
+const MAX_DECODED_BYTES: u64 = scnc::check::MAX_PIXELS * 8;
+
+/// Reads a PNG that scnc (or anyone) wrote, within the documented image limits: the
+/// side and pixel limits of `render`, not the decoder's default of 512 MiB, which a
+/// 16-bit 8200×8200 part exceeds.
+pub(crate) fn read_png(path: &Path) -> Result<image::DynamicImage, String> {
+    let cannot = |e: &dyn std::fmt::Display| format!("cannot read `{}`: {e}", path.display());
+    let mut reader = image::ImageReader::open(path).map_err(|e| cannot(&e))?;
+    reader.set_format(image::ImageFormat::Png);
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(scnc::check::MAX_IMAGE_SIDE);
+    limits.max_image_height = Some(scnc::check::MAX_IMAGE_SIDE);
+    limits.max_alloc = Some(MAX_DECODED_BYTES);
+    reader.limits(limits);
+    reader.decode().map_err(|e| cannot(&e))
+}
+
+/// A PNG's size (width, height) and its tEXt chunks (keyword, text).
+pub(crate) type PngHeader = ((u32, u32), Vec<(String, String)>);
+
+/// A PNG's size and its tEXt chunks, from its header alone.
+pub(crate) fn png_header(path: &Path) -> Result<PngHeader, String> {
+    let cannot = |e: &dyn std::fmt::Display| format!("cannot read `{}`: {e}", path.display());
+    let file = std::fs::File::open(path).map_err(|e| cannot(&e))?;
+    let mut decoder = png::Decoder::new(std::io::BufReader::new(file));
+    // The header only: no image data is read or allocated.
+    decoder.set_limits(png::Limits { bytes: MAX_DECODED_BYTES as usize });
+    let reader = decoder.read_info().map_err(|e| cannot(&e))?;
+    let info = reader.info();
+    let text = info.uncompressed_latin1_text.iter().map(|t| (t.keyword.clone(), t.text.clone())).collect();
+    Ok(((info.width, info.height), text))
 }
 
 /// Encodes a part of a `width × height` image whole or not at all: RGBA at full size,
@@ -205,10 +305,6 @@ pub(crate) fn write_part_png(
 ) -> std::io::Result<()> {
     // One sample is one byte, or two in the machine's order.
     let sample = image.depth.sample_bytes();
-    let colour = match image.depth {
-        BitDepth::Eight => image::ExtendedColorType::Rgba8,
-        BitDepth::Sixteen => image::ExtendedColorType::Rgba16,
-    };
     let mut rgba = vec![0u8; width as usize * height as usize * 4 * sample];
     for (dy, row) in image.pixels.chunks_exact(3 * sample * image.width as usize).enumerate() {
         let start = ((region.y0 as usize + dy) * width as usize + region.x0 as usize) * 4 * sample;
@@ -218,5 +314,5 @@ pub(crate) fn write_part_png(
             out[3 * sample..].fill(255);
         }
     }
-    encode_png(path, &rgba, width, height, colour)
+    encode_png(path, &rgba, width, height, png::ColorType::Rgba, image.depth, &[])
 }

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use scnc::render::BitDepth;
 
-use super::files::{cannot_write, check_output, write_png};
+use super::files::{cannot_write, check_output, overwritten_input, read_png, write_png};
 
 #[derive(clap::Args)]
 pub(crate) struct MergeArgs {
@@ -28,7 +28,7 @@ struct Part {
 
 /// Reads a part.
 fn read_part(path: &Path) -> Result<Part, String> {
-    let image = image::open(path).map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
+    let image = read_png(path)?;
     let (width, height) = (image.width(), image.height());
     let (depth, rgba) = match image {
         image::DynamicImage::ImageRgba8(rgba) => (BitDepth::Eight, rgba.into_raw()),
@@ -123,6 +123,13 @@ pub(crate) fn merge_cmd(args: MergeArgs) -> ExitCode {
     if let Err(e) = check_output(&args.output) {
         return super::usage_error(&e);
     }
+    if let Some(part) = overwritten_input(&args.output, args.parts.iter().map(PathBuf::as_path)) {
+        return super::usage_error(&format!(
+            "`{}` is one of the parts (`{}`): name another output",
+            args.output.display(),
+            part.display()
+        ));
+    }
     let image = match merge(&args.parts) {
         Ok(image) => image,
         Err(e) => {
@@ -130,7 +137,7 @@ pub(crate) fn merge_cmd(args: MergeArgs) -> ExitCode {
             return ExitCode::from(1);
         }
     };
-    if let Err(e) = write_png(&args.output, &image) {
+    if let Err(e) = write_png(&args.output, &image, &[]) {
         let _ = writeln!(std::io::stderr(), "error: {}", cannot_write(&args.output, &e));
         return ExitCode::from(1);
     }

@@ -16,7 +16,7 @@ use scnc::Compiled;
 
 use scnc::render::{BitDepth, Region};
 
-use super::files::{cannot_write, check_output, stop_on_interrupt, write_part_png, write_png};
+use super::files::{cannot_write, check_output, stop_on_interrupt, write_part_png, write_png, FPS_KEY};
 use super::frames::{frame_path, is_pattern, parse_frames, FrameChoice};
 use super::progress::Progress;
 use super::{compile, report, usage_error, worker_pool, MessageFormat};
@@ -108,7 +108,7 @@ pub(crate) struct RenderArgs {
     /// Leave frames whose output file already exists (outputs are written whole or not
     /// at all, so one that exists is complete).
     #[arg(long)]
-    skip_existing: bool,
+    pub(crate) skip_existing: bool,
     /// Render the chunk of frames picked by the task index in this environment variable
     /// (`SLURM_ARRAY_TASK_ID`, `JOB_COMPLETION_INDEX`, …): task I renders frames I·K to
     /// I·K + K − 1 of the selection, K being `--chunk`.
@@ -426,7 +426,9 @@ fn render_scene(
     let traced = started.elapsed() - lowered;
     let written = match part {
         Some(region) => write_part_png(output, frame.width, frame.height, region, &image),
-        None => write_png(output, &image),
+        // An animation's frames carry its rate, which `scnc encode` reads.
+        None if scene.settings.frames > 1 => write_png(output, &image, &[(FPS_KEY, scene.settings.fps.to_string())]),
+        None => write_png(output, &image, &[]),
     };
     if let Err(e) = written {
         let _ = writeln!(std::io::stderr(), "error: {}", cannot_write(output, &e));

@@ -110,7 +110,7 @@ pub(crate) fn sweep_cmd(args: SweepArgs) -> ExitCode {
         let path = args.output.join(name);
         let written = chart::error_chart(&rows, axis, &title)
             .map_err(std::io::Error::other)
-            .and_then(|img| write_png(&path, &img));
+            .and_then(|img| write_png(&path, &img, &[]));
         if let Err(e) = written {
             let _ = writeln!(std::io::stderr(), "error: {}", cannot_write(&path, &e));
             return ExitCode::from(1);

@@ -14,6 +14,13 @@ const DEBOUNCE: std::time::Duration = std::time::Duration::from_millis(150);
 
 pub(crate) fn watch_cmd(args: RenderArgs) -> ExitCode {
     use notify::Watcher as _;
+    if args.skip_existing {
+        // Every frame exists after the first render, so every later one would skip them
+        // all and the images would never follow the edits.
+        return usage_error(
+            "`watch` renders every frame again on each change; `--skip-existing` would keep the old frames: leave it out",
+        );
+    }
     // Ctrl-C is how a watch ends: at once, even mid-render, with the last image whole
     // and no temporary file left.
     let pool = match args.checked_pool(0) {

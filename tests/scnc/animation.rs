@@ -231,3 +231,142 @@ fn warnings_are_shown_once_per_render() {
     assert_eq!(err.matches("W0801").count(), 1, "{err}");
     assert_eq!(err.matches("rendered").count(), 3, "{err}");
 }
+
+/// An animation at `fps` frames per second, 16×12, three frames.
+fn rated_scene(dir: &Path, fps: &str) -> std::path::PathBuf {
+    let scene = dir.join("rated.scn");
+    let text = format!(
+        "render(width = 16, height = 12, frames = 3, fps = {fps})\nlight ambient(1)\nobject sphere(0.5 + 0.1 * clock) at [0, 0, 3]\n"
+    );
+    std::fs::write(&scene, text).expect("writing the scene");
+    scene
+}
+
+/// The APNG's frame delay.
+fn apng_delay(file: &Path) -> Option<(u16, u16)> {
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(file).expect("apng")));
+    let reader = decoder.read_info().expect("png header");
+    reader.info().frame_control.map(|f| (f.delay_num, f.delay_den))
+}
+
+#[test]
+fn encode_plays_at_the_scenes_rate_unless_told_and_takes_fractional_rates() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let scene = rated_scene(dir.path(), "10");
+    let pattern = dir.path().join("f-##.png");
+    ok(&scnc(&["render", path(&scene), "-o", path(&pattern)]));
+    let apng = dir.path().join("a.png");
+    let out = scnc(&["encode", path(&pattern), "-o", path(&apng)]);
+    ok(&out);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("at 10 fps (the scene's rate"), "{out:?}");
+    assert_eq!(apng_delay(&apng), Some((1, 10)));
+    ok(&scnc(&["encode", path(&pattern), "-o", path(&apng), "--fps", "23.976"]));
+    assert_eq!(apng_delay(&apng), Some((1000, 23976)));
+    let gif = dir.path().join("a.gif");
+    ok(&scnc(&["encode", path(&pattern), "-o", path(&gif), "--fps", "12.5"]));
+    for bad in ["0", "-3", "nan", "1001"] {
+        refused(&scnc(&["encode", path(&pattern), "-o", path(&gif), &format!("--fps={bad}")]), 2, "frames per second");
+    }
+}
+
+#[test]
+fn an_output_that_is_an_input_is_refused_before_any_work() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let scene = rated_scene(dir.path(), "10");
+    let pattern = dir.path().join("f-##.png");
+    ok(&scnc(&["render", path(&scene), "-o", path(&pattern)]));
+    let before = std::fs::read(dir.path().join("f-01.png")).expect("frame 1");
+    // Replacing frame 1, adding frame 6 (the next encode would include it), or the same
+    // frame reached through `..`.
+    let inner = dir.path().join("sub");
+    std::fs::create_dir(&inner).expect("mkdir");
+    for out in [dir.path().join("f-01.png"), dir.path().join("f-06.png"), inner.join("../f-02.png")] {
+        refused(&scnc(&["encode", path(&pattern), "-o", path(&out)]), 2, "name another output");
+    }
+    assert_eq!(std::fs::read(dir.path().join("f-01.png")).expect("frame 1"), before);
+    assert!(!dir.path().join("f-06.png").exists());
+    // A part merged over itself.
+    let (a, b) = (dir.path().join("a.png"), dir.path().join("b.png"));
+    ok(&scnc(&["render", path(&scene), "-o", path(&a), "--frames", "0", "--tile", "0/2"]));
+    ok(&scnc(&["render", path(&scene), "-o", path(&b), "--frames", "0", "--tile", "1/2"]));
+    let part = std::fs::read(&a).expect("part");
+    refused(&scnc(&["merge", path(&a), path(&b), "-o", path(&a)]), 2, "is one of the parts");
+    assert_eq!(std::fs::read(&a).expect("part"), part);
+    // `watch` cannot keep frames that exist.
+    refused(&scnc(&["watch", path(&scene), "-o", path(&pattern), "--skip-existing"]), 2, "--skip-existing");
+}
+
+#[test]
+fn every_format_refuses_frames_of_two_sizes_before_encoding() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let scene = rated_scene(dir.path(), "10");
+    let pattern = dir.path().join("f-##.png");
+    ok(&scnc(&["render", path(&scene), "-o", path(&pattern)]));
+    ok(&scnc(&["render", path(&scene), "-o", path(&dir.path().join("f-01.png")), "--frames", "1", "--width", "20"]));
+    for out in ["x.gif", "x.png", "x.mp4"] {
+        // MP4 included: the sizes are checked before ffmpeg is looked for.
+        let out = scnc_env(&["encode", path(&pattern), "-o", path(&dir.path().join(out))], &[("PATH", "/nonexistent")]);
+        refused(&out, 2, "every frame must have one size");
+    }
+}
+
+/// Memory holds one frame at a time: 40 frames of 1500×1500 (360 MB as RGBA, which the
+/// old encoder held at once) encode under a 300 MB address-space limit.
+#[cfg(unix)]
+#[test]
+fn encode_streams_its_frames_in_bounded_memory() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let frame = image::RgbImage::from_fn(1500, 1500, |x, y| image::Rgb([(x % 256) as u8, (y % 256) as u8, 90]));
+    for i in 0..40 {
+        frame.save(dir.path().join(format!("f-{i:02}.png"))).expect("writing a frame");
+    }
+    let bin = env!("CARGO_BIN_EXE_scnc");
+    let out = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!("ulimit -v 300000 && exec {bin} encode f-##.png -o a.png --fps 10"))
+        .current_dir(dir.path())
+        .output()
+        .expect("running encode");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(dir.path().join("a.png")).expect("a")));
+    assert_eq!(decoder.read_info().expect("header").info().animation_control.map(|a| a.num_frames), Some(40));
+}
+
+/// SIGTERM and SIGHUP (what `timeout`, `kill`, Slurm and Kubernetes send) end an
+/// encode as Ctrl-C does: caught while the output's temporary file is being written, it
+/// is removed, and the process ends with the shell's code for the signal.
+#[cfg(unix)]
+#[test]
+fn a_signal_leaves_no_temporary_file_and_exits_with_its_code() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let frame = image::RgbImage::from_fn(1000, 1000, |x, y| image::Rgb([(x * y % 251) as u8, (x % 256) as u8, 90]));
+    for i in 0..30 {
+        frame.save(dir.path().join(format!("f-{i:02}.png"))).expect("writing a frame");
+    }
+    let temporary = || {
+        std::fs::read_dir(dir.path())
+            .expect("read dir")
+            .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+            .filter(|n| n.starts_with(".scnc-") || n == "a.png")
+            .collect::<Vec<_>>()
+    };
+    for (signal, code) in [("TERM", 143), ("HUP", 129), ("INT", 130)] {
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_scnc"))
+            .args(["encode", "f-##.png", "-o", "a.png"])
+            .current_dir(dir.path())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .expect("starting an encode");
+        // Signalled once the temporary file is there (the encoder writes it frame by frame).
+        let start = std::time::Instant::now();
+        while temporary().is_empty() {
+            assert!(start.elapsed().as_secs() < 30, "no temporary file appeared");
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+        let sent = std::process::Command::new("kill").args([&format!("-{signal}"), &child.id().to_string()]).status();
+        assert!(sent.expect("kill").success());
+        let status = child.wait().expect("the encode ends");
+        assert_eq!(status.code(), Some(code), "after SIG{signal}");
+        assert!(temporary().is_empty(), "after SIG{signal}: {:?}", temporary());
+    }
+}
