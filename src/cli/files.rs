@@ -170,15 +170,10 @@ pub(crate) fn link_target(path: &Path) -> PathBuf {
     p
 }
 
-/// Writes `path` through `write` into a temporary file beside it (named with `suffix`),
-/// then renames it into place: the target is replaced whole, or left as it was.
-pub(crate) fn write_atomic(
-    path: &Path,
-    suffix: &str,
-    write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
-) -> std::io::Result<()> {
-    let path = &link_target(path);
-    let dir = parent_dir(path);
+/// An empty temporary file of a random name beside `path` (a resolved target), with
+/// the mode the file will have: a new file's usual mode (0666 less the umask), or the
+/// mode of the file it will replace.
+pub(crate) fn stage_beside(path: &Path, suffix: &str) -> std::io::Result<tempfile::NamedTempFile> {
     let mut builder = tempfile::Builder::new();
     builder.prefix(".scnc-").suffix(suffix);
     // A new file gets the mode any tool gives one (0666 less the umask, applied by the
@@ -188,12 +183,24 @@ pub(crate) fn write_atomic(
         use std::os::unix::fs::PermissionsExt;
         builder.permissions(std::fs::Permissions::from_mode(0o666));
     }
-    let mut tmp = builder.tempfile_in(dir)?;
-    let _pending = Pending::new(tmp.path());
+    let tmp = builder.tempfile_in(parent_dir(path))?;
     // Replacing a file keeps its permissions (a temporary file is private by default).
     if let Ok(meta) = std::fs::metadata(path) {
         tmp.as_file().set_permissions(meta.permissions())?;
     }
+    Ok(tmp)
+}
+
+/// Writes `path` through `write` into a temporary file beside it (named with `suffix`),
+/// then renames it into place: the target is replaced whole, or left as it was.
+pub(crate) fn write_atomic(
+    path: &Path,
+    suffix: &str,
+    write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    let path = &link_target(path);
+    let mut tmp = stage_beside(path, suffix)?;
+    let _pending = Pending::new(tmp.path());
     {
         let mut w = std::io::BufWriter::new(tmp.as_file_mut());
         write(&mut w)?;

@@ -109,6 +109,10 @@ pub(crate) struct RenderArgs {
     /// at all, so one that exists is complete).
     #[arg(long)]
     pub(crate) skip_existing: bool,
+    /// Write an animation's frames only when every one has rendered (set by `watch`, so
+    /// that an edit failing at a later frame leaves the whole sequence as it was).
+    #[arg(skip)]
+    pub(crate) whole_revisions: bool,
     /// Render the chunk of frames picked by the task index in this environment variable
     /// (`SLURM_ARRAY_TASK_ID`, `JOB_COMPLETION_INDEX`, …): task I renders frames I·K to
     /// I·K + K − 1 of the selection, K being `--chunk`.
@@ -330,6 +334,11 @@ fn render_compiled(args: &RenderArgs, pool: &rayon::ThreadPool, mut compiled: Co
         cache: scnc::world::FrameCache::default(),
         shown: compiled.diagnostics.iter().map(diagnostic_key).collect(),
     };
+    // With `whole_revisions`, frames are staged beside their outputs and renamed into
+    // place only once every frame has rendered: an error at a later frame leaves the
+    // whole sequence as it was, never frames of two revisions.
+    let together = args.whole_revisions && frames.len() > 1;
+    let mut staged: Vec<(tempfile::NamedTempFile, PathBuf, super::files::Pending)> = Vec::new();
     for number in frames {
         let output = frame_path(&args.output, number);
         if args.skip_existing && output.exists() {
@@ -340,7 +349,24 @@ fn render_compiled(args: &RenderArgs, pool: &rayon::ThreadPool, mut compiled: Co
             Some(scene) => scene,
             None => evaluate_frame(&mut compiled, number, &declared, &mut sequence.shown, args.message_format)?,
         };
-        render_scene(args, pool, &compiled.map, scene, &output, &mut sequence)?;
+        if together {
+            let target = super::files::link_target(&output);
+            let stage = super::files::stage_beside(&target, ".png.tmp").map_err(|e| {
+                let _ = writeln!(std::io::stderr(), "error: {}", cannot_write(&output, &e));
+                ExitCode::from(1)
+            })?;
+            let pending = super::files::Pending::new(stage.path());
+            render_scene(args, pool, &compiled.map, scene, stage.path(), &output, &mut sequence)?;
+            staged.push((stage, target, pending));
+        } else {
+            render_scene(args, pool, &compiled.map, scene, &output, &output, &mut sequence)?;
+        }
+    }
+    for (stage, target, _pending) in staged {
+        stage.persist(&target).map_err(|e| {
+            let _ = writeln!(std::io::stderr(), "error: {}", cannot_write(&target, &e.error));
+            ExitCode::from(1)
+        })?;
     }
     Ok(())
 }
@@ -390,6 +416,7 @@ fn render_scene(
     map: &scnc::source::SourceMap,
     mut scene: scnc::ir::Scene,
     output: &Path,
+    shown: &Path,
     sequence: &mut Sequence,
 ) -> Result<(), ExitCode> {
     let (mode, part) = args.apply(&mut scene)?;
@@ -431,7 +458,7 @@ fn render_scene(
         None => write_png(output, &image, &[]),
     };
     if let Err(e) = written {
-        let _ = writeln!(std::io::stderr(), "error: {}", cannot_write(output, &e));
+        let _ = writeln!(std::io::stderr(), "error: {}", cannot_write(shown, &e));
         return Err(ExitCode::from(1));
     }
     let secs = traced.as_secs_f64();
@@ -443,7 +470,7 @@ fn render_scene(
     let _ = writeln!(
         err,
         "rendered {}: {size} in {:.3} s ({:.2} M rays/s, {} thread{})",
-        output.display(),
+        shown.display(),
         started.elapsed().as_secs_f64(),
         counters.rays() as f64 / secs.max(1e-9) / 1e6,
         pool.current_num_threads(),

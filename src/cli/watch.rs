@@ -12,8 +12,9 @@ use super::usage_error;
 /// several file-system events) renders once.
 const DEBOUNCE: std::time::Duration = std::time::Duration::from_millis(150);
 
-pub(crate) fn watch_cmd(args: RenderArgs) -> ExitCode {
+pub(crate) fn watch_cmd(mut args: RenderArgs) -> ExitCode {
     use notify::Watcher as _;
+    args.whole_revisions = true;
     if args.skip_existing {
         // Every frame exists after the first render, so every later one would skip them
         // all and the images would never follow the edits.

@@ -101,3 +101,45 @@ fn watch_rerenders_on_change_keeps_the_last_image_on_error_and_stops_on_ctrl_c()
     names.sort();
     assert_eq!(names, ["inc.scn", "out.png", "scene.scn"]);
 }
+
+/// An edit that fails only at a later frame of an animation leaves every frame as it
+/// was: frames are written only when the whole revision has rendered.
+#[test]
+fn watch_writes_an_animation_whole_or_not_at_all() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = dir.path().join("scene.scn");
+    let head = "render(width = 16, height = 12, frames = 3)\nlight ambient(1)\n";
+    std::fs::write(&scene, format!("{head}object sphere(0.5 + 0.2 * clock) at [0, 0, 3]\n")).expect("writing");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_scnc"))
+        .args(["watch", "scene.scn", "-o", "f-#.png"])
+        .current_dir(dir.path())
+        .env("NO_COLOR", "1")
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("starting scnc watch");
+    let stderr = BufReader::new(child.stderr.take().expect("stderr"));
+    let (tx, lines) = mpsc::channel();
+    std::thread::spawn(move || {
+        for line in stderr.lines().map_while(Result::ok) {
+            let _ = tx.send(line);
+        }
+    });
+    let mut log = Vec::new();
+    wait_for(&lines, "rendered f-2.png", &mut log);
+    let frames =
+        || (0..3).map(|i| std::fs::read(dir.path().join(format!("f-{i}.png"))).expect("a frame")).collect::<Vec<_>>();
+    let before = frames();
+    // Frames 0 and 1 would change; frame 2 reaches radius 0, an error.
+    let failing = format!("{head}object sphere(1 - clock) at [0, 0, 3]\n");
+    write_until(&scene, &failing, &lines, "keeps the last good image", &mut log);
+    assert_eq!(frames(), before, "a failed revision changed some frames:\n{}", log.join("\n"));
+    let _ = Command::new("kill").args(["-INT", &child.id().to_string()]).status();
+    let _ = child.wait();
+    let stray: Vec<String> = std::fs::read_dir(dir.path())
+        .expect("listing")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with(".scnc-"))
+        .collect();
+    assert!(stray.is_empty(), "{stray:?}");
+}
