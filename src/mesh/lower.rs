@@ -308,16 +308,26 @@ pub fn explicit(
                 )
                 .with_note(format!("looked for {}", path.display()))
             })?;
-            obj::parse(&bytes).map_err(|e| {
-                let place = if e.line > 0 { format!("{written}:{}", e.line) } else { written.clone() };
+            let bad = |place: String, message: String| {
                 Diagnostic::error(
                     codes::LOWERING,
                     m.span,
                     format!("bad mesh file `{written}`"),
-                    format!("{place}: {}", e.message),
+                    format!("{place}: {message}"),
                 )
-                .with_note("scnc reads OBJ files: `v x y z` and `f a b c …` records")
-            })?
+                .with_note(
+                    "scnc reads OBJ files (`v x y z` and `f a b c …` records) and STL files (binary or ASCII, z up)",
+                )
+            };
+            let stl = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("stl"));
+            if stl {
+                super::stl::parse(&bytes).map_err(|e| bad(written.clone(), e))?
+            } else {
+                obj::parse(&bytes).map_err(|e| {
+                    let place = if e.line > 0 { format!("{written}:{}", e.line) } else { written.clone() };
+                    bad(place, e.message)
+                })?
+            }
         }
     };
     if expected.is_none() {

@@ -1,4 +1,4 @@
-//! The mesh back-end: triangle meshes (generated, read from OBJ, or extracted from any
+//! The mesh back-end: triangle meshes (generated, read from OBJ or STL, or extracted from any
 //! shape as an isosurface), each with its own binned-SAH BVH, traced with a watertight
 //! ray/triangle test. Vertices are stored in render space (camera-relative f32),
 //! transformed once at lowering from f64.
@@ -16,6 +16,7 @@ pub mod obj;
 pub mod octree;
 pub mod parts;
 mod qef;
+pub mod stl;
 pub mod triangle;
 
 use glam::{DAffine3, DVec3, Vec3A, Vec4};

@@ -359,11 +359,11 @@ fn a_tolerance_export_refines_a_sheet_thinner_than_its_cell() {
     assert!(err.contains("watertight and manifold"), "{err}");
 }
 
-/// A model exported to OBJ and read back with `mesh file(…)` lands where it was, not
+/// A model exported to OBJ or STL and read back with `mesh file(…)` lands where it was, not
 /// mirrored: an asymmetric arrangement of boxes (which tell left from right, and front
 /// from back) renders the same, pixel for pixel, as the scene itself as meshes.
 #[test]
-fn an_exported_obj_reads_back_where_it_was() {
+fn an_exported_obj_or_stl_reads_back_where_it_was() {
     let dir = tempfile::tempdir().expect("temp dir");
     let common = "camera(position = [1.4, 2, -3.6], look_at = [0.5, 0.5, 0.5])\n\
                   render(width = 96, height = 96)\n\
@@ -379,11 +379,6 @@ fn an_exported_obj_reads_back_where_it_was() {
         ),
     )
     .expect("writing the scene");
-    let obj = dir.path().join("l.obj");
-    let run = scnc(&["export", scene.to_str().expect("utf-8"), "-o", obj.to_str().expect("utf-8")]);
-    assert_eq!(run.status.code(), Some(0), "{}", String::from_utf8_lossy(&run.stderr));
-    let back = dir.path().join("back.scn");
-    std::fs::write(&back, format!("{common}object mesh file(\"l.obj\") with m\n")).expect("writing");
     let render = |scene: &Path, out: &str, extra: &[&str]| {
         let png = dir.path().join(out);
         let mut args = vec!["render", scene.to_str().expect("utf-8"), "-o", png.to_str().expect("utf-8")];
@@ -393,9 +388,17 @@ fn an_exported_obj_reads_back_where_it_was() {
         image::open(&png).expect("a PNG").to_rgb8()
     };
     let meshed = render(&scene, "meshed.png", &["--geometry", "mesh"]);
-    let read_back = render(&back, "back.png", &[]);
-    let off = meshed.pixels().zip(read_back.pixels()).filter(|(a, b)| a != b).count();
-    assert_eq!(off, 0, "{off} pixels differ between the scene as meshes and its OBJ read back");
+    // OBJ is y up, STL z up (as export writes them); both read back unmirrored.
+    for format in ["obj", "stl"] {
+        let file = dir.path().join(format!("l.{format}"));
+        let run = scnc(&["export", scene.to_str().expect("utf-8"), "-o", file.to_str().expect("utf-8")]);
+        assert_eq!(run.status.code(), Some(0), "{}", String::from_utf8_lossy(&run.stderr));
+        let back = dir.path().join(format!("back-{format}.scn"));
+        std::fs::write(&back, format!("{common}object mesh file(\"l.{format}\") with m\n")).expect("writing");
+        let read_back = render(&back, &format!("back-{format}.png"), &[]);
+        let off = meshed.pixels().zip(read_back.pixels()).filter(|(a, b)| a != b).count();
+        assert_eq!(off, 0, "{off} pixels differ between the scene as meshes and its {format} read back");
+    }
     let background = meshed.pixels().filter(|p| **p == meshed[(0, 0)]).count();
     assert!(background < 96 * 96 * 9 / 10, "the boxes fill a tenth of the view");
 }

@@ -105,7 +105,7 @@ crate::params! {
 crate::params! {
     /// `mesh file(…)`.
     pub struct FileArgs {
-        /// the OBJ file, relative to the scene file
+        /// the OBJ or STL (`.stl`) file, relative to the scene file
         path: String as Str = required;
         /// whether normals are interpolated across faces
         smooth: bool as Bool = false;
