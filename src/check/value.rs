@@ -155,8 +155,12 @@ impl Value {
 /// A 2D shape: its signed distance as an expression of the point `[u, v, 0]`, and its box.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Profile {
-    /// The signed distance, exact.
+    /// The signed distance: exact for a circle, rectangle or polygon, moved or not; a
+    /// bound after `union`, `intersect`, `subtract`, `round` or `shell`.
     pub body: Arc<ir::field::Expr>,
+    /// Its outline when it is one simple polygon (a rectangle or polygon, moved or not),
+    /// `[u, v]` corners in order: what an extrusion's exact mesh is made from.
+    pub outline: Option<Arc<Vec<glam::DVec2>>>,
     /// Smallest corner `[u, v]`.
     pub min: glam::DVec2,
     /// Largest corner `[u, v]`.

@@ -3,6 +3,7 @@
 
 pub mod axes;
 pub mod noise;
+pub mod polygon;
 pub mod tessellate;
 
 pub use noise::noise;

@@ -112,7 +112,7 @@ impl Dumper<'_> {
                 self.line(indent, &format!("paint {}", Self::material(material)), Some(material.span));
                 self.shape(indent + 1, child);
             }
-            ShapeKind::Field { body, bounds, lipschitz } => {
+            ShapeKind::Field { body, bounds, lipschitz, .. } => {
                 self.line(indent, &format!("field{}{}", Self::bounds(bounds), Self::lipschitz(lipschitz)), span);
                 self.body(indent + 1, body);
             }

@@ -342,6 +342,9 @@ pub enum ShapeKind {
         bounds: Option<Aabb>,
         /// The bound of the body's slope it is marched with.
         lipschitz: Lipschitz,
+        /// A mesh that is exactly its zero set, when the builder knows one (an extruded
+        /// polygon's prism): the mesh back-end uses it instead of the isosurface mesher.
+        exact: Option<Arc<crate::geom::TriMesh>>,
     },
     /// `warp(shape, p => q)`: the shape seen at `q(p)`, cut to `bounds` when given.
     Warp {

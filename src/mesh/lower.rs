@@ -50,6 +50,10 @@ pub fn tessellate(
     }
     let made = match &node.kind {
         ShapeKind::Primitive(p) => p.tessellate(detail.resolution()),
+        ShapeKind::Field { exact: Some(mesh), .. } => {
+            let mesh = mesh.clone();
+            Tessellation::Triangles(mesh.triangles.len() as u64, Box::new(move || (*mesh).clone()))
+        }
         ShapeKind::Csg { .. }
         | ShapeKind::Round { .. }
         | ShapeKind::Shell { .. }

@@ -6,6 +6,7 @@
 
 use glam::DVec3;
 
+use crate::geom::polygon::triangulate;
 use crate::geom::{axes, TriMesh};
 
 /// A problem in an OBJ file.
@@ -139,51 +140,6 @@ pub fn parse(bytes: &[u8]) -> Result<TriMesh, ObjError> {
         return Err(err(0, "the file has no faces"));
     }
     Ok(mesh)
-}
-
-/// A polygon's triangles, wound as the polygon: a triangle as it is, a larger polygon by
-/// ear clipping in the plane of its Newell normal, so a concave outline (an L, a notch)
-/// keeps its shape; a fan where clipping finds no ear (a degenerate or self-crossing
-/// polygon, which has no right answer).
-fn triangulate(v: &[u32], positions: &[DVec3]) -> Vec<[u32; 3]> {
-    if v.len() == 3 {
-        return vec![[v[0], v[1], v[2]]];
-    }
-    let fan = || (1..v.len() - 1).map(|k| [v[0], v[k], v[k + 1]]).collect();
-    let p: Vec<DVec3> = v.iter().map(|&i| positions[i as usize]).collect();
-    let normal = (0..p.len()).fold(DVec3::ZERO, |n, i| {
-        let (a, b) = (p[i], p[(i + 1) % p.len()]);
-        n + DVec3::new((a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y))
-    });
-    let Some(n) = normal.try_normalize() else { return fan() };
-    // Any two axes across the normal; the polygon's winding is counter-clockwise there.
-    let u = n.any_orthonormal_vector();
-    let w = n.cross(u);
-    let flat: Vec<(f64, f64)> = p.iter().map(|q| (q.dot(u), q.dot(w))).collect();
-    let cross = |a: (f64, f64), b: (f64, f64), c: (f64, f64)| (b.0 - a.0) * (c.1 - a.1) - (b.1 - a.1) * (c.0 - a.0);
-    let mut left: Vec<usize> = (0..v.len()).collect();
-    let mut out = Vec::with_capacity(v.len() - 2);
-    while left.len() > 3 {
-        let m = left.len();
-        let ear = (0..m).find(|&k| {
-            let (a, b, c) = (left[(k + m - 1) % m], left[k], left[(k + 1) % m]);
-            let (fa, fb, fc) = (flat[a], flat[b], flat[c]);
-            cross(fa, fb, fc) > 0.0
-                && left.iter().all(|&o| {
-                    o == a
-                        || o == b
-                        || o == c
-                        || cross(fa, fb, flat[o]) < 0.0
-                        || cross(fb, fc, flat[o]) < 0.0
-                        || cross(fc, fa, flat[o]) < 0.0
-                })
-        });
-        let Some(k) = ear else { return fan() };
-        out.push([v[left[(k + m - 1) % m]], v[left[k]], v[left[(k + 1) % m]]]);
-        left.remove(k);
-    }
-    out.push([v[left[0]], v[left[1]], v[left[2]]]);
-    out
 }
 
 #[cfg(test)]

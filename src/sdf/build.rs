@@ -314,7 +314,7 @@ impl<'a> Builder<'a> {
                 let rep2 = rep.clone();
                 (self.sdf(move |p| rep.eval(p, |q| d(q))), self.mat(move |p| rep2.eval_surf(p, |q| m(q))))
             }
-            ShapeKind::Field { body, bounds, lipschitz } => {
+            ShapeKind::Field { body, bounds, lipschitz, .. } => {
                 let body = self.body(body, mat);
                 self.last_field = Some((shape as *const Shape as usize, body.clone()));
                 let (k, cut) = (1.0 / lipschitz.value as f32, bounds.as_ref().map(BoxCut::new));

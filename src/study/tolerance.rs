@@ -106,6 +106,8 @@ fn curvature_radius(shape: &Shape, scale: f64) -> (f64, Option<f64>) {
             curvature_radius(child, scale * k)
         }
         ShapeKind::Paint { child, .. } => curvature_radius(child, scale),
+        // An extruded polygon's prism: its own flat faces.
+        ShapeKind::Field { exact: Some(_), .. } => (0.0, None),
         ShapeKind::Csg { .. }
         | ShapeKind::Round { .. }
         | ShapeKind::Shell { .. }

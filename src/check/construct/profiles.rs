@@ -122,6 +122,11 @@ fn segments_meet(a0: DVec2, a1: DVec2, b0: DVec2, b1: DVec2) -> bool {
         || (d4 == 0.0 && on(a0, a1, b1))
 }
 
+/// The outline of `profile`, if it has one, with every corner moved by `f`.
+fn moved_outline(profile: &Profile, f: impl Fn(DVec2) -> DVec2) -> Option<Arc<Vec<DVec2>>> {
+    profile.outline.as_ref().map(|o| Arc::new(o.iter().map(|c| f(*c)).collect()))
+}
+
 impl Ctx<'_> {
     /// A profile builtin's value (a profile, or a sweep's shape), or poison after reporting.
     pub(in crate::check) fn profile(&mut self, f: ProfileFn, a: &BoundArgs) -> Value {
@@ -132,25 +137,31 @@ impl Ctx<'_> {
             ProfileFn::Circle => {
                 let CircleArgs { r } = CircleArgs::from_args(a);
                 let body = bin(Binary::Sub, &un(Unary::Length, &p), &num(r));
-                Some(Profile { body, min: DVec2::splat(-r), max: DVec2::splat(r) })
+                Some(Profile { body, outline: None, min: DVec2::splat(-r), max: DVec2::splat(r) })
             }
             ProfileFn::Rect => {
                 let RectArgs { half_u, half_v } = RectArgs::from_args(a);
                 let qu = bin(Binary::Sub, &un(Unary::Abs, &u), &num(half_u));
                 let qv = bin(Binary::Sub, &un(Unary::Abs, &v), &num(half_v));
                 let h = DVec2::new(half_u, half_v);
-                Some(Profile { body: corner(&qu, &qv), min: -h, max: h })
+                let outline = Some(Arc::new(vec![-h, DVec2::new(h.x, -h.y), h, DVec2::new(-h.x, h.y)]));
+                Some(Profile { body: corner(&qu, &qv), outline, min: -h, max: h })
             }
             ProfileFn::Polygon => {
                 let PolygonArgs { points } = PolygonArgs::from_args(a);
-                self.polygon(&points, a.span_of("points")).map(|(body, min, max)| Profile { body, min, max })
+                self.polygon(&points, a.span_of("points")).map(|(body, corners, min, max)| Profile {
+                    body,
+                    outline: Some(Arc::new(corners)),
+                    min,
+                    max,
+                })
             }
             ProfileFn::Round => {
                 let RoundProfileArgs { profile: Value::Profile(inner), r } = RoundProfileArgs::from_args(a) else {
                     return Value::Error;
                 };
                 let body = bin(Binary::Sub, &inner.body, &num(r));
-                Some(Profile { body, min: inner.min - r, max: inner.max + r })
+                Some(Profile { body, outline: None, min: inner.min - r, max: inner.max + r })
             }
             ProfileFn::Shell => {
                 let ShellProfileArgs { profile: Value::Profile(inner), thickness: t } = ShellProfileArgs::from_args(a)
@@ -158,7 +169,7 @@ impl Ctx<'_> {
                     return Value::Error;
                 };
                 let body = bin(Binary::Sub, &un(Unary::Abs, &inner.body), &num(t / 2.0));
-                Some(Profile { body, min: inner.min - t / 2.0, max: inner.max + t / 2.0 })
+                Some(Profile { body, outline: None, min: inner.min - t / 2.0, max: inner.max + t / 2.0 })
             }
             ProfileFn::Extrude | ProfileFn::Revolve => {
                 return match self.sweep(f, a) {
@@ -200,7 +211,13 @@ impl Ctx<'_> {
         let made = match (op, arg, two) {
             (TransformOp::At, _, Some(d)) => {
                 let moved = vec2(bin(Binary::Sub, &u, &num(d.x)), bin(Binary::Sub, &v, &num(d.y)));
-                Some(Profile { body: profile.body.substitute(&moved), min: profile.min + d, max: profile.max + d })
+                let outline = moved_outline(profile, |c| c + d);
+                Some(Profile {
+                    body: profile.body.substitute(&moved),
+                    outline,
+                    min: profile.min + d,
+                    max: profile.max + d,
+                })
             }
             (TransformOp::Rotate, Value::Num(deg), _) => {
                 let (sin, cos) = deg.to_radians().sin_cos();
@@ -210,12 +227,14 @@ impl Ctx<'_> {
                     bin(Binary::Sub, &bin(Binary::Mul, &v, &num(cos)), &bin(Binary::Mul, &u, &num(sin))),
                 );
                 let (min, max) = boxed(corners.map(|c| DVec2::new(c.x * cos - c.y * sin, c.x * sin + c.y * cos)));
-                Some(Profile { body: profile.body.substitute(&back), min, max })
+                let outline = moved_outline(profile, |c| DVec2::new(c.x * cos - c.y * sin, c.x * sin + c.y * cos));
+                Some(Profile { body: profile.body.substitute(&back), outline, min, max })
             }
             (TransformOp::Scale, Value::Num(k), _) if *k > 0.0 && k.is_finite() => {
                 let shrunk = vec2(bin(Binary::Div, &u, &num(*k)), bin(Binary::Div, &v, &num(*k)));
                 let body = bin(Binary::Mul, &num(*k), &profile.body.substitute(&shrunk));
-                Some(Profile { body, min: profile.min * *k, max: profile.max * *k })
+                let outline = moved_outline(profile, |c| c * *k);
+                Some(Profile { body, outline, min: profile.min * *k, max: profile.max * *k })
             }
             _ => None,
         };
@@ -323,7 +342,7 @@ impl Ctx<'_> {
             );
             return None;
         }
-        Some(Profile { body, min, max })
+        Some(Profile { body, outline: None, min, max })
     }
 
     /// `extrude` or `revolve` as a field of the solid's point, or `None` after reporting.
@@ -342,7 +361,8 @@ impl Ctx<'_> {
                     min: DVec3::new(profile.min.x, -h, profile.min.y),
                     max: DVec3::new(profile.max.x, h, profile.max.y),
                 };
-                Some(ShapeKind::Field { body: corner(&d2, &dy), bounds: Some(bounds), lipschitz: exact })
+                let mesh = profile.outline.as_ref().map(|corners| Arc::new(crate::geom::polygon::prism(corners, h)));
+                Some(ShapeKind::Field { body: corner(&d2, &dy), bounds: Some(bounds), lipschitz: exact, exact: mesh })
             }
             ProfileFn::Revolve => {
                 let RevolveArgs { profile: Value::Profile(profile) } = RevolveArgs::from_args(a) else {
@@ -367,7 +387,7 @@ impl Ctx<'_> {
                 let body = profile.body.substitute(&vec2(radius, y));
                 let r = profile.max.x;
                 let bounds = Aabb { min: DVec3::new(-r, profile.min.y, -r), max: DVec3::new(r, profile.max.y, r) };
-                Some(ShapeKind::Field { body, bounds: Some(bounds), lipschitz: exact })
+                Some(ShapeKind::Field { body, bounds: Some(bounds), lipschitz: exact, exact: None })
             }
             ProfileFn::Csg(_)
             | ProfileFn::Circle
@@ -379,8 +399,8 @@ impl Ctx<'_> {
     }
 
     /// A simple polygon's exact signed distance (Quilez's: the nearest edge, the sign by
-    /// the crossing count) and box, or `None` after reporting a bad polygon.
-    fn polygon(&mut self, points: &Value, span: Span) -> Option<(Arc<Expr>, DVec2, DVec2)> {
+    /// the crossing count), corners and box, or `None` after reporting a bad polygon.
+    fn polygon(&mut self, points: &Value, span: Span) -> Option<(Arc<Expr>, Vec<DVec2>, DVec2, DVec2)> {
         let bad = |this: &mut Self, what: String, label: &str| {
             this.report(
                 Diagnostic::error(codes::OUT_OF_RANGE, span, what, label)
@@ -483,6 +503,6 @@ impl Ctx<'_> {
         let body = bin(Binary::Mul, &sign, &d);
         let min = corners.iter().fold(DVec2::INFINITY, |m, c| m.min(*c));
         let max = corners.iter().fold(DVec2::NEG_INFINITY, |m, c| m.max(*c));
-        Some((body, min, max))
+        Some((body, corners, min, max))
     }
 }
