@@ -2,10 +2,10 @@
 
 use std::sync::Arc;
 
-use glam::{DVec3, Vec3A};
+use glam::DVec3;
 
-use super::polytope::Polytope;
-use super::{Facets, Field, Refusal, Resolution, Solid, Tessellation};
+use super::polytope::{polyhedron_facts, Polytope};
+use super::{Refusal, Solid};
 use crate::geom::Aabb;
 use crate::sig::{Args, Param, Range};
 
@@ -55,36 +55,7 @@ impl Solid for HexPrism {
         Some(self.r.hypot(self.half_height))
     }
 
-    fn half_space(&self) -> Option<(DVec3, f64)> {
-        None
-    }
-
-    fn is_convex(&self) -> bool {
-        true
-    }
-
-    fn is_exact(&self) -> bool {
-        true
-    }
-
-    fn distance(&self) -> impl Field<f32> {
-        let s = self.solid();
-        move |p: Vec3A| s.distance(p)
-    }
-
-    fn gradient(&self) -> impl Field<Vec3A> {
-        let s = self.solid();
-        move |p: Vec3A| s.gradient(p)
-    }
-
-    fn facets(&self) -> Facets {
-        Facets::Exact
-    }
-
-    fn tessellate(&self, _: Resolution) -> Tessellation {
-        let s = self.solid();
-        Tessellation::Triangles(s.triangle_count(), Box::new(move || s.mesh()))
-    }
+    polyhedron_facts!();
 
     fn fields(&self) -> Vec<(&'static str, String)> {
         self.shown::<()>()

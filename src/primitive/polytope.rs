@@ -130,6 +130,46 @@ impl Polytope {
     }
 }
 
+/// The [`Solid`](super::Solid) facts every convex polyhedron here states alike, given
+/// its `fn solid(&self) -> Arc<Polytope>`: no half-space, convex, an exact distance and
+/// gradient, and its own faces as its exact mesh at any resolution. Written into each
+/// `impl Solid`, so the facts stay listed where the primitive is.
+macro_rules! polyhedron_facts {
+    () => {
+        fn half_space(&self) -> Option<(glam::DVec3, f64)> {
+            None
+        }
+
+        fn is_convex(&self) -> bool {
+            true
+        }
+
+        fn is_exact(&self) -> bool {
+            true
+        }
+
+        fn distance(&self) -> impl super::Field<f32> {
+            let s = self.solid();
+            move |p: glam::Vec3A| s.distance(p)
+        }
+
+        fn gradient(&self) -> impl super::Field<glam::Vec3A> {
+            let s = self.solid();
+            move |p: glam::Vec3A| s.gradient(p)
+        }
+
+        fn facets(&self) -> super::Facets {
+            super::Facets::Exact
+        }
+
+        fn tessellate(&self, _: super::Resolution) -> super::Tessellation {
+            let s = self.solid();
+            super::Tessellation::Triangles(s.triangle_count(), Box::new(move || s.mesh()))
+        }
+    };
+}
+pub(super) use polyhedron_facts;
+
 #[inline]
 fn nearest_on_segment(p: Vec3A, a: Vec3A, b: Vec3A) -> Vec3A {
     let ab = b - a;

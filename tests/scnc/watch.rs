@@ -40,19 +40,12 @@ fn wait_for(lines: &Receiver<String>, want: &str, log: &mut Vec<String>) {
     }
 }
 
-#[test]
-fn watch_rerenders_on_change_keeps_the_last_image_on_error_and_stops_on_ctrl_c() {
-    let dir = tempfile::tempdir().expect("temp dir");
-    let scene = dir.path().join("scene.scn");
-    let inc = dir.path().join("inc.scn");
-    let out = dir.path().join("out.png");
-    let good = "include \"inc.scn\"\nobject sphere(1) at [0, 0, 5] with m\n";
-    std::fs::write(&scene, good).expect("writing");
-    std::fs::write(&inc, "light ambient(1)\nlet m = material(color = #ff0000)\n").expect("writing");
-
+/// `scnc watch ARGS` started in `dir`, and its stderr's lines as they come.
+fn start_watch(dir: &Path, args: &[&str]) -> (std::process::Child, Receiver<String>) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_scnc"))
-        .args(["watch", "scene.scn", "-o", "out.png", "--width", "24", "--height", "24"])
-        .current_dir(dir.path())
+        .arg("watch")
+        .args(args)
+        .current_dir(dir)
         .env("NO_COLOR", "1")
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
@@ -65,6 +58,21 @@ fn watch_rerenders_on_change_keeps_the_last_image_on_error_and_stops_on_ctrl_c()
             let _ = tx.send(line);
         }
     });
+    (child, lines)
+}
+
+#[test]
+fn watch_rerenders_on_change_keeps_the_last_image_on_error_and_stops_on_ctrl_c() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = dir.path().join("scene.scn");
+    let inc = dir.path().join("inc.scn");
+    let out = dir.path().join("out.png");
+    let good = "include \"inc.scn\"\nobject sphere(1) at [0, 0, 5] with m\n";
+    std::fs::write(&scene, good).expect("writing");
+    std::fs::write(&inc, "light ambient(1)\nlet m = material(color = #ff0000)\n").expect("writing");
+
+    let (mut child, lines) =
+        start_watch(dir.path(), &["scene.scn", "-o", "out.png", "--width", "24", "--height", "24"]);
     let mut log = Vec::new();
     wait_for(&lines, "rendered out.png", &mut log);
     let red = std::fs::read(&out).expect("the first render wrote the image");
@@ -110,21 +118,7 @@ fn watch_writes_an_animation_whole_or_not_at_all() {
     let scene = dir.path().join("scene.scn");
     let head = "render(width = 16, height = 12, frames = 3)\nlight ambient(1)\n";
     std::fs::write(&scene, format!("{head}object sphere(0.5 + 0.2 * clock) at [0, 0, 3]\n")).expect("writing");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_scnc"))
-        .args(["watch", "scene.scn", "-o", "f-#.png"])
-        .current_dir(dir.path())
-        .env("NO_COLOR", "1")
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("starting scnc watch");
-    let stderr = BufReader::new(child.stderr.take().expect("stderr"));
-    let (tx, lines) = mpsc::channel();
-    std::thread::spawn(move || {
-        for line in stderr.lines().map_while(Result::ok) {
-            let _ = tx.send(line);
-        }
-    });
+    let (mut child, lines) = start_watch(dir.path(), &["scene.scn", "-o", "f-#.png"]);
     let mut log = Vec::new();
     wait_for(&lines, "rendered f-2.png", &mut log);
     let frames =
