@@ -10,6 +10,7 @@ mod derived;
 mod effects;
 mod export;
 mod fields;
+mod flat_faces;
 mod fmt;
 mod glass;
 mod golden;

@@ -4,6 +4,7 @@
 //!   (its `Host` and `Origin` are the server's own, its body is bounded, its path is one
 //!   of a fixed set: nothing is served from the disk by name);
 //! - [`http`]: requests and responses, streamed ones included;
+//! - [`diagnostics`]: diagnostics and text positions as the page counts them;
 //! - [`edit`]: the editor's questions (check, hover, completion, format, save, the
 //!   camera line) and export;
 //! - [`preview`]: renders, coarse first then the full frame in bands, the newest
@@ -11,6 +12,7 @@
 //! - [`files`]: the one file it edits, the includes below its directory, and the
 //!   watcher that tells the page when they change on disk.
 
+mod diagnostics;
 mod edit;
 mod files;
 mod http;

@@ -19,7 +19,7 @@ use scnc::render::{Image, Region};
 use scnc::trace::Counters;
 use scnc::world::Mode;
 
-use super::edit::diagnostics_json;
+use super::diagnostics::diagnostics_json;
 use super::files::lock;
 use super::http::{Req, Stream};
 use super::Studio;
