@@ -31,7 +31,8 @@ use super::usage_error;
 
 #[derive(clap::Args)]
 pub(crate) struct StudioArgs {
-    /// The scene file to edit (created, empty, when it does not exist yet).
+    /// The scene file to edit; it need not exist yet (the first save writes it).
+    #[arg(default_value = "scene.scn")]
     file: PathBuf,
     /// The port to listen on; 0 picks a free one.
     #[arg(long, default_value = "7117")]
