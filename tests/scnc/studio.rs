@@ -494,3 +494,43 @@ fn studio_screenshot_for_the_readme() {
     );
     b.screenshot(&artefacts().join("readme.png"));
 }
+
+/// The accuracy ladder over the API: each rung's error against the finest falls to 0 at
+/// the finest, on both back-ends; and the export buttons' files are what the formats'
+/// own readers accept.
+#[test]
+fn studio_measures_the_ladder_and_exports_valid_files() {
+    let (_dir, scene) = seed_scene();
+    let s = Server::start(&scene);
+    let text = std::fs::read_to_string(&scene).unwrap();
+    for backend in ["sdf", "mesh"] {
+        let mut off = Vec::new();
+        for rung in [0, 2, 5] {
+            let (status, body) = s.post(&format!("/api/render?coarse=1&backend={backend}&rung={rung}"), &text);
+            assert_eq!(status, 200);
+            let msgs = messages(&body);
+            let stats = msgs.iter().find(|(k, _)| *k == b'S').expect("statistics");
+            let stats: serde_json::Value = serde_json::from_slice(&stats.1).unwrap();
+            assert!(stats["setting"].as_str().unwrap().to_lowercase().starts_with(backend), "{stats}");
+            let a = msgs.iter().find(|(k, _)| *k == b'A').expect("an accuracy message");
+            let a: serde_json::Value = serde_json::from_slice(&a.1).unwrap();
+            off.push(a["differing_percent"].as_f64().unwrap());
+        }
+        assert_eq!(off[2], 0.0, "{backend}: the finest rung against itself");
+        assert!(off[0] >= off[1] && off[0] > 0.0, "{backend}: coarser is not worse: {off:?}");
+    }
+    let (status, stl) = s.post("/api/export?format=stl", &text);
+    assert_eq!(status, 200);
+    let mesh = stl_io::read_stl(&mut std::io::Cursor::new(stl)).expect("an STL");
+    assert!(mesh.faces.len() > 100);
+    let (status, three_mf) = s.post("/api/export?format=3mf", &text);
+    assert_eq!(status, 200);
+    let models = threemf::read(std::io::Cursor::new(three_mf)).expect("a 3MF");
+    assert_eq!(models.len(), 1);
+    let (status, glb) = s.post("/api/export?format=glb", &text);
+    assert_eq!(status, 200);
+    let gltf = gltf::Gltf::from_slice(&glb).expect("a glb");
+    assert_eq!(gltf.nodes().count(), 3, "one node per object");
+    assert_eq!(s.post("/api/export?format=dwg", &text).0, 400);
+    assert_eq!(s.post("/api/export?format=stl", "object sphre(1)").0, 422);
+}
