@@ -380,6 +380,8 @@ pub mod codes {
     pub const STEEP_FIELD: &str = "W0007";
     /// A `polar` shape reaching out of its sector: the distance is only a bound there.
     pub const CROSSES_SECTOR: &str = "W0008";
+    /// A CSG node whose parts crowd one place: every step of a ray there evaluates them all.
+    pub const CROWDED_CSG: &str = "W0009";
     /// Parts of a shape too small for its isosurface's cell, left out of the mesh.
     pub const LOST_PARTS: &str = "W0801";
     /// Isosurface edges left on four triangles where parts are thinner than the cell.

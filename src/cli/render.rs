@@ -362,11 +362,15 @@ fn render_compiled(args: &RenderArgs, pool: &rayon::ThreadPool, mut compiled: Co
             render_scene(args, pool, &compiled.map, scene, &output, &output, &mut sequence)?;
         }
     }
+    let count = staged.len();
     for (stage, target, _pending) in staged {
         stage.persist(&target).map_err(|e| {
             let _ = writeln!(std::io::stderr(), "error: {}", cannot_write(&target, &e.error));
             ExitCode::from(1)
         })?;
+    }
+    if together {
+        let _ = writeln!(std::io::stderr(), "wrote {count} frames of {}, all of this revision", args.output.display());
     }
     Ok(())
 }

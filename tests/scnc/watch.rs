@@ -120,7 +120,7 @@ fn watch_writes_an_animation_whole_or_not_at_all() {
     std::fs::write(&scene, format!("{head}object sphere(0.5 + 0.2 * clock) at [0, 0, 3]\n")).expect("writing");
     let (mut child, lines) = start_watch(dir.path(), &["scene.scn", "-o", "f-#.png"]);
     let mut log = Vec::new();
-    wait_for(&lines, "rendered f-2.png", &mut log);
+    wait_for(&lines, "wrote 3 frames of f-#.png", &mut log);
     let frames =
         || (0..3).map(|i| std::fs::read(dir.path().join(format!("f-{i}.png"))).expect("a frame")).collect::<Vec<_>>();
     let before = frames();

@@ -8,7 +8,9 @@ use crate::check::builtins::{Builtin, Modifier};
 use crate::check::expr::BoundArgs;
 use crate::check::{Ctx, Value, MAX_OBJECTS};
 use crate::diag::{codes, Diagnostic};
-use crate::ir::{CsgOp, Primitive, ShapeKind};
+use std::sync::Arc;
+
+use crate::ir::{self, CsgOp, Primitive, ShapeKind};
 use crate::primitive::Entry;
 use crate::sig::Range;
 
@@ -101,8 +103,27 @@ impl Ctx<'_> {
             return None;
         }
         let CsgArgs { smooth } = CsgArgs::from_args(a);
-        let children =
+        let children: Vec<_> =
             a.rest.iter().filter_map(|(v, _)| if let Value::Shape(s) = v { Some(s.clone()) } else { None }).collect();
+        if op == CsgOp::Intersect || smooth > 0.0 {
+            if let Some(crowd) = crowded(&children, smooth) {
+                self.report(
+                    Diagnostic::warning(
+                        codes::CROWDED_CSG,
+                        a.call,
+                        format!("{crowd} parts of this `{}` overlap one place", b.name),
+                        "every step of a ray there evaluates all of them",
+                    )
+                    .with_note(format!(
+                        "an `intersect`, or a smooth `union` or `subtract`, cannot skip a part that reaches the \
+                         point; {crowd} distances a step make a large image take minutes"
+                    ))
+                    .with_hint(
+                        "combine fewer parts, spread them apart, or use a sharp `union` (pruned by a hierarchy)",
+                    ),
+                );
+            }
+        }
         Some(ShapeKind::Csg { op, children, smooth })
     }
 
@@ -125,4 +146,26 @@ impl Ctx<'_> {
             }
         })
     }
+}
+
+/// Parts of a combination from which [`crowded`] warns.
+pub const CROWDED_PARTS: usize = 10_000;
+
+/// The most parts whose boxes (grown by the blend `smooth`) hold one point, sampled at up
+/// to 64 parts' centres, when it is at least [`CROWDED_PARTS`]; an unbounded part holds
+/// every point.
+fn crowded(children: &[Arc<ir::Shape>], smooth: f64) -> Option<usize> {
+    if children.len() < CROWDED_PARTS {
+        return None;
+    }
+    let boxes: Vec<Option<crate::geom::Aabb>> =
+        children.iter().map(|c| ir::shape_bounds(c).map(|b| b.grow(smooth))).collect();
+    let step = (children.len() / 64).max(1);
+    let most = (0..children.len())
+        .step_by(step)
+        .filter_map(|i| boxes[i].map(|b| b.centre()))
+        .map(|p| boxes.iter().filter(|b| b.is_none_or(|b| p.cmpge(b.min).all() && p.cmple(b.max).all())).count())
+        .max()
+        .unwrap_or(children.len());
+    (most >= CROWDED_PARTS).then_some(most)
 }
