@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use super::files::{
-    cannot_write, check_output_as, link_target, parent_dir, png_header, read_png, run_child, stop_on_interrupt,
-    write_atomic, Pending, FPS_KEY,
+    cannot_write, check_output_as, link_target, parent_dir, png_header, read_png, resolved, run_child, stage_beside,
+    stop_on_interrupt, write_atomic, Pending, FPS_KEY,
 };
 use super::frames::{frame_path, Pattern};
 use super::usage_error;
@@ -57,10 +57,7 @@ fn find_frames(pattern: &Path) -> Result<Vec<u32>, String> {
     let names = Pattern::of(pattern).ok_or_else(|| {
         format!("`{}` names one file: give the frames' pattern, like `out/frame-####.png`", pattern.display())
     })?;
-    let dir = match pattern.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
+    let dir = parent_dir(pattern);
     let entries = std::fs::read_dir(dir).map_err(|e| format!("cannot read the directory `{}`: {e}", dir.display()))?;
     let mut numbers: Vec<u32> = entries.filter_map(|e| names.frame_of(e.ok()?.file_name().to_str()?)).collect();
     numbers.sort_unstable();
@@ -187,10 +184,7 @@ const DEFAULT_FPS: f64 = 24.0;
 fn output_is_a_frame(output: &Path, pattern: &Path) -> Option<u32> {
     let names = Pattern::of(pattern)?;
     let frame = names.frame_of(output.file_name()?.to_str()?)?;
-    let dir = |p: &Path| -> Option<PathBuf> {
-        p.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new(".")).canonicalize().ok()
-    };
-    (dir(output)? == dir(pattern)?).then_some(frame)
+    (resolved(output)?.parent() == resolved(pattern)?.parent()).then_some(frame)
 }
 
 /// Adapts a fallible frame reader to the encoders' `io::Error`.
@@ -250,21 +244,14 @@ fn mp4(output: &Path, frames: &Frames<'_>, fps: f64) -> Result<(), String> {
     // ffmpeg's image2 pattern: `%04d` for `####` (a literal `%` doubled).
     let escaped = |s: &str| s.replace('%', "%%");
     let input = format!("{}%0{}d{}", escaped(&p.prefix), p.width, escaped(&p.suffix));
-    let dir = match frames.pattern.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
+    let dir = parent_dir(frames.pattern);
     let target = link_target(output);
-    let tmp = tempfile::Builder::new()
-        .prefix(".scnc-")
-        .suffix(".tmp.mp4")
-        .tempfile_in(parent_dir(&target))
-        .map_err(|e| cannot_write(output, &e))?;
+    let tmp = stage_beside(&target, ".tmp.mp4").map_err(|e| cannot_write(output, &e))?;
     let _pending = Pending::new(tmp.path());
     let tmp_path = std::path::absolute(tmp.path()).map_err(|e| cannot_write(output, &e))?;
     let status = run_child(
         std::process::Command::new("ffmpeg")
-            .current_dir(&dir)
+            .current_dir(dir)
             .args(["-loglevel", "error", "-nostdin", "-y", "-framerate", &fps.to_string()])
             .args(["-start_number", &frames.numbers[0].to_string(), "-i"])
             .arg(&input)

@@ -219,8 +219,7 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
     let up = match args.up {
         Some(UpArg::Y) => Up::Y,
         Some(UpArg::Z) => Up::Z,
-        None if format.for_printing() => Up::Z,
-        None => Up::Y,
+        None => format.default_up(),
     };
     let frame = Frame { up, scale: args.scale };
     let skip = args.skip_unbounded || format.for_printing();

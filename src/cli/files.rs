@@ -117,21 +117,21 @@ pub(crate) fn check_output_as(path: &Path, what: &str) -> Result<(), String> {
     Ok(())
 }
 
-/// Why `path` could not be written, in the user's terms: their path (never the
-/// temporary file beside it), the reason, and what to do.
-/// The input among `inputs` that writing `output` would overwrite, if any: paths are
-/// compared after resolving links and `..` (the output need not exist yet, its folder
-/// must), so `-o ./model.obj` is caught for `mesh file("model.obj")`.
-pub(crate) fn overwritten_input<'a>(output: &Path, inputs: impl IntoIterator<Item = &'a Path>) -> Option<&'a Path> {
-    let resolve = |p: &Path| -> Option<std::path::PathBuf> {
-        let name = p.file_name()?;
-        let parent = p.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
-        Some(parent.canonicalize().ok()?.join(name))
-    };
-    let out = resolve(output)?;
-    inputs.into_iter().find(|i| resolve(i).is_some_and(|p| p == out))
+/// `p` with its folder resolved (links and `..`; the folder must exist, the file need
+/// not): two paths naming one file resolve alike.
+pub(crate) fn resolved(p: &Path) -> Option<PathBuf> {
+    Some(parent_dir(p).canonicalize().ok()?.join(p.file_name()?))
 }
 
+/// The input among `inputs` that writing `output` would overwrite, if any ([`resolved`]
+/// paths compared), so `-o ./model.obj` is caught for `mesh file("model.obj")`.
+pub(crate) fn overwritten_input<'a>(output: &Path, inputs: impl IntoIterator<Item = &'a Path>) -> Option<&'a Path> {
+    let out = resolved(output)?;
+    inputs.into_iter().find(|i| resolved(i).is_some_and(|p| p == out))
+}
+
+/// Why `path` could not be written, in the user's terms: their path (never the
+/// temporary file beside it), the reason, and what to do.
 pub(crate) fn cannot_write(path: &Path, e: &std::io::Error) -> String {
     use std::io::ErrorKind;
     let dir = parent_dir(&link_target(path)).display().to_string();

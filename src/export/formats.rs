@@ -42,6 +42,16 @@ impl Format {
         matches!(self, Format::Stl | Format::StlAscii | Format::ThreeMf)
     }
 
+    /// The up axis a file of this format gets unless told: z for printing (slicers,
+    /// CAD), y for viewers (OBJ, PLY, glTF).
+    pub fn default_up(self) -> super::Up {
+        if self.for_printing() {
+            super::Up::Z
+        } else {
+            super::Up::Y
+        }
+    }
+
     /// Writes `export` in this format. OBJ's `mtl` names the MTL file its `mtllib` line
     /// points to (written by [`mtl`]).
     pub fn write(self, export: &Export, units: &str, mtl: &str, w: &mut dyn Write) -> io::Result<()> {

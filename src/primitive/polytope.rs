@@ -51,58 +51,36 @@ impl Polytope {
         Arc::new(Polytope { corners, faces, planes })
     }
 
-    /// The face plane `p` is most in front of (or least behind), and by how much.
+    /// In one pass over the faces: the face whose plane `p` is most in front of (or
+    /// least behind) and by how much, and, when `p` is outside, the nearest point of the
+    /// surface (searched only on faces `p` is in front of).
     #[inline]
-    fn nearest_plane(&self, p: Vec3A) -> (usize, f32) {
-        let mut best = (0, f32::NEG_INFINITY);
-        for (i, (n, d, _)) in self.planes.iter().enumerate() {
+    fn nearest(&self, p: Vec3A) -> (usize, f32, Option<Vec3A>) {
+        let (mut face, mut most) = (0, f32::NEG_INFINITY);
+        let mut best: Option<(f32, Vec3A)> = None;
+        for (i, (n, d, corners)) in self.planes.iter().enumerate() {
             let s = n.dot(p) - d;
-            if s > best.1 {
-                best = (i, s);
+            if s > most {
+                (face, most) = (i, s);
             }
-        }
-        best
-    }
-
-    /// The nearest point of the surface to `p`, which is outside.
-    #[inline]
-    fn nearest_outside(&self, p: Vec3A) -> Vec3A {
-        let mut best = (f32::INFINITY, p);
-        for (n, d, corners) in &self.planes {
-            let s = n.dot(p) - d;
             if s <= 0.0 {
                 continue;
             }
-            let q = p - *n * s;
-            let k = corners.len();
-            let inside = (0..k).all(|i| {
-                let (a, b) = (corners[i], corners[(i + 1) % k]);
-                (b - a).cross(q - a).dot(*n) >= 0.0
-            });
-            let c = if inside {
-                q
-            } else {
-                (0..k)
-                    .map(|i| nearest_on_segment(p, corners[i], corners[(i + 1) % k]))
-                    .min_by(|a, b| a.distance_squared(p).total_cmp(&b.distance_squared(p)))
-                    .unwrap_or(q)
-            };
+            let c = nearest_on_face(p, *n, s, corners);
             let d2 = c.distance_squared(p);
-            if d2 < best.0 {
-                best = (d2, c);
+            if best.is_none_or(|(b, _)| d2 < b) {
+                best = Some((d2, c));
             }
         }
-        best.1
+        (face, most, best.map(|(_, c)| c))
     }
 
     /// The exact signed distance.
     #[inline]
     pub(super) fn distance(&self, p: Vec3A) -> f32 {
-        let (_, s) = self.nearest_plane(p);
-        if s <= 0.0 {
-            s
-        } else {
-            p.distance(self.nearest_outside(p))
+        match self.nearest(p) {
+            (_, _, Some(c)) => p.distance(c),
+            (_, inside, None) => inside,
         }
     }
 
@@ -110,12 +88,9 @@ impl Polytope {
     /// and on the surface, away from the nearest point outside.
     #[inline]
     pub(super) fn gradient(&self, p: Vec3A) -> Vec3A {
-        let (i, s) = self.nearest_plane(p);
-        let face = self.planes[i].0;
-        if s <= 0.0 {
-            return face;
-        }
-        (p - self.nearest_outside(p)).try_normalize().unwrap_or(face)
+        let (face, _, outside) = self.nearest(p);
+        let normal = self.planes[face].0;
+        outside.and_then(|c| (p - c).try_normalize()).unwrap_or(normal)
     }
 
     /// Triangles: each face as a fan (exact, as the faces are flat and convex).
@@ -169,6 +144,29 @@ macro_rules! polyhedron_facts {
     };
 }
 pub(super) use polyhedron_facts;
+
+/// The nearest point to `p` of the convex face with unit normal `n` and `corners`, `p`
+/// lying `s` in front of its plane: `p`'s projection if it falls inside the face, else
+/// the nearest point of its edges.
+#[inline]
+fn nearest_on_face(p: Vec3A, n: Vec3A, s: f32, corners: &[Vec3A]) -> Vec3A {
+    let q = p - n * s;
+    let k = corners.len();
+    let edge = |i: usize| (corners[i], corners[(i + 1) % k]);
+    if (0..k).all(|i| {
+        let (a, b) = edge(i);
+        (b - a).cross(q - a).dot(n) >= 0.0
+    }) {
+        return q;
+    }
+    (0..k)
+        .map(|i| {
+            let (a, b) = edge(i);
+            nearest_on_segment(p, a, b)
+        })
+        .min_by(|a, b| a.distance_squared(p).total_cmp(&b.distance_squared(p)))
+        .unwrap_or(q)
+}
 
 #[inline]
 fn nearest_on_segment(p: Vec3A, a: Vec3A, b: Vec3A) -> Vec3A {

@@ -192,15 +192,6 @@ impl Ctx<'_> {
     ) -> Value {
         let p = Expr::point();
         let (u, v) = (Expr::component(&p, 0), Expr::component(&p, 1));
-        let corners = [
-            profile.min,
-            DVec2::new(profile.max.x, profile.min.y),
-            profile.max,
-            DVec2::new(profile.min.x, profile.max.y),
-        ];
-        let boxed = |pts: [DVec2; 4]| {
-            (pts.iter().fold(DVec2::INFINITY, |m, c| m.min(*c)), pts.iter().fold(DVec2::NEG_INFINITY, |m, c| m.max(*c)))
-        };
         let two = match arg {
             Value::List(items) if items.len() == 2 => match (&items[0], &items[1]) {
                 (Value::Num(a), Value::Num(b)) if a.is_finite() && b.is_finite() => Some(DVec2::new(*a, *b)),
@@ -226,8 +217,12 @@ impl Ctx<'_> {
                     bin(Binary::Add, &bin(Binary::Mul, &u, &num(cos)), &bin(Binary::Mul, &v, &num(sin))),
                     bin(Binary::Sub, &bin(Binary::Mul, &v, &num(cos)), &bin(Binary::Mul, &u, &num(sin))),
                 );
-                let (min, max) = boxed(corners.map(|c| DVec2::new(c.x * cos - c.y * sin, c.x * sin + c.y * cos)));
-                let outline = moved_outline(profile, |c| DVec2::new(c.x * cos - c.y * sin, c.x * sin + c.y * cos));
+                let turn = |c: DVec2| DVec2::new(c.x * cos - c.y * sin, c.x * sin + c.y * cos);
+                let (lo, hi) = (profile.min, profile.max);
+                let corners = [lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)].map(turn);
+                let min = corners.iter().fold(DVec2::INFINITY, |m, c| m.min(*c));
+                let max = corners.iter().fold(DVec2::NEG_INFINITY, |m, c| m.max(*c));
+                let outline = moved_outline(profile, turn);
                 Some(Profile { body: profile.body.substitute(&back), outline, min, max })
             }
             (TransformOp::Scale, Value::Num(k), _) if *k > 0.0 && k.is_finite() => {
@@ -274,11 +269,7 @@ impl Ctx<'_> {
     /// (Quilez's quadratic blend with `smooth`), a bound that is exact outside a union
     /// and inside an intersection; `None` after reporting.
     fn profile_csg(&mut self, op: CsgOp, a: &BoundArgs) -> Option<Profile> {
-        let name = match op {
-            CsgOp::Union => "union",
-            CsgOp::Intersect => "intersect",
-            CsgOp::Subtract => "subtract",
-        };
+        let name = op.name();
         let parts: Vec<Arc<Profile>> =
             a.rest.iter().filter_map(|(v, _)| if let Value::Profile(p) = v { Some(p.clone()) } else { None }).collect();
         if parts.len() != a.rest.len() {

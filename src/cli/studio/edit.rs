@@ -95,9 +95,7 @@ pub(crate) fn save(studio: &Studio, text: String) -> Reply {
 
 /// The text with its camera statement (or a new one) set to the page's view, formatted.
 pub(crate) fn camera_line(studio: &Studio, text: String, view: &View) -> Reply {
-    let loader = studio.files.loader();
-    let root = studio.files.root.clone();
-    let compiled = scnc::with_big_stack(|| scnc::compile_source("scene", &root, text.clone(), &loader));
+    let compiled = studio.files.compile(text.clone());
     let Some(scene) = &compiled.scene else {
         return Reply::json(&serde_json::json!({
             "diagnostics": diagnostics_json(&compiled.map, &compiled.diagnostics),
@@ -152,7 +150,7 @@ fn insert_before_first_statement(text: &str, line: &str) -> String {
 /// The scene as a mesh file to download, as `scnc export` writes it with its defaults
 /// (detail high; z up for STL and 3MF, which are for printing, y up otherwise).
 pub(crate) fn export(studio: &Studio, text: String, format: &str) -> Reply {
-    use scnc::export::{Frame, Up};
+    use scnc::export::Frame;
     let (format, mime, ext) = match format {
         "stl" => (Format::Stl, "model/stl", "stl"),
         "3mf" => (Format::ThreeMf, "model/3mf", "3mf"),
@@ -160,22 +158,21 @@ pub(crate) fn export(studio: &Studio, text: String, format: &str) -> Reply {
         "ply" => (Format::Ply, "application/octet-stream", "ply"),
         other => return Reply::text(400, &format!("`{other}`: the studio exports stl, 3mf, glb or ply")),
     };
-    let loader = studio.files.loader();
-    let root = studio.files.root.clone();
-    let compiled = scnc::with_big_stack(|| scnc::compile_source("scene", &root, text, &loader));
+    let compiled = studio.files.compile(text);
     let Some(scene) = &compiled.scene else {
         return Reply::text(422, "the scene has errors: fix them to export");
     };
     if scene.objects.is_empty() {
         return Reply::text(422, "the scene has no objects to export");
     }
-    let printing = matches!(format, Format::Stl | Format::ThreeMf);
-    let frame = Frame { up: if printing { Up::Z } else { Up::Y }, scale: 1.0 };
+    let frame = Frame { up: format.default_up(), scale: 1.0 };
     let limit = scnc::mesh::lower::DEFAULT_MEMORY_LIMIT;
+    let loader = studio.files.loader();
+    let skip_unbounded = format.for_printing();
     let collected = studio
         .preview
         .pool
-        .install(|| scnc::export::collect(scene, scnc::mesh::Detail::High, frame, limit, printing, &loader));
+        .install(|| scnc::export::collect(scene, scnc::mesh::Detail::High, frame, limit, skip_unbounded, &loader));
     let export = match collected {
         Ok(e) if !e.parts.is_empty() => e,
         Ok(_) => return Reply::text(422, "no object of the scene has a surface to write"),

@@ -36,11 +36,7 @@ impl Files {
     /// directory must, and if it exists it must be a scene-sized regular file.
     pub(crate) fn open(path: &Path) -> Result<Files, String> {
         let name = path.file_name().ok_or_else(|| format!("`{}` does not name a file", path.display()))?;
-        let parent = match path.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
-        let dir = parent
+        let dir = crate::cli::files::parent_dir(path)
             .canonicalize()
             .map_err(|e| format!("cannot open `{}`: its directory: {}", path.display(), scnc::source::io_reason(&e)))?;
         let root = dir.join(name);
@@ -67,6 +63,12 @@ impl Files {
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(String::new()),
             Err(e) => Err(format!("cannot read `{}`: {}", self.root.display(), scnc::source::io_reason(&e))),
         }
+    }
+
+    /// `text` compiled as the file (its includes read through [`Files::loader`]).
+    pub(crate) fn compile(&self, text: String) -> scnc::Compiled {
+        let name = self.root.file_name().map_or_else(|| "scene".into(), |n| n.to_string_lossy().into_owned());
+        scnc::with_big_stack(|| scnc::compile_source(&name, &self.root, text, &self.loader()))
     }
 
     /// The loader compiles use: the disk, below the file's directory only.

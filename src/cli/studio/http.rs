@@ -201,11 +201,13 @@ impl Stream {
     /// Sends a message of the render stream: a kind byte, the payload's length (u32,
     /// little-endian) and the payload (see `assets/studio.js`, `readMessages`).
     pub(crate) fn message(&mut self, kind: u8, payload: &[u8]) -> std::io::Result<()> {
-        let mut bytes = Vec::with_capacity(payload.len() + 5);
-        bytes.push(kind);
-        bytes.extend_from_slice(&(payload.len() as u32).to_le_bytes());
-        bytes.extend_from_slice(payload);
-        self.send(&bytes)
+        // One chunk, written in place: a band is megabytes, not worth copying.
+        write!(self.w, "{:x}\r\n", payload.len() + 5)?;
+        self.w.write_all(&[kind])?;
+        self.w.write_all(&(payload.len() as u32).to_le_bytes())?;
+        self.w.write_all(payload)?;
+        self.w.write_all(b"\r\n")?;
+        self.w.flush()
     }
 }
 

@@ -14,10 +14,11 @@ use std::time::Instant;
 
 use glam::DQuat;
 
+use scnc::diag::Diagnostic;
 use scnc::mesh::Detail;
-use scnc::render::{Image, Region};
+use scnc::render::{Frame, Image, Region};
 use scnc::trace::Counters;
-use scnc::world::Mode;
+use scnc::world::{Mode, World};
 
 use super::diagnostics::diagnostics_json;
 use super::files::lock;
@@ -47,7 +48,7 @@ pub(crate) struct Previews {
     /// One render at a time.
     running: Mutex<()>,
     /// The last reference render: its key and image.
-    reference: Mutex<Option<(u64, Image, f64)>>,
+    reference: Mutex<Option<(u64, Arc<Image>, f64)>>,
 }
 
 impl Previews {
@@ -150,14 +151,27 @@ struct Ask {
 }
 
 impl Ask {
-    /// The back-end at rung `r` (or the scene's own setting).
-    fn mode(&self, rung: Option<usize>) -> Mode {
+    /// Sets `scene` to rung `r` (or leaves its own setting) and says which back-end
+    /// renders it: the SDF's hit threshold or the mesh's detail, one place for both.
+    fn setting(&self, rung: Option<usize>, scene: &mut scnc::ir::Scene) -> Mode {
         match (self.mesh, rung) {
             (true, Some(r)) => Mode::Mesh(Detail::N(MESH_RUNGS[r])),
             (true, None) => Mode::Mesh(Detail::High),
-            (false, _) => Mode::Sdf,
+            (false, Some(r)) => {
+                scene.settings.epsilon = SDF_RUNGS[r];
+                Mode::Sdf
+            }
+            (false, None) => Mode::Sdf,
         }
     }
+}
+
+/// `scene` lowered for `mode` with the effects it calls for, on the render workers.
+fn lower(studio: &Studio, scene: &scnc::ir::Scene, mode: Mode) -> Result<(Frame, World), Diagnostic> {
+    let effects = scnc::render::effects::derive(scene);
+    let limit = scnc::mesh::lower::DEFAULT_MEMORY_LIMIT;
+    let loader = studio.files.loader();
+    studio.preview.pool.install(|| scnc::world::prepare_within(scene, effects, mode, &loader, limit))
 }
 
 fn json_message(out: &mut Stream, kind: u8, value: serde_json::Value) -> std::io::Result<()> {
@@ -166,8 +180,7 @@ fn json_message(out: &mut Stream, kind: u8, value: serde_json::Value) -> std::io
 
 fn run(studio: &Studio, text: &str, ask: &Ask, out: &mut Stream, current: &dyn Fn() -> bool) -> std::io::Result<()> {
     let loader = studio.files.loader();
-    let root = studio.files.root.clone();
-    let mut compiled = scnc::with_big_stack(|| scnc::compile_source("scene", &root, text.to_string(), &loader));
+    let mut compiled = studio.files.compile(text.to_string());
     let Some(first) = compiled.scene.take() else {
         return json_message(out, b'E', diagnostics_json(&compiled.map, &compiled.diagnostics));
     };
@@ -195,15 +208,9 @@ fn run(studio: &Studio, text: &str, ask: &Ask, out: &mut Stream, current: &dyn F
         );
         json_message(out, b'N', serde_json::json!({ "note": note }))?;
     }
-    if let (false, Some(r)) = (ask.mesh, ask.rung) {
-        s.epsilon = SDF_RUNGS[r];
-    }
-    let mode = ask.mode(ask.rung);
+    let mode = ask.setting(ask.rung, &mut scene);
     let started = Instant::now();
-    let effects = scnc::render::effects::derive(&scene);
-    let limit = scnc::mesh::lower::DEFAULT_MEMORY_LIMIT;
-    let lowered = studio.preview.pool.install(|| scnc::world::prepare_within(&scene, effects, mode, &loader, limit));
-    let (frame, world) = match lowered {
+    let (frame, world) = match lower(studio, &scene, mode) {
         Ok(l) => l,
         Err(d) => return json_message(out, b'E', diagnostics_json(&compiled.map, &[d])),
     };
@@ -262,7 +269,7 @@ fn run(studio: &Studio, text: &str, ask: &Ask, out: &mut Stream, current: &dyn F
         serde_json::json!({
             "text": stats, "effects": frame.effects.to_string(), "lower_ms": lower_s * 1e3,
             "coarse_ms": trace_s * 1e3, "full_ms": full_s * 1e3, "rays": counters.rays(),
-            "setting": setting_label(ask, &scene),
+            "setting": setting_label(mode, &scene),
         }),
     )?;
     if let Some(rung) = ask.rung {
@@ -273,8 +280,8 @@ fn run(studio: &Studio, text: &str, ask: &Ask, out: &mut Stream, current: &dyn F
 }
 
 /// What the accuracy setting of this render was.
-fn setting_label(ask: &Ask, scene: &scnc::ir::Scene) -> String {
-    match ask.mode(ask.rung) {
+fn setting_label(mode: Mode, scene: &scnc::ir::Scene) -> String {
+    match mode {
         Mode::Sdf => format!("SDF, hit threshold {:e}", scene.settings.epsilon),
         Mode::Mesh(d) => format!("mesh, detail {}", d.rings()),
     }
@@ -310,29 +317,21 @@ fn accuracy(
     [ask.view.yaw, ask.view.pitch, ask.view.zoom, ask.view.pan[0], ask.view.pan[1]].map(f64::to_bits).hash(&mut h);
     let key = h.finish();
     let cached =
-        lock(&studio.preview.reference).as_ref().filter(|(k, _, _)| *k == key).map(|(_, i, s)| (i.clone(), *s));
+        lock(&studio.preview.reference).as_ref().filter(|(k, _, _)| *k == key).map(|(_, i, s)| (Arc::clone(i), *s));
     let (reference, reference_s) = match cached {
         Some(r) => r,
-        None if rung == finest => (image.clone(), seconds),
+        None if rung == finest => (Arc::new(image.clone()), seconds),
         None => {
             if !current() {
                 return out.message(b'X', b"{}");
             }
             let mut scene = scene.clone();
-            if !ask.mesh {
-                scene.settings.epsilon = SDF_RUNGS[finest];
-            }
+            let mode = ask.setting(Some(finest), &mut scene);
             let t = Instant::now();
-            let loader = studio.files.loader();
-            let effects = scnc::render::effects::derive(&scene);
-            let limit = scnc::mesh::lower::DEFAULT_MEMORY_LIMIT;
-            let mode = ask.mode(Some(finest));
-            let rendered = studio.preview.pool.install(|| {
-                scnc::world::prepare_within(&scene, effects, mode, &loader, limit)
-                    .map(|(frame, world)| scnc::render::render(&world, &frame, &|| {}).0)
-            });
+            let rendered = lower(studio, &scene, mode)
+                .map(|(frame, world)| studio.preview.pool.install(|| scnc::render::render(&world, &frame, &|| {}).0));
             match rendered {
-                Ok(i) => (i, t.elapsed().as_secs_f64()),
+                Ok(i) => (Arc::new(i), t.elapsed().as_secs_f64()),
                 Err(d) => {
                     let note = format!("the finest rung cannot be made: {}", d.message);
                     return json_message(out, b'N', serde_json::json!({ "note": note }));
@@ -340,7 +339,7 @@ fn accuracy(
             }
         }
     };
-    *lock(&studio.preview.reference) = Some((key, reference.clone(), reference_s));
+    *lock(&studio.preview.reference) = Some((key, Arc::clone(&reference), reference_s));
     let differing = image
         .pixels
         .chunks_exact(3)
