@@ -138,6 +138,10 @@ struct Ctx<'a> {
     settings: Option<Settings>,
     lights: Vec<ir::Light>,
     objects: Vec<ir::Object>,
+    /// Object names given so far (they are made unique).
+    object_names: HashSet<String>,
+    /// Materials bound by `let`, by their call's span: the first name wins.
+    material_names: HashMap<Span, String>,
     iterations: u64,
     call_depth: usize,
     expr_depth: usize,
@@ -337,6 +341,9 @@ impl Ctx<'_> {
             ast::StmtKind::Let { name, params: None, value } => {
                 let v = self.expr(value);
                 self.lets.entry(name.span).or_insert_with(|| (name.name.clone(), false));
+                if let Value::Material(m) = &v {
+                    self.material_names.entry(m.span).or_insert_with(|| name.name.clone());
+                }
                 let ty = (!v.is_error()).then(|| v.ty_name());
                 self.note_def(name, index::DefKind::Value, ty, stmt.span.end, self.block_end);
                 self.bind(name, Bound::Value(v));
@@ -352,7 +359,7 @@ impl Ctx<'_> {
             }
             ast::StmtKind::Object(e) => {
                 let v = self.expr(e);
-                self.object(v, e.span, stmt.span);
+                self.object(v, e, stmt.span);
             }
             ast::StmtKind::Light(e) => {
                 let v = self.expr(e);
@@ -540,6 +547,8 @@ fn run(
         settings: None,
         lights: Vec::new(),
         objects: Vec::new(),
+        object_names: HashSet::new(),
+        material_names: HashMap::new(),
         iterations: 0,
         call_depth: 0,
         expr_depth: 0,

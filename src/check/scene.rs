@@ -6,10 +6,13 @@ use super::{Ctx, Value, MAX_OBJECTS, MAX_SCENE_NODES};
 use crate::diag::{codes, Diagnostic};
 use crate::ir::{self, Camera, Scene};
 use crate::span::Span;
+use crate::syntax::ast;
+use std::path::Path;
 
 impl Ctx<'_> {
     /// Adds the value of an `object` statement to the scene.
-    pub(super) fn object(&mut self, v: Value, expr_span: Span, stmt_span: Span) {
+    pub(super) fn object(&mut self, v: Value, expr: &ast::Expr, stmt_span: Span) {
+        let expr_span = expr.span;
         let geometry = match v {
             Value::Shape(s) => ir::Geometry::Shape(s),
             Value::Mesh(m) => ir::Geometry::Mesh(m),
@@ -77,7 +80,8 @@ impl Ctx<'_> {
             );
             return;
         }
-        self.objects.push(ir::Object { geometry, span: stmt_span });
+        let name = self.unique_name(base_name(expr));
+        self.objects.push(ir::Object { geometry, span: stmt_span, name });
     }
 
     /// The scene and every diagnostic, with the scene-wide warnings added.
@@ -156,9 +160,52 @@ impl Ctx<'_> {
         if diags.iter().any(Diagnostic::is_error) {
             return (None, diags);
         }
-        let scene =
-            Scene { camera, settings: self.settings.unwrap_or_default(), lights: self.lights, objects: self.objects };
+        let mut material_names: Vec<(Span, String)> = self.material_names.into_iter().collect();
+        material_names.sort();
+        let scene = Scene {
+            camera,
+            settings: self.settings.unwrap_or_default(),
+            lights: self.lights,
+            objects: self.objects,
+            material_names,
+        };
         (Some(scene), diags)
+    }
+}
+
+impl Ctx<'_> {
+    /// `base`, or `base_2`, `base_3`, … if an earlier object has it.
+    fn unique_name(&mut self, base: String) -> String {
+        let mut name = base.clone();
+        let mut n = 1;
+        while !self.object_names.insert(name.clone()) {
+            n += 1;
+            name = format!("{base}_{n}");
+        }
+        name
+    }
+}
+
+/// The name an object's expression starts from: `wheel at p` is `wheel`, `bead(0.2)` is
+/// `bead`, `mesh file("scan.obj")` is `scan`; anything else (an `if`, a list) `object`.
+fn base_name(e: &ast::Expr) -> String {
+    match &e.kind {
+        ast::ExprKind::Transform { target, .. } => base_name(target),
+        ast::ExprKind::Ident(id) => id.name.clone(),
+        ast::ExprKind::Call { callee, .. } => callee.name.clone(),
+        ast::ExprKind::Mesh { generator, args } => {
+            let file = args.first().and_then(|a| match &a.value.kind {
+                ast::ExprKind::Str(s) if generator.name == "file" => Path::new(s).file_stem()?.to_str(),
+                _ => None,
+            });
+            // Names are written into OBJ lines and XML attributes: a file name keeps
+            // only the characters every format takes as they are.
+            file.map(|f| {
+                f.chars().map(|c| if c.is_ascii_alphanumeric() || "_-.".contains(c) { c } else { '_' }).collect()
+            })
+            .unwrap_or_else(|| generator.name.clone())
+        }
+        _ => "object".to_string(),
     }
 }
 

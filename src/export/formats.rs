@@ -101,8 +101,8 @@ fn stl_ascii(export: &Export, w: &mut dyn Write) -> io::Result<()> {
 }
 
 /// The name of material `m` in OBJ/MTL, 3MF and glTF.
-fn material_name(m: u32) -> String {
-    format!("material_{m}")
+fn material_name(export: &Export, m: u32) -> &str {
+    &export.material_names[m as usize]
 }
 
 fn obj(export: &Export, mtl: &str, w: &mut dyn Write) -> io::Result<()> {
@@ -129,7 +129,7 @@ fn obj(export: &Export, mtl: &str, w: &mut dyn Write) -> io::Result<()> {
         for (t, tri) in p.mesh.triangles.iter().enumerate() {
             if current != Some(p.materials[t]) {
                 current = Some(p.materials[t]);
-                writeln!(w, "usemtl {}", material_name(p.materials[t]))?;
+                writeln!(w, "usemtl {}", material_name(export, p.materials[t]))?;
             }
             let [a, b, c] = tri.map(|i| base + i as u64);
             if p.smooth {
@@ -152,7 +152,7 @@ pub fn mtl(export: &Export, w: &mut dyn Write) -> io::Result<()> {
     writeln!(w, "# scnc export: material colours")?;
     for m in used(export) {
         let [r, g, b] = export.colours[m as usize].rgb8().map(|c| c as f32 / 255.0);
-        writeln!(w, "newmtl {}", material_name(m))?;
+        writeln!(w, "newmtl {}", material_name(export, m))?;
         writeln!(w, "Kd {r} {g} {b}")?;
     }
     Ok(())
@@ -256,7 +256,7 @@ fn xml_model(export: &Export, units: &str, out: &mut String) {
         let _ = writeln!(
             out,
             "<base name=\"{}\" displaycolor=\"{}\"/>",
-            material_name(m),
+            material_name(export, m),
             export.colours[m as usize].hex()
         );
     }
@@ -365,7 +365,7 @@ fn glb(export: &Export, w: &mut dyn Write) -> io::Result<()> {
         .map(|&m| {
             let [r, g, b] = export.colours[m as usize].linear();
             json!({
-                "name": material_name(m),
+                "name": material_name(export, m),
                 "pbrMetallicRoughness": { "baseColorFactor": [r, g, b, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.8 },
             })
         })

@@ -72,7 +72,7 @@ impl Colour {
 /// One scene object as a mesh in the file's frame.
 #[derive(Clone, Debug)]
 pub struct Part {
-    /// A name for the object: `object_N`, N counting the scene's objects from 1.
+    /// The object's name in the scene ([`ir::Object::name`]), unique in the file.
     pub name: String,
     /// The `object` statement.
     pub span: Span,
@@ -153,6 +153,8 @@ pub struct Export {
     pub parts: Vec<Part>,
     /// Every material's colour (a part's materials index this).
     pub colours: Vec<Colour>,
+    /// Each colour's material name: the `let` that named it, else `material_N`, unique.
+    pub material_names: Vec<String>,
     /// What meshing found wrong but survivable, in scene order (parts an isosurface lost).
     pub warnings: Vec<crate::diag::Diagnostic>,
 }
@@ -205,15 +207,15 @@ pub fn collect(
             }
             ir::Geometry::Mesh(m) => mesh::lower::explicit(m, DAffine3::IDENTITY, &mut budget, &mut materials, loader)?,
         };
-        jobs.push((job, obj.span));
+        jobs.push((job, obj.span, &obj.name));
     }
     budget.confirm()?;
     let warnings =
-        skipped.into_iter().chain(jobs.iter_mut().flat_map(|(job, _)| std::mem::take(&mut job.warnings))).collect();
+        skipped.into_iter().chain(jobs.iter_mut().flat_map(|(job, ..)| std::mem::take(&mut job.warnings))).collect();
     let mut warnings: Vec<Diagnostic> = warnings;
     let mut parts = Vec::with_capacity(jobs.len());
-    for (n, (job, span)) in jobs.into_iter().enumerate() {
-        let p = part(n, job, span, frame);
+    for (job, span, name) in jobs {
+        let p = part(name.clone(), job, span, frame);
         if let Some(coarse) = too_coarse_for_f32(&p.mesh) {
             return Err(collapsed(span, coarse));
         }
@@ -238,11 +240,35 @@ pub fn collect(
         }
     }
     let colours = materials.materials.iter().map(|m| Colour(m.color.as_dvec3().to_array())).collect();
-    Ok(Export { parts, colours, warnings })
+    let material_names = material_names(scene, &materials.spans);
+    Ok(Export { parts, colours, material_names, warnings })
 }
 
-/// Object `n`'s mesh in the file's frame, without its zero-area triangles.
-fn part(n: usize, job: mesh::MeshJob, span: Span, frame: Frame) -> Part {
+/// The interned materials' names: the `let` that named each (`scene.material_names`),
+/// else `material_N`; a name taken already gets `_2`, `_3`, ….
+fn material_names(scene: &Scene, spans: &[Span]) -> Vec<String> {
+    let mut taken = std::collections::HashSet::new();
+    spans
+        .iter()
+        .enumerate()
+        .map(|(m, span)| {
+            let base = match scene.material_names.binary_search_by(|(s, _)| s.cmp(span)) {
+                Ok(k) => scene.material_names[k].1.clone(),
+                Err(_) if m == 0 => "default_grey".to_string(),
+                Err(_) => format!("material_{m}"),
+            };
+            let (mut name, mut n) = (base.clone(), 1);
+            while !taken.insert(name.clone()) {
+                n += 1;
+                name = format!("{base}_{n}");
+            }
+            name
+        })
+        .collect()
+}
+
+/// Object `name`'s mesh in the file's frame, without its zero-area triangles.
+fn part(name: String, job: mesh::MeshJob, span: Span, frame: Frame) -> Part {
     let positions: Vec<DVec3> = job.mesh.positions.iter().map(|&p| frame.place(job.xf.transform_point3(p))).collect();
     // The reflection into the file's frame turns every triangle inside out; a transform
     // that mirrors (negative determinant) turns it back.
@@ -263,7 +289,7 @@ fn part(n: usize, job: mesh::MeshJob, span: Span, frame: Frame) -> Part {
         materials.push(job.per_triangle.as_ref().map_or(job.material, |m| m[t]));
     }
     Part {
-        name: format!("object_{}", n + 1),
+        name,
         span,
         mesh: crate::geom::TriMesh { positions, triangles },
         materials,

@@ -41,6 +41,9 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// Objects in source order.
     pub objects: Vec<Object>,
+    /// The names `let` gave materials, by the span of their `material(…)` call (what
+    /// exported files call them).
+    pub material_names: Vec<(Span, String)>,
 }
 
 /// A pinhole camera.
@@ -221,6 +224,9 @@ pub struct Object {
     pub geometry: Geometry,
     /// The statement.
     pub span: Span,
+    /// What exported files call it: the name its expression starts from (a `let`, a
+    /// function, a builtin, a mesh file's stem), made unique in the scene with `_2`, `_3`….
+    pub name: String,
 }
 
 /// Either an SDF-able shape tree or an explicit mesh.

@@ -44,6 +44,8 @@ impl ShadeMaterial {
 pub struct MaterialTable {
     /// The materials.
     pub materials: Vec<ShadeMaterial>,
+    /// The `material(…)` call each was first interned from (the default grey's is empty).
+    pub spans: Vec<crate::span::Span>,
     /// How the scene's colours are read.
     space: ColorSpace,
 }
@@ -57,7 +59,7 @@ impl Default for MaterialTable {
 impl MaterialTable {
     /// An empty table but for the default grey, reading colours in `space`.
     pub fn new(space: ColorSpace) -> MaterialTable {
-        let mut t = MaterialTable { materials: Vec::new(), space };
+        let mut t = MaterialTable { materials: Vec::new(), spans: Vec::new(), space };
         t.intern(&ir::Material::default_grey(), DAffine3::IDENTITY);
         t
     }
@@ -80,6 +82,7 @@ impl MaterialTable {
             Some(i) => i as u32,
             None => {
                 self.materials.push(sm);
+                self.spans.push(m.span);
                 self.materials.len() as u32 - 1
             }
         }

@@ -87,11 +87,37 @@ fn obj_reads_back_through_scncs_reader_with_its_colours() {
     // sphere's far side is at x = −3.
     assert!((v - 8.0 - SPHERE).abs() < 0.01 * SPHERE, "volume {v}");
     assert!((lo.x + 3.0).abs() < 1e-6, "bounds from {lo}");
-    assert!(text.contains("mtllib unit.mtl\no object_1\n") && text.contains("\no object_2\n"));
+    assert!(text.contains("mtllib unit.mtl\no sphere\n") && text.contains("\no box\n"));
     let mtl = std::fs::read_to_string(dir.path().join("unit.mtl")).expect("the MTL beside it");
     let kd: Vec<&str> = mtl.lines().filter(|l| l.starts_with("Kd ")).collect();
     assert_eq!(kd.len(), 2, "{mtl}");
     assert!(kd.iter().any(|l| l.starts_with("Kd 0.78431374 0.11764706 0.11764706")), "{mtl}");
+}
+
+/// Objects are named from the scene (a `let`, a function, a builtin; repeats numbered)
+/// and materials by their `let`, the same in OBJ, 3MF and glb.
+#[test]
+fn objects_and_materials_are_named_from_the_scene() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = "tests/data/export/names.scn";
+    let objects = ["wheel", "wheel_2", "bead", "bead_2", "sphere"];
+    let obj = String::from_utf8(export(scene, dir.path(), "n.obj", &[])).expect("text");
+    let named: Vec<&str> = obj.lines().filter_map(|l| l.strip_prefix("o ")).collect();
+    assert_eq!(named, objects);
+    let mtl = std::fs::read_to_string(dir.path().join("n.mtl")).expect("the MTL");
+    let materials: Vec<&str> = mtl.lines().filter_map(|l| l.strip_prefix("newmtl ")).collect();
+    assert_eq!(materials, ["default_grey", "gold", "material_2"]);
+    let glb = export(scene, dir.path(), "n.glb", &[]);
+    let gltf = gltf::Gltf::from_slice(&glb).expect("a valid glTF");
+    let nodes: Vec<&str> = gltf.nodes().filter_map(|n| n.name()).collect();
+    assert_eq!(nodes, objects);
+    let used: Vec<&str> = gltf.materials().filter_map(|m| m.name()).collect();
+    assert_eq!(used, ["default_grey", "gold", "material_2"]);
+    let three_mf = export(scene, dir.path(), "n.3mf", &[]);
+    let model = threemf::read(std::io::Cursor::new(three_mf)).expect("threemf reads it");
+    let names: Vec<String> =
+        model.iter().flat_map(|m| m.resources.object.iter().filter_map(|o| o.name.clone())).collect();
+    assert_eq!(names, objects);
 }
 
 #[test]
@@ -101,7 +127,7 @@ fn glb_passes_the_gltf_crates_validation_with_nodes_colours_and_normals() {
     let gltf = gltf::Gltf::from_slice(&bytes).expect("a valid glTF");
     let blob = gltf.blob.clone().expect("a binary chunk");
     let nodes: Vec<String> = gltf.nodes().map(|n| n.name().unwrap_or("").to_string()).collect();
-    assert_eq!(nodes, ["object_1", "object_2"]);
+    assert_eq!(nodes, ["union", "uvsphere"]);
     let mut tris = Vec::new();
     let mut smooth = Vec::new();
     for mesh in gltf.meshes() {
@@ -321,7 +347,7 @@ fn stats_report_each_object_closed_and_scale_multiplies_lengths() {
     let lines: Vec<&str> = err.lines().collect();
     assert!(lines[0].starts_with(&format!("exported {}: 2 objects, 740 triangles", out.display())), "{err}");
     assert!(
-        lines[1].contains("object_1 (tests/data/export/unit.scn:6): 728 triangles, watertight and manifold"),
+        lines[1].contains("sphere (tests/data/export/unit.scn:6): 728 triangles, watertight and manifold"),
         "{err}"
     );
     // A side-2 box scaled by 10: 8000 cubic units, wherever it is turned.
