@@ -43,6 +43,15 @@ enum UpArg {
     Z,
 }
 
+impl From<UpArg> for Up {
+    fn from(u: UpArg) -> Up {
+        match u {
+            UpArg::Y => Up::Y,
+            UpArg::Z => Up::Z,
+        }
+    }
+}
+
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum Units {
     /// Millimetres.
@@ -90,10 +99,11 @@ pub(crate) struct ExportArgs {
     /// The file's up axis (default: `z` for STL and 3MF, `y` for OBJ, PLY and glb).
     #[arg(long, value_enum)]
     up: Option<UpArg>,
-    /// File units per scene unit.
-    #[arg(long, value_parser = parse_scale, default_value = "1")]
-    scale: f64,
-    /// The unit a 3MF file declares (default: mm, one scene unit a millimetre).
+    /// File units per scene unit (default: 10 for STL, whose unit slicers read as mm,
+    /// so a scene unit prints as a centimetre; 1 otherwise).
+    #[arg(long, value_parser = parse_scale)]
+    scale: Option<f64>,
+    /// The unit a 3MF file declares (default: cm, one scene unit a centimetre).
     #[arg(long, value_enum)]
     units: Option<Units>,
     /// Most memory the meshes may take while they are made (as `render`).
@@ -162,6 +172,13 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
         Ok(f) => f,
         Err(e) => return usage_error(&e),
     };
+    if let (Some(fixed), Some(asked)) = (format.fixed_up(), args.up) {
+        if Up::from(asked) != fixed {
+            return usage_error(
+                "--up: glTF fixes +y as up (glTF 2.0, \"Coordinate System and Units\"); turn the scene instead",
+            );
+        }
+    }
     if args.units.is_some() && format != Format::ThreeMf {
         return usage_error("--units is for 3MF, the one format that records units; use --scale to convert");
     }
@@ -216,12 +233,8 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
         }
         None => args.detail,
     };
-    let up = match args.up {
-        Some(UpArg::Y) => Up::Y,
-        Some(UpArg::Z) => Up::Z,
-        None => format.default_up(),
-    };
-    let frame = Frame { up, scale: args.scale };
+    let up = args.up.map_or(format.default_up(), Up::from);
+    let frame = Frame { up, scale: args.scale.unwrap_or(format.default_scale()) };
     let skip = args.skip_unbounded || format.for_printing();
     let collect =
         |detail| pool.install(|| scnc::export::collect(scene, detail, frame, args.memory_limit, skip, &FsLoader));
@@ -269,7 +282,7 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
         );
         return ExitCode::from(1);
     }
-    let units = args.units.unwrap_or(Units::Mm).three_mf();
+    let units = args.units.map_or(scnc::export::formats::DEFAULT_3MF_UNIT, Units::three_mf);
     let mtl_name = mtl.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
     let mut bytes = 0u64;
     let mut write = |path: &Path, what: &dyn Fn(&mut dyn Write) -> std::io::Result<()>| {

@@ -6,6 +6,10 @@
 use std::io::{self, Write};
 
 use super::{Export, Part};
+use crate::geom::axes;
+
+/// The unit a 3MF file declares unless told: a scene unit is a centimetre for printing.
+pub const DEFAULT_3MF_UNIT: &str = "centimeter";
 
 /// A mesh file format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -49,6 +53,25 @@ impl Format {
             super::Up::Z
         } else {
             super::Up::Y
+        }
+    }
+
+    /// File units per scene unit unless told: a scene unit is a centimetre for
+    /// printing, so STL (millimetres to every slicer) is scaled by
+    /// [`axes::STL_PER_UNIT`] and 3MF declares [`DEFAULT_3MF_UNIT`]; OBJ, PLY and glb
+    /// (metres to glTF readers) get the scene's numbers as they are.
+    pub fn default_scale(self) -> f64 {
+        match self {
+            Format::Stl | Format::StlAscii => axes::STL_PER_UNIT,
+            Format::Obj | Format::Ply | Format::ThreeMf | Format::Glb => 1.0,
+        }
+    }
+
+    /// The one up axis a format allows, where its specification fixes it (glTF: +y).
+    pub fn fixed_up(self) -> Option<super::Up> {
+        match self {
+            Format::Glb => Some(super::Up::Y),
+            Format::Stl | Format::StlAscii | Format::Obj | Format::Ply | Format::ThreeMf => None,
         }
     }
 

@@ -19,6 +19,11 @@ pub enum Up {
     Z,
 }
 
+/// STL has no units and every slicer reads millimetres, while for printing a scene unit
+/// is a centimetre (a unit sphere a 2 cm ball): STL export writes this many file units
+/// per scene unit unless told otherwise, and STL import divides by it.
+pub const STL_PER_UNIT: f64 = 10.0;
+
 /// Whether a triangle's corners must be reversed when it crosses between the frames
 /// (both mappings are reflections).
 pub const REVERSES_WINDING: bool = true;

@@ -1,6 +1,7 @@
 //! An STL reader (binary or ASCII, through `stl_io`, which export already uses): facets
 //! welded into a connected mesh by exact vertex position, mapped from the file's z-up
-//! frame, the one STL export writes and slicers and CAD tools use.
+//! frame, the one STL export writes and slicers and CAD tools use, and from millimetres
+//! (a scene unit is [`axes::STL_PER_UNIT`] of them).
 
 use glam::DVec3;
 
@@ -15,7 +16,7 @@ pub fn parse(bytes: &[u8]) -> Result<TriMesh, String> {
     }
     let mut mesh = TriMesh::default();
     for (i, v) in indexed.vertices.iter().enumerate() {
-        let p = DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
+        let p = DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64) / axes::STL_PER_UNIT;
         if !p.is_finite() {
             return Err(format!("vertex {} is not finite", i + 1));
         }

@@ -26,6 +26,14 @@ fn measure(triangles: &[[DVec3; 3]]) -> (f64, DVec3, DVec3) {
     (volume, lo, hi)
 }
 
+/// An STL file's triangles (read by `stl_io`) in scene units: STL is written in
+/// millimetres, ten to a scene unit (a centimetre), unless `--scale` says otherwise.
+fn stl_triangles(bytes: &[u8]) -> Vec<[DVec3; 3]> {
+    let mesh = stl_io::read_stl(&mut std::io::Cursor::new(bytes)).expect("stl_io reads it");
+    let unit = |v: usize| DVec3::from(mesh.vertices[v].0.map(f64::from)) / 10.0;
+    mesh.faces.iter().map(|f| f.vertices.map(unit)).collect()
+}
+
 fn close(a: DVec3, b: DVec3, tol: f64) -> bool {
     (a - b).abs().max_element() <= tol
 }
@@ -41,9 +49,7 @@ fn stl_reads_back_through_stl_io_with_its_volume_and_bounds() {
         let extra: &[&str] = if ascii { &["--ascii", "--detail", "28"] } else { &["--detail", "28"] };
         let bytes = export("tests/data/export/unit.scn", dir.path(), "unit.stl", extra);
         assert_eq!(bytes.starts_with(b"solid scnc"), ascii);
-        let mesh = stl_io::read_stl(&mut std::io::Cursor::new(bytes)).expect("stl_io reads it");
-        let tris: Vec<[DVec3; 3]> =
-            mesh.faces.iter().map(|f| f.vertices.map(|v| DVec3::from(mesh.vertices[v].0.map(f64::from)))).collect();
+        let tris = stl_triangles(&bytes);
         // Z up by default for STL: the box (side 2, at y = 1 in the scene) is at z ≈ 1.
         let box_tris: Vec<[DVec3; 3]> = tris.iter().copied().filter(|t| t[0].x > 0.0).collect();
         let sphere_tris: Vec<[DVec3; 3]> = tris.iter().copied().filter(|t| t[0].x < 0.0).collect();
@@ -64,13 +70,7 @@ fn stl_reads_back_through_stl_io_with_its_volume_and_bounds() {
 fn the_default_detail_loses_the_chord_volume_and_no_more() {
     let dir = tempfile::tempdir().expect("temp dir");
     let bytes = export("tests/data/export/unit.scn", dir.path(), "unit.stl", &[]);
-    let mesh = stl_io::read_stl(&mut std::io::Cursor::new(bytes)).expect("stl_io reads it");
-    let tris: Vec<[DVec3; 3]> = mesh
-        .faces
-        .iter()
-        .filter(|f| mesh.vertices[f.vertices[0]].0[0] < 0.0)
-        .map(|f| f.vertices.map(|v| DVec3::from(mesh.vertices[v].0.map(f64::from))))
-        .collect();
+    let tris: Vec<[DVec3; 3]> = stl_triangles(&bytes).into_iter().filter(|t| t[0].x < 0.0).collect();
     let (v, _, _) = measure(&tris);
     assert!(v < SPHERE && v > 0.975 * SPHERE, "sphere volume {v} of {SPHERE}");
 }
@@ -156,7 +156,11 @@ fn glb_passes_the_gltf_crates_validation_with_nodes_colours_and_normals() {
 #[test]
 fn three_mf_reads_back_through_the_threemf_crate_with_units_and_colours() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let bytes = export("tests/data/export/unit.scn", dir.path(), "unit.3mf", &["--detail", "28", "--units", "cm"]);
+    // A scene unit is a centimetre for printing, unless `--units` says otherwise.
+    let mm = export("tests/data/export/unit.scn", dir.path(), "mm.3mf", &["--units", "mm"]);
+    let mm = threemf::read(std::io::Cursor::new(mm)).expect("threemf reads it");
+    assert!(matches!(mm[0].unit, threemf::model::Unit::Millimeter));
+    let bytes = export("tests/data/export/unit.scn", dir.path(), "unit.3mf", &["--detail", "28"]);
     let models = threemf::read(std::io::Cursor::new(bytes.clone())).expect("threemf reads it");
     assert_eq!(models.len(), 1);
     let objects = &models[0].resources.object;
@@ -303,7 +307,8 @@ fn every_example_exports_to_every_format_or_names_its_unbounded_object() {
 fn bad_exports_are_clear_errors_and_write_nothing() {
     let dir = tempfile::tempdir().expect("temp dir");
     let at = |name: &str| dir.path().join(name).to_str().expect("path").to_string();
-    let cases: [(Vec<String>, i32, &str); 6] = [
+    let cases: [(Vec<String>, i32, &str); 7] = [
+        (vec![at("x.glb"), "--up".into(), "z".into()], 2, "glTF fixes +y as up"),
         (vec![at("x.dae")], 2, "cannot tell the format of"),
         (vec![at("x.obj"), "--ascii".into()], 2, "--ascii is for STL only"),
         (vec![at("x.stl"), "--units".into(), "mm".into()], 2, "--units is for 3MF"),
@@ -542,9 +547,7 @@ fn extruded_polygons_mesh_exactly_and_holes_go_through() {
     let volume_of = |scene_text: &str, name: &str| {
         std::fs::write(&scene, format!("light ambient(1)\n{scene_text}")).expect("writing");
         let bytes = export(scene.to_str().expect("utf-8"), dir.path(), name, &["--detail", "low"]);
-        let mesh = stl_io::read_stl(&mut std::io::Cursor::new(bytes)).expect("stl_io reads it");
-        let tris: Vec<[DVec3; 3]> =
-            mesh.faces.iter().map(|f| f.vertices.map(|v| DVec3::from(mesh.vertices[v].0.map(f64::from)))).collect();
+        let tris = stl_triangles(&bytes);
         (tris.len(), measure(&tris).0)
     };
     let l = "polygon([[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]])";

@@ -165,7 +165,7 @@ pub(crate) fn export(studio: &Studio, text: String, format: &str) -> Reply {
     if scene.objects.is_empty() {
         return Reply::text(422, "the scene has no objects to export");
     }
-    let frame = Frame { up: format.default_up(), scale: 1.0 };
+    let frame = Frame { up: format.default_up(), scale: format.default_scale() };
     let limit = scnc::mesh::lower::DEFAULT_MEMORY_LIMIT;
     let loader = studio.files.loader();
     let skip_unbounded = format.for_printing();
@@ -179,7 +179,7 @@ pub(crate) fn export(studio: &Studio, text: String, format: &str) -> Reply {
         Err(d) => return Reply::text(422, &format!("error[{}]: {}", d.code, d.message)),
     };
     let mut bytes = Vec::new();
-    if let Err(e) = format.write(&export, "millimeter", "", &mut bytes) {
+    if let Err(e) = format.write(&export, scnc::export::formats::DEFAULT_3MF_UNIT, "", &mut bytes) {
         return Reply::text(500, &format!("cannot write the {ext}: {e}"));
     }
     let stem = studio.files.root.file_stem().map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
