@@ -9,6 +9,7 @@
 //! part keeps its shape (it is not mirrored in a slicer) and stays wound outward.
 
 pub mod formats;
+pub mod mend;
 pub mod report;
 
 use glam::{DAffine3, DVec3};
@@ -89,9 +90,12 @@ pub struct Part {
 }
 
 impl Part {
-    /// Unit normal of triangle `t` (zero for none, which [`collect`] never keeps).
+    /// Unit normal of triangle `t` as the file holds it: of the 32-bit corners every
+    /// format writes (far from the origin rounding turns small triangles; admesh
+    /// "fixes" a stored normal that disagrees with its corners). Zero for none, which
+    /// [`collect`] never keeps.
     pub fn face_normal(&self, t: usize) -> DVec3 {
-        let [a, b, c] = self.mesh.triangles[t].map(|i| self.mesh.positions[i as usize]);
+        let [a, b, c] = self.mesh.triangles[t].map(|i| self.mesh.positions[i as usize].as_vec3().as_dvec3());
         (b - a).cross(c - a).normalize_or_zero()
     }
 
@@ -273,7 +277,7 @@ fn part(name: String, job: mesh::MeshJob, span: Span, frame: Frame) -> Part {
     // The reflection into the file's frame turns every triangle inside out; a transform
     // that mirrors (negative determinant) turns it back.
     let flip = crate::geom::axes::REVERSES_WINDING != (job.xf.matrix3.determinant() < 0.0);
-    let (mut triangles, mut materials, mut degenerate, mut rounded_away) = (Vec::new(), Vec::new(), 0, 0);
+    let (mut triangles, mut materials, mut rounded_away) = (Vec::new(), Vec::new(), 0);
     for (t, &[a, b, c]) in job.mesh.triangles.iter().enumerate() {
         // Judged on the f32 corners every format writes (a triangle with area in f64
         // can lose it in f32 far from the origin); repeated corners give a zero cross
@@ -282,12 +286,26 @@ fn part(name: String, job: mesh::MeshJob, span: Span, frame: Frame) -> Part {
         if (pb - pa).cross(pc - pa).length_squared() == 0.0 {
             let [qa, qb, qc] = [a, b, c].map(|i| positions[i as usize]);
             rounded_away += usize::from((qb - qa).cross(qc - qa).length_squared() > 0.0);
-            degenerate += 1;
-            continue;
         }
         triangles.push(if flip { [a, c, b] } else { [a, b, c] });
         materials.push(job.per_triangle.as_ref().map_or(job.material, |m| m[t]));
     }
+    let written: Vec<glam::Vec3> = positions.iter().map(|p| p.as_vec3()).collect();
+    let mended = mend::mend(&written, &mut triangles, &mut materials);
+    let degenerate = mended.removed + mended.dropped;
+    // Collapsed corners leave vertices no triangle uses: the file lists only used ones,
+    // in their order.
+    let mut new_index = vec![u32::MAX; positions.len()];
+    triangles.iter().flatten().for_each(|&i| new_index[i as usize] = 0);
+    let mut kept = Vec::with_capacity(positions.len());
+    for (i, p) in positions.iter().enumerate() {
+        if new_index[i] == 0 {
+            new_index[i] = kept.len() as u32;
+            kept.push(*p);
+        }
+    }
+    triangles.iter_mut().flatten().for_each(|i| *i = new_index[*i as usize]);
+    let positions = kept;
     Part {
         name,
         span,

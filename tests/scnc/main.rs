@@ -30,4 +30,5 @@ mod stability;
 mod studio;
 mod support;
 mod tiles;
+mod validators;
 mod watch;

@@ -169,8 +169,17 @@ impl Rng {
 /// `chromium`). Where it cannot, those tests are skipped with a note, unless
 /// `SCNC_REQUIRE_TOOLS=1` (set by `.ci/run`, which installs them) makes that a failure.
 pub fn have_tool(name: &str) -> bool {
-    let found = std::process::Command::new(name)
-        .arg("--version")
+    available(name, std::process::Command::new(name).arg("--version"))
+}
+
+/// Whether Python 3 can import `module` (a validator some tests drive, such as
+/// `lib3mf`), skipped or required as [`have_tool`] says.
+pub fn have_python_module(module: &str) -> bool {
+    available(module, std::process::Command::new("python3").args(["-c", &format!("import {module}")]))
+}
+
+fn available(name: &str, probe: &mut std::process::Command) -> bool {
+    let found = probe
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::null())
         .status()
