@@ -140,6 +140,8 @@ struct Ctx<'a> {
     objects: Vec<ir::Object>,
     /// Object names given so far (they are made unique).
     object_names: HashSet<String>,
+    /// The number the next object of each base name gets.
+    name_counts: HashMap<String, usize>,
     /// Materials bound by `let`, by their call's span: the first name wins.
     material_names: HashMap<Span, String>,
     iterations: u64,
@@ -548,6 +550,7 @@ fn run(
         lights: Vec::new(),
         objects: Vec::new(),
         object_names: HashSet::new(),
+        name_counts: HashMap::new(),
         material_names: HashMap::new(),
         iterations: 0,
         call_depth: 0,

@@ -174,14 +174,16 @@ impl Ctx<'_> {
 }
 
 impl Ctx<'_> {
-    /// `base`, or `base_2`, `base_3`, … if an earlier object has it.
+    /// `base`, or `base_2`, `base_3`, … if an earlier object has it. Each base
+    /// remembers its next number, so 100,000 `sphere`s take linear time.
     fn unique_name(&mut self, base: String) -> String {
-        let mut name = base.clone();
-        let mut n = 1;
+        let next = self.name_counts.entry(base.clone()).or_insert(1);
+        let mut name = if *next == 1 { base.clone() } else { format!("{base}_{next}") };
         while !self.object_names.insert(name.clone()) {
-            n += 1;
-            name = format!("{base}_{n}");
+            *next += 1;
+            name = format!("{base}_{next}");
         }
+        *next += 1;
         name
     }
 }
