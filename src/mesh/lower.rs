@@ -327,17 +327,18 @@ pub fn explicit(
                     format!("{place}: {message}"),
                 )
                 .with_note(
-                    "scnc reads OBJ files (`v x y z` and `f a b c …` records) and STL files (binary or ASCII, z up)",
+                    "scnc reads OBJ files (`v x y z` and `f a b c …` records), STL (`.stl`, binary or ASCII, z up, millimetres), PLY (`.ply`) and binary glTF (`.glb`)",
                 )
             };
-            let stl = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("stl"));
-            if stl {
-                super::stl::parse(&bytes).map_err(|e| bad(written.clone(), e))?
-            } else {
-                obj::parse(&bytes).map_err(|e| {
+            let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+            match ext.as_deref() {
+                Some("stl") => super::stl::parse(&bytes).map_err(|e| bad(written.clone(), e))?,
+                Some("ply") => super::ply::parse(&bytes).map_err(|e| bad(written.clone(), e))?,
+                Some("glb") => super::glb::parse(&bytes).map_err(|e| bad(written.clone(), e))?,
+                _ => obj::parse(&bytes).map_err(|e| {
                     let place = if e.line > 0 { format!("{written}:{}", e.line) } else { written.clone() };
                     bad(place, e.message)
-                })?
+                })?,
             }
         }
     };

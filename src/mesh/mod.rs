@@ -10,11 +10,13 @@
 mod detail;
 mod iso_job;
 pub(crate) use iso_job::approx;
+pub mod glb;
 pub mod isosurface;
 pub mod lower;
 pub mod obj;
 pub mod octree;
 pub mod parts;
+pub mod ply;
 mod qef;
 pub mod stl;
 pub mod triangle;

@@ -390,11 +390,11 @@ fn a_tolerance_export_refines_a_sheet_thinner_than_its_cell() {
     assert!(err.contains("watertight and manifold"), "{err}");
 }
 
-/// A model exported to OBJ or STL and read back with `mesh file(…)` lands where it was, not
+/// A model exported to OBJ, STL, PLY or glb and read back with `mesh file(…)` lands where it was, not
 /// mirrored: an asymmetric arrangement of boxes (which tell left from right, and front
 /// from back) renders the same, pixel for pixel, as the scene itself as meshes.
 #[test]
-fn an_exported_obj_or_stl_reads_back_where_it_was() {
+fn an_exported_mesh_file_reads_back_where_it_was() {
     let dir = tempfile::tempdir().expect("temp dir");
     let common = "camera(position = [1.4, 2, -3.6], look_at = [0.5, 0.5, 0.5])\n\
                   render(width = 96, height = 96)\n\
@@ -419,8 +419,9 @@ fn an_exported_obj_or_stl_reads_back_where_it_was() {
         image::open(&png).expect("a PNG").to_rgb8()
     };
     let meshed = render(&scene, "meshed.png", &["--geometry", "mesh"]);
-    // OBJ is y up, STL z up (as export writes them); both read back unmirrored.
-    for format in ["obj", "stl"] {
+    // OBJ, PLY and glb are y up, STL z up and in millimetres (as export writes them);
+    // every one reads back unmirrored, at its size.
+    for format in ["obj", "stl", "ply", "glb"] {
         let file = dir.path().join(format!("l.{format}"));
         let run = scnc(&["export", scene.to_str().expect("utf-8"), "-o", file.to_str().expect("utf-8")]);
         assert_eq!(run.status.code(), Some(0), "{}", String::from_utf8_lossy(&run.stderr));

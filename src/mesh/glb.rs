@@ -1,0 +1,168 @@
+//! A binary glTF (`.glb`) reader through the `gltf` crate (the glTF project's Rust
+//! reader, which validates the document): the triangles of every mesh the default scene
+//! places, through each node's transform, in one mesh. glTF is y up and right-handed
+//! ([`axes::Up::Y`]), as export writes it; its buffers must be inside the file.
+
+use glam::{DMat4, DVec3};
+
+use super::obj::{MAX_COORDINATE, MAX_ELEMENTS};
+use crate::geom::{axes, TriMesh};
+
+/// Parses a `.glb` file's bytes into scnc's space; an error says what is wrong.
+pub fn parse(bytes: &[u8]) -> Result<TriMesh, String> {
+    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| format!("not a readable glb file ({e})"))?;
+    let blob = gltf.blob.as_deref();
+    let mut mesh = TriMesh::default();
+    let scene = gltf.default_scene().or_else(|| gltf.scenes().next()).ok_or("the file has no scene")?;
+    // Nodes with their parents' transforms, depth first; a node may be used once per path.
+    let mut stack: Vec<(gltf::Node, DMat4, usize)> = scene.nodes().map(|n| (n, DMat4::IDENTITY, 0)).collect();
+    while let Some((node, parent, depth)) = stack.pop() {
+        if depth > 64 {
+            return Err("its nodes nest more than 64 deep".into());
+        }
+        let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
+        let world = parent * local;
+        if let Some(m) = node.mesh() {
+            for p in m.primitives() {
+                add(&mut mesh, &p, world, blob)?;
+            }
+        }
+        stack.extend(node.children().map(|c| (c, world, depth + 1)));
+    }
+    if mesh.triangles.is_empty() {
+        return Err("the file's scene has no triangles".into());
+    }
+    Ok(mesh)
+}
+
+/// Appends one primitive's triangles, placed by `world`.
+fn add(mesh: &mut TriMesh, p: &gltf::Primitive, world: DMat4, blob: Option<&[u8]>) -> Result<(), String> {
+    use gltf::mesh::Mode;
+    let external = p
+        .attributes()
+        .any(|(_, a)| a.view().is_some_and(|v| matches!(v.buffer().source(), gltf::buffer::Source::Uri(_))));
+    let reader = p.reader(|b| match b.source() {
+        gltf::buffer::Source::Bin => blob,
+        gltf::buffer::Source::Uri(_) => None,
+    });
+    let Some(positions) = reader.read_positions() else {
+        return Err(if external {
+            "its buffers are in other files: scnc reads a .glb whose data is inside it".into()
+        } else {
+            "a primitive has no positions".into()
+        });
+    };
+    let base = mesh.positions.len() as u32;
+    for q in positions {
+        let q = world.transform_point3(DVec3::from(q.map(f64::from)));
+        if !q.is_finite() || q.abs().max_element() > MAX_COORDINATE {
+            return Err(format!("a vertex is beyond the renderable range (±{MAX_COORDINATE:e})"));
+        }
+        mesh.positions.push(axes::from_file(q, axes::Up::Y));
+    }
+    let count = mesh.positions.len() as u32 - base;
+    if mesh.positions.len() > MAX_ELEMENTS {
+        return Err(format!("more than {MAX_ELEMENTS} vertices"));
+    }
+    let indices: Vec<u32> = match reader.read_indices() {
+        Some(i) => i.into_u32().collect(),
+        None => (0..count).collect(),
+    };
+    if let Some(&i) = indices.iter().find(|&&i| i >= count) {
+        return Err(format!("index {i} is out of range: the primitive has {count} vertices"));
+    }
+    let triangles: Vec<[u32; 3]> = match p.mode() {
+        Mode::Triangles => indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
+        // Every other strip triangle is wound the other way (glTF 2.0, 3.7.2.1).
+        Mode::TriangleStrip => (2..indices.len())
+            .map(|k| {
+                let (a, b, c) = (indices[k - 2], indices[k - 1], indices[k]);
+                if k % 2 == 0 {
+                    [a, b, c]
+                } else {
+                    [b, a, c]
+                }
+            })
+            .collect(),
+        Mode::TriangleFan => (2..indices.len()).map(|k| [indices[0], indices[k - 1], indices[k]]).collect(),
+        // Points and lines have no surface.
+        Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip => Vec::new(),
+    };
+    // A transform that mirrors turns the file's winding inside out; the mapping into
+    // scnc's space is a reflection too.
+    let flip = axes::REVERSES_WINDING != (world.determinant() < 0.0);
+    for t in triangles {
+        if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+            continue;
+        }
+        let [a, b, c] = t.map(|i| base + i);
+        mesh.triangles.push(if flip { [a, c, b] } else { [a, b, c] });
+    }
+    if mesh.triangles.len() > MAX_ELEMENTS {
+        return Err(format!("more than {MAX_ELEMENTS} triangles"));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A .glb of one triangle (no indices), placed by `nodes` (the scene is node 0).
+    fn glb(nodes: serde_json::Value, mode: u32) -> Vec<u8> {
+        let bin: Vec<u8> = [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+            .iter()
+            .flatten()
+            .flat_map(|c| c.to_le_bytes())
+            .collect();
+        let doc = serde_json::json!({
+            "asset": { "version": "2.0" },
+            "scene": 0,
+            "scenes": [{ "nodes": [0] }],
+            "nodes": nodes,
+            "meshes": [{ "primitives": [{ "attributes": { "POSITION": 0 }, "mode": mode }] }],
+            "accessors": [{ "bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                            "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 0.0] }],
+            "bufferViews": [{ "buffer": 0, "byteLength": 36 }],
+            "buffers": [{ "byteLength": 36 }],
+        });
+        let mut json = serde_json::to_vec(&doc).expect("json");
+        while !json.len().is_multiple_of(4) {
+            json.push(b' ');
+        }
+        let mut out = b"glTF".to_vec();
+        out.extend(2u32.to_le_bytes());
+        out.extend(((12 + 8 + json.len() + 8 + bin.len()) as u32).to_le_bytes());
+        out.extend((json.len() as u32).to_le_bytes());
+        out.extend(b"JSON");
+        out.extend(json);
+        out.extend((bin.len() as u32).to_le_bytes());
+        out.extend(b"BIN\0");
+        out.extend(bin);
+        out
+    }
+
+    #[test]
+    fn nodes_place_their_meshes_and_a_mirror_keeps_the_winding_outward() {
+        let plain = parse(&glb(serde_json::json!([{ "mesh": 0 }]), 4)).expect("reads");
+        assert_eq!(plain.positions[1], DVec3::new(1.0, 0.0, 0.0));
+        // A parent moves, a child mirrors in x: (1, 0, 0) lands at (−1 + 0, 0, 2) in the
+        // file, (−1, 0, −2) in scnc's space, and the triangle is wound the other way.
+        let nodes = serde_json::json!([{ "translation": [0.0, 0.0, 2.0], "children": [1] }, { "scale": [-1.0, 1.0, 1.0], "mesh": 0 }]);
+        let placed = parse(&glb(nodes, 4)).expect("reads");
+        assert_eq!(placed.positions[1], DVec3::new(-1.0, 0.0, -2.0));
+        let [a, b, c] = plain.triangles[0];
+        assert_eq!(placed.triangles[0], [a, c, b]);
+    }
+
+    #[test]
+    fn strips_and_fans_are_triangles_and_points_have_none() {
+        for mode in [5, 6] {
+            assert_eq!(parse(&glb(serde_json::json!([{ "mesh": 0 }]), mode)).expect("reads").triangles.len(), 1);
+        }
+        let e = parse(&glb(serde_json::json!([{ "mesh": 0 }]), 0)).expect_err("points only");
+        assert!(e.contains("no triangles"), "{e}");
+        let e = parse(b"glTF\x02\0\0\0").expect_err("truncated");
+        assert!(e.contains("not a readable glb"), "{e}");
+    }
+}
