@@ -78,6 +78,8 @@ pub struct Surface {
     /// Edges left on four triangles: where a part thinner than a cell crosses a cell
     /// face twice from both sides and the sheets could not be split (0 otherwise).
     pub pinched: usize,
+    /// Pairs of triangles that still cross each other after [`super::unfold`].
+    pub crossing_pairs: usize,
 }
 
 /// Extracts the zero set of `f` on `grid`, refining at most [`MAX_CELLS`] cells.
@@ -132,16 +134,18 @@ pub fn extract_within(f: &(dyn Fn(Vec3A) -> f32 + Sync), grid: &Grid, max_cells:
     let crossings: Vec<Crossing> = edges.par_iter().map(|&e| crossing(f, grid, &corners, e)).collect();
 
     // One vertex per sheet of every cell, in cell order.
-    let mut per_cell: Vec<(Sheets, Vec<DVec3>)> =
+    let mut per_cell: Vec<(Sheets, Vec<[DVec3; 2]>)> =
         cells.par_iter().zip(&values).map(|(&c, v)| sheets::<4>(grid, c, v, &edges, &crossings, 0)).collect();
     // Where a part is thinner than a cell, one sheet can cross an ambiguous face twice,
     // in both cells of the face: the two vertices would then share four quads' edge.
     let pinched = split_doubled_faces(grid, &cells, &values, &edges, &crossings, &mut per_cell);
     let mut mesh = TriMesh::default();
+    let mut mass = Vec::new();
     let mut sheets_of = Vec::with_capacity(per_cell.len());
     for (mut s, vertices) in per_cell {
         s.first = mesh.positions.len() as u32;
-        mesh.positions.extend(vertices);
+        mesh.positions.extend(vertices.iter().map(|v| v[0]));
+        mass.extend(vertices.iter().map(|v| v[1]));
         sheets_of.push(s);
     }
     let quads: Vec<[[u32; 3]; 2]> = edges
@@ -159,7 +163,8 @@ pub fn extract_within(f: &(dyn Fn(Vec3A) -> f32 + Sync), grid: &Grid, max_cells:
         })
         .collect();
     mesh.triangles = quads.into_iter().flatten().collect();
-    Ok(Surface { mesh, pinched })
+    let crossing_pairs = super::unfold::unfold(&mut mesh, &mass, grid.cell);
+    Ok(Surface { mesh, pinched, crossing_pairs })
 }
 
 /// Splits sheets that cross a face twice from both sides. Leaving the face's pairing
@@ -180,9 +185,9 @@ fn split_doubled_faces(
     values: &[[f32; 8]],
     edges: &[EdgeKey],
     crossings: &[Crossing],
-    per_cell: &mut [(Sheets, Vec<DVec3>)],
+    per_cell: &mut [(Sheets, Vec<[DVec3; 2]>)],
 ) -> usize {
-    let doubled = |per_cell: &[(Sheets, Vec<DVec3>)], i: usize, n: u8| per_cell[i].0.doubled & (1 << n) != 0;
+    let doubled = |per_cell: &[(Sheets, Vec<[DVec3; 2]>)], i: usize, n: u8| per_cell[i].0.doubled & (1 << n) != 0;
     // Each face doubled on both sides, once, from its lower cell.
     let faces: Vec<(usize, u8, usize)> = (0..cells.len())
         .into_par_iter()
@@ -449,7 +454,7 @@ fn sheets<const N: usize>(
     edges: &[EdgeKey],
     crossings: &[Crossing],
     skip: u8,
-) -> (Sheets, Vec<DVec3>) {
+) -> (Sheets, Vec<[DVec3; 2]>) {
     let c = unkey(cell);
     let crossed: [bool; 12] = std::array::from_fn(|e| crossed(v, e));
     // Union-find over the twelve edges, joined by each face's pairs.
@@ -526,7 +531,8 @@ fn sheets<const N: usize>(
     }
     let lo = grid.point(c);
     let hi = lo + grid.cell;
-    let vertices = qefs[..count].iter().map(|q| q.solve().clamp(lo, hi)).collect();
+    // Each vertex with its mass point, where an unfolding moves it (`unfold`).
+    let vertices = qefs[..count].iter().map(|q| [q.solve().clamp(lo, hi), q.mass_point()]).collect();
     (Sheets { of_edge, first: 0, doubled }, vertices)
 }
 

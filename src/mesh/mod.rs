@@ -20,6 +20,7 @@ pub mod ply;
 mod qef;
 pub mod stl;
 pub mod triangle;
+pub mod unfold;
 
 use glam::{DAffine3, DVec3, Vec3A, Vec4};
 use rayon::prelude::*;
