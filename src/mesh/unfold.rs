@@ -156,40 +156,24 @@ fn through(p: DVec3, q: DVec3, [a, b, c]: [DVec3; 3]) -> bool {
 mod tests {
     use super::*;
 
+    /// A triangle, one through its interior, and one above it, apart.
+    fn three() -> TriMesh {
+        let p = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.2, 0.2, -0.5], [0.2, 0.2, 0.5]];
+        let q = [[0.3, 0.4, 0.5], [0.2, 0.2, 1.5], [0.8, 0.2, 1.5], [0.2, 0.8, 1.5]];
+        TriMesh {
+            positions: p.iter().chain(&q).map(|&c| DVec3::from(c)).collect(),
+            triangles: vec![[0, 1, 2], [3, 4, 5], [6, 7, 8]],
+        }
+    }
+
     #[test]
     fn crossing_triangles_are_found_and_apart_ones_are_not() {
-        let mesh = TriMesh {
-            positions: vec![
-                DVec3::new(0.0, 0.0, 0.0),
-                DVec3::new(1.0, 0.0, 0.0),
-                DVec3::new(0.0, 1.0, 0.0),
-                // Through the first triangle's interior.
-                DVec3::new(0.2, 0.2, -0.5),
-                DVec3::new(0.2, 0.2, 0.5),
-                DVec3::new(0.3, 0.4, 0.5),
-                // Above it, apart.
-                DVec3::new(0.2, 0.2, 1.5),
-                DVec3::new(0.8, 0.2, 1.5),
-                DVec3::new(0.2, 0.8, 1.5),
-            ],
-            triangles: vec![[0, 1, 2], [3, 4, 5], [6, 7, 8]],
-        };
-        assert_eq!(crossing_pairs(&mesh, 0.5), [(0, 1)]);
+        assert_eq!(crossing_pairs(&three(), 0.5), [(0, 1)]);
     }
 
     #[test]
     fn a_fold_is_undone_at_the_mass_points() {
-        let mut mesh = TriMesh {
-            positions: vec![
-                DVec3::new(0.0, 0.0, 0.0),
-                DVec3::new(1.0, 0.0, 0.0),
-                DVec3::new(0.0, 1.0, 0.0),
-                DVec3::new(0.2, 0.2, -0.5),
-                DVec3::new(0.2, 0.2, 0.5),
-                DVec3::new(0.3, 0.4, 0.5),
-            ],
-            triangles: vec![[0, 1, 2], [3, 4, 5]],
-        };
+        let mut mesh = three();
         let mut mass = mesh.positions.clone();
         // The second triangle's mass points lie above the first.
         mass[3].z = 0.1;

@@ -320,13 +320,7 @@ fn encode_streams_its_frames_in_bounded_memory() {
     for i in 0..40 {
         frame.save(dir.path().join(format!("f-{i:02}.png"))).expect("writing a frame");
     }
-    let bin = env!("CARGO_BIN_EXE_scnc");
-    let out = std::process::Command::new("sh")
-        .arg("-c")
-        .arg(format!("ulimit -v 300000 && exec {bin} encode f-##.png -o a.png --fps 10"))
-        .current_dir(dir.path())
-        .output()
-        .expect("running encode");
+    let out = super::support::scnc_capped(300_000, dir.path(), &["encode", "f-##.png", "-o", "a.png", "--fps", "10"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(dir.path().join("a.png")).expect("a")));
     assert_eq!(decoder.read_info().expect("header").info().animation_control.map(|a| a.num_frames), Some(40));

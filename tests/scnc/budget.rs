@@ -99,14 +99,8 @@ fn an_address_space_cap_is_an_error_not_an_abort() {
     let text = "light ambient(1)\nobject mesh uvsphere(rings = 2000, segments = 2000) at [0, 0, 5]\n";
     std::fs::write(&scene, text).expect("write");
     let out = dir.path().join("big.png");
-    let script =
-        "ulimit -v 1000000 && exec \"$0\" render \"$1\" -o \"$2\" --geometry mesh --width 16 --height 16 --memory-limit 16G";
-    let run = std::process::Command::new("sh")
-        .args(["-c", script, env!("CARGO_BIN_EXE_scnc")])
-        .arg(&scene)
-        .arg(&out)
-        .output()
-        .expect("running sh");
+    let args = ["render", "big.scn", "-o", "big.png", "--geometry", "mesh", "--width", "16", "--height", "16"];
+    let run = super::support::scnc_capped(1_000_000, dir.path(), &[&args[..], &["--memory-limit", "16G"]].concat());
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert_eq!(run.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("the system would not give the memory"), "{stderr}");

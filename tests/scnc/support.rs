@@ -10,6 +10,18 @@ pub fn scnc(args: &[&str]) -> std::process::Output {
     scnc_env(args, &[])
 }
 
+/// Runs the scnc binary with `args` under an address-space cap of `kib` KiB (`ulimit
+/// -v`), from `dir`: what a memory test needs to see an error, not an allocation abort.
+pub fn scnc_capped(kib: u64, dir: &std::path::Path, args: &[&str]) -> std::process::Output {
+    std::process::Command::new("sh")
+        .args(["-c", &format!("ulimit -v {kib} && exec \"$0\" \"$@\""), env!("CARGO_BIN_EXE_scnc")])
+        .args(args)
+        .current_dir(dir)
+        .env("NO_COLOR", "1")
+        .output()
+        .expect("running sh")
+}
+
 /// The run succeeded.
 pub fn ok(out: &std::process::Output) {
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));

@@ -87,13 +87,8 @@ fn twenty_million_triangles_stream_to_3mf_under_an_address_space_cap() {
     let text = "object sphere(1) at [-1.2, 0, 0]\nobject mesh uvsphere(r = 1, rings = 900) at [1.2, 0, 0]\n";
     std::fs::write(&scene, text).expect("write");
     let out = dir.path().join("big.3mf");
-    let script = "ulimit -v 3500000 && exec \"$0\" export \"$1\" -o \"$2\" --detail 2048";
-    let run = std::process::Command::new("sh")
-        .args(["-c", script, env!("CARGO_BIN_EXE_scnc")])
-        .arg(&scene)
-        .arg(&out)
-        .output()
-        .expect("running sh");
+    let run =
+        super::support::scnc_capped(3_500_000, dir.path(), &["export", "big.scn", "-o", "big.3mf", "--detail", "2048"]);
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert_eq!(run.status.code(), Some(0), "{stderr}");
     assert!(stderr.contains("2 objects, 20005424 triangles"), "{stderr}");
