@@ -282,16 +282,6 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
         );
         return ExitCode::from(1);
     }
-    let working = format.working_bytes(&export);
-    if !scnc::mesh::lower::system_gives(working) {
-        let _ = writeln!(
-            std::io::stderr(),
-            "error: the system would not give the {} that writing `{}` needs beside the meshes (see `ulimit -v`); nothing written",
-            scnc::diag::bytes(working),
-            args.output.display()
-        );
-        return ExitCode::from(1);
-    }
     let units = args.units.map_or(scnc::export::formats::DEFAULT_3MF_UNIT, Units::three_mf);
     let mtl_name = mtl.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
     let mut bytes = 0u64;

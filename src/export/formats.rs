@@ -101,7 +101,19 @@ impl Format {
 
     /// Writes `export` in this format. OBJ's `mtl` names the MTL file its `mtllib` line
     /// points to (written by [`mtl`]).
+    /// First it asks the system for the writer's [`Format::working_bytes`]: refused, it
+    /// is an error before a byte is written, not an allocation abort halfway.
     pub fn write(self, export: &Export, units: &str, mtl: &str, w: &mut dyn Write) -> io::Result<()> {
+        let working = self.working_bytes(export);
+        if !crate::mesh::system_gives(working) {
+            return Err(io::Error::new(
+                io::ErrorKind::OutOfMemory,
+                format!(
+                    "the system would not give the {} writing it needs beside the meshes (see `ulimit -v`)",
+                    crate::diag::bytes(working)
+                ),
+            ));
+        }
         match self {
             Format::Stl => stl_binary(export, w),
             Format::StlAscii => stl_ascii(export, w),

@@ -155,14 +155,6 @@ const CONFIRM_FROM: u64 = 64 << 20;
 /// The default memory limit for meshes: 4 GiB, room on a laptop and on the test machine.
 pub const DEFAULT_MEMORY_LIMIT: u64 = 4 << 30;
 
-/// Whether the system would give `bytes` more now: address space only is taken (no page
-/// is touched) and given back, so an allocation this size that follows at once is not
-/// an abort but for what runs beside it.
-pub fn system_gives(bytes: u64) -> bool {
-    let Ok(bytes) = usize::try_from(bytes) else { return false };
-    Vec::<u8>::new().try_reserve_exact(bytes).is_ok()
-}
-
 /// What the scene's meshes may still use: triangles, and bytes at the estimate above.
 #[derive(Clone, Copy, Debug)]
 pub struct Budget {
@@ -202,7 +194,7 @@ impl Budget {
     pub fn confirm(&mut self) -> Result<(), Diagnostic> {
         let planned = std::mem::take(&mut self.unconfirmed);
         let Some((_, span)) = self.largest.take() else { return Ok(()) };
-        if system_gives(planned) {
+        if super::system_gives(planned) {
             return Ok(());
         }
         Err(Diagnostic::error(

@@ -387,6 +387,14 @@ impl MeshObject {
     }
 }
 
+/// Whether the system would give `bytes` more now: address space only is taken (no page
+/// is touched) and given back, so an allocation this size that follows at once is not
+/// an abort but for what runs beside it.
+pub fn system_gives(bytes: u64) -> bool {
+    let Ok(bytes) = usize::try_from(bytes) else { return false };
+    Vec::<u8>::new().try_reserve_exact(bytes).is_ok()
+}
+
 /// A bounding sphere of a set of points (centre of the box, farthest point).
 pub fn points_sphere(points: &[Vec3A]) -> Option<(Vec3A, f32)> {
     let b = points.iter().fold(Aabb::EMPTY, |b, p| b.union(Aabb { min: *p, max: *p }));
