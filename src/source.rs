@@ -196,3 +196,9 @@ fn floor_char_boundary(s: &str, mut i: usize) -> usize {
     }
     i
 }
+
+/// `name` with every character but ASCII letters, digits, `_`, `-` and `.` made `_`: a
+/// name any file format, XML attribute, OBJ line or download header takes as it is.
+pub fn file_safe(name: &str) -> String {
+    name.chars().map(|c| if c.is_ascii_alphanumeric() || "_-.".contains(c) { c } else { '_' }).collect()
+}

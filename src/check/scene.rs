@@ -202,10 +202,7 @@ fn base_name(e: &ast::Expr) -> String {
             });
             // Names are written into OBJ lines and XML attributes: a file name keeps
             // only the characters every format takes as they are.
-            file.map(|f| {
-                f.chars().map(|c| if c.is_ascii_alphanumeric() || "_-.".contains(c) { c } else { '_' }).collect()
-            })
-            .unwrap_or_else(|| generator.name.clone())
+            file.map_or_else(|| generator.name.clone(), crate::source::file_safe)
         }
         _ => "object".to_string(),
     }

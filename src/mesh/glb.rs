@@ -5,7 +5,7 @@
 
 use glam::{DMat4, DVec3};
 
-use super::obj::{MAX_COORDINATE, MAX_ELEMENTS};
+use super::obj::MAX_ELEMENTS;
 use crate::geom::{axes, TriMesh};
 
 /// Parses a `.glb` file's bytes into scnc's space; an error says what is wrong.
@@ -55,8 +55,8 @@ fn add(mesh: &mut TriMesh, p: &gltf::Primitive, world: DMat4, blob: Option<&[u8]
     let base = mesh.positions.len() as u32;
     for q in positions {
         let q = world.transform_point3(DVec3::from(q.map(f64::from)));
-        if !q.is_finite() || q.abs().max_element() > MAX_COORDINATE {
-            return Err(format!("a vertex is beyond the renderable range (±{MAX_COORDINATE:e})"));
+        if let Some(why) = super::obj::unrenderable(q) {
+            return Err(format!("a vertex {why}"));
         }
         mesh.positions.push(axes::from_file(q, axes::Up::Y));
     }

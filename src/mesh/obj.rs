@@ -29,6 +29,13 @@ pub const MAX_ELEMENTS: usize = 50_000_000;
 /// (docs/limits.md), so a mesh file places nothing a scene could not.
 pub const MAX_COORDINATE: f64 = 1e15;
 
+/// Why a mesh file's vertex `p` cannot be placed, if it cannot: not finite, or beyond
+/// [`MAX_COORDINATE`] (every reader's one check).
+pub fn unrenderable(p: DVec3) -> Option<String> {
+    (!p.is_finite() || p.abs().max_element() > MAX_COORDINATE)
+        .then(|| format!("is beyond the renderable range (±{MAX_COORDINATE:e})"))
+}
+
 /// The logical lines of an OBJ file, numbered from 1: lines end at `\n`, `\r\n` or a lone
 /// `\r` (old Mac exporters), a line ending in `\` continues on the next (its number is
 /// the first's), and a comment runs from `#` to the end of its line whatever bytes it

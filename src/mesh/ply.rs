@@ -8,7 +8,7 @@
 
 use glam::DVec3;
 
-use super::obj::{MAX_COORDINATE, MAX_ELEMENTS};
+use super::obj::MAX_ELEMENTS;
 use crate::geom::polygon::triangulate;
 use crate::geom::{axes, TriMesh};
 
@@ -232,8 +232,8 @@ fn read(elements: &[Element], values: &mut dyn Values) -> Result<TriMesh, String
             }
             if xyz.is_some() {
                 let p = DVec3::from(p);
-                if !p.is_finite() || p.abs().max_element() > MAX_COORDINATE {
-                    return Err(format!("vertex {} is beyond the renderable range (±{MAX_COORDINATE:e})", i + 1));
+                if let Some(why) = super::obj::unrenderable(p) {
+                    return Err(format!("vertex {} {why}", i + 1));
                 }
                 file_positions.push(p);
             }

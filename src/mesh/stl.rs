@@ -20,8 +20,8 @@ pub fn parse(bytes: &[u8]) -> Result<TriMesh, String> {
         if !p.is_finite() {
             return Err(format!("vertex {} is not finite", i + 1));
         }
-        if p.abs().max_element() > super::obj::MAX_COORDINATE {
-            return Err(format!("vertex {} is beyond the renderable range (±{:e})", i + 1, super::obj::MAX_COORDINATE));
+        if let Some(why) = super::obj::unrenderable(p) {
+            return Err(format!("vertex {} {why}", i + 1));
         }
         mesh.positions.push(axes::from_file(p, axes::Up::Z));
     }

@@ -183,8 +183,7 @@ pub(crate) fn export(studio: &Studio, text: String, format: &str) -> Reply {
         return Reply::text(500, &format!("cannot write the {ext}: {e}"));
     }
     let stem = studio.files.root.file_stem().map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
-    let stem: String =
-        stem.chars().map(|c| if c.is_ascii_alphanumeric() || "-_.".contains(c) { c } else { '_' }).collect();
+    let stem = scnc::source::file_safe(&stem);
     Reply::download(mime, format!("{stem}.{ext}"), bytes)
 }
 
