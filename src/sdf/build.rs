@@ -174,7 +174,7 @@ impl<'a> Builder<'a> {
                 match part_bounds(&children[1..], xf) {
                     Some(bounds) => {
                         let (first, cutters) = (kids[0].clone(), kids[1..].to_vec());
-                        self.pruned_subtract(first, cutters, bounds)
+                        self.pruned_subtract(first, cutters, bounds, 0.0)
                     }
                     None => self.combine(kids, CsgOp::Subtract),
                 }
@@ -278,10 +278,21 @@ impl<'a> Builder<'a> {
         let id = DAffine3::IDENTITY;
         match &shape.kind {
             ShapeKind::Csg { op, children, smooth } => {
-                let kids: Vec<(Sdf, SurfSdf)> = children.iter().map(|c| self.build(c, id, mat)).collect();
-                match (op, part_bounds(children, id)) {
-                    (CsgOp::Union, Some(bounds)) => self.pruned_union(shape, kids, bounds, *smooth as f32),
-                    _ => self.smooth(kids, *op, *smooth as f32),
+                let mut kids: Vec<(Sdf, SurfSdf)> = children.iter().map(|c| self.build(c, id, mat)).collect();
+                let k = *smooth as f32;
+                match op {
+                    CsgOp::Union => match part_bounds(children, id) {
+                        Some(bounds) => self.pruned_union(shape, kids, bounds, k),
+                        None => self.smooth(kids, *op, k),
+                    },
+                    CsgOp::Subtract => match part_bounds(&children[1..], id) {
+                        Some(bounds) if kids.len() > 1 => {
+                            let cutters = kids.split_off(1);
+                            self.pruned_subtract(kids.remove(0), cutters, bounds, k)
+                        }
+                        _ => self.smooth(kids, *op, k),
+                    },
+                    CsgOp::Intersect => self.smooth(kids, *op, k),
                 }
             }
             ShapeKind::Round { child, radius } => {
@@ -429,21 +440,33 @@ impl<'a> Builder<'a> {
         (d, m)
     }
 
-    /// `subtract(a, cutters…)` with many bounded cutters, walked through a hierarchy of
-    /// their bounds: a cutter removes material only where its value is below minus the
-    /// result so far, so where `p` is outside a node by at least that much (and outside
-    /// it at all), nothing in it can change the result. Exact, cutters clamped to their
-    /// bounds as a union's parts are.
+    /// `subtract(a, cutters…)` with bounded cutters, walked through a hierarchy of their
+    /// bounds. Sharp (`k` = 0): a cutter removes material only where its value is below
+    /// minus the result so far, so where `p` is outside a node by at least that much (and
+    /// outside it at all), nothing in it can change the result. Smooth: the cutters are
+    /// folded nearest first onto the first shape turned inside out (see
+    /// [`union::smooth_cut`]), and one `k` or more above the running value blends by
+    /// nothing. Exact, cutters clamped to their bounds as a union's parts are.
     fn pruned_subtract(
         &mut self,
         (first, first_mat): (Sdf, SurfSdf),
         cutters: Vec<(Sdf, SurfSdf)>,
         bounds: PartBounds,
+        k: f32,
     ) -> (Sdf, SurfSdf) {
         let tree = Arc::new(PartTree::new(bounds.boxes, bounds.spheres, self.prune));
         let (cs, ms): (Vec<Sdf>, Vec<SurfSdf>) = cutters.into_iter().unzip();
         self.bytes += (cs.len() + 1) * 2 * std::mem::size_of::<Sdf>() + tree.bytes();
         let t = tree.clone();
+        if k > 0.0 {
+            let d = self.sdf(move |p| {
+                let mut fold = Fold::cut(-first(p), k);
+                t.visit(p, fold.threshold(), |i, bound| fold.push(union::clamp(cs[i](p), bound)));
+                -fold.finish()
+            });
+            let m = self.mat(move |p| tree.cut_surface(first_mat(p), &ms, k, p));
+            return (d, m);
+        }
         let d = self.sdf(move |p| {
             let mut acc = first(p);
             t.visit(p, -acc, |i, bound| {
@@ -486,9 +509,13 @@ impl<'a> Builder<'a> {
                     let first = vals.next().unwrap_or(f32::INFINITY);
                     -vals.fold(-first, |a, b| prim::smin(a, -b, k))
                 }
+                // Nearest first too, as with bounded cutters (see `pruned_subtract`).
                 CsgOp::Subtract => {
-                    let first = vals.next().unwrap_or(f32::INFINITY);
-                    -vals.fold(-first, |a, b| prim::smin(a, b, k))
+                    let mut fold = Fold::cut(-vals.next().unwrap_or(f32::INFINITY), k);
+                    vals.for_each(|v| {
+                        fold.push(v);
+                    });
+                    -fold.finish()
                 }
             }
         };
@@ -499,7 +526,7 @@ impl<'a> Builder<'a> {
             match op {
                 CsgOp::Union => union::smooth_surf(std::iter::once(first).chain(rest), k),
                 CsgOp::Intersect => rest.fold(first.complement(), |a, b| a.smin(b.complement(), k)).complement(),
-                CsgOp::Subtract => rest.fold(first.complement(), |a, b| a.smin(b, k)).complement(),
+                CsgOp::Subtract => union::smooth_cut(first, rest.collect(), k),
             }
         });
         (d, m)

@@ -125,6 +125,23 @@ impl PartTree {
         smooth_surf(near.iter().map(|&(_, s)| s), k)
     }
 
+    /// A smooth subtraction's field at `p` (blend radius `k` > 0) from its first shape's
+    /// field `first` there and its cutters' surface closures `surfs`: only the cutters
+    /// that can blend in are evaluated (see [`smooth_cut`]).
+    pub fn cut_surface(&self, first: Surf, surfs: &[super::SurfSdf], k: f32, p: Vec3A) -> Surf {
+        let mut near: Vec<(u32, Surf)> = Vec::with_capacity(8);
+        let mut best = -first.d;
+        self.visit(p, best + k, |i, _| {
+            let s = self.clamped(i, surfs[i](p), p);
+            best = best.min(s.d);
+            near.push((i as u32, s));
+            best + k
+        });
+        // In the order the cutters were written, so the first of equal values wins.
+        near.sort_unstable_by_key(|&(i, _)| i);
+        smooth_cut(first, near.into_iter().map(|(_, s)| s).collect(), k)
+    }
+
     /// Walks the parts nearest first, calling `part(i, bound)` (see [`bound`](Self::bound))
     /// for each part not skipped. `part` returns the threshold from then on: a node is
     /// skipped when `p` is outside it by at least the threshold (`start` at first), and
@@ -147,12 +164,15 @@ impl PartTree {
 /// The smooth minimum of `values` folded nearest first with blend radius `k`; a value
 /// `k` or more above the running result blends by exactly nothing, and so does every
 /// value after it.
-fn smooth_fold(values: &mut [f32], k: f32) -> f32 {
+/// When `start` is given, the fold begins there (a subtraction's first shape, turned
+/// inside out) and takes every value after it.
+fn smooth_fold(start: Option<f32>, values: &mut [f32], k: f32) -> f32 {
     values.sort_unstable_by(f32::total_cmp);
-    let Some((&first, rest)) = values.split_first() else {
-        return f32::INFINITY;
+    let (mut acc, rest) = match (start, values.split_first()) {
+        (Some(a), _) => (a, &values[..]),
+        (None, Some((&first, rest))) => (first, rest),
+        (None, None) => return f32::INFINITY,
     };
-    let mut acc = first;
     for &v in rest {
         if v - acc >= k {
             break;
@@ -173,14 +193,29 @@ pub(crate) fn smooth_surf(parts: impl Iterator<Item = Surf>, k: f32) -> Surf {
     let Some((&first, rest)) = all.split_first() else {
         return NOTHING;
     };
-    let mut acc = first;
-    for &s in rest {
+    Surf { mat: lowest.mat, ..fold_sorted(first, rest, k) }
+}
+
+/// A smooth subtraction's field: the complement of the smooth minimum of `start` (its
+/// first shape turned inside out) and its cutters' `cuts` folded nearest first, so that
+/// it does not depend on the order the cutters were written in, and a cutter `k` or
+/// more above the running value (with every one after it) blends by nothing, which is
+/// what lets [`PartTree::visit`] skip it. The cut faces take the cutter's material.
+pub(crate) fn smooth_cut(start: Surf, mut cuts: Vec<Surf>, k: f32) -> Surf {
+    cuts.sort_by(|a, b| a.d.total_cmp(&b.d));
+    fold_sorted(start.complement(), &cuts, k).complement()
+}
+
+/// `acc` folded with `sorted` (in increasing order of value) until one is `k` or more
+/// above it.
+fn fold_sorted(mut acc: Surf, sorted: &[Surf], k: f32) -> Surf {
+    for &s in sorted {
         if s.d - acc.d >= k {
             break;
         }
         acc = acc.smin(s, k);
     }
-    Surf { mat: lowest.mat, ..acc }
+    acc
 }
 
 /// A union's value, gathered part by part: the minimum for a sharp union (`k = 0`), the
@@ -188,6 +223,8 @@ pub(crate) fn smooth_surf(parts: impl Iterator<Item = Surf>, k: f32) -> Surf {
 /// [`INLINE`], then on the heap.
 pub(crate) struct Fold {
     k: f32,
+    /// Where a subtraction's fold begins (see [`Fold::cut`]).
+    start: Option<f32>,
     best: f32,
     inline: [f32; INLINE],
     len: usize,
@@ -198,7 +235,21 @@ impl Fold {
     /// Nothing gathered yet, blend radius `k`.
     #[inline]
     pub fn new(k: f32) -> Fold {
-        Fold { k, best: f32::INFINITY, inline: [0.0; INLINE], len: 0, spill: Vec::new() }
+        Fold { k, start: None, best: f32::INFINITY, inline: [0.0; INLINE], len: 0, spill: Vec::new() }
+    }
+
+    /// A smooth subtraction's fold (`k` > 0): it begins at `start`, minus its first
+    /// shape's value, and gathers its cutters' values; the subtraction's value is minus
+    /// what [`finish`](Self::finish) gives (see [`smooth_cut`]).
+    #[inline]
+    pub fn cut(start: f32, k: f32) -> Fold {
+        Fold { start: Some(start), best: start, ..Fold::new(k) }
+    }
+
+    /// The threshold of [`PartTree::visit`] before any part is pushed.
+    #[inline]
+    pub fn threshold(&self) -> f32 {
+        self.best + self.k
     }
 
     /// Adds a part's value; returns the threshold of [`PartTree::visit`] from then on
@@ -223,10 +274,10 @@ impl Fold {
             return self.best;
         }
         if self.spill.is_empty() {
-            return smooth_fold(&mut self.inline[..self.len], self.k);
+            return smooth_fold(self.start, &mut self.inline[..self.len], self.k);
         }
         self.spill.extend_from_slice(&self.inline[..self.len]);
-        smooth_fold(&mut self.spill, self.k)
+        smooth_fold(self.start, &mut self.spill, self.k)
     }
 }
 

@@ -76,7 +76,7 @@ static REST: &[Builtin] = &[
         Ty::Shape,
         CsgArgs::PARAMS,
         Ty::Shape,
-        "the first shape minus all the others",
+        "the first shape minus all the others (smooth: the cutters blend nearest first, in any order written)",
     ),
     f(
         "round",

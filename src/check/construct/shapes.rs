@@ -107,21 +107,33 @@ impl Ctx<'_> {
             a.rest.iter().filter_map(|(v, _)| if let Value::Shape(s) = v { Some(s.clone()) } else { None }).collect();
         if op == CsgOp::Intersect || smooth > 0.0 {
             if let Some(crowd) = crowded(&children, smooth) {
+                let why = "an `intersect`, or a smooth `union` or `subtract`, cannot skip a part that reaches the \
+                           point";
+                let hint = "combine fewer parts, spread them apart, or use a sharp `union` (pruned by a hierarchy)";
+                let (name, label) = (b.name, "every step of a ray there evaluates all of them");
                 self.report(
-                    Diagnostic::warning(
-                        codes::CROWDED_CSG,
-                        a.call,
-                        format!("{crowd} parts of this `{}` overlap one place", b.name),
-                        "every step of a ray there evaluates all of them",
-                    )
-                    .with_note(format!(
-                        "an `intersect`, or a smooth `union` or `subtract`, cannot skip a part that reaches the \
-                         point; {crowd} distances a step make a large image take minutes"
-                    ))
-                    .with_hint(
-                        "combine fewer parts, spread them apart, or use a sharp `union` (pruned by a hierarchy)",
-                    ),
+                    if crowd > MAX_CROWD {
+                        Diagnostic::error(
+                            codes::TOO_LARGE,
+                            a.call,
+                            format!("{crowd} parts of this `{name}` overlap one place"),
+                            label,
+                        )
+                        .with_note(format!("{why}; at most {MAX_CROWD} parts may overlap one place"))
+                    } else {
+                        Diagnostic::warning(
+                            codes::CROWDED_CSG,
+                            a.call,
+                            format!("{crowd} parts of this `{name}` overlap one place"),
+                            label,
+                        )
+                        .with_note(format!("{why}; {crowd} distances a step make a large image take minutes"))
+                    }
+                    .with_hint(hint),
                 );
+                if crowd > MAX_CROWD {
+                    return None;
+                }
             }
         }
         Some(ShapeKind::Csg { op, children, smooth })
@@ -148,8 +160,13 @@ impl Ctx<'_> {
     }
 }
 
-/// Parts of a combination from which [`crowded`] warns.
-pub const CROWDED_PARTS: usize = 10_000;
+/// Parts of a combination overlapping one place from which [`crowded`] warns.
+pub const CROWDED_PARTS: usize = 1_000;
+
+/// The most parts of a combination that may overlap one place: each is evaluated at
+/// every step there (10,000 coincident spheres in a smooth union render at 64×64 in
+/// 0.27 s, 100,000 in 5.7 s: `scnc render`, see docs/limits.md).
+pub const MAX_CROWD: usize = 10_000;
 
 /// The most parts whose boxes (grown by the blend `smooth`) hold one point, sampled at up
 /// to 64 parts' centres, when it is at least [`CROWDED_PARTS`]; an unbounded part holds
