@@ -74,10 +74,11 @@ fn bad_parts_are_refused_and_nothing_is_written() {
     let whole = part("whole.png", &SIZE);
     let out = dir.path().join("out.png");
     for (parts, message) in [
-        (vec![&a, &a, &b], "both cover pixel (0, 0)"),
-        (vec![&a], "pixels are in no part, the first at (0, 30)"),
-        (vec![&a, &small], "parts of one image have its size"),
-        (vec![&whole], "is not a part"),
+        // The part an overlap is with is found again among the earlier ones.
+        (vec![&b, &a, &a], format!("`{a}` and `{a}` both cover pixel (0, 0)")),
+        (vec![&a], "pixels are in no part, the first at (0, 30)".into()),
+        (vec![&a, &small], "parts of one image have its size".into()),
+        (vec![&whole], "is not a part".into()),
     ] {
         let mut args = vec!["merge"];
         args.extend(parts.iter().map(|p| p.as_str()));
@@ -85,7 +86,7 @@ fn bad_parts_are_refused_and_nothing_is_written() {
         let run = scnc(&args);
         let err = String::from_utf8_lossy(&run.stderr);
         assert_eq!(run.status.code(), Some(1), "{err}");
-        assert!(err.contains(message), "expected `{message}` in: {err}");
+        assert!(err.contains(&message), "expected `{message}` in: {err}");
         assert!(!out.exists(), "a failed merge wrote {}", out.display());
     }
     for (flag, value, message) in [
@@ -136,4 +137,48 @@ fn sixteen_bit_renders_and_parts() {
     refused(&scnc(&["merge", &parts[0], path(&eight), "-o", path(&mixed)]), 1, "bits per channel");
     assert!(!mixed.exists());
     refused(&scnc(&["render", scene, "-o", path(&dir.path().join("x.png")), "--bit-depth", "12"]), 2, "8 or 16");
+}
+
+/// The largest 16-bit image `render` writes (8200×8200, within its 100-million-pixel
+/// limit) merges from two parts under a 1 GB address-space cap: the parts are read a
+/// row at a time into the image (403 MB as RGB), where reading each whole (538 MB as
+/// RGBA, then copied) needed 1.75 GB. The parts are written here, row by row, as
+/// `render --tile` writes them: the top band opaque in one, the rest in the other.
+#[cfg(unix)]
+#[test]
+fn the_largest_sixteen_bit_parts_merge_in_bounded_memory() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let side = 8200usize;
+    for (name, band) in [("top.png", 0..3000), ("bottom.png", 3000..side)] {
+        let file = std::io::BufWriter::new(std::fs::File::create(dir.path().join(name)).expect("a part"));
+        let mut encoder = png::Encoder::new(file, side as u32, side as u32);
+        encoder.set_color(png::ColorType::Rgba);
+        encoder.set_depth(png::BitDepth::Sixteen);
+        encoder.set_compression(png::Compression::Fastest);
+        let mut writer = encoder.write_header().expect("header");
+        let mut stream = writer.stream_writer().expect("stream");
+        let (opaque, clear) = ([0x12u8, 0x34, 0x56, 0x78, 0x9a, 0xbc, 0xff, 0xff].repeat(side), vec![0u8; side * 8]);
+        for y in 0..side {
+            std::io::Write::write_all(&mut stream, if band.contains(&y) { &opaque } else { &clear }).expect("a row");
+        }
+        stream.finish().expect("the part");
+    }
+    let run = crate::support::scnc_capped(1_000_000, dir.path(), &["merge", "top.png", "bottom.png", "-o", "all.png"]);
+    ok(&run);
+    let mut reader =
+        png::Decoder::new(std::io::BufReader::new(std::fs::File::open(dir.path().join("all.png")).expect("merged")))
+            .read_info()
+            .expect("a PNG");
+    let info = reader.info();
+    assert_eq!(
+        (info.width, info.height, info.color_type, info.bit_depth),
+        (8200, 8200, png::ColorType::Rgb, png::BitDepth::Sixteen)
+    );
+    let expected = [0x12u8, 0x34, 0x56, 0x78, 0x9a, 0xbc].repeat(side);
+    let mut rows = 0;
+    while let Some(row) = reader.next_row().expect("a row") {
+        assert!(row.data() == expected.as_slice(), "row {rows} differs");
+        rows += 1;
+    }
+    assert_eq!(rows, side);
 }
