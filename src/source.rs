@@ -20,14 +20,50 @@ pub trait Loader {
     fn read_bytes(&self, path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
         read_regular_file(path, limit)
     }
+
+    /// A data file at `path` opened to be read a buffer at a time (a large mesh need not
+    /// be held whole), failing once it passes `limit` bytes; from the disk unless a loader
+    /// serves its own.
+    fn open_bytes(&self, path: &Path, limit: u64) -> std::io::Result<Box<dyn std::io::BufRead + '_>> {
+        Ok(Box::new(std::io::BufReader::with_capacity(1 << 16, open_regular_file(path, limit)?)))
+    }
 }
 
-/// Reads a regular file of at most `limit` bytes, checking the limit while reading (a
-/// file may grow after it was measured). A directory, device, pipe or socket is refused
-/// before it is opened: `/dev/zero` would never end and opening a pipe blocks until a
-/// writer comes.
-pub fn read_regular_file(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
-    use std::io::Read as _;
+/// A regular file opened for reading, which fails once more than its limit is read.
+pub struct Limited {
+    file: std::fs::File,
+    /// Bytes that may still be read.
+    left: u64,
+    /// The limit, for the error.
+    limit: u64,
+}
+
+impl std::io::Read for Limited {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.file.read(buf)?;
+        self.left = self.left.checked_sub(n as u64).ok_or_else(|| too_large(self.limit))?;
+        Ok(n)
+    }
+}
+
+fn too_large(limit: u64) -> std::io::Error {
+    std::io::Error::other(format!("it is larger than the {} limit", size_name(limit)))
+}
+
+/// Opens a regular file of at most `limit` bytes, checked as [`read_regular_file`] checks
+/// it, and again while it is read.
+pub fn open_regular_file(path: &Path, limit: u64) -> std::io::Result<Limited> {
+    let meta = regular(path)?;
+    if meta.len() > limit {
+        return Err(too_large(limit));
+    }
+    Ok(Limited { file: std::fs::File::open(path)?, left: limit, limit })
+}
+
+/// The metadata of `path` if it is a regular file: a directory, device, pipe or socket is
+/// refused before it is opened (`/dev/zero` would never end and opening a pipe blocks
+/// until a writer comes).
+fn regular(path: &Path) -> std::io::Result<std::fs::Metadata> {
     let meta = std::fs::metadata(path)?;
     if meta.is_dir() {
         return Err(std::io::Error::other("it is a directory"));
@@ -35,15 +71,23 @@ pub fn read_regular_file(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
     if !meta.is_file() {
         return Err(std::io::Error::other("it is not a regular file (a device, pipe or socket)"));
     }
-    let too_large = || std::io::Error::other(format!("it is larger than the {} limit", size_name(limit)));
+    Ok(meta)
+}
+
+/// Reads a regular file of at most `limit` bytes, checking the limit while reading (a
+/// file may grow after it was measured). A directory, device, pipe or socket is refused
+/// before it is opened.
+pub fn read_regular_file(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
+    use std::io::Read as _;
+    let meta = regular(path)?;
     if meta.len() > limit {
-        return Err(too_large());
+        return Err(too_large(limit));
     }
     let mut bytes = Vec::new();
     bytes.try_reserve_exact(meta.len() as usize).map_err(|_| std::io::Error::other("not enough memory to read it"))?;
     std::fs::File::open(path)?.take(limit + 1).read_to_end(&mut bytes)?;
     if bytes.len() as u64 > limit {
-        return Err(too_large());
+        return Err(too_large(limit));
     }
     Ok(bytes)
 }

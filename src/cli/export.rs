@@ -8,12 +8,12 @@ use std::time::Instant;
 
 use clap::ValueEnum;
 
+use super::progress::Reading;
 use scnc::diag::codes;
 use scnc::export::formats::{self, Format};
 use scnc::export::report::MeshReport;
 use scnc::export::{Frame, Up};
 use scnc::mesh::Detail;
-use scnc::source::FsLoader;
 use scnc::study::tolerance::Tolerance;
 
 use super::files::{cannot_write, check_output_as, overwritten_input, write_atomic};
@@ -237,7 +237,7 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
     let frame = Frame { up, scale: args.scale.unwrap_or(format.default_scale()) };
     let skip = args.skip_unbounded || format.for_printing();
     let collect =
-        |detail| pool.install(|| scnc::export::collect(scene, detail, frame, args.memory_limit, skip, &FsLoader));
+        |detail| pool.install(|| scnc::export::collect(scene, detail, frame, args.memory_limit, skip, &Reading));
     let mut result = collect(detail);
     // A tolerance promises a mesh good enough to use: where an isosurface is pinched or
     // lost volume (a part thinner than the cell), refine, a few times at most.

@@ -3,10 +3,17 @@
 //! even while no step finishes (one large mesh can take many seconds), and only when
 //! stderr is a terminal.
 
-use std::io::IsTerminal;
+use std::io::{BufRead, IsTerminal, Read};
+use std::path::Path;
+
+use scnc::source::{FsLoader, Loader};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
+use std::sync::{Arc, LazyLock};
 use std::time::Duration;
+
+/// Every bar shown, drawn together (a mesh file read while objects are lowered has a bar
+/// of its own under the lowering one).
+static SHOWN: LazyLock<indicatif::MultiProgress> = LazyLock::new(indicatif::MultiProgress::new);
 
 /// How long work runs before its bar appears.
 const QUIET: Duration = Duration::from_secs(1);
@@ -31,7 +38,7 @@ impl Progress {
             std::thread::spawn(move || {
                 std::thread::sleep(QUIET);
                 if !done.load(Ordering::Acquire) {
-                    shown.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+                    SHOWN.add(shown.clone());
                     shown.enable_steady_tick(Duration::from_millis(120));
                 }
             });
@@ -42,8 +49,13 @@ impl Progress {
 
     /// One step done.
     pub(crate) fn step(&self) {
+        self.steps(1);
+    }
+
+    /// `n` steps done.
+    pub(crate) fn steps(&self, n: u64) {
         if let Some(bar) = &self.bar {
-            bar.inc(1);
+            bar.inc(n);
         }
     }
 
@@ -52,7 +64,46 @@ impl Progress {
         self.done.store(true, Ordering::Release);
         if let Some(bar) = &self.bar {
             bar.finish_and_clear();
+            SHOWN.remove(bar);
         }
+    }
+}
+
+/// Reads files from the file system as [`FsLoader`] does, with a bar for a data file
+/// (a mesh) that takes more than a second to read.
+pub(crate) struct Reading;
+
+impl Loader for Reading {
+    fn read(&self, path: &Path) -> std::io::Result<String> {
+        FsLoader.read(path)
+    }
+
+    fn open_bytes(&self, path: &Path, limit: u64) -> std::io::Result<Box<dyn BufRead + '_>> {
+        let file = scnc::source::open_regular_file(path, limit)?;
+        let len = std::fs::metadata(path)?.len();
+        let name = path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned());
+        let progress = Progress::new(len.div_ceil(MIB), "MiB", &format!("reading {name}"));
+        Ok(Box::new(std::io::BufReader::with_capacity(1 << 16, Counted { file, progress, read: 0 })))
+    }
+}
+
+const MIB: u64 = 1 << 20;
+
+/// A file whose reading moves a bar a mebibyte at a time.
+struct Counted<R> {
+    file: R,
+    progress: Progress,
+    /// Bytes read so far.
+    read: u64,
+}
+
+impl<R: Read> Read for Counted<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.file.read(buf)?;
+        let before = self.read / MIB;
+        self.read += n as u64;
+        self.progress.steps(self.read / MIB - before);
+        Ok(n)
     }
 }
 

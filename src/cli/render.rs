@@ -18,7 +18,7 @@ use scnc::render::{BitDepth, Region};
 
 use super::files::{cannot_write, check_output, stop_on_interrupt, write_part_png, write_png, FPS_KEY};
 use super::frames::{frame_path, is_pattern, parse_frames, FrameChoice};
-use super::progress::Progress;
+use super::progress::{Progress, Reading};
 use super::{compile, report, usage_error, worker_pool, MessageFormat};
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -432,7 +432,7 @@ fn render_scene(
     let building = Progress::new(scnc::world::lowering_steps(&scene), "steps", "lowering");
     let lowered = pool.install(|| {
         let cache = &mut sequence.cache;
-        scnc::world::prepare_reusing(&scene, effects, mode, &FsLoader, args.memory_limit, cache, &|| building.step())
+        scnc::world::prepare_reusing(&scene, effects, mode, &Reading, args.memory_limit, cache, &|| building.step())
     });
     building.finish();
     let (mut frame, geometry) = match lowered {

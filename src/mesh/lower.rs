@@ -302,7 +302,7 @@ pub fn explicit(
             return Ok(job);
         }
         MeshSource::File { path, written } => {
-            let bytes = loader.read_bytes(path, crate::source::MAX_MESH_FILE_BYTES).map_err(|e| {
+            let cannot = |e: std::io::Error| {
                 Diagnostic::error(
                     codes::LOWERING,
                     m.span,
@@ -310,7 +310,7 @@ pub fn explicit(
                     crate::source::io_reason(&e),
                 )
                 .with_note(format!("looked for {}", path.display()))
-            })?;
+            };
             let bad = |place: String, message: String| {
                 Diagnostic::error(
                     codes::LOWERING,
@@ -322,12 +322,15 @@ pub fn explicit(
                     "scnc reads OBJ files (`v x y z` and `f a b c …` records), STL (`.stl`, binary or ASCII, z up, millimetres), PLY (`.ply`) and binary glTF (`.glb`)",
                 )
             };
+            let limit = crate::source::MAX_MESH_FILE_BYTES;
             let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+            let whole = || loader.read_bytes(path, limit).map_err(cannot);
             match ext.as_deref() {
-                Some("stl") => super::stl::parse(&bytes).map_err(|e| bad(written.clone(), e))?,
-                Some("ply") => super::ply::parse(&bytes).map_err(|e| bad(written.clone(), e))?,
-                Some("glb") => super::glb::parse(&bytes).map_err(|e| bad(written.clone(), e))?,
-                _ => obj::parse(&bytes).map_err(|e| {
+                Some("stl") => super::stl::parse(&whole()?).map_err(|e| bad(written.clone(), e))?,
+                Some("ply") => super::ply::parse(&whole()?).map_err(|e| bad(written.clone(), e))?,
+                Some("glb") => super::glb::parse(&whole()?).map_err(|e| bad(written.clone(), e))?,
+                // OBJ, the format of large scans, is read a buffer at a time.
+                _ => obj::read(loader.open_bytes(path, limit).map_err(cannot)?).map_err(|e| {
                     let place = if e.line > 0 { format!("{written}:{}", e.line) } else { written.clone() };
                     bad(place, e.message)
                 })?,

@@ -36,63 +36,130 @@ pub fn unrenderable(p: DVec3) -> Option<String> {
         .then(|| format!("is beyond the renderable range (±{MAX_COORDINATE:e})"))
 }
 
-/// The logical lines of an OBJ file, numbered from 1: lines end at `\n`, `\r\n` or a lone
-/// `\r` (old Mac exporters), a line ending in `\` continues on the next (its number is
-/// the first's), and a comment runs from `#` to the end of its line whatever bytes it
-/// holds (Latin-1 in a comment is common).
-fn logical_lines(bytes: &[u8]) -> impl Iterator<Item = (usize, String)> + '_ {
-    let mut physical = bytes
-        .split(|&b| b == b'\n')
-        .flat_map(|l| {
-            let l = l.strip_suffix(b"\r").unwrap_or(l);
-            l.split(|&b| b == b'\r')
-        })
-        .enumerate()
-        .map(|(n, l)| (n + 1, l));
-    std::iter::from_fn(move || {
-        let (first, line) = physical.next()?;
-        let mut joined: Vec<u8> = Vec::new();
+/// The physical lines of an OBJ file read from `r` a buffer at a time: a line ends at
+/// `\n`, `\r\n` or a lone `\r` (old Mac exporters), so memory holds one line, not the
+/// file.
+struct Physical<R> {
+    r: R,
+    /// The line being read (its end not included).
+    line: Vec<u8>,
+    /// The last line ended at a `\r`: a `\n` right after it ends nothing.
+    after_cr: bool,
+}
+
+impl<R: std::io::BufRead> Physical<R> {
+    /// The next line, `None` at the end of the file.
+    fn next(&mut self) -> std::io::Result<Option<&[u8]>> {
+        self.line.clear();
+        let mut any = false;
+        loop {
+            let buf = self.r.fill_buf()?;
+            if buf.is_empty() {
+                return Ok(any.then_some(&self.line[..]));
+            }
+            if std::mem::take(&mut self.after_cr) && buf[0] == b'\n' {
+                self.r.consume(1);
+                continue;
+            }
+            any = true;
+            match buf.iter().position(|&b| b == b'\n' || b == b'\r') {
+                Some(i) => {
+                    self.line.extend_from_slice(&buf[..i]);
+                    self.after_cr = buf[i] == b'\r';
+                    self.r.consume(i + 1);
+                    return Ok(Some(&self.line[..]));
+                }
+                None => {
+                    let n = buf.len();
+                    self.line.extend_from_slice(buf);
+                    self.r.consume(n);
+                }
+            }
+        }
+    }
+}
+
+/// The logical lines of an OBJ file, numbered from 1: a line ending in `\` continues on
+/// the next (its number is the first's), and a comment runs from `#` to the end of its
+/// line whatever bytes it holds (Latin-1 in a comment is common).
+struct Logical<R> {
+    physical: Physical<R>,
+    /// Physical lines read so far.
+    number: usize,
+    /// The logical line: its records without comments, continuations joined by a space.
+    joined: Vec<u8>,
+}
+
+impl<R: std::io::BufRead> Logical<R> {
+    fn new(r: R) -> Logical<R> {
+        Logical { physical: Physical { r, line: Vec::new(), after_cr: false }, number: 0, joined: Vec::new() }
+    }
+
+    /// The next logical line and its number, `None` at the end of the file.
+    fn next(&mut self) -> Result<Option<(usize, &[u8])>, ObjError> {
+        let io = |e: std::io::Error| err(0, format!("cannot read it: {}", crate::source::io_reason(&e)));
+        self.joined.clear();
+        let Some(line) = self.physical.next().map_err(io)? else { return Ok(None) };
+        self.number += 1;
+        let first = self.number;
         let mut line = line;
         loop {
             let content = line.split(|&b| b == b'#').next().unwrap_or(&[]);
-            let trimmed = content.trim_ascii_end();
-            match trimmed.strip_suffix(b"\\") {
+            match content.trim_ascii_end().strip_suffix(b"\\") {
                 Some(head) if content.len() == line.len() => {
-                    joined.extend_from_slice(head);
-                    joined.push(b' ');
-                    match physical.next() {
-                        Some((_, next)) => line = next,
+                    self.joined.extend_from_slice(head);
+                    self.joined.push(b' ');
+                    match self.physical.next().map_err(io)? {
+                        Some(next) => {
+                            self.number += 1;
+                            line = next;
+                        }
                         None => break,
                     }
                 }
                 _ => {
-                    joined.extend_from_slice(content);
+                    self.joined.extend_from_slice(content);
                     break;
                 }
             }
         }
-        Some((first, String::from_utf8_lossy(&joined).into_owned()))
-    })
+        Ok(Some((first, &self.joined[..])))
+    }
 }
 
-/// Parses an OBJ file's bytes into scnc's space: the file's right-handed, y-up frame
-/// mapped as export maps it ([`crate::geom::axes`]), so an exported model reads back where
-/// it was, unmirrored.
+/// A word of a record as text (a replacement character if it is not UTF-8, which no
+/// number or index is, so it is refused as one).
+fn text(word: &[u8]) -> &str {
+    std::str::from_utf8(word).unwrap_or("\u{fffd}")
+}
+
+/// Parses an OBJ file's bytes into scnc's space (see [`read`]).
 pub fn parse(bytes: &[u8]) -> Result<TriMesh, ObjError> {
-    // Some exporters start the file with a byte-order mark; it would hide the first `v`.
-    let bytes = bytes.strip_prefix("\u{feff}".as_bytes()).unwrap_or(bytes);
+    read(bytes)
+}
+
+/// Reads an OBJ file into scnc's space a line at a time: the file's right-handed, y-up
+/// frame mapped as export maps it ([`crate::geom::axes`]), so an exported model reads back
+/// where it was, unmirrored. A face is triangulated as it is read when its vertices are
+/// there already (as they are in files exporters write); one naming vertices further on
+/// waits for the end.
+pub fn read(r: impl std::io::BufRead) -> Result<TriMesh, ObjError> {
+    let mut lines = Logical::new(r);
     let mut mesh = TriMesh::default();
-    let mut faces: Vec<(usize, Vec<i64>)> = Vec::new();
-    for (line, content) in logical_lines(bytes) {
-        let mut words = content.split_whitespace();
+    // Faces naming vertices not yet read: (line, indices from 1).
+    let mut later: Vec<(usize, Vec<i64>)> = Vec::new();
+    let mut idx: Vec<i64> = Vec::new();
+    let mut faces = 0usize;
+    while let Some((line, content)) = lines.next()? {
+        // Some exporters start the file with a byte-order mark; it would hide the first `v`.
+        let content = if line == 1 { content.strip_prefix("\u{feff}".as_bytes()).unwrap_or(content) } else { content };
+        let mut words = content.split(u8::is_ascii_whitespace).filter(|w| !w.is_empty());
         match words.next() {
-            Some("v") => {
-                let coords: Vec<&str> = words.collect();
-                if coords.len() < 3 {
-                    return Err(err(line, format!("a vertex needs 3 coordinates, found {}", coords.len())));
-                }
+            Some(b"v") => {
                 let mut p = [0.0; 3];
-                for (k, w) in coords.iter().take(3).enumerate() {
+                let mut found = 0;
+                for w in words.by_ref().take(3) {
+                    let w = text(w);
                     let x: f64 = w.parse().map_err(|_| err(line, format!("`{w}` is not a number")))?;
                     if !x.is_finite() {
                         return Err(err(line, format!("vertex coordinate `{w}` is not finite")));
@@ -103,15 +170,21 @@ pub fn parse(bytes: &[u8]) -> Result<TriMesh, ObjError> {
                             format!("vertex coordinate `{w}` is beyond the renderable range (±{MAX_COORDINATE:e})"),
                         ));
                     }
-                    p[k] = x;
+                    p[found] = x;
+                    found += 1;
+                }
+                if found < 3 {
+                    return Err(err(line, format!("a vertex needs 3 coordinates, found {found}")));
                 }
                 mesh.positions.push(axes::from_file(DVec3::from(p), axes::Up::Y));
             }
-            Some("f") => {
-                let mut idx = Vec::new();
+            Some(b"f") => {
+                idx.clear();
                 for w in words {
-                    let first = w.split('/').next().unwrap_or("");
-                    let i: i64 = first.parse().map_err(|_| err(line, format!("`{w}` is not a vertex index")))?;
+                    let first = w.split(|&b| b == b'/').next().unwrap_or(&[]);
+                    let i: i64 = text(first)
+                        .parse()
+                        .map_err(|_| err(line, format!("`{}` is not a vertex index", String::from_utf8_lossy(w))))?;
                     if i == 0 {
                         return Err(err(line, "vertex indices start at 1; 0 is not valid"));
                     }
@@ -121,32 +194,46 @@ pub fn parse(bytes: &[u8]) -> Result<TriMesh, ObjError> {
                 if idx.len() < 3 {
                     return Err(err(line, format!("a face needs at least 3 vertices, found {}", idx.len())));
                 }
-                faces.push((line, idx));
+                faces += 1;
+                if idx.iter().all(|&i| i >= 1 && i <= mesh.positions.len() as i64) {
+                    add_face(&mut mesh, &idx);
+                } else {
+                    later.push((line, idx.clone()));
+                }
             }
             _ => {}
         }
-        if mesh.positions.len() > MAX_ELEMENTS || faces.len() > MAX_ELEMENTS {
+        if mesh.positions.len() > MAX_ELEMENTS || faces > MAX_ELEMENTS {
             return Err(err(line, format!("more than {MAX_ELEMENTS} vertices or faces")));
         }
     }
     let count = mesh.positions.len() as i64;
-    for (line, idx) in faces {
-        for &i in &idx {
-            if i < 1 || i > count {
-                return Err(err(line, format!("vertex index {i} is out of range: the file has {count} vertices")));
-            }
+    for (line, idx) in later {
+        if let Some(i) = idx.iter().find(|&&i| i < 1 || i > count) {
+            return Err(err(line, format!("vertex index {i} is out of range: the file has {count} vertices")));
         }
-        let v: Vec<u32> = idx.iter().map(|&i| (i - 1) as u32).collect();
-        for [a, b, c] in triangulate(&v, &mesh.positions) {
-            // The mapping from the file is a reflection: reversed, a face stays wound
-            // as the file winds it, seen from the same side.
-            mesh.triangles.push(if axes::REVERSES_WINDING { [a, c, b] } else { [a, b, c] });
-        }
+        add_face(&mut mesh, &idx);
     }
     if mesh.triangles.is_empty() {
         return Err(err(0, "the file has no faces"));
     }
     Ok(mesh)
+}
+
+/// Adds the triangles of a face whose indices (from 1) are all in range.
+fn add_face(mesh: &mut TriMesh, idx: &[i64]) {
+    // The mapping from the file is a reflection: reversed, a face stays wound as the file
+    // winds it, seen from the same side.
+    let push = |mesh: &mut TriMesh, [a, b, c]: [u32; 3]| {
+        mesh.triangles.push(if axes::REVERSES_WINDING { [a, c, b] } else { [a, b, c] })
+    };
+    if let [a, b, c] = idx[..] {
+        return push(mesh, [a, b, c].map(|i| (i - 1) as u32));
+    }
+    let v: Vec<u32> = idx.iter().map(|&i| (i - 1) as u32).collect();
+    for t in triangulate(&v, &mesh.positions) {
+        push(mesh, t);
+    }
 }
 
 #[cfg(test)]
@@ -185,6 +272,30 @@ mod tests {
         assert_eq!(latin1.triangles.len(), 1);
         // A continued line keeps the number of its first line in errors.
         assert_eq!(parse(b"v 0 0 0\nv 1 \\\n x 0\n").unwrap_err().line, 2);
+    }
+
+    /// Read a few bytes at a time, so that every line end, `\r\n` pair and continuation
+    /// falls across the reader's buffers somewhere, a file reads as it does whole.
+    #[test]
+    fn lines_split_across_buffers_read_as_whole() {
+        let files: [&[u8]; 4] = [
+            b"v 0 0 0\rv 1 0 0\r\nv 0 1 0\n\rf 1 2 3\r",
+            b"# caf\xe9\r\nv 0 0 0\nv 1 \\\r\n 0 0\nv 0 1 0 # x\r\nf 1 \\\r2 3",
+            b"v 0 0 0\nv 2 0 0\nv 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\nf 1 2 3 4 5 6\n",
+            b"f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\n",
+        ];
+        for bytes in files {
+            let whole = parse(bytes).expect("valid");
+            for capacity in 1..8 {
+                let mesh = read(std::io::BufReader::with_capacity(capacity, bytes)).expect("valid");
+                assert_eq!((&mesh.positions, &mesh.triangles), (&whole.positions, &whole.triangles), "{capacity}");
+            }
+        }
+        // Line numbers count `\r\n` once, split or not.
+        let bad = b"v 0 0 0\r\nv 1 0 0\r\nv x 0 0\r\n";
+        for capacity in 1..8 {
+            assert_eq!(read(std::io::BufReader::with_capacity(capacity, &bad[..])).unwrap_err().line, 3);
+        }
     }
 
     /// An L-shaped plate: ear clipping keeps the notch open (a fan from the first corner

@@ -186,4 +186,9 @@ impl Loader for Below<'_> {
         self.inside(path)?;
         FsLoader.read_bytes(path, limit)
     }
+
+    fn open_bytes(&self, path: &Path, limit: u64) -> std::io::Result<Box<dyn std::io::BufRead + '_>> {
+        self.inside(path)?;
+        FsLoader.open_bytes(path, limit)
+    }
 }
