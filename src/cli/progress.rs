@@ -69,8 +69,8 @@ impl Progress {
     }
 }
 
-/// Reads files from the file system as [`FsLoader`] does, with a bar for a data file
-/// (a mesh) that takes more than a second to read.
+/// Reads files from the file system as [`FsLoader`] does (the same checks and limits),
+/// with a bar for a data file (a mesh) that takes more than a second to read.
 pub(crate) struct Reading;
 
 impl Loader for Reading {
@@ -78,12 +78,28 @@ impl Loader for Reading {
         FsLoader.read(path)
     }
 
+    fn read_bytes(&self, path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
+        let (mut file, len) = Reading::counted(path, limit)?;
+        let mut bytes = Vec::new();
+        bytes.try_reserve_exact(len as usize).map_err(|_| std::io::Error::other("not enough memory to read it"))?;
+        file.read_to_end(&mut bytes)?;
+        Ok(bytes)
+    }
+
     fn open_bytes(&self, path: &Path, limit: u64) -> std::io::Result<Box<dyn BufRead + '_>> {
+        Ok(Box::new(std::io::BufReader::with_capacity(1 << 16, Reading::counted(path, limit)?.0)))
+    }
+}
+
+impl Reading {
+    /// `path` opened as [`scnc::source::open_regular_file`] opens it, with a bar, and its
+    /// length.
+    fn counted(path: &Path, limit: u64) -> std::io::Result<(Counted<scnc::source::Limited>, u64)> {
         let file = scnc::source::open_regular_file(path, limit)?;
         let len = std::fs::metadata(path)?.len();
         let name = path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned());
         let progress = Progress::new(len.div_ceil(MIB), "MiB", &format!("reading {name}"));
-        Ok(Box::new(std::io::BufReader::with_capacity(1 << 16, Counted { file, progress, read: 0 })))
+        Ok((Counted { file, progress, read: 0 }, len))
     }
 }
 
