@@ -319,7 +319,7 @@ pub fn explicit(
                     format!("{place}: {message}"),
                 )
                 .with_note(
-                    "scnc reads OBJ files (`v x y z` and `f a b c …` records), STL (`.stl`, binary or ASCII, z up, millimetres), PLY (`.ply`) and binary glTF (`.glb`)",
+                    "scnc reads OBJ files (`v x y z` and `f a b c …` records), STL (`.stl`, binary or ASCII, z up, millimetres), PLY (`.ply`), binary glTF (`.glb`) and 3MF (`.3mf`, z up, in its declared unit)",
                 )
             };
             let limit = crate::source::MAX_MESH_FILE_BYTES;
@@ -329,6 +329,7 @@ pub fn explicit(
                 Some("stl") => super::stl::parse(&whole()?).map_err(|e| bad(written.clone(), e))?,
                 Some("ply") => super::ply::parse(&whole()?).map_err(|e| bad(written.clone(), e))?,
                 Some("glb") => super::glb::parse(&whole()?).map_err(|e| bad(written.clone(), e))?,
+                Some("3mf") => super::threemf::parse(&whole()?).map_err(|e| bad(written.clone(), e))?,
                 // OBJ, the format of large scans, is read a buffer at a time.
                 _ => obj::read(loader.open_bytes(path, limit).map_err(cannot)?).map_err(|e| {
                     let place = if e.line > 0 { format!("{written}:{}", e.line) } else { written.clone() };

@@ -19,6 +19,7 @@ pub mod parts;
 pub mod ply;
 mod qef;
 pub mod stl;
+pub mod threemf;
 pub mod triangle;
 pub mod unfold;
 

@@ -390,9 +390,10 @@ fn a_tolerance_export_refines_a_sheet_thinner_than_its_cell() {
     assert!(err.contains("watertight and manifold"), "{err}");
 }
 
-/// A model exported to OBJ, STL, PLY or glb and read back with `mesh file(…)` lands where it was, not
-/// mirrored: an asymmetric arrangement of boxes (which tell left from right, and front
-/// from back) renders the same, pixel for pixel, as the scene itself as meshes.
+/// A model exported to OBJ, STL, PLY, glb or 3MF and read back with `mesh file(…)` lands
+/// where it was, not mirrored: an asymmetric arrangement of boxes (which tell left from
+/// right, and front from back) renders the same, pixel for pixel, as the scene itself as
+/// meshes. A 3MF declared in millimetres (numbers ten times larger) reads back at its size too.
 #[test]
 fn an_exported_mesh_file_reads_back_where_it_was() {
     let dir = tempfile::tempdir().expect("temp dir");
@@ -419,17 +420,26 @@ fn an_exported_mesh_file_reads_back_where_it_was() {
         image::open(&png).expect("a PNG").to_rgb8()
     };
     let meshed = render(&scene, "meshed.png", &["--geometry", "mesh"]);
-    // OBJ, PLY and glb are y up, STL z up and in millimetres (as export writes them);
-    // every one reads back unmirrored, at its size.
-    for format in ["obj", "stl", "ply", "glb"] {
-        let file = dir.path().join(format!("l.{format}"));
-        let run = scnc(&["export", scene.to_str().expect("utf-8"), "-o", file.to_str().expect("utf-8")]);
+    // OBJ, PLY and glb are y up, STL z up and in millimetres, 3MF z up in its declared
+    // unit (as export writes them); every one reads back unmirrored, at its size.
+    for (name, extra) in [
+        ("l.obj", &[][..]),
+        ("l.stl", &[]),
+        ("l.ply", &[]),
+        ("l.glb", &[]),
+        ("l.3mf", &[]),
+        ("mm.3mf", &["--units", "mm", "--scale", "10"]),
+    ] {
+        let file = dir.path().join(name);
+        let mut args = vec!["export", scene.to_str().expect("utf-8"), "-o", file.to_str().expect("utf-8")];
+        args.extend_from_slice(extra);
+        let run = scnc(&args);
         assert_eq!(run.status.code(), Some(0), "{}", String::from_utf8_lossy(&run.stderr));
-        let back = dir.path().join(format!("back-{format}.scn"));
-        std::fs::write(&back, format!("{common}object mesh file(\"l.{format}\") with m\n")).expect("writing");
-        let read_back = render(&back, &format!("back-{format}.png"), &[]);
+        let back = dir.path().join(format!("back-{name}.scn"));
+        std::fs::write(&back, format!("{common}object mesh file(\"{name}\") with m\n")).expect("writing");
+        let read_back = render(&back, &format!("back-{name}.png"), &[]);
         let off = meshed.pixels().zip(read_back.pixels()).filter(|(a, b)| a != b).count();
-        assert_eq!(off, 0, "{off} pixels differ between the scene as meshes and its {format} read back");
+        assert_eq!(off, 0, "{off} pixels differ between the scene as meshes and its {name} read back");
     }
     let background = meshed.pixels().filter(|p| **p == meshed[(0, 0)]).count();
     assert!(background < 96 * 96 * 9 / 10, "the boxes fill a tenth of the view");
