@@ -162,6 +162,7 @@ pub fn extract_within(f: &(dyn Fn(Vec3A) -> f32 + Sync), grid: &Grid, max_cells:
         .collect();
     mesh.triangles = quads.into_iter().flatten().collect();
     let crossing_pairs = super::unfold::unfold(&mut mesh, &mass, grid.cell);
+    super::pinch::split(&mut mesh, grid.cell);
     Ok(Surface { mesh, pinched, crossing_pairs })
 }
 

@@ -16,6 +16,7 @@ pub mod lower;
 pub mod obj;
 pub mod octree;
 pub mod parts;
+pub mod pinch;
 pub mod ply;
 mod qef;
 pub mod stl;

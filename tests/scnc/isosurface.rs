@@ -218,3 +218,17 @@ fn isosurfaces_at_sharp_corners_have_no_crossing_triangles() {
     assert!(mesh.triangles.len() > 4000, "{}", mesh.triangles.len());
     assert_eq!(scnc::mesh::unfold::crossing_pairs(&mesh, 0.05), []);
 }
+
+/// A gyroid sheet meshed at a cell wider than the sheet is thick (0.099 against a wall
+/// about 0.05 thick): where two fans of triangles met at one vertex (12 vertices before
+/// `mesh::pinch`), each fan has its own, and the mesh stays closed.
+#[test]
+fn thin_sheets_mesh_without_pinched_vertices() {
+    let gyroid = "field(p => max(abs(sin(450 * p.x) * cos(450 * p.y) + sin(450 * p.y) * cos(450 * p.z) \
+                  + sin(450 * p.z) * cos(450 * p.x)) - 0.3, length(p) - 1.6), bounds = [[-1.6, -1.6, -1.6], [1.6, 1.6, 1.6]])";
+    for cell in [0.099, 0.04] {
+        let mesh = meshed(gyroid, cell).1.expect("a mesh");
+        assert_eq!(scnc::mesh::pinch::pinched(&mesh).len(), 0, "cell {cell}");
+        assert_eq!(mesh.open_edges(), (0, 0), "cell {cell}");
+    }
+}
