@@ -79,6 +79,80 @@ pub fn prism(corners: &[DVec2], half_height: f64) -> TriMesh {
     m
 }
 
+/// Whether `corners` (`[radius, height]`) revolve into a closed, manifold lathe: none at
+/// a negative radius, and those on the axis (at most two) next to each other, so the
+/// surface meets the axis in one point or along one edge.
+pub fn lathe_ok(corners: &[DVec2]) -> bool {
+    let n = corners.len();
+    let axis: Vec<usize> = (0..n).filter(|&i| corners[i].x == 0.0).collect();
+    corners.iter().all(|c| c.x >= 0.0)
+        && match axis[..] {
+            [] | [_] => true,
+            [a, b] => b == a + 1 || (a == 0 && b == n - 1),
+            _ => false,
+        }
+}
+
+/// The polygon `corners` (`[radius, height]`, see [`lathe_ok`]) revolved about `y` in
+/// `segments` steps, every vertex on the surface of revolution: closed and outward for
+/// either winding. A corner on the axis is one vertex; an edge along the axis makes no
+/// triangles.
+pub fn lathe(corners: &[DVec2], segments: u32) -> TriMesh {
+    let n = corners.len();
+    let mut m = TriMesh::default();
+    let mut first = Vec::with_capacity(n);
+    for c in corners {
+        first.push(m.positions.len() as u32);
+        if c.x == 0.0 {
+            m.positions.push(DVec3::new(0.0, c.y, 0.0));
+        } else {
+            m.positions.extend((0..segments).map(|j| {
+                let a = std::f64::consts::TAU * f64::from(j) / f64::from(segments);
+                DVec3::new(c.x * a.cos(), c.y, c.x * a.sin())
+            }));
+        }
+    }
+    let at = |i: usize, j: u32| if corners[i].x == 0.0 { first[i] } else { first[i] + j % segments };
+    for i in 0..n {
+        let k = (i + 1) % n;
+        for j in 0..segments {
+            let (a, b, c, d) = (at(i, j), at(k, j), at(k, j + 1), at(i, j + 1));
+            // Next to the axis a quad is one triangle: the other has two corners in one.
+            for t in [[a, b, c], [a, c, d]] {
+                if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
+                    m.triangles.push(t);
+                }
+            }
+        }
+    }
+    // Built for one winding of the outline; the other comes out inside out.
+    if m.signed_volume() < 0.0 {
+        m.triangles.iter_mut().for_each(|t| t.swap(1, 2));
+    }
+    m
+}
+
+/// Corner normals for a [`lathe`]: each triangle's facet normal split into its
+/// meridian's radial and `y` parts and turned to each corner's angle, so the surface
+/// shades smooth around the axis and keeps the profile's creases.
+pub fn lathe_normals(m: &TriMesh) -> Vec<[DVec3; 3]> {
+    let angle = |p: DVec3| p.z.atan2(p.x);
+    m.triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| m.positions[i as usize]);
+            let n = (b - a).cross(c - a).normalize_or_zero();
+            let mid = angle(a + b + c);
+            let radial = n.x * mid.cos() + n.z * mid.sin();
+            [a, b, c].map(|p| {
+                // A corner on the axis has no angle of its own: the facet's.
+                let at = if p.x == 0.0 && p.z == 0.0 { mid } else { angle(p) };
+                DVec3::new(radial * at.cos(), n.y, radial * at.sin()).normalize_or(n)
+            })
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -92,5 +166,38 @@ mod tests {
             assert!((m.signed_volume() - 3.0).abs() < 1e-12, "{}", m.signed_volume());
             assert_eq!(m.triangles.len(), 2 * 4 + 2 * 6);
         }
+    }
+
+    /// A tube (a rectangle off the axis) and a cone (a triangle with an edge on the axis)
+    /// revolved: closed, outward for either winding, and holding the volume of the
+    /// inscribed polygonal solid exactly (`n/2 · sin(2π/n)` of the circle's area).
+    #[test]
+    fn lathes_are_closed_outward_and_inscribed() {
+        let n = 48u32;
+        let inscribed = f64::from(n) / 2.0 * (std::f64::consts::TAU / f64::from(n)).sin();
+        let tube = [[1.0, -0.5], [2.0, -0.5], [2.0, 0.5], [1.0, 0.5]].map(DVec2::from);
+        let cone = [[0.0, 0.0], [1.0, 0.0], [0.0, 2.0]].map(DVec2::from);
+        for (corners, volume) in [(&tube[..], inscribed * 3.0), (&cone[..], inscribed * 2.0 / 3.0)] {
+            assert!(lathe_ok(corners));
+            for corners in [corners.to_vec(), corners.iter().rev().copied().collect()] {
+                let m = lathe(&corners, n);
+                assert_eq!(m.open_edges(), (0, 0));
+                // Each corner's normal points out of its facet's side and has no part
+                // along the circle.
+                for (t, normals) in m.triangles.iter().zip(lathe_normals(&m)) {
+                    let [a, b, c] = t.map(|i| m.positions[i as usize]);
+                    let facet = (b - a).cross(c - a).normalize();
+                    for (p, n) in [a, b, c].into_iter().zip(normals) {
+                        assert!(n.dot(facet) > 0.9 && (n.length() - 1.0).abs() < 1e-12);
+                        let tangent = DVec3::new(-p.z, 0.0, p.x);
+                        assert!(n.dot(tangent).abs() < 1e-9 * tangent.length().max(1.0));
+                    }
+                }
+                assert!((m.signed_volume() - volume).abs() < 1e-9, "{} against {volume}", m.signed_volume());
+            }
+        }
+        // Across the axis, or touching it at two corners apart: not a lathe.
+        assert!(!lathe_ok(&[[-1.0, 0.0], [1.0, 0.0], [0.0, 1.0]].map(DVec2::from)));
+        assert!(!lathe_ok(&[[0.0, 0.0], [1.0, 1.0], [0.0, 2.0], [2.0, 1.0]].map(DVec2::from)));
     }
 }

@@ -289,6 +289,17 @@ impl CsgOp {
     }
 }
 
+/// A mesh a sweep knows for its zero set, better than the isosurface mesher's.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ExactMesh {
+    /// Flat faces that are exactly the zero set (an extruded polygon's prism).
+    Faces(Arc<crate::geom::TriMesh>),
+    /// A polygon of corners `[radius, height]` (none at a negative radius, those on the
+    /// axis next to each other) revolved about `y`: tessellated at lowering with as many
+    /// segments as a circle has at the detail, every vertex on the surface.
+    Lathe(Arc<Vec<glam::DVec2>>),
+}
+
 /// Shape nodes: a primitive leaf, a CSG operator, a modifier, a transform or a material.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ShapeKind {
@@ -348,9 +359,10 @@ pub enum ShapeKind {
         bounds: Option<Aabb>,
         /// The bound of the body's slope it is marched with.
         lipschitz: Lipschitz,
-        /// A mesh that is exactly its zero set, when the builder knows one (an extruded
-        /// polygon's prism): the mesh back-end uses it instead of the isosurface mesher.
-        exact: Option<Arc<crate::geom::TriMesh>>,
+        /// A mesh of its zero set, when the builder knows one (an extruded polygon's
+        /// prism, a revolved polygon's lathe): the mesh back-end uses it instead of the
+        /// isosurface mesher.
+        exact: Option<ExactMesh>,
     },
     /// `warp(shape, p => q)`: the shape seen at `q(p)`, cut to `bounds` when given.
     Warp {

@@ -10,7 +10,7 @@ use super::{isosurface, obj, Detail, MeshJob, Normals};
 use crate::diag::{codes, Diagnostic};
 use crate::geom::tessellate::count;
 use crate::geom::{tessellate, TriMesh};
-use crate::ir::{self, MeshSource, Shape, ShapeKind};
+use crate::ir::{self, ExactMesh, MeshSource, Shape, ShapeKind};
 use crate::primitive::{Facets, Tessellation};
 use crate::source::Loader;
 use crate::span::Span;
@@ -50,9 +50,16 @@ pub fn tessellate(
     }
     let made = match &node.kind {
         ShapeKind::Primitive(p) => p.tessellate(detail.resolution()),
-        ShapeKind::Field { exact: Some(mesh), .. } => {
+        ShapeKind::Field { exact: Some(ExactMesh::Faces(mesh)), .. } => {
             let mesh = mesh.clone();
             Tessellation::Triangles(mesh.triangles.len() as u64, Box::new(move || (*mesh).clone()))
+        }
+        ShapeKind::Field { exact: Some(ExactMesh::Lathe(corners)), .. } => {
+            // As many segments as a circle has at this detail; two triangles a segment
+            // per edge, at most.
+            let (corners, n) = (corners.clone(), detail.circle());
+            let triangles = 2 * corners.len() as u64 * u64::from(n);
+            Tessellation::Triangles(triangles, Box::new(move || crate::geom::polygon::lathe(&corners, n)))
         }
         ShapeKind::Csg { .. }
         | ShapeKind::Round { .. }
@@ -74,6 +81,9 @@ pub fn tessellate(
             let normals = match &node.kind {
                 ShapeKind::Primitive(p) if matches!(p.facets(), Facets::Inscribed(_)) => {
                     Normals::Corners(p.corner_normals(&mesh))
+                }
+                ShapeKind::Field { exact: Some(ExactMesh::Lathe(_)), .. } => {
+                    Normals::Corners(crate::geom::polygon::lathe_normals(&mesh))
                 }
                 _ => Normals::Flat,
             };

@@ -24,7 +24,7 @@
 //!   through it), at least its own diameter: `tests/data/ladder/sphere.scn`, a glass
 //!   sphere over a floor, is then within 1.5 % of the SDF sphere's pixels at `pixel`.
 
-use crate::ir::{self, Facets, Geometry, Scene, Shape, ShapeKind};
+use crate::ir::{self, ExactMesh, Facets, Geometry, Scene, Shape, ShapeKind};
 use crate::mesh::Detail;
 
 /// A geometric error bound.
@@ -107,7 +107,11 @@ fn curvature_radius(shape: &Shape, scale: f64) -> (f64, Option<f64>) {
         }
         ShapeKind::Paint { child, .. } => curvature_radius(child, scale),
         // An extruded polygon's prism: its own flat faces.
-        ShapeKind::Field { exact: Some(_), .. } => (0.0, None),
+        ShapeKind::Field { exact: Some(ExactMesh::Faces(_)), .. } => (0.0, None),
+        // A lathe is inscribed in circles of up to its widest corner's radius.
+        ShapeKind::Field { exact: Some(ExactMesh::Lathe(corners)), .. } => {
+            (corners.iter().fold(0.0f64, |r, c| r.max(c.x)) * scale, None)
+        }
         ShapeKind::Csg { .. }
         | ShapeKind::Round { .. }
         | ShapeKind::Shell { .. }

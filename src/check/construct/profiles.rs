@@ -18,7 +18,7 @@ use crate::check::{Ctx, Value};
 use crate::diag::{codes, Diagnostic};
 use crate::geom::Aabb;
 use crate::ir::field::{Binary, Expr, Kind, Ty, Unary};
-use crate::ir::{CsgOp, Lipschitz, ShapeKind};
+use crate::ir::{CsgOp, ExactMesh, Lipschitz, ShapeKind};
 use crate::sig::Range;
 use crate::span::Span;
 use crate::syntax::ast::TransformOp;
@@ -352,7 +352,10 @@ impl Ctx<'_> {
                     min: DVec3::new(profile.min.x, -h, profile.min.y),
                     max: DVec3::new(profile.max.x, h, profile.max.y),
                 };
-                let mesh = profile.outline.as_ref().map(|corners| Arc::new(crate::geom::polygon::prism(corners, h)));
+                let mesh = profile
+                    .outline
+                    .as_ref()
+                    .map(|corners| ExactMesh::Faces(Arc::new(crate::geom::polygon::prism(corners, h))));
                 Some(ShapeKind::Field { body: corner(&d2, &dy), bounds: Some(bounds), lipschitz: exact, exact: mesh })
             }
             ProfileFn::Revolve => {
@@ -378,7 +381,10 @@ impl Ctx<'_> {
                 let body = profile.body.substitute(&vec2(radius, y));
                 let r = profile.max.x;
                 let bounds = Aabb { min: DVec3::new(-r, profile.min.y, -r), max: DVec3::new(r, profile.max.y, r) };
-                Some(ShapeKind::Field { body, bounds: Some(bounds), lipschitz: exact, exact: None })
+                // A polygon wholly at u ≥ 0 is tessellated as a lathe; anything else (a
+                // circle, a profile cut by the axis) by the isosurface mesher.
+                let lathe = profile.outline.clone().filter(|o| crate::geom::polygon::lathe_ok(o)).map(ExactMesh::Lathe);
+                Some(ShapeKind::Field { body, bounds: Some(bounds), lipschitz: exact, exact: lathe })
             }
             ProfileFn::Csg(_)
             | ProfileFn::Circle
