@@ -127,7 +127,7 @@ impl PartTree {
 
     /// A smooth subtraction's field at `p` (blend radius `k` > 0) from its first shape's
     /// field `first` there and its cutters' surface closures `surfs`: only the cutters
-    /// that can blend in are evaluated (see [`smooth_cut`]).
+    /// that can blend in are evaluated (folded as `smooth_cut` folds them).
     pub fn cut_surface(&self, first: Surf, surfs: &[super::SurfSdf], k: f32, p: Vec3A) -> Surf {
         let mut near: Vec<(u32, Surf)> = Vec::with_capacity(8);
         let mut best = -first.d;
