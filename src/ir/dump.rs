@@ -116,7 +116,7 @@ impl Dumper<'_> {
                 self.line(indent, &format!("field{}{}", Self::bounds(bounds), Self::lipschitz(lipschitz)), span);
                 self.body(indent + 1, body);
             }
-            ShapeKind::Warp { child, map, bounds, lipschitz } => {
+            ShapeKind::Warp { child, map, bounds, lipschitz, .. } => {
                 self.line(indent, &format!("warp{}{}", Self::bounds(bounds), Self::lipschitz(lipschitz)), span);
                 self.body(indent + 1, map);
                 self.shape(indent + 1, child);

@@ -374,6 +374,9 @@ pub enum ShapeKind {
         bounds: Option<Aabb>,
         /// The bound of how much the map stretches a distance.
         lipschitz: Lipschitz,
+        /// For `twist`: its degrees per unit about `y`, with which the mesher twists the
+        /// child's own mesh instead of meshing the isosurface.
+        twist: Option<f64>,
     },
     /// `displace(shape, p => d)`: the shape's distance plus `d(p)`.
     Displace {

@@ -50,17 +50,8 @@ pub fn tessellate(
     }
     let made = match &node.kind {
         ShapeKind::Primitive(p) => p.tessellate(detail.resolution()),
-        ShapeKind::Field { exact: Some(ExactMesh::Faces(mesh)), .. } => {
-            let mesh = mesh.clone();
-            Tessellation::Triangles(mesh.triangles.len() as u64, Box::new(move || (*mesh).clone()))
-        }
-        ShapeKind::Field { exact: Some(ExactMesh::Lathe(corners)), .. } => {
-            // As many segments as a circle has at this detail; two triangles a segment
-            // per edge, at most.
-            let (corners, n) = (corners.clone(), detail.circle());
-            let triangles = 2 * corners.len() as u64 * u64::from(n);
-            Tessellation::Triangles(triangles, Box::new(move || crate::geom::polygon::lathe(&corners, n)))
-        }
+        ShapeKind::Field { exact: Some(exact), .. } => exact_tessellation(exact, detail),
+        ShapeKind::Warp { child, twist: Some(k), .. } => twisted(child, *k, detail),
         ShapeKind::Csg { .. }
         | ShapeKind::Round { .. }
         | ShapeKind::Shell { .. }
@@ -145,6 +136,57 @@ pub fn tessellate(
             Ok(job)
         }
     }
+}
+
+/// The mesh a sweep knows for itself, at `detail`.
+fn exact_tessellation(exact: &ExactMesh, detail: Detail) -> Tessellation {
+    match exact {
+        ExactMesh::Faces(mesh) => {
+            let mesh = mesh.clone();
+            Tessellation::Triangles(mesh.triangles.len() as u64, Box::new(move || (*mesh).clone()))
+        }
+        ExactMesh::Lathe(corners) => {
+            // As many segments as a circle has at this detail; two triangles a segment
+            // per edge, at most.
+            let (corners, n) = (corners.clone(), detail.circle());
+            let triangles = 2 * corners.len() as u64 * u64::from(n);
+            Tessellation::Triangles(triangles, Box::new(move || crate::geom::polygon::lathe(&corners, n)))
+        }
+    }
+}
+
+/// `twist(child, k)` as the child's own mesh (through its transforms) twisted, its edges
+/// split until none turns by more than a circle's step at `detail` (`mesh::twist`); the
+/// isosurface where the child has no mesh of its own. The count charged is the most the
+/// splitting can make (each round splits a triangle into four at most).
+fn twisted(child: &Shape, k: f64, detail: Detail) -> Tessellation {
+    let (mut node, mut xf) = (child, DAffine3::IDENTITY);
+    while let ShapeKind::Transform { child, xf: inner } = &node.kind {
+        xf *= *inner;
+        node = child;
+    }
+    let own = match &node.kind {
+        ShapeKind::Primitive(p) => p.tessellate(detail.resolution()),
+        ShapeKind::Field { exact: Some(exact), .. } => exact_tessellation(exact, detail),
+        _ => Tessellation::Isosurface,
+    };
+    let (Tessellation::Triangles(count, make), Some(b)) = (own, ir::shape_bounds(child)) else {
+        return Tessellation::Isosurface;
+    };
+    let step = 360.0 / f64::from(detail.circle());
+    let rounds = super::twist::rounds(b.max.y - b.min.y, k, step);
+    let most = count.saturating_mul(4u64.saturating_pow(rounds));
+    Tessellation::Triangles(
+        most,
+        Box::new(move || {
+            let mut mesh = make();
+            mesh.positions.iter_mut().for_each(|p| *p = xf.transform_point3(*p));
+            if xf.matrix3.determinant() < 0.0 {
+                mesh.triangles.iter_mut().for_each(|t| t.swap(1, 2));
+            }
+            super::twist::twisted(mesh, k, step, rounds)
+        }),
+    )
 }
 
 /// Most triangles all meshes of one scene may have together (about 2.4 GB with BVHs).

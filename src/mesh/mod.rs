@@ -22,6 +22,7 @@ mod qef;
 pub mod stl;
 pub mod threemf;
 pub mod triangle;
+pub mod twist;
 pub mod unfold;
 
 use glam::{DAffine3, DVec3, Vec3A, Vec4};

@@ -342,7 +342,7 @@ impl<'a> Builder<'a> {
                     }),
                 )
             }
-            ShapeKind::Warp { child, map, bounds, lipschitz } => {
+            ShapeKind::Warp { child, map, bounds, lipschitz, .. } => {
                 let (d, m) = self.build(child, id, mat);
                 let map = self.body(map, mat);
                 let (k, cut) = (1.0 / lipschitz.value as f32, bounds.as_ref().map(BoxCut::new));

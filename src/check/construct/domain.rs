@@ -117,7 +117,7 @@ impl Ctx<'_> {
                 let map = Expr::vector([qx, y.clone(), qz]);
                 let r = radius_about_y(&b);
                 let bounds = Aabb { min: DVec3::new(-r, b.min.y, -r), max: DVec3::new(r, b.max.y, r) };
-                self.warp(child, map, bounds, span, "this twist")
+                self.warp(child, map, bounds, span, "this twist", Some(k))
             }
             FieldFn::Bend => {
                 let BendArgs { shape: Value::Shape(child), degrees_per_unit: k } = BendArgs::from_args(a) else {
@@ -131,7 +131,7 @@ impl Ctx<'_> {
                 let map = Expr::vector([qx, qy, z.clone()]);
                 // A turn about the origin keeps the distance from it.
                 let r = b.min.abs().max(b.max.abs()).length();
-                self.warp(child, map, Aabb { min: DVec3::splat(-r), max: DVec3::splat(r) }, span, "this bend")
+                self.warp(child, map, Aabb { min: DVec3::splat(-r), max: DVec3::splat(r) }, span, "this bend", None)
             }
             FieldFn::Elongate => {
                 let ElongateArgs { shape: Value::Shape(child), by: h } = ElongateArgs::from_args(a) else {
@@ -145,7 +145,7 @@ impl Ctx<'_> {
                     bin(Binary::Sub, &c, &clamped)
                 });
                 let bounds = ir::shape_bounds(&child).map(|b| Aabb { min: b.min - h, max: b.max + h });
-                Some(ShapeKind::Warp { child, map: Expr::vector(q), bounds, lipschitz: exact })
+                Some(ShapeKind::Warp { child, map: Expr::vector(q), bounds, lipschitz: exact, twist: None })
             }
             FieldFn::Symmetric => {
                 let SymmetricArgs { shape: Value::Shape(child), axes } = SymmetricArgs::from_args(a) else {
@@ -168,7 +168,7 @@ impl Ctx<'_> {
                     }
                     Aabb { min: lo, max: hi }
                 });
-                Some(ShapeKind::Warp { child, map: Expr::vector(q), bounds, lipschitz: exact })
+                Some(ShapeKind::Warp { child, map: Expr::vector(q), bounds, lipschitz: exact, twist: None })
             }
             FieldFn::Polar => {
                 let PolarArgs { shape: Value::Shape(child), count } = PolarArgs::from_args(a) else {
@@ -211,17 +211,25 @@ impl Ctx<'_> {
                 let back = bin(Binary::Mul, &step, &Expr::num(-w));
                 let (qx, qz) = turn(&x, &z, &back);
                 let map = Expr::vector([qx, y.clone(), qz]);
-                Some(ShapeKind::Warp { child, map, bounds: Some(bounds), lipschitz: exact })
+                Some(ShapeKind::Warp { child, map, bounds: Some(bounds), lipschitz: exact, twist: None })
             }
             FieldFn::Field | FieldFn::Warp | FieldFn::Displace => None,
         }
     }
 
     /// A warp by `map` cut to `bounds`, its slope estimated there.
-    fn warp(&mut self, child: Arc<Shape>, map: Arc<Expr>, bounds: Aabb, span: Span, what: &str) -> Option<ShapeKind> {
+    fn warp(
+        &mut self,
+        child: Arc<Shape>,
+        map: Arc<Expr>,
+        bounds: Aabb,
+        span: Span,
+        what: &str,
+        twist: Option<f64>,
+    ) -> Option<ShapeKind> {
         let tape = self.field_tape(&map, span)?;
         let lipschitz = self.field_slope(&tape, Some(bounds), None, span, what)?;
-        Some(ShapeKind::Warp { child, map, bounds: Some(bounds), lipschitz })
+        Some(ShapeKind::Warp { child, map, bounds: Some(bounds), lipschitz, twist })
     }
 
     /// The shape's box, or `None` after reporting that `op` needs one.
