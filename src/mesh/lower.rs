@@ -176,6 +176,11 @@ fn twisted(child: &Shape, k: f64, detail: Detail) -> Tessellation {
     let step = 360.0 / f64::from(detail.circle());
     let rounds = super::twist::rounds(b.max.y - b.min.y, k, step);
     let most = count.saturating_mul(4u64.saturating_pow(rounds));
+    // The bound grows four times a round where the splitting mostly doubles: past a few
+    // million, leave a steep twist to the isosurface rather than refuse it.
+    if most > 1 << 22 {
+        return Tessellation::Isosurface;
+    }
     Tessellation::Triangles(
         most,
         Box::new(move || {
