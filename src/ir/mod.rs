@@ -289,6 +289,15 @@ impl CsgOp {
     }
 }
 
+/// A domain operation whose mesh is made from its child's own mesh.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MeshOp {
+    /// `twist(s, k)`: `k` degrees per unit about `y`.
+    Twist(f64),
+    /// `polar(s, count)` of a part within its sector: `count` copies turned about `y`.
+    Polar(u32),
+}
+
 /// A mesh a sweep knows for its zero set, better than the isosurface mesher's.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ExactMesh {
@@ -374,9 +383,9 @@ pub enum ShapeKind {
         bounds: Option<Aabb>,
         /// The bound of how much the map stretches a distance.
         lipschitz: Lipschitz,
-        /// For `twist`: its degrees per unit about `y`, with which the mesher twists the
-        /// child's own mesh instead of meshing the isosurface.
-        twist: Option<f64>,
+        /// What the warp is when a builtin made it and the mesher can make its mesh from
+        /// the child's own instead of meshing the isosurface.
+        mesh_op: Option<MeshOp>,
     },
     /// `displace(shape, p => d)`: the shape's distance plus `d(p)`.
     Displace {

@@ -51,7 +51,7 @@ pub fn tessellate(
     let made = match &node.kind {
         ShapeKind::Primitive(p) => p.tessellate(detail.resolution()),
         ShapeKind::Field { exact: Some(exact), .. } => exact_tessellation(exact, detail),
-        ShapeKind::Warp { child, twist: Some(k), .. } => twisted(child, *k, detail),
+        ShapeKind::Warp { child, mesh_op: Some(op), .. } => from_child(child, *op, detail),
         ShapeKind::Csg { .. }
         | ShapeKind::Round { .. }
         | ShapeKind::Shell { .. }
@@ -155,11 +155,12 @@ fn exact_tessellation(exact: &ExactMesh, detail: Detail) -> Tessellation {
     }
 }
 
-/// `twist(child, k)` as the child's own mesh (through its transforms) twisted, its edges
-/// split until none turns by more than a circle's step at `detail` (`mesh::twist`); the
-/// isosurface where the child has no mesh of its own. The count charged is the most the
+/// A domain operation's mesh made from its child's own mesh (through its transforms):
+/// `twist` splits the mesh's edges until none turns by more than a circle's step at
+/// `detail`, then twists it (`mesh::twist`); `polar` copies it about `y`. The
+/// isosurface where the child has no mesh of its own. A twist is charged the most the
 /// splitting can make (each round splits a triangle into four at most).
-fn twisted(child: &Shape, k: f64, detail: Detail) -> Tessellation {
+fn from_child(child: &Shape, op: ir::MeshOp, detail: Detail) -> Tessellation {
     let (mut node, mut xf) = (child, DAffine3::IDENTITY);
     while let ShapeKind::Transform { child, xf: inner } = &node.kind {
         xf *= *inner;
@@ -173,25 +174,31 @@ fn twisted(child: &Shape, k: f64, detail: Detail) -> Tessellation {
     let (Tessellation::Triangles(count, make), Some(b)) = (own, ir::shape_bounds(child)) else {
         return Tessellation::Isosurface;
     };
-    let step = 360.0 / f64::from(detail.circle());
-    let rounds = super::twist::rounds(b.max.y - b.min.y, k, step);
-    let most = count.saturating_mul(4u64.saturating_pow(rounds));
-    // The bound grows four times a round where the splitting mostly doubles: past a few
-    // million, leave a steep twist to the isosurface rather than refuse it.
-    if most > 1 << 22 {
-        return Tessellation::Isosurface;
-    }
-    Tessellation::Triangles(
-        most,
-        Box::new(move || {
-            let mut mesh = make();
-            mesh.positions.iter_mut().for_each(|p| *p = xf.transform_point3(*p));
-            if xf.matrix3.determinant() < 0.0 {
-                mesh.triangles.iter_mut().for_each(|t| t.swap(1, 2));
+    let placed = move || {
+        let mut mesh = make();
+        mesh.positions.iter_mut().for_each(|p| *p = xf.transform_point3(*p));
+        if xf.matrix3.determinant() < 0.0 {
+            mesh.triangles.iter_mut().for_each(|t| t.swap(1, 2));
+        }
+        mesh
+    };
+    match op {
+        ir::MeshOp::Twist(k) => {
+            let step = 360.0 / f64::from(detail.circle());
+            let rounds = super::twist::rounds(b.max.y - b.min.y, k, step);
+            let most = count.saturating_mul(4u64.saturating_pow(rounds));
+            // The bound grows four times a round where the splitting mostly doubles: past
+            // a few million, leave a steep twist to the isosurface rather than refuse it.
+            if most > 1 << 22 {
+                return Tessellation::Isosurface;
             }
-            super::twist::twisted(mesh, k, step, rounds)
-        }),
-    )
+            Tessellation::Triangles(most, Box::new(move || super::twist::twisted(placed(), k, step, rounds)))
+        }
+        ir::MeshOp::Polar(copies) => Tessellation::Triangles(
+            count.saturating_mul(u64::from(copies)),
+            Box::new(move || super::twist::copies_about_y(&placed(), copies)),
+        ),
+    }
 }
 
 /// Most triangles all meshes of one scene may have together (about 2.4 GB with BVHs).

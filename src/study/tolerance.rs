@@ -24,7 +24,7 @@
 //!   through it), at least its own diameter: `tests/data/ladder/sphere.scn`, a glass
 //!   sphere over a floor, is then within 1.5 % of the SDF sphere's pixels at `pixel`.
 
-use crate::ir::{self, ExactMesh, Facets, Geometry, Scene, Shape, ShapeKind};
+use crate::ir::{self, ExactMesh, Facets, Geometry, MeshOp, Scene, Shape, ShapeKind};
 use crate::mesh::Detail;
 
 /// A geometric error bound.
@@ -112,6 +112,20 @@ fn curvature_radius(shape: &Shape, scale: f64) -> (f64, Option<f64>) {
         ShapeKind::Field { exact: Some(ExactMesh::Lathe(corners)), .. } => {
             (corners.iter().fold(0.0f64, |r, c| r.max(c.x)) * scale, None)
         }
+        // A twist of a shape with a mesh of its own splits that mesh's edges by a
+        // circle's step (`mesh::twist`): a circle about `y` through its farthest point.
+        ShapeKind::Warp { child, mesh_op: Some(MeshOp::Twist(_)), .. } => {
+            match (curvature_radius(child, scale), ir::shape_bounds(child)) {
+                ((r, None), Some(b)) => {
+                    let x = b.min.x.abs().max(b.max.x.abs());
+                    let z = b.min.z.abs().max(b.max.z.abs());
+                    (r.max(x.hypot(z) * scale), None)
+                }
+                _ => isosurface(),
+            }
+        }
+        // Copies of a part: the part's.
+        ShapeKind::Warp { child, mesh_op: Some(MeshOp::Polar(_)), .. } => curvature_radius(child, scale),
         ShapeKind::Csg { .. }
         | ShapeKind::Round { .. }
         | ShapeKind::Shell { .. }

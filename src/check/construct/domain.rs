@@ -14,7 +14,7 @@ use crate::check::{Ctx, Value};
 use crate::diag::{codes, Diagnostic};
 use crate::geom::Aabb;
 use crate::ir::field::{Binary, Expr, Kind, Ty, Unary};
-use crate::ir::{self, Lipschitz, Shape, ShapeKind};
+use crate::ir::{self, Lipschitz, MeshOp, Shape, ShapeKind};
 use crate::sig::Range;
 use crate::span::Span;
 
@@ -117,7 +117,7 @@ impl Ctx<'_> {
                 let map = Expr::vector([qx, y.clone(), qz]);
                 let r = radius_about_y(&b);
                 let bounds = Aabb { min: DVec3::new(-r, b.min.y, -r), max: DVec3::new(r, b.max.y, r) };
-                self.warp(child, map, bounds, span, "this twist", Some(k))
+                self.warp(child, map, bounds, span, "this twist", Some(MeshOp::Twist(k)))
             }
             FieldFn::Bend => {
                 let BendArgs { shape: Value::Shape(child), degrees_per_unit: k } = BendArgs::from_args(a) else {
@@ -145,7 +145,7 @@ impl Ctx<'_> {
                     bin(Binary::Sub, &c, &clamped)
                 });
                 let bounds = ir::shape_bounds(&child).map(|b| Aabb { min: b.min - h, max: b.max + h });
-                Some(ShapeKind::Warp { child, map: Expr::vector(q), bounds, lipschitz: exact, twist: None })
+                Some(ShapeKind::Warp { child, map: Expr::vector(q), bounds, lipschitz: exact, mesh_op: None })
             }
             FieldFn::Symmetric => {
                 let SymmetricArgs { shape: Value::Shape(child), axes } = SymmetricArgs::from_args(a) else {
@@ -168,7 +168,7 @@ impl Ctx<'_> {
                     }
                     Aabb { min: lo, max: hi }
                 });
-                Some(ShapeKind::Warp { child, map: Expr::vector(q), bounds, lipschitz: exact, twist: None })
+                Some(ShapeKind::Warp { child, map: Expr::vector(q), bounds, lipschitz: exact, mesh_op: None })
             }
             FieldFn::Polar => {
                 let PolarArgs { shape: Value::Shape(child), count } = PolarArgs::from_args(a) else {
@@ -211,7 +211,9 @@ impl Ctx<'_> {
                 let back = bin(Binary::Mul, &step, &Expr::num(-w));
                 let (qx, qz) = turn(&x, &z, &back);
                 let map = Expr::vector([qx, y.clone(), qz]);
-                Some(ShapeKind::Warp { child, map, bounds: Some(bounds), lipschitz: exact, twist: None })
+                // Within its sector, a part's copies are apart: their mesh is the part's, copied.
+                let mesh_op = (!self.crosses_sector(&b, w)).then_some(MeshOp::Polar(count));
+                Some(ShapeKind::Warp { child, map, bounds: Some(bounds), lipschitz: exact, mesh_op })
             }
             FieldFn::Field | FieldFn::Warp | FieldFn::Displace => None,
         }
@@ -225,11 +227,11 @@ impl Ctx<'_> {
         bounds: Aabb,
         span: Span,
         what: &str,
-        twist: Option<f64>,
+        mesh_op: Option<MeshOp>,
     ) -> Option<ShapeKind> {
         let tape = self.field_tape(&map, span)?;
         let lipschitz = self.field_slope(&tape, Some(bounds), None, span, what)?;
-        Some(ShapeKind::Warp { child, map, bounds: Some(bounds), lipschitz, twist })
+        Some(ShapeKind::Warp { child, map, bounds: Some(bounds), lipschitz, mesh_op })
     }
 
     /// The shape's box, or `None` after reporting that `op` needs one.
