@@ -276,7 +276,7 @@ fn part(name: String, job: mesh::MeshJob, span: Span, frame: Frame) -> Part {
     let positions: Vec<DVec3> = job.mesh.positions.iter().map(|&p| frame.place(job.xf.transform_point3(p))).collect();
     // The reflection into the file's frame turns every triangle inside out; a transform
     // that mirrors (negative determinant) turns it back.
-    let flip = crate::geom::axes::REVERSES_WINDING != (job.xf.matrix3.determinant() < 0.0);
+    let mirrored = job.xf.matrix3.determinant() < 0.0;
     let (mut triangles, mut materials, mut rounded_away) = (Vec::new(), Vec::new(), 0);
     for (t, &[a, b, c]) in job.mesh.triangles.iter().enumerate() {
         // Judged on the f32 corners every format writes (a triangle with area in f64
@@ -287,7 +287,7 @@ fn part(name: String, job: mesh::MeshJob, span: Span, frame: Frame) -> Part {
             let [qa, qb, qc] = [a, b, c].map(|i| positions[i as usize]);
             rounded_away += usize::from((qb - qa).cross(qc - qa).length_squared() > 0.0);
         }
-        triangles.push(if flip { [a, c, b] } else { [a, b, c] });
+        triangles.push(crate::geom::axes::wound([a, b, c], mirrored));
         materials.push(job.per_triangle.as_ref().map_or(job.material, |m| m[t]));
     }
     let written: Vec<glam::Vec3> = positions.iter().map(|p| p.as_vec3()).collect();

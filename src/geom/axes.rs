@@ -28,6 +28,16 @@ pub const STL_PER_UNIT: f64 = 10.0;
 /// (both mappings are reflections).
 pub const REVERSES_WINDING: bool = true;
 
+/// A triangle wound for the other frame, placed by a map that mirrors (`mirrored`,
+/// a negative determinant) or not: reversed when exactly one of the two reflects.
+pub fn wound(t: [u32; 3], mirrored: bool) -> [u32; 3] {
+    if REVERSES_WINDING != mirrored {
+        [t[0], t[2], t[1]]
+    } else {
+        t
+    }
+}
+
 /// A point of scnc's space in a file's frame.
 pub fn to_file(p: DVec3, up: Up) -> DVec3 {
     match up {

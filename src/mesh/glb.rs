@@ -88,15 +88,13 @@ fn add(mesh: &mut TriMesh, p: &gltf::Primitive, world: DMat4, blob: Option<&[u8]
         // Points and lines have no surface.
         Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip => Vec::new(),
     };
-    // A transform that mirrors turns the file's winding inside out; the mapping into
-    // scnc's space is a reflection too.
-    let flip = axes::REVERSES_WINDING != (world.determinant() < 0.0);
+    // A transform that mirrors turns the file's winding inside out.
+    let mirrored = world.determinant() < 0.0;
     for t in triangles {
         if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
             continue;
         }
-        let [a, b, c] = t.map(|i| base + i);
-        mesh.triangles.push(if flip { [a, c, b] } else { [a, b, c] });
+        mesh.triangles.push(axes::wound(t.map(|i| base + i), mirrored));
     }
     if mesh.triangles.len() > MAX_ELEMENTS {
         return Err(format!("more than {MAX_ELEMENTS} triangles"));

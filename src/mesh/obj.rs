@@ -220,19 +220,15 @@ pub fn read(r: impl std::io::BufRead) -> Result<TriMesh, ObjError> {
     Ok(mesh)
 }
 
-/// Adds the triangles of a face whose indices (from 1) are all in range.
+/// Adds the triangles of a face whose indices (from 1) are all in range, wound for
+/// scnc's space (the mapping from the file is a reflection).
 fn add_face(mesh: &mut TriMesh, idx: &[i64]) {
-    // The mapping from the file is a reflection: reversed, a face stays wound as the file
-    // winds it, seen from the same side.
-    let push = |mesh: &mut TriMesh, [a, b, c]: [u32; 3]| {
-        mesh.triangles.push(if axes::REVERSES_WINDING { [a, c, b] } else { [a, b, c] })
-    };
     if let [a, b, c] = idx[..] {
-        return push(mesh, [a, b, c].map(|i| (i - 1) as u32));
+        return mesh.triangles.push(axes::wound([a, b, c].map(|i| (i - 1) as u32), false));
     }
     let v: Vec<u32> = idx.iter().map(|&i| (i - 1) as u32).collect();
     for t in triangulate(&v, &mesh.positions) {
-        push(mesh, t);
+        mesh.triangles.push(axes::wound(t, false));
     }
 }
 

@@ -252,7 +252,7 @@ fn read(elements: &[Element], values: &mut dyn Values) -> Result<TriMesh, String
             ));
         }
         for [a, b, c] in triangulate(idx, &mesh.positions) {
-            mesh.triangles.push(if axes::REVERSES_WINDING { [a, c, b] } else { [a, b, c] });
+            mesh.triangles.push(axes::wound([a, b, c], false));
         }
     }
     if mesh.triangles.is_empty() {

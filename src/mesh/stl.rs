@@ -31,7 +31,7 @@ pub fn parse(bytes: &[u8]) -> Result<TriMesh, String> {
         if a == b || b == c || a == c {
             continue;
         }
-        mesh.triangles.push(if axes::REVERSES_WINDING { [a, c, b] } else { [a, b, c] });
+        mesh.triangles.push(axes::wound([a, b, c], false));
     }
     if mesh.triangles.is_empty() {
         return Err("the file has no facets with area".into());

@@ -103,15 +103,14 @@ fn add(
         }
         mesh.positions.push(axes::from_file(p, axes::Up::Z));
     }
-    // A transform that mirrors turns its triangles inside out, as does the file's frame.
-    let flip = axes::REVERSES_WINDING != (place.matrix3.determinant() < 0.0);
+    // A transform that mirrors turns its triangles inside out.
+    let mirrored = place.matrix3.determinant() < 0.0;
     for t in triangles {
         let v = [t.v1, t.v2, t.v3];
         if let Some(&i) = v.iter().find(|&&i| i >= vertices.len()) {
             return Err(format!("a triangle of object {id} names vertex {i} of {}", vertices.len()));
         }
-        let [a, b, c] = v.map(|i| (base + i) as u32);
-        mesh.triangles.push(if flip { [a, c, b] } else { [a, b, c] });
+        mesh.triangles.push(axes::wound(v.map(|i| (base + i) as u32), mirrored));
     }
     Ok(())
 }
