@@ -49,18 +49,8 @@ pub fn tessellate(
         }
     }
     let made = match &node.kind {
-        ShapeKind::Primitive(p) => p.tessellate(detail.resolution()),
-        ShapeKind::Field { exact: Some(exact), .. } => exact_tessellation(exact, detail),
         ShapeKind::Warp { child, mesh_op: Some(op), .. } => from_child(child, *op, detail),
-        ShapeKind::Csg { .. }
-        | ShapeKind::Round { .. }
-        | ShapeKind::Shell { .. }
-        | ShapeKind::Repeat { .. }
-        | ShapeKind::Transform { .. }
-        | ShapeKind::Paint { .. }
-        | ShapeKind::Field { .. }
-        | ShapeKind::Warp { .. }
-        | ShapeKind::Displace { .. } => Tessellation::Isosurface,
+        _ => own_tessellation(node, detail),
     };
     match made {
         Tessellation::Triangles(triangles, make) => {
@@ -138,6 +128,25 @@ pub fn tessellate(
     }
 }
 
+/// A shape's own mesh at `detail`, where it has one: a primitive's generator, the mesh
+/// a sweep knows; otherwise the isosurface. (A domain operation's is made from its
+/// child's own, [`from_child`].)
+fn own_tessellation(node: &Shape, detail: Detail) -> Tessellation {
+    match &node.kind {
+        ShapeKind::Primitive(p) => p.tessellate(detail.resolution()),
+        ShapeKind::Field { exact: Some(exact), .. } => exact_tessellation(exact, detail),
+        ShapeKind::Csg { .. }
+        | ShapeKind::Round { .. }
+        | ShapeKind::Shell { .. }
+        | ShapeKind::Repeat { .. }
+        | ShapeKind::Transform { .. }
+        | ShapeKind::Paint { .. }
+        | ShapeKind::Field { .. }
+        | ShapeKind::Warp { .. }
+        | ShapeKind::Displace { .. } => Tessellation::Isosurface,
+    }
+}
+
 /// The mesh a sweep knows for itself, at `detail`.
 fn exact_tessellation(exact: &ExactMesh, detail: Detail) -> Tessellation {
     match exact {
@@ -166,12 +175,8 @@ fn from_child(child: &Shape, op: ir::MeshOp, detail: Detail) -> Tessellation {
         xf *= *inner;
         node = child;
     }
-    let own = match &node.kind {
-        ShapeKind::Primitive(p) => p.tessellate(detail.resolution()),
-        ShapeKind::Field { exact: Some(exact), .. } => exact_tessellation(exact, detail),
-        _ => Tessellation::Isosurface,
-    };
-    let (Tessellation::Triangles(count, make), Some(b)) = (own, ir::shape_bounds(child)) else {
+    let (Tessellation::Triangles(count, make), Some(b)) = (own_tessellation(node, detail), ir::shape_bounds(child))
+    else {
         return Tessellation::Isosurface;
     };
     let placed = move || {
