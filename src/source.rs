@@ -32,6 +32,8 @@ pub trait Loader {
 /// A regular file opened for reading, which fails once more than its limit is read.
 pub struct Limited {
     file: std::fs::File,
+    /// Its length when opened.
+    len: u64,
     /// Bytes that may still be read.
     left: u64,
     /// The limit, for the error.
@@ -57,7 +59,28 @@ pub fn open_regular_file(path: &Path, limit: u64) -> std::io::Result<Limited> {
     if meta.len() > limit {
         return Err(too_large(limit));
     }
-    Ok(Limited { file: std::fs::File::open(path)?, left: limit, limit })
+    Ok(Limited { file: std::fs::File::open(path)?, len: meta.len(), left: limit, limit })
+}
+
+impl Limited {
+    /// Its length when it was opened.
+    pub fn len(&self) -> u64 {
+        self.len
+    }
+
+    /// Whether it was empty when it was opened.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+}
+
+/// All of `r`, a file of `len` bytes when opened: the bytes are asked of the system
+/// first, so a file too large for memory is an error, not an abort.
+pub fn read_all(mut r: impl std::io::Read, len: u64) -> std::io::Result<Vec<u8>> {
+    let mut bytes = Vec::new();
+    bytes.try_reserve_exact(len as usize).map_err(|_| std::io::Error::other("not enough memory to read it"))?;
+    r.read_to_end(&mut bytes)?;
+    Ok(bytes)
 }
 
 /// The metadata of `path` if it is a regular file: a directory, device, pipe or socket is
@@ -78,18 +101,9 @@ fn regular(path: &Path) -> std::io::Result<std::fs::Metadata> {
 /// file may grow after it was measured). A directory, device, pipe or socket is refused
 /// before it is opened.
 pub fn read_regular_file(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
-    use std::io::Read as _;
-    let meta = regular(path)?;
-    if meta.len() > limit {
-        return Err(too_large(limit));
-    }
-    let mut bytes = Vec::new();
-    bytes.try_reserve_exact(meta.len() as usize).map_err(|_| std::io::Error::other("not enough memory to read it"))?;
-    std::fs::File::open(path)?.take(limit + 1).read_to_end(&mut bytes)?;
-    if bytes.len() as u64 > limit {
-        return Err(too_large(limit));
-    }
-    Ok(bytes)
+    let file = open_regular_file(path, limit)?;
+    let len = file.len();
+    read_all(file, len)
 }
 
 /// A byte count as a limit is named: `4 MiB`, `2 GiB`.

@@ -79,11 +79,8 @@ impl Loader for Reading {
     }
 
     fn read_bytes(&self, path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
-        let (mut file, len) = Reading::counted(path, limit)?;
-        let mut bytes = Vec::new();
-        bytes.try_reserve_exact(len as usize).map_err(|_| std::io::Error::other("not enough memory to read it"))?;
-        file.read_to_end(&mut bytes)?;
-        Ok(bytes)
+        let (file, len) = Reading::counted(path, limit)?;
+        scnc::source::read_all(file, len)
     }
 
     fn open_bytes(&self, path: &Path, limit: u64) -> std::io::Result<Box<dyn BufRead + '_>> {
@@ -96,7 +93,7 @@ impl Reading {
     /// length.
     fn counted(path: &Path, limit: u64) -> std::io::Result<(Counted<scnc::source::Limited>, u64)> {
         let file = scnc::source::open_regular_file(path, limit)?;
-        let len = std::fs::metadata(path)?.len();
+        let len = file.len();
         let name = path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned());
         let progress = Progress::new(len.div_ceil(MIB), "MiB", &format!("reading {name}"));
         Ok((Counted { file, progress, read: 0 }, len))
