@@ -25,6 +25,13 @@ impl Aabb {
         Aabb { min: -half, max: half }
     }
 
+    /// The largest distance from the `y` axis within it.
+    pub fn radius_about_y(&self) -> f64 {
+        let x = self.min.x.abs().max(self.max.x.abs());
+        let z = self.min.z.abs().max(self.max.z.abs());
+        x.hypot(z)
+    }
+
     /// Grown by `d` on every side.
     pub fn grow(self, d: f64) -> Aabb {
         Aabb { min: self.min - d, max: self.max + d }

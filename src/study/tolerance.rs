@@ -116,11 +116,7 @@ fn curvature_radius(shape: &Shape, scale: f64) -> (f64, Option<f64>) {
         // circle's step (`mesh::twist`): a circle about `y` through its farthest point.
         ShapeKind::Warp { child, mesh_op: Some(MeshOp::Twist(_)), .. } => {
             match (curvature_radius(child, scale), ir::shape_bounds(child)) {
-                ((r, None), Some(b)) => {
-                    let x = b.min.x.abs().max(b.max.x.abs());
-                    let z = b.min.z.abs().max(b.max.z.abs());
-                    (r.max(x.hypot(z) * scale), None)
-                }
+                ((r, None), Some(b)) => (r.max(b.radius_about_y() * scale), None),
                 _ => isosurface(),
             }
         }

@@ -90,13 +90,6 @@ fn turn(a: &Arc<Expr>, b: &Arc<Expr>, theta: &Arc<Expr>) -> (Arc<Expr>, Arc<Expr
     (first, second)
 }
 
-/// The largest distance from the `y` axis within `b`.
-fn radius_about_y(b: &Aabb) -> f64 {
-    let x = b.min.x.abs().max(b.max.x.abs());
-    let z = b.min.z.abs().max(b.max.z.abs());
-    x.hypot(z)
-}
-
 impl Ctx<'_> {
     /// A domain operation, or `None` after reporting.
     pub(in crate::check) fn domain_shape(&mut self, f: FieldFn, a: &BoundArgs, span: Span) -> Option<ShapeKind> {
@@ -115,7 +108,7 @@ impl Ctx<'_> {
                 let theta = bin(Binary::Mul, &Expr::num(k), &y);
                 let (qx, qz) = turn(&x, &z, &theta);
                 let map = Expr::vector([qx, y.clone(), qz]);
-                let r = radius_about_y(&b);
+                let r = b.radius_about_y();
                 let bounds = Aabb { min: DVec3::new(-r, b.min.y, -r), max: DVec3::new(r, b.max.y, r) };
                 self.warp(child, map, bounds, span, "this twist", Some(MeshOp::Twist(k)))
             }
@@ -176,7 +169,7 @@ impl Ctx<'_> {
                 };
                 let b = self.bounded(&child, "polar", span)?;
                 let w = 360.0 / f64::from(count);
-                let r = radius_about_y(&b);
+                let r = b.radius_about_y();
                 let bounds = Aabb { min: DVec3::new(-r, b.min.y, -r), max: DVec3::new(r, b.max.y, r) };
                 if self.crosses_sector(&b, w) {
                     if count <= MAX_EXACT_COPIES {
