@@ -111,8 +111,9 @@ impl Ctx<'_> {
                            point";
                 let hint = "combine fewer parts, spread them apart, or use a sharp `union` (pruned by a hierarchy)";
                 let (name, label) = (b.name, "every step of a ray there evaluates all of them");
+                let refused = crowd > MAX_CROWD;
                 self.report(
-                    if crowd > MAX_CROWD {
+                    if refused {
                         Diagnostic::error(
                             codes::TOO_LARGE,
                             a.call,
@@ -131,7 +132,7 @@ impl Ctx<'_> {
                     }
                     .with_hint(hint),
                 );
-                if crowd > MAX_CROWD {
+                if refused {
                     return None;
                 }
             }
