@@ -94,10 +94,8 @@ fn a_long_compile_asks_whether_to_go_on() {
 #[cfg(target_os = "linux")]
 #[test]
 fn an_address_space_cap_is_an_error_not_an_abort() {
-    let dir = tempfile::tempdir().expect("temp dir");
-    let scene = dir.path().join("big.scn");
     let text = "light ambient(1)\nobject mesh uvsphere(rings = 2000, segments = 2000) at [0, 0, 5]\n";
-    std::fs::write(&scene, text).expect("write");
+    let dir = super::support::files(&[("big.scn", text.as_bytes())]);
     let out = dir.path().join("big.png");
     let args = ["render", "big.scn", "-o", "big.png", "--geometry", "mesh", "--width", "16", "--height", "16"];
     let run = super::support::scnc_capped(1_000_000, dir.path(), &[&args[..], &["--memory-limit", "16G"]].concat());

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 
-use super::support::{check_golden, scnc};
+use super::support::{check_golden, files, scnc};
 
 /// Exports `scene` to `dir/name` with `extra` flags; the file's bytes.
 fn export(scene: &str, dir: &Path, name: &str, extra: &[&str]) -> Vec<u8> {
@@ -443,15 +443,6 @@ fn an_exported_mesh_file_reads_back_where_it_was() {
     }
     let background = meshed.pixels().filter(|p| **p == meshed[(0, 0)]).count();
     assert!(background < 96 * 96 * 9 / 10, "the boxes fill a tenth of the view");
-}
-
-/// Writes `files` (name, bytes) into a new temporary directory.
-fn files(list: &[(&str, &[u8])]) -> tempfile::TempDir {
-    let dir = tempfile::tempdir().expect("temp dir");
-    for (name, bytes) in list {
-        std::fs::write(dir.path().join(name), bytes).expect("writing");
-    }
-    dir
 }
 
 /// The reproducers of what validators and slicers refused: an object with no triangle

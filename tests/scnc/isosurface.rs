@@ -199,18 +199,11 @@ fn lowering_reports_the_farthest_vertex() {
 /// exported mesh, read back, has none, and stays closed.
 #[test]
 fn isosurfaces_at_sharp_corners_have_no_crossing_triangles() {
-    let dir = tempfile::tempdir().expect("temp dir");
-    let scene = dir.path().join("corner.scn");
     let text = "object mesh isosurface(union(sphere(0.5), box(0.4) at [0.5, 0, 0], smooth = 0.2), cell = 0.05)\n";
-    std::fs::write(&scene, text).expect("write");
-    let out = dir.path().join("corner.obj");
-    let run = super::support::scnc(&[
-        "export",
-        scene.to_str().expect("utf-8"),
-        "-o",
-        out.to_str().expect("utf-8"),
-        "--stats",
-    ]);
+    let dir = super::support::files(&[("corner.scn", text.as_bytes())]);
+    let (scene, out) = (dir.path().join("corner.scn"), dir.path().join("corner.obj"));
+    let run =
+        super::support::scnc(&["export", super::support::path(&scene), "-o", super::support::path(&out), "--stats"]);
     let err = String::from_utf8_lossy(&run.stderr);
     assert_eq!(run.status.code(), Some(0), "{err}");
     assert!(err.contains("watertight and manifold"), "{err}");

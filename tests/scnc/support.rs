@@ -208,3 +208,12 @@ fn available(name: &str, probe: &mut std::process::Command) -> bool {
     }
     found
 }
+
+/// Writes `files` (name, bytes) into a new temporary directory.
+pub fn files(list: &[(&str, &[u8])]) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().expect("temp dir");
+    for (name, bytes) in list {
+        std::fs::write(dir.path().join(name), bytes).expect("writing");
+    }
+    dir
+}

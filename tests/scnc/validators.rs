@@ -81,11 +81,9 @@ fn lib3mf_reads_3mf_exports_strictly() {
 #[cfg(target_os = "linux")]
 #[test]
 fn twenty_million_triangles_stream_to_3mf_under_an_address_space_cap() {
-    let dir = tempfile::tempdir().expect("temp dir");
-    let scene = dir.path().join("big.scn");
     // 16,769,024 + 3,236,400 triangles.
     let text = "object sphere(1) at [-1.2, 0, 0]\nobject mesh uvsphere(r = 1, rings = 900) at [1.2, 0, 0]\n";
-    std::fs::write(&scene, text).expect("write");
+    let dir = super::support::files(&[("big.scn", text.as_bytes())]);
     let out = dir.path().join("big.3mf");
     let run =
         super::support::scnc_capped(3_500_000, dir.path(), &["export", "big.scn", "-o", "big.3mf", "--detail", "2048"]);
