@@ -296,6 +296,10 @@ pub enum MeshOp {
     Twist(f64),
     /// `polar(s, count)` of a part within its sector: `count` copies turned about `y`.
     Polar(u32),
+    /// `elongate(s, h)`: the halves moved apart by `±h` along each axis, a band between.
+    Elongate(glam::DVec3),
+    /// `symmetric(s, axes)`: the half at positive coordinates mirrored along each axis set.
+    Mirror([bool; 3]),
 }
 
 /// A mesh a sweep knows for its zero set, better than the isosurface mesher's.

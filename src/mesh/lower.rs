@@ -166,7 +166,8 @@ fn exact_tessellation(exact: &ExactMesh, detail: Detail) -> Tessellation {
 
 /// A domain operation's mesh made from its child's own mesh (through its transforms):
 /// `twist` splits the mesh's edges until none turns by more than a circle's step at
-/// `detail`, then twists it (`mesh::twist`); `polar` copies it about `y`. The
+/// `detail`, then twists it (`mesh::twist`); `polar` copies it about `y`; `elongate`
+/// and `symmetric` cut it at the axes' planes (`geom::slab`). The
 /// isosurface where the child has no mesh of its own. A twist is charged the most the
 /// splitting can make (each round splits a triangle into four at most).
 fn from_child(child: &Shape, op: ir::MeshOp, detail: Detail) -> Tessellation {
@@ -203,7 +204,18 @@ fn from_child(child: &Shape, op: ir::MeshOp, detail: Detail) -> Tessellation {
             count.saturating_mul(u64::from(copies)),
             Box::new(move || super::twist::copies_about_y(&placed(), copies)),
         ),
+        // What a cut makes depends on where the plane meets the mesh, so the mesh is made
+        // here (in linear time) and charged what it has; past a few million triangles in
+        // the child, the isosurface instead, as for a twist.
+        ir::MeshOp::Elongate(_) | ir::MeshOp::Mirror(_) if count > 1 << 22 => Tessellation::Isosurface,
+        ir::MeshOp::Elongate(h) => made(crate::geom::slab::elongated(placed(), h)),
+        ir::MeshOp::Mirror(axes) => made(crate::geom::slab::mirrored(placed(), axes)),
     }
+}
+
+/// A mesh already made, as a tessellation charged what it has.
+fn made(mesh: crate::geom::TriMesh) -> Tessellation {
+    Tessellation::Triangles(mesh.triangles.len() as u64, Box::new(move || mesh))
 }
 
 /// Most triangles all meshes of one scene may have together (about 2.4 GB with BVHs).

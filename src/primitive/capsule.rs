@@ -3,7 +3,7 @@
 use glam::{DVec3, Vec3A};
 
 use super::{Facets, Field, Refusal, Resolution, Solid, Tessellation};
-use crate::geom::Aabb;
+use crate::geom::{slab, tessellate, Aabb};
 use crate::sig::{Args, Param, Range};
 
 crate::params! {
@@ -57,11 +57,20 @@ impl Solid for Capsule {
     }
 
     fn facets(&self) -> Facets {
-        Facets::Isosurface
+        Facets::Inscribed(self.r)
     }
 
-    fn tessellate(&self, _: Resolution) -> Tessellation {
-        Tessellation::Isosurface
+    /// The sphere's mesh elongated: its halves moved to `±half_height`, a band of quads
+    /// between (`geom::slab`).
+    fn tessellate(&self, res: Resolution) -> Tessellation {
+        // An even ring count puts a ring on the equator, where the halves part: the band
+        // is then two triangles a segment, and no triangle is split.
+        let (r, h, rings) = (self.r, self.half_height, res.rings.max(2).next_multiple_of(2));
+        let count = tessellate::count::uvsphere(rings, 2 * rings) + 2 * 2 * u64::from(rings);
+        Tessellation::Triangles(
+            count,
+            Box::new(move || slab::elongated(tessellate::uvsphere(r, rings, 2 * rings), DVec3::new(0.0, h, 0.0))),
+        )
     }
 
     fn fields(&self) -> Vec<(&'static str, String)> {

@@ -120,8 +120,10 @@ fn curvature_radius(shape: &Shape, scale: f64) -> (f64, Option<f64>) {
                 _ => isosurface(),
             }
         }
-        // Copies of a part: the part's.
-        ShapeKind::Warp { child, mesh_op: Some(MeshOp::Polar(_)), .. } => curvature_radius(child, scale),
+        // Copies of a part, its halves moved apart or mirrored: the part's.
+        ShapeKind::Warp {
+            child, mesh_op: Some(MeshOp::Polar(_) | MeshOp::Elongate(_) | MeshOp::Mirror(_)), ..
+        } => curvature_radius(child, scale),
         ShapeKind::Csg { .. }
         | ShapeKind::Round { .. }
         | ShapeKind::Shell { .. }

@@ -563,3 +563,30 @@ fn extruded_polygons_mesh_exactly_and_holes_go_through() {
     let exact = (4.0 - std::f64::consts::PI * 0.16) * 0.4;
     assert!((v - exact).abs() < 0.01 * exact, "the holed plate holds {v}, not {exact}");
 }
+
+/// `elongate` and `symmetric` of a shape with a mesh of its own are that mesh cut at
+/// the axes' planes (`geom::slab`), not an isosurface: an elongated sphere exports as
+/// about as many triangles as the capsule primitive, holding the capsule's volume as
+/// closely, and a box mirrored across `x` holds exactly the wider box's volume.
+#[test]
+fn elongated_and_mirrored_shapes_are_cut_from_their_childs_mesh() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = dir.path().join("cut.scn");
+    let of = |text: &str, name: &str| {
+        std::fs::write(&scene, format!("light ambient(1)\nobject {text}\n")).expect("writing");
+        let tris = stl_triangles(&export(scene.to_str().expect("utf-8"), dir.path(), name, &["--tolerance", "0.001"]));
+        (tris.len(), measure(&tris).0)
+    };
+    let (n_capsule, v_capsule) = of("capsule(0.5, 0.6)", "capsule.stl");
+    let (n, v) = of("elongate(sphere(0.5), [0, 0.6, 0])", "elongated.stl");
+    let exact = std::f64::consts::PI * 0.25 * (4.0 / 3.0 * 0.5 + 1.2);
+    assert!(n < 2 * n_capsule, "{n} triangles where the capsule has {n_capsule}");
+    assert!(
+        (v - exact).abs() < 2.0 * (v_capsule - exact).abs().max(1e-4 * exact),
+        "{v} against {exact}; capsule {n_capsule} {v_capsule}, {n}"
+    );
+    let (n, v) = of("symmetric(box(0.5) at [0.25, 0, 0], \"x\")", "mirrored.stl");
+    // The box cut across four faces: their kept halves split in three, twice over.
+    assert!(n <= 28, "{n}");
+    assert!((v - 1.5).abs() < 1e-6, "{v}");
+}

@@ -22,7 +22,7 @@ fn convexity_follows_the_lowered_object() {
         ("cylinder(0.5, 1) rotate [30, 0, 0]", [0.0, 0.0, 5.0], true, true),
         ("cone(0.7, 0.8)", [0.0, 0.0, 5.0], true, true),
         ("plane(normal = [0, 1, 0], offset = -1)", [0.0, -1.0, 5.0], true, true),
-        ("capsule(0.4, 0.6)", [0.0, 0.0, 5.0], true, false),
+        ("capsule(0.4, 0.6)", [0.0, 0.0, 5.0], true, true),
         ("round(box(0.5), 0.2)", [0.0, 0.0, 5.0], true, false),
         ("intersect(sphere(1), box(0.8))", [0.0, 0.0, 5.0], true, false),
         ("intersect(sphere(1), box(0.8), smooth = 0.2)", [0.0, 0.0, 5.0], false, false),

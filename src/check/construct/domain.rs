@@ -138,7 +138,8 @@ impl Ctx<'_> {
                     bin(Binary::Sub, &c, &clamped)
                 });
                 let bounds = ir::shape_bounds(&child).map(|b| Aabb { min: b.min - h, max: b.max + h });
-                Some(ShapeKind::Warp { child, map: Expr::vector(q), bounds, lipschitz: exact, mesh_op: None })
+                let mesh_op = Some(MeshOp::Elongate(h));
+                Some(ShapeKind::Warp { child, map: Expr::vector(q), bounds, lipschitz: exact, mesh_op })
             }
             FieldFn::Symmetric => {
                 let SymmetricArgs { shape: Value::Shape(child), axes } = SymmetricArgs::from_args(a) else {
@@ -161,7 +162,8 @@ impl Ctx<'_> {
                     }
                     Aabb { min: lo, max: hi }
                 });
-                Some(ShapeKind::Warp { child, map: Expr::vector(q), bounds, lipschitz: exact, mesh_op: None })
+                let mesh_op = Some(MeshOp::Mirror(mirrored));
+                Some(ShapeKind::Warp { child, map: Expr::vector(q), bounds, lipschitz: exact, mesh_op })
             }
             FieldFn::Polar => {
                 let PolarArgs { shape: Value::Shape(child), count } = PolarArgs::from_args(a) else {
