@@ -71,7 +71,10 @@ pub fn mend(p: &[Vec3], triangles: &mut Vec<[u32; 3]>, tag: &mut Vec<u32>) -> Me
     }
     let mut alive = vec![true; kept.len()];
     let mut work: Vec<usize> = (0..kept.len()).filter(|&i| flat(p, kept[i])).collect();
-    let mut rounds = 0;
+    // Bounded by the triangles there were at the start: every split adds one, so a bound
+    // on the growing count could be chased for ever (a disc of radius 1e-12 extruded,
+    // all of whose caps are flat in f32, was).
+    let (mut rounds, most) = (0, 4 * kept.len());
     while let Some(i) = work.pop() {
         if !alive[i] || !flat(p, kept[i]) {
             continue;
@@ -84,7 +87,7 @@ pub fn mend(p: &[Vec3], triangles: &mut Vec<[u32; 3]>, tag: &mut Vec<u32>) -> Me
         let (a, c, b) = (t[long], t[(long + 1) % 3], t[(long + 2) % 3]);
         // The neighbour holds the long edge the other way round: (c, a, d).
         let neighbour = edges.get(&(c, a)).copied().filter(|&n| alive[n] && n != i);
-        let Some(n) = neighbour.filter(|_| rounds <= 4 * kept.len()) else {
+        let Some(n) = neighbour.filter(|_| rounds <= most) else {
             alive[i] = false;
             out.dropped += 1;
             continue;
@@ -176,6 +179,21 @@ mod tests {
         let m = mend(&p, &mut t, &mut tag);
         assert_eq!(m.dropped, 0);
         assert!(closed(&t), "{t:?}");
+        assert!(t.iter().all(|&t| !flat(&p, t)));
+    }
+
+    /// A needle: a disc of radius 1e-12 extruded, every cap triangle flat in f32. Each
+    /// split makes another flat triangle, so mending must stop by its bound (it once
+    /// chased a bound that grew with every split, for ever) and drop what is left.
+    #[test]
+    fn a_needle_of_flat_triangles_is_mended_in_bounded_rounds() {
+        let disc = crate::geom::region::Region::Circle { centre: glam::DVec2::ZERO, r: 1e-12 };
+        let m = crate::geom::region::extrusion(&disc, 0.5, 50).expect("a needle");
+        let p: Vec<Vec3> = m.positions.iter().map(|q| q.as_vec3()).collect();
+        let (mut t, mut tag) = (m.triangles.clone(), vec![0; m.triangles.len()]);
+        let before = t.len();
+        let mended = mend(&p, &mut t, &mut tag);
+        assert!(mended.removed + mended.dropped > 0 && t.len() <= 5 * before, "{mended:?}, {} left", t.len());
         assert!(t.iter().all(|&t| !flat(&p, t)));
     }
 }
