@@ -158,9 +158,10 @@ pub struct Profile {
     /// The signed distance: exact for a circle, rectangle or polygon, moved or not; a
     /// bound after `union`, `intersect`, `subtract`, `round` or `shell`.
     pub body: Arc<ir::field::Expr>,
-    /// Its outline when it is one simple polygon (a rectangle or polygon, moved or not),
-    /// `[u, v]` corners in order: what an extrusion's exact mesh is made from.
-    pub outline: Option<Arc<Vec<glam::DVec2>>>,
+    /// The region it covers when that is made of polygons and circles by sharp CSG
+    /// (moved or not): what an extrusion's mesh is made from, and a lathe's when it is one
+    /// polygon. `None` after `round` or `shell` of anything but a circle, or a smooth CSG.
+    pub region: Option<Arc<crate::geom::region::Region>>,
     /// Smallest corner `[u, v]`.
     pub min: glam::DVec2,
     /// Largest corner `[u, v]`.

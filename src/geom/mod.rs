@@ -4,6 +4,7 @@
 pub mod axes;
 pub mod noise;
 pub mod polygon;
+pub mod region;
 pub mod slab;
 pub mod tessellate;
 

@@ -311,6 +311,15 @@ pub enum ExactMesh {
     /// axis next to each other) revolved about `y`: tessellated at lowering with as many
     /// segments as a circle has at the detail, every vertex on the surface.
     Lathe(Arc<Vec<glam::DVec2>>),
+    /// A region of polygons and circles with holes or several parts, extruded from
+    /// `y = -half_height` to `half_height`: its circles tessellated at lowering, the
+    /// booleans taken and the caps triangulated there (`geom::region::extrusion`).
+    Extrusion {
+        /// The profile's region, `[u, v]` as the solid's `x`, `z`.
+        region: Arc<crate::geom::region::Region>,
+        /// Half the extrusion's height.
+        half_height: f64,
+    },
 }
 
 /// Shape nodes: a primitive leaf, a CSG operator, a modifier, a transform or a material.

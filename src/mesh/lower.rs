@@ -161,6 +161,14 @@ fn exact_tessellation(exact: &ExactMesh, detail: Detail) -> Tessellation {
             let triangles = 2 * corners.len() as u64 * u64::from(n);
             Tessellation::Triangles(triangles, Box::new(move || crate::geom::polygon::lathe(&corners, n)))
         }
+        // Made here: its count depends on what the booleans leave. A region cut away
+        // wholly, or too far out for the overlay, is left to the isosurface mesher.
+        ExactMesh::Extrusion { region, half_height } => {
+            match crate::geom::region::extrusion(region, *half_height, detail.circle()) {
+                Some(mesh) => made(mesh),
+                None => Tessellation::Isosurface,
+            }
+        }
     }
 }
 

@@ -108,6 +108,10 @@ fn curvature_radius(shape: &Shape, scale: f64) -> (f64, Option<f64>) {
         ShapeKind::Paint { child, .. } => curvature_radius(child, scale),
         // An extruded polygon's prism: its own flat faces.
         ShapeKind::Field { exact: Some(ExactMesh::Faces(_)), .. } => (0.0, None),
+        // An extruded region's flat faces are exact; its circles are inscribed polygons.
+        ShapeKind::Field { exact: Some(ExactMesh::Extrusion { region, .. }), .. } => {
+            (region.largest_radius() * scale, None)
+        }
         // A lathe is inscribed in circles of up to its widest corner's radius.
         ShapeKind::Field { exact: Some(ExactMesh::Lathe(corners)), .. } => {
             (corners.iter().fold(0.0f64, |r, c| r.max(c.x)) * scale, None)

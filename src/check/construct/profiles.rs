@@ -16,6 +16,7 @@ use crate::check::expr::BoundArgs;
 use crate::check::value::Profile;
 use crate::check::{Ctx, Value};
 use crate::diag::{codes, Diagnostic};
+use crate::geom::region::{Combine, Region};
 use crate::geom::Aabb;
 use crate::ir::field::{Binary, Expr, Kind, Ty, Unary};
 use crate::ir::{CsgOp, ExactMesh, Lipschitz, ShapeKind};
@@ -122,9 +123,14 @@ fn segments_meet(a0: DVec2, a1: DVec2, b0: DVec2, b1: DVec2) -> bool {
         || (d4 == 0.0 && on(a0, a1, b1))
 }
 
-/// The outline of `profile`, if it has one, with every corner moved by `f`.
-fn moved_outline(profile: &Profile, f: impl Fn(DVec2) -> DVec2) -> Option<Arc<Vec<DVec2>>> {
-    profile.outline.as_ref().map(|o| Arc::new(o.iter().map(|c| f(*c)).collect()))
+/// The region of `profile`, if it has one, moved by `f` (scaling by `k`).
+fn moved_region(profile: &Profile, f: impl Fn(DVec2) -> DVec2, k: f64) -> Option<Arc<Region>> {
+    profile.region.as_ref().map(|r| Arc::new(r.moved(&f, k)))
+}
+
+/// A disc's region.
+fn disc(r: f64) -> Option<Arc<Region>> {
+    Some(Arc::new(Region::Circle { centre: DVec2::ZERO, r }))
 }
 
 impl Ctx<'_> {
@@ -137,21 +143,21 @@ impl Ctx<'_> {
             ProfileFn::Circle => {
                 let CircleArgs { r } = CircleArgs::from_args(a);
                 let body = bin(Binary::Sub, &un(Unary::Length, &p), &num(r));
-                Some(Profile { body, outline: None, min: DVec2::splat(-r), max: DVec2::splat(r) })
+                Some(Profile { body, region: disc(r), min: DVec2::splat(-r), max: DVec2::splat(r) })
             }
             ProfileFn::Rect => {
                 let RectArgs { half_u, half_v } = RectArgs::from_args(a);
                 let qu = bin(Binary::Sub, &un(Unary::Abs, &u), &num(half_u));
                 let qv = bin(Binary::Sub, &un(Unary::Abs, &v), &num(half_v));
                 let h = DVec2::new(half_u, half_v);
-                let outline = Some(Arc::new(vec![-h, DVec2::new(h.x, -h.y), h, DVec2::new(-h.x, h.y)]));
-                Some(Profile { body: corner(&qu, &qv), outline, min: -h, max: h })
+                let region = Some(Arc::new(Region::Polygon(vec![-h, DVec2::new(h.x, -h.y), h, DVec2::new(-h.x, h.y)])));
+                Some(Profile { body: corner(&qu, &qv), region, min: -h, max: h })
             }
             ProfileFn::Polygon => {
                 let PolygonArgs { points } = PolygonArgs::from_args(a);
                 self.polygon(&points, a.span_of("points")).map(|(body, corners, min, max)| Profile {
                     body,
-                    outline: Some(Arc::new(corners)),
+                    region: Some(Arc::new(Region::Polygon(corners))),
                     min,
                     max,
                 })
@@ -161,7 +167,12 @@ impl Ctx<'_> {
                     return Value::Error;
                 };
                 let body = bin(Binary::Sub, &inner.body, &num(r));
-                Some(Profile { body, outline: None, min: inner.min - r, max: inner.max + r })
+                // A grown disc is a disc; a grown polygon has arcs at its corners.
+                let region = match inner.region.as_deref() {
+                    Some(&Region::Circle { centre, r: rc }) => Some(Arc::new(Region::Circle { centre, r: rc + r })),
+                    _ => None,
+                };
+                Some(Profile { body, region, min: inner.min - r, max: inner.max + r })
             }
             ProfileFn::Shell => {
                 let ShellProfileArgs { profile: Value::Profile(inner), thickness: t } = ShellProfileArgs::from_args(a)
@@ -169,7 +180,19 @@ impl Ctx<'_> {
                     return Value::Error;
                 };
                 let body = bin(Binary::Sub, &un(Unary::Abs, &inner.body), &num(t / 2.0));
-                Some(Profile { body, outline: None, min: inner.min - t / 2.0, max: inner.max + t / 2.0 })
+                // A disc's outline is a ring (a disc, when the hole closes up).
+                let region = match inner.region.as_deref() {
+                    Some(&Region::Circle { centre, r }) => {
+                        let outer = Region::Circle { centre, r: r + t / 2.0 };
+                        Some(Arc::new(if r > t / 2.0 {
+                            Region::Csg(Combine::Subtract, vec![outer, Region::Circle { centre, r: r - t / 2.0 }])
+                        } else {
+                            outer
+                        }))
+                    }
+                    _ => None,
+                };
+                Some(Profile { body, region, min: inner.min - t / 2.0, max: inner.max + t / 2.0 })
             }
             ProfileFn::Extrude | ProfileFn::Revolve => {
                 return match self.sweep(f, a) {
@@ -202,10 +225,10 @@ impl Ctx<'_> {
         let made = match (op, arg, two) {
             (TransformOp::At, _, Some(d)) => {
                 let moved = vec2(bin(Binary::Sub, &u, &num(d.x)), bin(Binary::Sub, &v, &num(d.y)));
-                let outline = moved_outline(profile, |c| c + d);
+                let region = moved_region(profile, |c| c + d, 1.0);
                 Some(Profile {
                     body: profile.body.substitute(&moved),
-                    outline,
+                    region,
                     min: profile.min + d,
                     max: profile.max + d,
                 })
@@ -222,14 +245,14 @@ impl Ctx<'_> {
                 let corners = [lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)].map(turn);
                 let min = corners.iter().fold(DVec2::INFINITY, |m, c| m.min(*c));
                 let max = corners.iter().fold(DVec2::NEG_INFINITY, |m, c| m.max(*c));
-                let outline = moved_outline(profile, turn);
-                Some(Profile { body: profile.body.substitute(&back), outline, min, max })
+                let region = moved_region(profile, turn, 1.0);
+                Some(Profile { body: profile.body.substitute(&back), region, min, max })
             }
             (TransformOp::Scale, Value::Num(k), _) if *k > 0.0 && k.is_finite() => {
                 let shrunk = vec2(bin(Binary::Div, &u, &num(*k)), bin(Binary::Div, &v, &num(*k)));
                 let body = bin(Binary::Mul, &num(*k), &profile.body.substitute(&shrunk));
-                let outline = moved_outline(profile, |c| c * *k);
-                Some(Profile { body, outline, min: profile.min * *k, max: profile.max * *k })
+                let region = moved_region(profile, |c| c * *k, *k);
+                Some(Profile { body, region, min: profile.min * *k, max: profile.max * *k })
             }
             _ => None,
         };
@@ -333,7 +356,17 @@ impl Ctx<'_> {
             );
             return None;
         }
-        Some(Profile { body, outline: None, min, max })
+        // A sharp combination of regions is the region of their combination.
+        let regions: Option<Vec<Region>> = parts.iter().map(|p| p.region.as_deref().cloned()).collect();
+        let region = regions.filter(|_| k == 0.0).map(|r| {
+            let combine = match op {
+                CsgOp::Union => Combine::Union,
+                CsgOp::Intersect => Combine::Intersect,
+                CsgOp::Subtract => Combine::Subtract,
+            };
+            Arc::new(Region::Csg(combine, r))
+        });
+        Some(Profile { body, region, min, max })
     }
 
     /// `extrude` or `revolve` as a field of the solid's point, or `None` after reporting.
@@ -352,10 +385,12 @@ impl Ctx<'_> {
                     min: DVec3::new(profile.min.x, -h, profile.min.y),
                     max: DVec3::new(profile.max.x, h, profile.max.y),
                 };
-                let mesh = profile
-                    .outline
-                    .as_ref()
-                    .map(|corners| ExactMesh::Faces(Arc::new(crate::geom::polygon::prism(corners, h))));
+                // A polygon's prism is made once, here; any other region's at the detail
+                // its circles are tessellated at.
+                let mesh = profile.region.as_deref().map(|region| match region {
+                    Region::Polygon(corners) => ExactMesh::Faces(Arc::new(crate::geom::polygon::prism(corners, h))),
+                    _ => ExactMesh::Extrusion { region: Arc::new(region.clone()), half_height: h },
+                });
                 Some(ShapeKind::Field { body: corner(&d2, &dy), bounds: Some(bounds), lipschitz: exact, exact: mesh })
             }
             ProfileFn::Revolve => {
@@ -383,7 +418,12 @@ impl Ctx<'_> {
                 let bounds = Aabb { min: DVec3::new(-r, profile.min.y, -r), max: DVec3::new(r, profile.max.y, r) };
                 // A polygon wholly at u ≥ 0 is tessellated as a lathe; anything else (a
                 // circle, a profile cut by the axis) by the isosurface mesher.
-                let lathe = profile.outline.clone().filter(|o| crate::geom::polygon::lathe_ok(o)).map(ExactMesh::Lathe);
+                let lathe = match profile.region.as_deref() {
+                    Some(Region::Polygon(corners)) if crate::geom::polygon::lathe_ok(corners) => {
+                        Some(ExactMesh::Lathe(Arc::new(corners.clone())))
+                    }
+                    _ => None,
+                };
                 Some(ShapeKind::Field { body, bounds: Some(bounds), lipschitz: exact, exact: lathe })
             }
             ProfileFn::Csg(_)

@@ -1,0 +1,212 @@
+//! The region a 2D profile covers, kept beside its distance so that an extrusion of it
+//! can be meshed from its outlines: polygons and circles (moved, turned and scaled) and
+//! their sharp unions, intersections and differences. At lowering the circles become
+//! polygons of a detail's segments, the booleans are taken on the polygons (iOverlay,
+//! the engine behind the `geo` crate's, robust where edges meet or overlap), and each
+//! resulting outline with its holes is triangulated (iTriangle) into the prism's caps.
+
+use glam::{DVec2, DVec3};
+use i_triangle::float::triangulatable::Triangulatable;
+use i_triangle::i_overlay::core::fill_rule::FillRule;
+use i_triangle::i_overlay::core::overlay_rule::OverlayRule;
+use i_triangle::i_overlay::float::single::SingleFloatOverlay;
+
+use super::TriMesh;
+
+/// How a region's parts combine.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Combine {
+    /// Covered by any part.
+    Union,
+    /// Covered by every part.
+    Intersect,
+    /// Covered by the first part and by none of the others.
+    Subtract,
+}
+
+/// A 2D region of `[u, v]` points.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Region {
+    /// A simple polygon's inside, corners in order (either winding).
+    Polygon(Vec<DVec2>),
+    /// A disc.
+    Circle {
+        /// Its centre.
+        centre: DVec2,
+        /// Its radius.
+        r: f64,
+    },
+    /// Sharp CSG of regions.
+    Csg(Combine, Vec<Region>),
+}
+
+/// Polygons (outlines, each followed by its holes) in iOverlay's form.
+type Shapes = Vec<Vec<Vec<[f64; 2]>>>;
+
+/// Coordinates beyond which a region is not meshed from its outlines (the overlay maps
+/// them to integers over the region's extent, and a far-flung one would cost precision).
+const MAX_COORDINATE: f64 = 1e9;
+
+impl Region {
+    /// The region moved by `f`, a rigid motion or a uniform scale by `k` (so a circle's
+    /// radius scales by `k`).
+    pub fn moved(&self, f: &impl Fn(DVec2) -> DVec2, k: f64) -> Region {
+        match self {
+            Region::Polygon(c) => Region::Polygon(c.iter().map(|p| f(*p)).collect()),
+            Region::Circle { centre, r } => Region::Circle { centre: f(*centre), r: r * k },
+            Region::Csg(op, parts) => Region::Csg(*op, parts.iter().map(|p| p.moved(f, k)).collect()),
+        }
+    }
+
+    /// The largest circle's radius, 0 when the region is all polygons (its outline is
+    /// then exact at any detail).
+    pub fn largest_radius(&self) -> f64 {
+        match self {
+            Region::Polygon(_) => 0.0,
+            Region::Circle { r, .. } => *r,
+            Region::Csg(_, parts) => parts.iter().map(Region::largest_radius).fold(0.0, f64::max),
+        }
+    }
+
+    /// Whether every coordinate is within reach of the overlay's integers.
+    fn in_reach(&self) -> bool {
+        match self {
+            Region::Polygon(c) => c.iter().all(|p| p.abs().max_element() < MAX_COORDINATE),
+            Region::Circle { centre, r } => centre.abs().max_element() + r < MAX_COORDINATE,
+            Region::Csg(_, parts) => parts.iter().all(Region::in_reach),
+        }
+    }
+
+    /// The region as polygons with holes, circles inscribed with `segments` sides.
+    fn shapes(&self, segments: u32) -> Shapes {
+        match self {
+            Region::Polygon(c) => vec![vec![c.iter().map(|p| p.to_array()).collect()]],
+            Region::Circle { centre, r } => {
+                let n = segments.max(3);
+                let ring = (0..n).map(|i| {
+                    let (sin, cos) = (std::f64::consts::TAU * f64::from(i) / f64::from(n)).sin_cos();
+                    (*centre + DVec2::new(cos, sin) * *r).to_array()
+                });
+                vec![vec![ring.collect()]]
+            }
+            Region::Csg(op, parts) => {
+                let rule = match op {
+                    Combine::Union => OverlayRule::Union,
+                    Combine::Intersect => OverlayRule::Intersect,
+                    Combine::Subtract => OverlayRule::Difference,
+                };
+                let mut parts = parts.iter().map(|p| p.shapes(segments));
+                let first = parts.next().unwrap_or_default();
+                parts.fold(first, |acc, p| acc.overlay(&p, rule, FillRule::NonZero))
+            }
+        }
+    }
+}
+
+/// The prism of `region` from `y = -half_height` to `half_height` (its `[u, v]` as `x`,
+/// `z`), circles with `segments` sides: closed and wound outward, or `None` when the
+/// region comes out empty or too far out to mesh this way.
+pub fn extrusion(region: &Region, half_height: f64, segments: u32) -> Option<TriMesh> {
+    if !region.in_reach() {
+        return None;
+    }
+    let mut points = Vec::new();
+    let mut triangles = Vec::new();
+    for shape in region.shapes(segments) {
+        let t = shape.triangulate().to_triangulation::<u32>();
+        let base = points.len() as u32;
+        points.extend(t.points.iter().map(|p| DVec2::from_array(*p)));
+        triangles.extend(t.indices.chunks_exact(3).map(|c| [c[0] + base, c[1] + base, c[2] + base]));
+    }
+    (!triangles.is_empty()).then(|| prism_of_caps(&points, &triangles, half_height))
+}
+
+/// A prism from a triangulated cap (`[u, v]` points, triangles of either winding): the
+/// cap at both heights and a quad on every edge of the cap's rim, so the walls meet the
+/// caps at the very same corners whatever the triangulation made of the outline.
+pub fn prism_of_caps(points: &[DVec2], triangles: &[[u32; 3]], half_height: f64) -> TriMesh {
+    let n = points.len() as u32;
+    let mut m = TriMesh::default();
+    for y in [-half_height, half_height] {
+        m.positions.extend(points.iter().map(|c| DVec3::new(c.x, y, c.y)));
+    }
+    // Counter-clockwise in `[u, v]` is clockwise seen from +y (`v` is `z`): so wound,
+    // a triangle faces down, as the bottom cap should.
+    let ccw: Vec<[u32; 3]> = triangles
+        .iter()
+        .filter_map(|&[a, b, c]| {
+            let [pa, pb, pc] = [a, b, c].map(|i| points[i as usize]);
+            let area = (pb - pa).perp_dot(pc - pa);
+            (area != 0.0).then_some(if area > 0.0 { [a, b, c] } else { [a, c, b] })
+        })
+        .collect();
+    let mut rim: std::collections::HashSet<(u32, u32)> = std::collections::HashSet::new();
+    for t in &ccw {
+        m.triangles.push(*t);
+        m.triangles.push([t[0] + n, t[2] + n, t[1] + n]);
+        for e in 0..3 {
+            let (a, b) = (t[e], t[(e + 1) % 3]);
+            if !rim.remove(&(b, a)) {
+                rim.insert((a, b));
+            }
+        }
+    }
+    // A rim edge a→b of the bottom cap: its wall runs up from it, wound against it.
+    let mut rim: Vec<(u32, u32)> = rim.into_iter().collect();
+    rim.sort_unstable();
+    for (a, b) in rim {
+        m.triangles.push([b, a, a + n]);
+        m.triangles.push([b, a + n, b + n]);
+    }
+    m
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rect(h: DVec2) -> Region {
+        Region::Polygon(vec![-h, DVec2::new(h.x, -h.y), h, DVec2::new(-h.x, h.y)])
+    }
+
+    /// A plate with a round hole is closed and outward, holds the plate less the hole's
+    /// polygon, and has a hole: no triangle covers the hole's centre.
+    #[test]
+    fn a_plate_with_a_hole_is_closed_and_holed() {
+        let plate = Region::Csg(
+            Combine::Subtract,
+            vec![rect(DVec2::new(1.0, 0.7)), Region::Circle { centre: DVec2::new(0.2, 0.0), r: 0.3 }],
+        );
+        let n = 64;
+        let m = extrusion(&plate, 0.1, n).expect("a plate");
+        assert_eq!(m.open_edges(), (0, 0));
+        let hole = 0.5 * f64::from(n) * 0.09 * (std::f64::consts::TAU / f64::from(n)).sin();
+        let want = (2.0 * 1.4 - hole) * 0.2;
+        assert!((m.signed_volume() - want).abs() < 1e-9, "{} not {want}", m.signed_volume());
+        // Flat-faced but the hole: the plate's 4 corners and the hole's 64, twice.
+        assert_eq!(m.positions.len(), 2 * (4 + 64));
+    }
+
+    /// Union, intersection and a ring (a disc less a smaller one) keep the areas the
+    /// polygons have; two apart squares are two prisms; a region cut away wholly is none.
+    #[test]
+    fn booleans_keep_their_areas() {
+        let a = rect(DVec2::splat(1.0));
+        let b = rect(DVec2::splat(1.0)).moved(&|p| p + DVec2::new(1.0, 1.0), 1.0);
+        let area = |r: &Region| extrusion(r, 0.5, 32).map_or(0.0, |m| m.signed_volume());
+        assert!((area(&Region::Csg(Combine::Union, vec![a.clone(), b.clone()])) - 7.0).abs() < 1e-9);
+        assert!((area(&Region::Csg(Combine::Intersect, vec![a.clone(), b.clone()])) - 1.0).abs() < 1e-9);
+        let far = a.moved(&|p| p + DVec2::new(5.0, 0.0), 1.0);
+        let two = extrusion(&Region::Csg(Combine::Union, vec![a.clone(), far]), 0.5, 32).expect("two");
+        assert_eq!(two.open_edges(), (0, 0));
+        assert!((two.signed_volume() - 8.0).abs() < 1e-9);
+        let disc = |r| Region::Circle { centre: DVec2::ZERO, r };
+        let ring = extrusion(&Region::Csg(Combine::Subtract, vec![disc(1.0), disc(0.5)]), 0.5, 48).expect("ring");
+        assert_eq!(ring.open_edges(), (0, 0));
+        let polygon_area = |r: f64| 0.5 * 48.0 * r * r * (std::f64::consts::TAU / 48.0).sin();
+        let want = polygon_area(1.0) - polygon_area(0.5);
+        // Within the overlay's integer grid (about 1e-9 of the extent) of the polygons'.
+        assert!((ring.signed_volume() - want).abs() < 1e-8, "{} not {want}", ring.signed_volume());
+        assert!(extrusion(&Region::Csg(Combine::Subtract, vec![rect(DVec2::splat(0.5)), a]), 0.5, 32).is_none());
+    }
+}
