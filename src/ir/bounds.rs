@@ -152,6 +152,36 @@ fn half_space_within(shape: &Shape, g: f64) -> Option<(DVec3, f64)> {
     }
 }
 
+/// Planes `n·p ≤ offset` whose intersection holds the shape, tight for a convex
+/// polyhedron under any affine map ([`Solid::faces`](crate::primitive::Solid::faces));
+/// `None` where there are none (anything with a curved or unbounded part outside them).
+pub fn shape_faces(shape: &Shape) -> Option<Vec<(DVec3, f64)>> {
+    faces_within(shape, 0.0)
+}
+
+/// Planes holding where the shape's field is at most `g`, by the rules of
+/// [`half_space_within`]: every operand's planes hold an intersection (all are kept),
+/// the first operand's a subtraction.
+fn faces_within(shape: &Shape, g: f64) -> Option<Vec<(DVec3, f64)>> {
+    let grown = |faces: Vec<(DVec3, f64)>, g: f64| faces.into_iter().map(|(n, o)| (n, o + g)).collect();
+    match &shape.kind {
+        ShapeKind::Primitive(p) => p.faces().map(|f| grown(f, g)),
+        ShapeKind::Csg { op: CsgOp::Intersect, children, smooth } => {
+            let all: Vec<_> = children.iter().filter_map(|c| faces_within(c, g + smooth)).flatten().collect();
+            (!all.is_empty()).then_some(all)
+        }
+        ShapeKind::Csg { op: CsgOp::Subtract, children, smooth } => faces_within(children.first()?, g + smooth),
+        ShapeKind::Csg { op: CsgOp::Union, .. } | ShapeKind::Repeat { .. } => None,
+        ShapeKind::Round { child, radius } => faces_within(child, g + radius),
+        ShapeKind::Shell { child, thickness } => faces_within(child, g + thickness * 0.5),
+        ShapeKind::Transform { child, xf } => {
+            faces_within(child, within_child(g, xf))?.into_iter().map(|h| transform_half_space(h, xf)).collect()
+        }
+        ShapeKind::Paint { child, .. } => faces_within(child, g),
+        ShapeKind::Field { .. } | ShapeKind::Warp { .. } | ShapeKind::Displace { .. } => None,
+    }
+}
+
 /// The image of the half-space `n·p ≤ offset` under an invertible affine map, which is
 /// exactly a half-space: its normal is `M⁻ᵀ n`, through the image of a point on the
 /// plane. `None` if the map is too degenerate to say.

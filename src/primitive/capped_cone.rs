@@ -52,6 +52,10 @@ impl Solid for CappedCone {
         None
     }
 
+    fn faces(&self) -> Option<Vec<(DVec3, f64)>> {
+        None
+    }
+
     fn is_convex(&self) -> bool {
         true
     }

@@ -40,6 +40,10 @@ impl Solid for Cone {
         None
     }
 
+    fn faces(&self) -> Option<Vec<(DVec3, f64)>> {
+        None
+    }
+
     fn is_convex(&self) -> bool {
         true
     }

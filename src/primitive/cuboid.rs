@@ -36,6 +36,12 @@ impl Solid for Cuboid {
         None
     }
 
+    fn faces(&self) -> Option<Vec<(DVec3, f64)>> {
+        let h = self.size;
+        let axes = [DVec3::X, DVec3::Y, DVec3::Z];
+        Some(axes.iter().zip([h.x, h.y, h.z]).flat_map(|(&n, d)| [(n, d), (-n, d)]).collect())
+    }
+
     fn is_convex(&self) -> bool {
         true
     }

@@ -53,6 +53,10 @@ impl Solid for Ellipsoid {
         None
     }
 
+    fn faces(&self) -> Option<Vec<(DVec3, f64)>> {
+        None
+    }
+
     fn is_convex(&self) -> bool {
         true
     }

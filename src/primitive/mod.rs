@@ -77,6 +77,11 @@ pub trait Solid: Clone + fmt::Debug + PartialEq + Send + Sync + 'static {
     /// sphere say more).
     fn half_space(&self) -> Option<(DVec3, f64)>;
 
+    /// The planes `n·p ≤ offset` (unit `n`) whose intersection is the solid, for a convex
+    /// polyhedron: a ray is clipped to them before it is marched, so a miss costs no
+    /// step and a hit starts on the surface. `None` for a curved or unbounded solid.
+    fn faces(&self) -> Option<Vec<(DVec3, f64)>>;
+
     /// Whether the solid is convex (a half-space is).
     fn is_convex(&self) -> bool;
 
@@ -263,6 +268,8 @@ impl Primitive {
         sphere_radius -> Option<f64>;
         /// A half-space holding an unbounded solid ([`Solid::half_space`]).
         half_space -> Option<(DVec3, f64)>;
+        /// The planes whose intersection is a convex polyhedron ([`Solid::faces`]).
+        faces -> Option<Vec<(DVec3, f64)>>;
         /// Whether the solid is convex (a half-space is).
         is_convex -> bool;
         /// Whether its distance is exact ([`Solid::is_exact`]).

@@ -41,6 +41,10 @@ impl Solid for Plane {
         Some((self.normal, self.offset))
     }
 
+    fn faces(&self) -> Option<Vec<(DVec3, f64)>> {
+        None
+    }
+
     fn is_convex(&self) -> bool {
         true
     }

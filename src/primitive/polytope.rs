@@ -36,14 +36,7 @@ impl Polytope {
             .iter()
             .map(|f| {
                 let p = |i: usize| corners[f[i] as usize];
-                // Newell's normal: robust for any planar polygon.
-                let n = (0..f.len())
-                    .map(|i| {
-                        let (a, b) = (p(i), p((i + 1) % f.len()));
-                        DVec3::new((a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y))
-                    })
-                    .sum::<DVec3>()
-                    .normalize();
+                let n = newell(f.len(), p);
                 let d = n.dot(p(0));
                 (n.as_vec3a(), d as f32, (0..f.len()).map(|i| p(i).as_vec3a()).collect())
             })
@@ -93,6 +86,18 @@ impl Polytope {
         outside.and_then(|c| (p - c).try_normalize()).unwrap_or(normal)
     }
 
+    /// Each face's plane `n·p ≤ d` in f64 (Newell's normal, as for the f32 planes).
+    pub(super) fn face_planes(&self) -> Vec<(DVec3, f64)> {
+        self.faces
+            .iter()
+            .map(|f| {
+                let p = |i: usize| self.corners[f[i] as usize];
+                let n = newell(f.len(), p);
+                (n, n.dot(p(0)))
+            })
+            .collect()
+    }
+
     /// Triangles: each face as a fan (exact, as the faces are flat and convex).
     pub(super) fn triangle_count(&self) -> u64 {
         self.faces.iter().map(|f| f.len() as u64 - 2).sum()
@@ -105,6 +110,17 @@ impl Polytope {
     }
 }
 
+/// Newell's unit normal of a polygon of `n` corners `p(i)`: robust for any planar one.
+fn newell(n: usize, p: impl Fn(usize) -> DVec3) -> DVec3 {
+    (0..n)
+        .map(|i| {
+            let (a, b) = (p(i), p((i + 1) % n));
+            DVec3::new((a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y))
+        })
+        .sum::<DVec3>()
+        .normalize()
+}
+
 /// The [`Solid`](super::Solid) facts every convex polyhedron here states alike, given
 /// its `fn solid(&self) -> Arc<Polytope>`: no half-space, convex, an exact distance and
 /// gradient, and its own faces as its exact mesh at any resolution. Written into each
@@ -113,6 +129,10 @@ macro_rules! polyhedron_facts {
     () => {
         fn half_space(&self) -> Option<(glam::DVec3, f64)> {
             None
+        }
+
+        fn faces(&self) -> Option<Vec<(glam::DVec3, f64)>> {
+            Some(self.solid().face_planes())
         }
 
         fn is_convex(&self) -> bool {

@@ -36,6 +36,10 @@ impl Solid for Sphere {
         None
     }
 
+    fn faces(&self) -> Option<Vec<(DVec3, f64)>> {
+        None
+    }
+
     fn is_convex(&self) -> bool {
         true
     }

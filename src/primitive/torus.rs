@@ -49,6 +49,10 @@ impl Solid for Torus {
         None
     }
 
+    fn faces(&self) -> Option<Vec<(DVec3, f64)>> {
+        None
+    }
+
     fn is_convex(&self) -> bool {
         false
     }

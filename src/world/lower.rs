@@ -31,6 +31,7 @@ struct Reach {
     bounds: Option<Aabb>,
     sphere: Option<(Vec3A, f32)>,
     half_space: Option<(Vec3A, f32)>,
+    faces: Option<Arc<[(Vec3A, f32)]>>,
 }
 
 impl Reach {
@@ -43,7 +44,14 @@ impl Reach {
                 .and_then(|h| ir::transform_half_space(h, to_render))
                 .map(|(n, o)| (n.as_vec3a(), o as f32)),
         };
-        Reach { bounds, sphere, half_space }
+        let faces = bounds.and(ir::shape_faces(shape)).and_then(|faces| {
+            let placed: Option<Vec<_>> = faces
+                .into_iter()
+                .map(|h| ir::transform_half_space(h, to_render).map(|(n, o)| (n.as_vec3a(), o as f32)))
+                .collect();
+            placed.map(Arc::from)
+        });
+        Reach { bounds, sphere, half_space, faces }
     }
 }
 
@@ -242,13 +250,13 @@ fn lower_reusing(
         .into_par_iter()
         .map(|(part, _, span)| {
             let object = match part {
-                Lowered::Sdf(s, Reach { bounds, sphere, half_space }) => {
-                    Object { kind: ObjectKind::Sdf(s), bounds, sphere, half_space, span }
+                Lowered::Sdf(s, Reach { bounds, sphere, half_space, faces }) => {
+                    Object { kind: ObjectKind::Sdf(s), bounds, sphere, half_space, faces, span }
                 }
                 Lowered::Mesh(job) => {
                     let m = job.build();
                     let (bounds, sphere) = (Some(m.bounds()), m.sphere());
-                    Object { bounds, sphere, half_space: None, kind: ObjectKind::Mesh(Arc::new(m)), span }
+                    Object { bounds, sphere, half_space: None, faces: None, kind: ObjectKind::Mesh(Arc::new(m)), span }
                 }
                 Lowered::Kept(object) => object,
             };

@@ -19,10 +19,14 @@ impl World {
             None => (ray.t_min, t_max),
         };
         let (t0, t1) = clip_to_sphere(o, ray, (t0, t1))?;
-        match o.half_space {
-            // A ray marching out of the solid needs its whole interval.
-            Some(h) if ray.inside != i => clip_to_half_space(h, ray, (t0, t1)),
-            _ => Some((t0, t1)),
+        // A ray marching out of the solid needs its whole interval.
+        if ray.inside == i {
+            return Some((t0, t1));
+        }
+        match (o.half_space, &o.faces) {
+            (Some(h), _) => clip_to_half_space(h, ray, (t0, t1)),
+            (None, Some(faces)) => clip_to_faces(faces, 2.0 * self.params.epsilon, ray, (t0, t1)),
+            (None, None) => Some((t0, t1)),
         }
     }
 
@@ -206,6 +210,43 @@ fn clip_to_half_space((n, offset): (Vec3A, f32), ray: &Ray, (t0, t1): (f32, f32)
     let enter = above / closing;
     let t0 = t0.max(enter - enter * 1e-6);
     (t0 <= t1).then_some((t0, t1))
+}
+
+/// `(t0, t1)` from where the ray enters the convex polyhedron `n·p ≤ offset` (every
+/// plane), or `None` if it never comes within the hit threshold of it; moved back by a
+/// millionth of the distance as for a half-space ([`clip_to_half_space`]). The
+/// threshold is at most `reach · t` (`sdf::march::threshold`) and a plane is never
+/// farther than the solid, so no hit the march would take is clipped away: a ray that
+/// misses the solid but grazes it within the threshold starts where it comes within
+/// reach of every plane. The far end is kept, for the march.
+#[inline]
+fn clip_to_faces(faces: &[(Vec3A, f32)], reach: f32, ray: &Ray, (t0, t1): (f32, f32)) -> Option<(f32, f32)> {
+    // [enter, leave] on the solid itself, and on it grown by the threshold.
+    let (mut solid, mut grown) = ((t0, t1), (t0, t1));
+    for &(n, offset) in faces {
+        let above = n.dot(ray.origin) - offset;
+        let closing = -n.dot(ray.dir);
+        for ((enter, leave), closing) in [(&mut solid, closing), (&mut grown, closing + reach)] {
+            // Inside the plane (grown by reach·t) at t: above ≤ t·closing.
+            if closing == 0.0 {
+                if above > 0.0 {
+                    *leave = f32::NEG_INFINITY;
+                }
+                continue;
+            }
+            let t = above / closing;
+            if closing > 0.0 {
+                *enter = enter.max(t - t.abs() * 1e-6);
+            } else {
+                *leave = leave.min(t + t.abs() * 1e-6);
+            }
+        }
+    }
+    match (solid, grown) {
+        ((enter, leave), _) if enter <= leave => Some((enter, t1)),
+        (_, (enter, leave)) if enter <= leave => Some((enter, t1)),
+        _ => None,
+    }
 }
 
 impl Geometry for World {

@@ -194,7 +194,11 @@ fn sweep_writes_csv_with_monotone_errors() {
 
 /// The cost axis that does not depend on the machine: each setting's work (unit
 /// operations per frame) is the same in two sweeps, and finer settings of a back-end
-/// take more of it; the timing columns say how the median was reached.
+/// take more of it; the timing columns say how the median was reached. The coarsest
+/// threshold (1e-2) is left out of the order: it fattens every surface by a percent of
+/// its distance, so more shadow and reflection rays hit (535 and 504 against 491 and
+/// 486 at 1e-3) and the frame holds more work, now that the box and the sphere cost a
+/// march of one step at any threshold (the box clipped to its faces).
 #[test]
 fn sweep_work_is_deterministic_and_grows_with_accuracy() {
     let work = |dir: &std::path::Path| {
@@ -231,7 +235,7 @@ fn sweep_work_is_deterministic_and_grows_with_accuracy() {
     assert_eq!(first, second, "work differs between two sweeps");
     // The thresholds' rungs, coarse to fine, and the mesh details, coarse to fine.
     let rung = |setting: &str| first.iter().find(|(_, s, _)| s == setting).map(|r| r.2).expect("a rung");
-    let sdf = ["epsilon 1e-2 steps 512", "epsilon 1e-3 steps 512", "epsilon 1e-4 steps 512", "epsilon 1e-5 steps 512"];
+    let sdf = ["epsilon 1e-3 steps 512", "epsilon 1e-4 steps 512", "epsilon 1e-5 steps 512"];
     let mesh = ["detail low", "detail high", "detail 28", "detail 56", "detail 112"];
     for ladder in [&sdf[..], &mesh[..]] {
         let works: Vec<f64> = ladder.iter().map(|s| rung(s)).collect();
