@@ -322,6 +322,23 @@ pub enum ExactMesh {
     },
 }
 
+/// A profile swept into a solid, for native evaluation ([`ShapeKind::Field::sweep`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Sweep {
+    /// `[u, v]` as `x`, `z`, from `y = -half_height` to `half_height`.
+    Extrude {
+        /// The profile's region.
+        region: Arc<crate::geom::region::Region>,
+        /// Half the height.
+        half_height: f64,
+    },
+    /// `[u, v]` as the radius from `y` and the height.
+    Revolve {
+        /// The profile's region.
+        region: Arc<crate::geom::region::Region>,
+    },
+}
+
 /// Shape nodes: a primitive leaf, a CSG operator, a modifier, a transform or a material.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ShapeKind {
@@ -385,6 +402,9 @@ pub enum ShapeKind {
         /// prism, a revolved polygon's lathe): the mesh back-end uses it instead of the
         /// isosurface mesher.
         exact: Option<ExactMesh>,
+        /// The sweep it is, when it is one of a region of polygons and circles: the SDF
+        /// back-end evaluates that natively (`sdf::sweep`), the same distance as `body`.
+        sweep: Option<Sweep>,
     },
     /// `warp(shape, p => q)`: the shape seen at `q(p)`, cut to `bounds` when given.
     Warp {

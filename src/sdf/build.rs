@@ -325,6 +325,23 @@ impl<'a> Builder<'a> {
                 let rep2 = rep.clone();
                 (self.sdf(move |p| rep.eval(p, |q| d(q))), self.mat(move |p| rep2.eval_surf(p, |q| m(q))))
             }
+            ShapeKind::Field { sweep: Some(sweep), bounds, .. } => {
+                // Marched as the plain distance it is: no field march, no tape.
+                let swept = std::sync::Arc::new(super::sweep::Swept::new(sweep));
+                self.bytes += swept.bytes() + ARC_HEADER;
+                let (cut, s) = (bounds.as_ref().map(BoxCut::new), swept.clone());
+                (
+                    self.sdf(move |p| {
+                        crate::trace::count_leaf();
+                        field::cut(&cut, p, s.distance(p))
+                    }),
+                    self.mat(move |p| {
+                        crate::trace::count_leaf();
+                        let (d, g) = swept.eval(p);
+                        field::cut_surf(&cut, p, Surf { d, g, mat })
+                    }),
+                )
+            }
             ShapeKind::Field { body, bounds, lipschitz, .. } => {
                 let body = self.body(body, mat);
                 self.last_field = Some((shape as *const Shape as usize, body.clone()));

@@ -11,6 +11,7 @@ mod field;
 pub mod march;
 pub mod prim;
 mod surf;
+mod sweep;
 pub mod union;
 
 use glam::{DAffine3, Vec3A};

@@ -181,7 +181,13 @@ impl Ctx<'_> {
                             Expr::new(Kind::Dist(child.clone(), Expr::vector([qx, y.clone(), qz])), Ty::Num)
                         });
                         let body = copies.reduce(|a, b| bin(Binary::Min, &a, &b)).unwrap_or_else(|| Expr::num(1.0));
-                        return Some(ShapeKind::Field { body, bounds: Some(bounds), lipschitz: exact, exact: None });
+                        return Some(ShapeKind::Field {
+                            body,
+                            bounds: Some(bounds),
+                            lipschitz: exact,
+                            exact: None,
+                            sweep: None,
+                        });
                     }
                     self.report(
                         Diagnostic::warning(

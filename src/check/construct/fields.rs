@@ -110,7 +110,7 @@ impl Ctx<'_> {
                 let bounds = self.bounds(bounds, a.span_of("bounds"))?;
                 let tape = self.field_tape(&lit.body, lit.span)?;
                 let l = self.field_slope(&tape, bounds, given, lit.span, "this field")?;
-                Some(ShapeKind::Field { body: lit.body.clone(), bounds, lipschitz: l, exact: None })
+                Some(ShapeKind::Field { body: lit.body.clone(), bounds, lipschitz: l, exact: None, sweep: None })
             }
             FieldFn::Warp => {
                 let WarpArgs { shape: Value::Shape(child), f: Value::Field(lit), bounds, lipschitz: given } =

@@ -19,7 +19,7 @@ use crate::diag::{codes, Diagnostic};
 use crate::geom::region::{Combine, Region};
 use crate::geom::Aabb;
 use crate::ir::field::{Binary, Expr, Kind, Ty, Unary};
-use crate::ir::{CsgOp, ExactMesh, Lipschitz, ShapeKind};
+use crate::ir::{CsgOp, ExactMesh, Lipschitz, ShapeKind, Sweep};
 use crate::sig::Range;
 use crate::span::Span;
 use crate::syntax::ast::TransformOp;
@@ -391,7 +391,14 @@ impl Ctx<'_> {
                     Region::Polygon(corners) => ExactMesh::Faces(Arc::new(crate::geom::polygon::prism(corners, h))),
                     _ => ExactMesh::Extrusion { region: Arc::new(region.clone()), half_height: h },
                 });
-                Some(ShapeKind::Field { body: corner(&d2, &dy), bounds: Some(bounds), lipschitz: exact, exact: mesh })
+                let sweep = profile.region.clone().map(|region| Sweep::Extrude { region, half_height: h });
+                Some(ShapeKind::Field {
+                    body: corner(&d2, &dy),
+                    bounds: Some(bounds),
+                    lipschitz: exact,
+                    exact: mesh,
+                    sweep,
+                })
             }
             ProfileFn::Revolve => {
                 let RevolveArgs { profile: Value::Profile(profile) } = RevolveArgs::from_args(a) else {
@@ -424,7 +431,8 @@ impl Ctx<'_> {
                     }
                     _ => None,
                 };
-                Some(ShapeKind::Field { body, bounds: Some(bounds), lipschitz: exact, exact: lathe })
+                let sweep = profile.region.clone().map(|region| Sweep::Revolve { region });
+                Some(ShapeKind::Field { body, bounds: Some(bounds), lipschitz: exact, exact: lathe, sweep })
             }
             ProfileFn::Csg(_)
             | ProfileFn::Circle
