@@ -359,10 +359,20 @@ impl<'a> Builder<'a> {
                     }),
                 )
             }
-            ShapeKind::Warp { child, map, bounds, lipschitz, .. } => {
+            ShapeKind::Warp { child, map, bounds, lipschitz, mesh_op } => {
                 let (d, m) = self.build(child, id, mat);
-                let map = self.body(map, mat);
                 let (k, cut) = (1.0 / lipschitz.value as f32, bounds.as_ref().map(BoxCut::new));
+                if let Some(map) = mesh_op.and_then(super::domain::Map::new) {
+                    return (
+                        self.sdf(move |p| field::cut(&cut, p, d(map.apply(p)) * k)),
+                        self.mat(move |p| {
+                            let q = map.apply(p);
+                            let s = m(q);
+                            field::cut_surf(&cut, p, Surf { d: s.d * k, g: map.pull(p, q, s.g) * k, mat: s.mat })
+                        }),
+                    );
+                }
+                let map = self.body(map, mat);
                 let q = map.clone();
                 (
                     self.sdf(move |p| field::cut(&cut, p, d(q.vec(p)) * k)),

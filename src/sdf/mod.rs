@@ -7,6 +7,7 @@
 //! back-end.
 
 mod build;
+mod domain;
 mod field;
 pub mod march;
 pub mod prim;
