@@ -103,6 +103,67 @@ impl Region {
     }
 }
 
+impl Region {
+    /// Points whose convex hull holds the region: polygons' corners, and the corners of
+    /// an octagon around each circle (a subtraction's and an intersection's first part's).
+    fn hull_points(&self, out: &mut Vec<DVec2>) {
+        match self {
+            Region::Polygon(c) => out.extend(c),
+            Region::Circle { centre, r } => {
+                let reach = r / (std::f64::consts::PI / 8.0).cos();
+                out.extend((0..8).map(|i| {
+                    let (sin, cos) = (std::f64::consts::FRAC_PI_4 * (f64::from(i) + 0.5)).sin_cos();
+                    *centre + DVec2::new(cos, sin) * reach
+                }));
+            }
+            Region::Csg(Combine::Union, parts) => parts.iter().for_each(|p| p.hull_points(out)),
+            Region::Csg(_, parts) => {
+                if let Some(first) = parts.first() {
+                    first.hull_points(out);
+                }
+            }
+        }
+    }
+
+    /// The convex hull's edges as lines `n·p ≤ d` (unit `n`), counter-clockwise: they
+    /// hold the region, exactly when it is a convex polygon.
+    pub fn hull_lines(&self) -> Vec<(DVec2, f64)> {
+        let mut pts = Vec::new();
+        self.hull_points(&mut pts);
+        pts.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+        pts.dedup();
+        if pts.len() < 3 {
+            return Vec::new();
+        }
+        // Andrew's monotone chain: lower then upper hull, turning left throughout.
+        let mut hull: Vec<DVec2> = Vec::with_capacity(2 * pts.len());
+        for pass in 0..2 {
+            let start = hull.len();
+            let iter: Box<dyn Iterator<Item = &DVec2>> =
+                if pass == 0 { Box::new(pts.iter()) } else { Box::new(pts.iter().rev()) };
+            for &p in iter {
+                while hull.len() >= start + 2 {
+                    let (a, b) = (hull[hull.len() - 2], hull[hull.len() - 1]);
+                    if (b - a).perp_dot(p - a) > 0.0 {
+                        break;
+                    }
+                    hull.pop();
+                }
+                hull.push(p);
+            }
+            hull.pop();
+        }
+        (0..hull.len())
+            .filter_map(|i| {
+                let (a, b) = (hull[i], hull[(i + 1) % hull.len()]);
+                // The outward normal of a counter-clockwise edge is its direction turned right.
+                let n = DVec2::new(b.y - a.y, a.x - b.x).try_normalize()?;
+                Some((n, n.dot(a)))
+            })
+            .collect()
+    }
+}
+
 /// The prism of `region` from `y = -half_height` to `half_height` (its `[u, v]` as `x`,
 /// `z`), circles with `segments` sides: closed and wound outward, or `None` when the
 /// region comes out empty or too far out to mesh this way.

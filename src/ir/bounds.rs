@@ -178,6 +178,13 @@ fn faces_within(shape: &Shape, g: f64) -> Option<Vec<(DVec3, f64)>> {
             faces_within(child, within_child(g, xf))?.into_iter().map(|h| transform_half_space(h, xf)).collect()
         }
         ShapeKind::Paint { child, .. } => faces_within(child, g),
+        // An extrusion lies within its slab and its profile's convex hull.
+        ShapeKind::Field { sweep: Some(crate::ir::Sweep::Extrude { region, half_height }), .. } => {
+            let lines = region.hull_lines();
+            let sides = lines.into_iter().map(|(n, d)| (DVec3::new(n.x, 0.0, n.y), d));
+            let caps = [(DVec3::Y, *half_height), (-DVec3::Y, *half_height)];
+            Some(grown(sides.chain(caps).collect(), g))
+        }
         ShapeKind::Field { .. } | ShapeKind::Warp { .. } | ShapeKind::Displace { .. } => None,
     }
 }

@@ -253,16 +253,24 @@ fn bounds_contain_the_solid() {
 }
 
 /// A tree's faces (`ir::shape_faces`, the planes a ray is clipped to before its march)
-/// hold every point where its field is at or below zero: boxes and polyhedra turned,
-/// stretched, cut by random solids, rounded and shelled, sharp and smooth.
+/// hold every point where its field is at or below zero: boxes, polyhedra and
+/// extrusions (an L, a holed plate with a disc beside) turned, stretched, cut by random
+/// solids, rounded and shelled, sharp and smooth.
 #[test]
 fn faces_contain_their_solids() {
     let mut rng = Rng(0xface5);
     let (mut inside, mut trees) = (0, 0);
-    let polyhedra = ["box(0.9, 0.5, 0.7)", "octahedron(1)", "pyramid(0.8, 1.2)", "hex_prism(0.8, 0.5)"];
+    let polyhedra = [
+        "box(0.9, 0.5, 0.7)",
+        "octahedron(1)",
+        "pyramid(0.8, 1.2)",
+        "hex_prism(0.8, 0.5)",
+        "extrude(polygon([[0, 0], [1, 0], [1, 0.5], [0.5, 0.5], [0.5, 1], [0, 1]]) at [-0.5, -0.5], 0.6)",
+        "extrude(union(subtract(rect(0.8, 0.6), circle(0.3)), circle(0.4) at [0.8, 0.6]), 0.5)",
+    ];
     for case in 0..120 {
         let mut budget = 20;
-        let mut tree = polyhedra[case % 4].to_string();
+        let mut tree = polyhedra[case % polyhedra.len()].to_string();
         for _ in 0..3 {
             let other = solid(&mut rng, 2, &mut budget);
             tree = match rng.below(7) {
@@ -298,7 +306,8 @@ fn faces_contain_their_solids() {
 /// A polyhedron's rays are clipped to its faces before they are marched: they hit
 /// where the march of the same distance without faces (a union of it alone) hits and
 /// miss where it misses, each hit within its threshold of the surface, for 4,000 rays
-/// aimed at and around each of a turned box, octahedron, pyramid and hex prism; and
+/// aimed at and around each of a turned box, octahedron, pyramid, hex prism and
+/// extruded triangle; and
 /// they take fewer steps. (Along a ray grazing an edge the two hits may be apart: the
 /// march stops where it first comes within the threshold, the clipped ray where it
 /// enters the solid.)
@@ -306,7 +315,14 @@ fn faces_contain_their_solids() {
 fn rays_clipped_to_faces_hit_where_the_march_does() {
     use scnc::trace::{Counters, Geometry, Ray};
     let mut rng = Rng(0xc119);
-    for solid in ["box(0.9, 0.5, 0.7)", "octahedron(1)", "pyramid(0.8, 1.2)", "hex_prism(0.8, 0.5)"] {
+    let solids = [
+        "box(0.9, 0.5, 0.7)",
+        "octahedron(1)",
+        "pyramid(0.8, 1.2)",
+        "hex_prism(0.8, 0.5)",
+        "extrude(polygon([[-0.8, -0.5], [0.9, -0.3], [0.1, 0.8]]), 0.4)",
+    ];
+    for solid in solids {
         // The camera at the origin looking along +z: render space is scene space.
         let text = |s: &str| {
             format!(
