@@ -364,7 +364,13 @@ impl<'a> Builder<'a> {
                 let (k, cut) = (1.0 / lipschitz.value as f32, bounds.as_ref().map(BoxCut::new));
                 if let Some(map) = mesh_op.and_then(super::domain::Map::new) {
                     return (
-                        self.sdf(move |p| field::cut(&cut, p, d(map.apply(p)) * k)),
+                        self.sdf(move |p| {
+                            // A step of at most |v| stays within the ball where the
+                            // local stretch holds.
+                            let v = d(map.apply(p));
+                            let local = map.stretch(p, v.abs()).map_or(k, |s| 1.0 / s);
+                            field::cut(&cut, p, v * local)
+                        }),
                         self.mat(move |p| {
                             let q = map.apply(p);
                             let s = m(q);
