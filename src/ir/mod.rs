@@ -289,11 +289,15 @@ impl CsgOp {
     }
 }
 
-/// A domain operation whose mesh is made from its child's own mesh.
+/// The builtin domain operation a warp is: the SDF back-end evaluates its map natively
+/// (`sdf::domain`), and the mesh back-end makes its mesh from the child's own where it
+/// can (all but `bend`, which the isosurface mesher meshes).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum MeshOp {
+pub enum DomainOp {
     /// `twist(s, k)`: `k` degrees per unit about `y`.
     Twist(f64),
+    /// `bend(s, k)`: the point at height `y` turned about `z` by `k·y` degrees.
+    Bend(f64),
     /// `polar(s, count)` of a part within its sector: `count` copies turned about `y`.
     Polar(u32),
     /// `elongate(s, h)`: the halves moved apart by `±h` along each axis, a band between.
@@ -416,9 +420,8 @@ pub enum ShapeKind {
         bounds: Option<Aabb>,
         /// The bound of how much the map stretches a distance.
         lipschitz: Lipschitz,
-        /// What the warp is when a builtin made it and the mesher can make its mesh from
-        /// the child's own instead of meshing the isosurface.
-        mesh_op: Option<MeshOp>,
+        /// The domain operation the warp is, when a builtin made it.
+        domain_op: Option<DomainOp>,
     },
     /// `displace(shape, p => d)`: the shape's distance plus `d(p)`.
     Displace {

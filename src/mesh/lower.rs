@@ -49,7 +49,7 @@ pub fn tessellate(
         }
     }
     let made = match &node.kind {
-        ShapeKind::Warp { child, mesh_op: Some(op), .. } => from_child(child, *op, detail),
+        ShapeKind::Warp { child, domain_op: Some(op), .. } => from_child(child, *op, detail),
         _ => own_tessellation(node, detail),
     };
     match made {
@@ -178,7 +178,7 @@ fn exact_tessellation(exact: &ExactMesh, detail: Detail) -> Tessellation {
 /// and `symmetric` cut it at the axes' planes (`geom::slab`). The
 /// isosurface where the child has no mesh of its own. A twist is charged the most the
 /// splitting can make (each round splits a triangle into four at most).
-fn from_child(child: &Shape, op: ir::MeshOp, detail: Detail) -> Tessellation {
+fn from_child(child: &Shape, op: ir::DomainOp, detail: Detail) -> Tessellation {
     let (mut node, mut xf) = (child, DAffine3::IDENTITY);
     while let ShapeKind::Transform { child, xf: inner } = &node.kind {
         xf *= *inner;
@@ -197,7 +197,9 @@ fn from_child(child: &Shape, op: ir::MeshOp, detail: Detail) -> Tessellation {
         mesh
     };
     match op {
-        ir::MeshOp::Twist(k) => {
+        // Its inverse map has no closed form to move the child's vertices by.
+        ir::DomainOp::Bend(_) => Tessellation::Isosurface,
+        ir::DomainOp::Twist(k) => {
             let step = 360.0 / f64::from(detail.circle());
             let rounds = super::twist::rounds(b.max.y - b.min.y, k, step);
             let most = count.saturating_mul(4u64.saturating_pow(rounds));
@@ -208,16 +210,16 @@ fn from_child(child: &Shape, op: ir::MeshOp, detail: Detail) -> Tessellation {
             }
             Tessellation::Triangles(most, Box::new(move || super::twist::twisted(placed(), k, step, rounds)))
         }
-        ir::MeshOp::Polar(copies) => Tessellation::Triangles(
+        ir::DomainOp::Polar(copies) => Tessellation::Triangles(
             count.saturating_mul(u64::from(copies)),
             Box::new(move || super::twist::copies_about_y(&placed(), copies)),
         ),
         // What a cut makes depends on where the plane meets the mesh, so the mesh is made
         // here (in linear time) and charged what it has; past a few million triangles in
         // the child, the isosurface instead, as for a twist.
-        ir::MeshOp::Elongate(_) | ir::MeshOp::Mirror(_) if count > 1 << 22 => Tessellation::Isosurface,
-        ir::MeshOp::Elongate(h) => made(crate::geom::slab::elongated(placed(), h)),
-        ir::MeshOp::Mirror(axes) => made(crate::geom::slab::mirrored(placed(), axes)),
+        ir::DomainOp::Elongate(_) | ir::DomainOp::Mirror(_) if count > 1 << 22 => Tessellation::Isosurface,
+        ir::DomainOp::Elongate(h) => made(crate::geom::slab::elongated(placed(), h)),
+        ir::DomainOp::Mirror(axes) => made(crate::geom::slab::mirrored(placed(), axes)),
     }
 }
 

@@ -359,10 +359,10 @@ impl<'a> Builder<'a> {
                     }),
                 )
             }
-            ShapeKind::Warp { child, map, bounds, lipschitz, mesh_op } => {
+            ShapeKind::Warp { child, map, bounds, lipschitz, domain_op } => {
                 let (d, m) = self.build(child, id, mat);
                 let (k, cut) = (1.0 / lipschitz.value as f32, bounds.as_ref().map(BoxCut::new));
-                if let Some(map) = mesh_op.and_then(super::domain::Map::new) {
+                if let Some(map) = domain_op.and_then(super::domain::Map::new) {
                     return (
                         self.sdf(move |p| {
                             // A step of at most |v| stays within the ball where the

@@ -1,17 +1,19 @@
-//! Domain operations' maps evaluated natively: `twist`, `elongate` and `symmetric` move
+//! Domain operations' maps evaluated natively: `twist`, `bend`, `elongate` and `symmetric` move
 //! the point by a few operations each, which the field interpreter paid a dispatch for
 //! one by one. Each is the map its `warp` body states (`check::construct::domain`), and
 //! the chain rule carries the shape's gradient back through it.
 
 use glam::Vec3A;
 
-use crate::ir::MeshOp;
+use crate::ir::DomainOp;
 
 /// A native map of the point.
 #[derive(Clone, Copy, Debug)]
 pub enum Map {
     /// Turned about `y` by `k` radians per unit of height, backwards.
     Twist(f32),
+    /// Turned about `z` by `k` radians per unit of height.
+    Bend(f32),
     /// The slab `[-h, h]` taken out.
     Elongate(Vec3A),
     /// Mirrored where the flag is 1: the absolute value of those components.
@@ -20,12 +22,13 @@ pub enum Map {
 
 impl Map {
     /// The native form of a domain operation's map, where there is one.
-    pub fn new(op: MeshOp) -> Option<Map> {
+    pub fn new(op: DomainOp) -> Option<Map> {
         match op {
-            MeshOp::Twist(k) => Some(Map::Twist(k.to_radians() as f32)),
-            MeshOp::Elongate(h) => Some(Map::Elongate(h.as_vec3a())),
-            MeshOp::Mirror(axes) => Some(Map::Mirror(Vec3A::from(axes.map(|a| if a { 1.0 } else { 0.0 })))),
-            MeshOp::Polar(_) => None,
+            DomainOp::Twist(k) => Some(Map::Twist(k.to_radians() as f32)),
+            DomainOp::Bend(k) => Some(Map::Bend(k.to_radians() as f32)),
+            DomainOp::Elongate(h) => Some(Map::Elongate(h.as_vec3a())),
+            DomainOp::Mirror(axes) => Some(Map::Mirror(Vec3A::from(axes.map(|a| if a { 1.0 } else { 0.0 })))),
+            DomainOp::Polar(_) => None,
         }
     }
 
@@ -37,6 +40,10 @@ impl Map {
                 // rotate [0, a, 0] turned the slice; (x, z) is turned by a·y back.
                 let (s, c) = (k * p.y).sin_cos();
                 Vec3A::new(p.x * c - p.z * s, p.y, p.x * s + p.z * c)
+            }
+            Map::Bend(k) => {
+                let (s, c) = (k * p.y).sin_cos();
+                Vec3A::new(p.x * c - p.y * s, p.x * s + p.y * c, p.z)
             }
             Map::Elongate(h) => p - p.clamp(-h, h),
             Map::Mirror(m) => Vec3A::select(m.cmpgt(Vec3A::ZERO), p.abs(), p),
@@ -56,6 +63,14 @@ impl Map {
                 let a = k.abs() * (p.x.hypot(p.z) + reach);
                 Some(0.5 * (a + (a * a + 4.0).sqrt()))
             }
+            // J = R(θ)·M in x, y, with M = [[1, −k·y], [0, 1 + k·x]]; M's largest singular
+            // value grows with |k·y| and |1 + k·x|, so their largest over the ball bound it.
+            Map::Bend(k) => {
+                let b = k.abs() * (p.y.abs() + reach);
+                let d = (1.0 + k * (p.x - reach)).abs().max((1.0 + k * (p.x + reach)).abs());
+                let t = 1.0 + b * b + d * d;
+                Some((0.5 * (t + (t * t - 4.0 * d * d).max(0.0).sqrt())).sqrt())
+            }
             Map::Elongate(_) | Map::Mirror(_) => None,
         }
     }
@@ -68,6 +83,11 @@ impl Map {
             Map::Twist(k) => {
                 let (s, c) = (k * p.y).sin_cos();
                 Vec3A::new(g.x * c + g.z * s, g.y + k * (q.x * g.z - q.z * g.x), g.z * c - g.x * s)
+            }
+            Map::Bend(k) => {
+                let (s, c) = (k * p.y).sin_cos();
+                let dy = (-s - k * q.y) * g.x + (c + k * q.x) * g.y;
+                Vec3A::new(c * g.x + s * g.y, dy, g.z)
             }
             // Inside the slab the point does not move the map: no slope along that axis.
             Map::Elongate(h) => Vec3A::select(p.abs().cmpgt(h), g, Vec3A::ZERO),
@@ -86,7 +106,7 @@ mod tests {
     use glam::DVec3;
 
     use super::Map;
-    use crate::ir::{Geometry, ShapeKind};
+    use crate::ir::{DomainOp, Geometry, ShapeKind};
 
     /// Each native map lands where its `warp` body does, at random points, and its pulled
     /// gradient is the slope of a linear function read through it.
@@ -114,7 +134,7 @@ mod tests {
                 &crate::source::FsLoader,
             );
             let Geometry::Shape(s) = c.scene.expect("compiles").objects[0].geometry.clone() else { panic!("a shape") };
-            let ShapeKind::Warp { map, mesh_op: Some(op), .. } = &s.kind else { panic!("{text}: not a warp") };
+            let ShapeKind::Warp { map, domain_op: Some(op), .. } = &s.kind else { panic!("{text}: not a warp") };
             let native = Map::new(*op).expect("a native map");
             let none = |_: &Arc<crate::ir::Shape>, _: DVec3| 0.0;
             for _ in 0..1_000 {
@@ -137,9 +157,9 @@ mod tests {
         }
     }
 
-    /// A twist's stretch bounds how far the map moves two points apart, relative to
-    /// their distance, at random points and directions, and is reached: some direction
-    /// stretches by nearly as much (so the march's local step is not needlessly short).
+    /// A twist's and a bend's stretch bound how far the map moves two points apart,
+    /// relative to their distance, at random points and directions, and are reached within
+    /// a tenth: the march's local step is not needlessly short.
     #[test]
     fn a_twists_stretch_bounds_and_is_reached() {
         let mut seed = 0x7_u64 << 40;
@@ -149,8 +169,10 @@ mod tests {
             seed ^= seed << 17;
             (seed >> 11) as f32 / (1u64 << 53) as f32 * 4.0 - 2.0
         };
-        for degrees in [15.0, 90.0, -200.0] {
-            let map = Map::new(crate::ir::MeshOp::Twist(degrees)).expect("a twist");
+        let ops = [15.0, 90.0, -200.0].into_iter().flat_map(|d| [DomainOp::Twist(d), DomainOp::Bend(d)]);
+        for op in ops {
+            let map = Map::new(op).expect("a map");
+            let degrees = format!("{op:?}");
             for _ in 0..300 {
                 let p = glam::Vec3A::new(next(), next(), next());
                 let bound = map.stretch(p, 1e-3).expect("a bound");
@@ -158,10 +180,10 @@ mod tests {
                 for _ in 0..200 {
                     let u = glam::Vec3A::new(next(), next(), next()).normalize_or(glam::Vec3A::X);
                     let moved = (map.apply(p + u * 1e-3) - map.apply(p)).length() / 1e-3;
-                    assert!(moved <= bound * 1.002, "{degrees}°/unit at {p}: {moved} over {bound}");
+                    assert!(moved <= bound * 1.002, "{degrees} at {p}: {moved} over {bound}");
                     most = most.max(moved);
                 }
-                assert!(most >= 0.9 * map.stretch(p, 0.0).expect("a bound"), "{degrees}° at {p}: {most} of {bound}");
+                assert!(most >= 0.9 * map.stretch(p, 0.0).expect("a bound"), "{degrees} at {p}: {most} of {bound}");
             }
         }
     }

@@ -24,7 +24,7 @@
 //!   through it), at least its own diameter: `tests/data/ladder/sphere.scn`, a glass
 //!   sphere over a floor, is then within 1.5 % of the SDF sphere's pixels at `pixel`.
 
-use crate::ir::{self, ExactMesh, Facets, Geometry, MeshOp, Scene, Shape, ShapeKind};
+use crate::ir::{self, DomainOp, ExactMesh, Facets, Geometry, Scene, Shape, ShapeKind};
 use crate::mesh::Detail;
 
 /// A geometric error bound.
@@ -118,7 +118,7 @@ fn curvature_radius(shape: &Shape, scale: f64) -> (f64, Option<f64>) {
         }
         // A twist of a shape with a mesh of its own splits that mesh's edges by a
         // circle's step (`mesh::twist`): a circle about `y` through its farthest point.
-        ShapeKind::Warp { child, mesh_op: Some(MeshOp::Twist(_)), .. } => {
+        ShapeKind::Warp { child, domain_op: Some(DomainOp::Twist(_)), .. } => {
             match (curvature_radius(child, scale), ir::shape_bounds(child)) {
                 ((r, None), Some(b)) => (r.max(b.radius_about_y() * scale), None),
                 _ => isosurface(),
@@ -126,7 +126,9 @@ fn curvature_radius(shape: &Shape, scale: f64) -> (f64, Option<f64>) {
         }
         // Copies of a part, its halves moved apart or mirrored: the part's.
         ShapeKind::Warp {
-            child, mesh_op: Some(MeshOp::Polar(_) | MeshOp::Elongate(_) | MeshOp::Mirror(_)), ..
+            child,
+            domain_op: Some(DomainOp::Polar(_) | DomainOp::Elongate(_) | DomainOp::Mirror(_)),
+            ..
         } => curvature_radius(child, scale),
         ShapeKind::Csg { .. }
         | ShapeKind::Round { .. }

@@ -14,7 +14,7 @@ use crate::check::{Ctx, Value};
 use crate::diag::{codes, Diagnostic};
 use crate::geom::Aabb;
 use crate::ir::field::{Binary, Expr, Kind, Ty, Unary};
-use crate::ir::{self, Lipschitz, MeshOp, Shape, ShapeKind};
+use crate::ir::{self, DomainOp, Lipschitz, Shape, ShapeKind};
 use crate::sig::Range;
 use crate::span::Span;
 
@@ -110,7 +110,7 @@ impl Ctx<'_> {
                 let map = Expr::vector([qx, y.clone(), qz]);
                 let r = b.radius_about_y();
                 let bounds = Aabb { min: DVec3::new(-r, b.min.y, -r), max: DVec3::new(r, b.max.y, r) };
-                self.warp(child, map, bounds, span, "this twist", Some(MeshOp::Twist(k)))
+                self.warp(child, map, bounds, span, "this twist", Some(DomainOp::Twist(k)))
             }
             FieldFn::Bend => {
                 let BendArgs { shape: Value::Shape(child), degrees_per_unit: k } = BendArgs::from_args(a) else {
@@ -124,7 +124,8 @@ impl Ctx<'_> {
                 let map = Expr::vector([qx, qy, z.clone()]);
                 // A turn about the origin keeps the distance from it.
                 let r = b.min.abs().max(b.max.abs()).length();
-                self.warp(child, map, Aabb { min: DVec3::splat(-r), max: DVec3::splat(r) }, span, "this bend", None)
+                let bounds = Aabb { min: DVec3::splat(-r), max: DVec3::splat(r) };
+                self.warp(child, map, bounds, span, "this bend", Some(DomainOp::Bend(k)))
             }
             FieldFn::Elongate => {
                 let ElongateArgs { shape: Value::Shape(child), by: h } = ElongateArgs::from_args(a) else {
@@ -138,8 +139,8 @@ impl Ctx<'_> {
                     bin(Binary::Sub, &c, &clamped)
                 });
                 let bounds = ir::shape_bounds(&child).map(|b| Aabb { min: b.min - h, max: b.max + h });
-                let mesh_op = Some(MeshOp::Elongate(h));
-                Some(ShapeKind::Warp { child, map: Expr::vector(q), bounds, lipschitz: exact, mesh_op })
+                let domain_op = Some(DomainOp::Elongate(h));
+                Some(ShapeKind::Warp { child, map: Expr::vector(q), bounds, lipschitz: exact, domain_op })
             }
             FieldFn::Symmetric => {
                 let SymmetricArgs { shape: Value::Shape(child), axes } = SymmetricArgs::from_args(a) else {
@@ -162,8 +163,8 @@ impl Ctx<'_> {
                     }
                     Aabb { min: lo, max: hi }
                 });
-                let mesh_op = Some(MeshOp::Mirror(mirrored));
-                Some(ShapeKind::Warp { child, map: Expr::vector(q), bounds, lipschitz: exact, mesh_op })
+                let domain_op = Some(DomainOp::Mirror(mirrored));
+                Some(ShapeKind::Warp { child, map: Expr::vector(q), bounds, lipschitz: exact, domain_op })
             }
             FieldFn::Polar => {
                 let PolarArgs { shape: Value::Shape(child), count } = PolarArgs::from_args(a) else {
@@ -213,8 +214,8 @@ impl Ctx<'_> {
                 let (qx, qz) = turn(&x, &z, &back);
                 let map = Expr::vector([qx, y.clone(), qz]);
                 // Within its sector, a part's copies are apart: their mesh is the part's, copied.
-                let mesh_op = (!self.crosses_sector(&b, w)).then_some(MeshOp::Polar(count));
-                Some(ShapeKind::Warp { child, map, bounds: Some(bounds), lipschitz: exact, mesh_op })
+                let domain_op = (!self.crosses_sector(&b, w)).then_some(DomainOp::Polar(count));
+                Some(ShapeKind::Warp { child, map, bounds: Some(bounds), lipschitz: exact, domain_op })
             }
             FieldFn::Field | FieldFn::Warp | FieldFn::Displace => None,
         }
@@ -228,11 +229,11 @@ impl Ctx<'_> {
         bounds: Aabb,
         span: Span,
         what: &str,
-        mesh_op: Option<MeshOp>,
+        domain_op: Option<DomainOp>,
     ) -> Option<ShapeKind> {
         let tape = self.field_tape(&map, span)?;
         let lipschitz = self.field_slope(&tape, Some(bounds), None, span, what)?;
-        Some(ShapeKind::Warp { child, map, bounds: Some(bounds), lipschitz, mesh_op })
+        Some(ShapeKind::Warp { child, map, bounds: Some(bounds), lipschitz, domain_op })
     }
 
     /// The shape's box, or `None` after reporting that `op` needs one.

@@ -121,7 +121,7 @@ impl Ctx<'_> {
                 let bounds = self.bounds(bounds, a.span_of("bounds"))?;
                 let tape = self.field_tape(&lit.body, lit.span)?;
                 let l = self.field_slope(&tape, bounds, given, lit.span, "this warp")?;
-                Some(ShapeKind::Warp { child, map: lit.body.clone(), bounds, lipschitz: l, mesh_op: None })
+                Some(ShapeKind::Warp { child, map: lit.body.clone(), bounds, lipschitz: l, domain_op: None })
             }
             FieldFn::Twist | FieldFn::Bend | FieldFn::Elongate | FieldFn::Symmetric | FieldFn::Polar => None,
             FieldFn::Displace => {
