@@ -105,8 +105,9 @@ mod tests {
 
     use glam::DVec3;
 
+    use super::super::testing::{only_shape, uniform};
     use super::Map;
-    use crate::ir::{DomainOp, Geometry, ShapeKind};
+    use crate::ir::{DomainOp, ShapeKind};
 
     /// Each native map lands where its `warp` body does, at random points, and its pulled
     /// gradient is the slope of a linear function read through it.
@@ -118,22 +119,9 @@ mod tests {
             "elongate(box(0.5), [0.3, 0, 0.7])",
             "symmetric(box(0.5), \"xz\")",
         ];
-        let mut seed = 0xd0_u64 << 8;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 2.0
-        };
+        let mut next = uniform(0xd000, -2.0, 2.0);
         for text in ops {
-            let path = std::path::Path::new("t.scn");
-            let c = crate::compile_source(
-                "t.scn",
-                path,
-                format!("light ambient(1)\nobject {text}\n"),
-                &crate::source::FsLoader,
-            );
-            let Geometry::Shape(s) = c.scene.expect("compiles").objects[0].geometry.clone() else { panic!("a shape") };
+            let s = only_shape(text);
             let ShapeKind::Warp { map, domain_op: Some(op), .. } = &s.kind else { panic!("{text}: not a warp") };
             let native = Map::new(*op).expect("a native map");
             let none = |_: &Arc<crate::ir::Shape>, _: DVec3| 0.0;
@@ -162,12 +150,9 @@ mod tests {
     /// a tenth: the march's local step is not needlessly short.
     #[test]
     fn a_twists_stretch_bounds_and_is_reached() {
-        let mut seed = 0x7_u64 << 40;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f32 / (1u64 << 53) as f32 * 4.0 - 2.0
+        let mut next = {
+            let mut f = uniform(0x7 << 40, -2.0, 2.0);
+            move || f() as f32
         };
         let ops = [15.0, 90.0, -200.0].into_iter().flat_map(|d| [DomainOp::Twist(d), DomainOp::Bend(d)]);
         for op in ops {

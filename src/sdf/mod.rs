@@ -13,6 +13,8 @@ pub mod march;
 pub mod prim;
 mod surf;
 mod sweep;
+#[cfg(test)]
+mod testing;
 pub mod union;
 
 use glam::{DAffine3, Vec3A};

@@ -155,20 +155,13 @@ mod tests {
 
     use glam::{DVec3, Vec3A};
 
+    use super::super::testing::{only_shape, uniform};
     use super::Swept;
-    use crate::ir::{Geometry, ShapeKind};
+    use crate::ir::ShapeKind;
 
     /// The sweep of the scene's only object, with its field body.
     fn sweep_of(text: &str) -> (Swept, Arc<crate::ir::field::Expr>) {
-        let path = std::path::Path::new("t.scn");
-        let c = crate::compile_source(
-            "t.scn",
-            path,
-            format!("light ambient(1)\nobject {text}\n"),
-            &crate::source::FsLoader,
-        );
-        let scene = c.scene.expect("compiles");
-        let Geometry::Shape(mut s) = scene.objects[0].geometry.clone() else { panic!("a shape") };
+        let mut s = only_shape(text);
         loop {
             match &s.kind {
                 ShapeKind::Field { sweep: Some(sweep), body, .. } => return (Swept::new(sweep), body.clone()),
@@ -194,13 +187,7 @@ mod tests {
             "shell(circle(0.7), 0.2)",
             "round(circle(0.4), 0.1) at [0.9, 0.2]",
         ];
-        let mut seed = 0x5eed_u64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 2.0
-        };
+        let mut next = uniform(0x5eed, -2.0, 2.0);
         let none = |_: &Arc<crate::ir::Shape>, _: DVec3| 0.0;
         for profile in profiles {
             for text in [format!("extrude({profile}, 0.6)"), format!("revolve({profile} at [1.2, 0])")] {

@@ -252,6 +252,26 @@ fn bounds_contain_the_solid() {
     assert!(inside > 1_000, "only {inside} points fell inside the solids");
 }
 
+/// `tree` cut by three random solids, rounded, shelled, turned or stretched in turn, each
+/// operation picked at random, sharp or smooth (a smooth subtraction when `smooth_cut`).
+fn cut_about(rng: &mut Rng, mut tree: String, smooth_cut: bool) -> String {
+    let mut budget = 20;
+    for _ in 0..3 {
+        let other = solid(rng, 2, &mut budget);
+        tree = match rng.below(7) {
+            0 => format!("intersect({tree}, {other})"),
+            1 => format!("intersect({other}, {tree}, smooth = {})", 0.05 + 0.3 * rng.f32()),
+            2 if smooth_cut => format!("subtract({tree}, {other}, smooth = {})", 0.3 * rng.f32()),
+            2 => format!("subtract({tree}, {other})"),
+            3 => format!("round({tree}, {})", 0.02 + 0.2 * rng.f32()),
+            4 => format!("shell({tree}, {})", 0.02 + 0.2 * rng.f32()),
+            5 => format!("({tree}) rotate [{}, {}, 0]", rng.below(180), rng.below(180)),
+            _ => format!("({tree}) scale [{}, 1, {}]", 0.3 + 2.0 * rng.f32(), 0.3 + 2.0 * rng.f32()),
+        };
+    }
+    tree
+}
+
 /// A tree's faces (`ir::shape_faces`, the planes a ray is clipped to before its march)
 /// hold every point where its field is at or below zero: boxes, polyhedra and
 /// extrusions (an L, a holed plate with a disc beside) turned, stretched, cut by random
@@ -269,20 +289,7 @@ fn faces_contain_their_solids() {
         "extrude(union(subtract(rect(0.8, 0.6), circle(0.3)), circle(0.4) at [0.8, 0.6]), 0.5)",
     ];
     for case in 0..120 {
-        let mut budget = 20;
-        let mut tree = polyhedra[case % polyhedra.len()].to_string();
-        for _ in 0..3 {
-            let other = solid(&mut rng, 2, &mut budget);
-            tree = match rng.below(7) {
-                0 => format!("intersect({tree}, {other})"),
-                1 => format!("intersect({other}, {tree}, smooth = {})", 0.05 + 0.3 * rng.f32()),
-                2 => format!("subtract({tree}, {other}, smooth = {})", 0.3 * rng.f32()),
-                3 => format!("round({tree}, {})", 0.02 + 0.2 * rng.f32()),
-                4 => format!("shell({tree}, {})", 0.02 + 0.2 * rng.f32()),
-                5 => format!("({tree}) rotate [{}, {}, 0]", rng.below(180), rng.below(180)),
-                _ => format!("({tree}) scale [{}, 1, {}]", 0.3 + 2.0 * rng.f32(), 0.3 + 2.0 * rng.f32()),
-            };
-        }
+        let tree = cut_about(&mut rng, polyhedra[case % polyhedra.len()].to_string(), true);
         let text = format!("light ambient(1)\nobject {tree} at [0, 0, 8]\n");
         let shape = &shape_of(&text);
         let faces = scnc::ir::shape_faces(shape).unwrap_or_else(|| panic!("case {case}: no faces\n{text}"));
@@ -367,22 +374,10 @@ fn half_spaces_contain_unbounded_solids() {
     let mut rng = Rng(0x4a1f_5bac);
     let mut inside = 0;
     for case in 0..80 {
-        let mut budget = 20;
         let mut num = |lo: f32, hi: f32| lo + (hi - lo) * rng.f32();
         let (nx, ny, nz) = (num(-1.0, 1.0), num(-1.0, 1.0), num(-1.0, 1.0));
-        let mut tree = format!("plane([{nx}, {ny}, {nz}], {})", num(-1.0, 1.0));
-        for _ in 0..3 {
-            let other = solid(&mut rng, 2, &mut budget);
-            tree = match rng.below(7) {
-                0 => format!("intersect({tree}, {other})"),
-                1 => format!("intersect({other}, {tree}, smooth = {})", 0.05 + 0.3 * rng.f32()),
-                2 => format!("subtract({tree}, {other})"),
-                3 => format!("round({tree}, {})", 0.02 + 0.2 * rng.f32()),
-                4 => format!("shell({tree}, {})", 0.02 + 0.2 * rng.f32()),
-                5 => format!("({tree}) rotate [{}, {}, 0]", rng.below(180), rng.below(180)),
-                _ => format!("({tree}) scale [{}, 1, {}]", 0.3 + 2.0 * rng.f32(), 0.3 + 2.0 * rng.f32()),
-            };
-        }
+        let plane = format!("plane([{nx}, {ny}, {nz}], {})", num(-1.0, 1.0));
+        let tree = cut_about(&mut rng, plane, false);
         let text = format!("light ambient(1)\nobject {tree} at [0, 0, 8]\n");
         let shape = &shape_of(&text);
         if scnc::ir::shape_bounds(shape).is_some() {
