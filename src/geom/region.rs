@@ -182,6 +182,45 @@ pub fn extrusion(region: &Region, half_height: f64, segments: u32) -> Option<Tri
     (!triangles.is_empty()).then(|| prism_of_caps(&points, &triangles, half_height))
 }
 
+/// The solid of `region` revolved about `y` in `segments` steps (its `[u, v]` the
+/// radius and the height; a part at `u < 0` clipped, as the distance clips it), circles
+/// with `segments` sides: each outline revolved as a lathe, each hole's turned inside
+/// out. `None` when the region comes out empty, too far out, or with an outline that
+/// meets the axis other than along one edge or at one corner (`polygon::lathe_ok`).
+pub fn revolution(region: &Region, segments: u32) -> Option<TriMesh> {
+    if !region.in_reach() {
+        return None;
+    }
+    let shapes = region.shapes(segments);
+    let far = shapes.iter().flatten().flatten().fold(1.0f64, |m, p| m.max(p[0].abs()).max(p[1].abs())) * 2.0;
+    let half_plane = vec![vec![[0.0, -far], [far, -far], [far, far], [0.0, far]]];
+    let clipped = shapes.overlay(&half_plane, OverlayRule::Intersect, FillRule::NonZero);
+    let on_axis = far * SNAP_TO_AXIS;
+    let mut out = TriMesh::default();
+    for shape in clipped {
+        for (k, contour) in shape.iter().enumerate() {
+            let corners: Vec<DVec2> =
+                contour.iter().map(|p| DVec2::new(if p[0] <= on_axis { 0.0 } else { p[0] }, p[1])).collect();
+            if !super::polygon::lathe_ok(&corners) {
+                return None;
+            }
+            let mut m = super::polygon::lathe(&corners, segments);
+            // The first contour is the outline, the others its holes.
+            if k > 0 {
+                m.triangles.iter_mut().for_each(|t| t.swap(1, 2));
+            }
+            let base = out.positions.len() as u32;
+            out.positions.extend(m.positions);
+            out.triangles.extend(m.triangles.iter().map(|t| t.map(|i| i + base)));
+        }
+    }
+    (!out.triangles.is_empty()).then_some(out)
+}
+
+/// Corners this close to the axis, relative to the region's extent, are on it: the
+/// overlay's integer grid leaves the clip's edge a rounding away from `u = 0`.
+const SNAP_TO_AXIS: f64 = 1e-9;
+
 /// A prism from a triangulated cap (`[u, v]` points, triangles of either winding): the
 /// cap at both heights and a quad on every edge of the cap's rim, so the walls meet the
 /// caps at the very same corners whatever the triangulation made of the outline.
@@ -269,5 +308,31 @@ mod tests {
         // Within the overlay's integer grid (about 1e-9 of the extent) of the polygons'.
         assert!((ring.signed_volume() - want).abs() < 1e-8, "{} not {want}", ring.signed_volume());
         assert!(extrusion(&Region::Csg(Combine::Subtract, vec![rect(DVec2::splat(0.5)), a]), 0.5, 32).is_none());
+    }
+
+    /// A disc off the axis revolves into a closed torus, a disc on it into a closed
+    /// ball (its left half clipped), a ring into a torus with a toroidal hole; each holds
+    /// its polygon's volume by Pappus (area times the path of its centroid).
+    #[test]
+    fn revolved_regions_are_closed_and_hold_pappus_volumes() {
+        let n = 48;
+        let area = |r: f64| 0.5 * f64::from(n) * r * r * (std::f64::consts::TAU / f64::from(n)).sin();
+        let disc = |centre: DVec2, r: f64| Region::Circle { centre, r };
+        let torus = revolution(&disc(DVec2::new(1.0, 0.2), 0.3), n).expect("a torus");
+        assert_eq!(torus.open_edges(), (0, 0));
+        // The revolved polygon's path is itself a polygon of n sides: its centroid's
+        // circle shrinks to the inscribed perimeter, n·sin(2π/n)/(2π) of it.
+        let path = f64::from(n) * (std::f64::consts::TAU / f64::from(n)).sin() / std::f64::consts::TAU;
+        let want = area(0.3) * std::f64::consts::TAU * 1.0 * path;
+        assert!((torus.signed_volume() - want).abs() < 1e-6 * want, "{} not {want}", torus.signed_volume());
+        let ball = revolution(&disc(DVec2::ZERO, 0.5), n).expect("a ball");
+        assert_eq!(ball.open_edges(), (0, 0));
+        assert!((ball.signed_volume() - 4.0 / 3.0 * std::f64::consts::PI * 0.125).abs() < 0.02 * 0.52);
+        let ring =
+            Region::Csg(Combine::Subtract, vec![disc(DVec2::new(1.0, 0.0), 0.4), disc(DVec2::new(1.0, 0.0), 0.2)]);
+        let hollow = revolution(&ring, n).expect("a hollow torus");
+        assert_eq!(hollow.open_edges(), (0, 0));
+        let want = (area(0.4) - area(0.2)) * std::f64::consts::TAU * path;
+        assert!((hollow.signed_volume() - want).abs() < 1e-6 * want, "{} not {want}", hollow.signed_volume());
     }
 }

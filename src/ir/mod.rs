@@ -315,6 +315,15 @@ pub enum ExactMesh {
     /// axis next to each other) revolved about `y`: tessellated at lowering with as many
     /// segments as a circle has at the detail, every vertex on the surface.
     Lathe(Arc<Vec<glam::DVec2>>),
+    /// A region of polygons and circles (but one polygon: [`ExactMesh::Lathe`]) revolved
+    /// about `y`: tessellated at lowering, each outline a lathe and each hole one turned
+    /// inside out (`geom::region::revolution`).
+    Revolution {
+        /// The profile's region, `[u, v]` as radius and height.
+        region: Arc<crate::geom::region::Region>,
+        /// Its largest radius (`u`), where its circles about `y` deviate most.
+        radius: f64,
+    },
     /// A region of polygons and circles with holes or several parts, extruded from
     /// `y = -half_height` to `half_height`: its circles tessellated at lowering, the
     /// booleans taken and the caps triangulated there (`geom::region::extrusion`).

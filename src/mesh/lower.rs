@@ -63,7 +63,7 @@ pub fn tessellate(
                 ShapeKind::Primitive(p) if matches!(p.facets(), Facets::Inscribed(_)) => {
                     Normals::Corners(p.corner_normals(&mesh))
                 }
-                ShapeKind::Field { exact: Some(ExactMesh::Lathe(_)), .. } => {
+                ShapeKind::Field { exact: Some(ExactMesh::Lathe(_) | ExactMesh::Revolution { .. }), .. } => {
                     Normals::Corners(crate::geom::polygon::lathe_normals(&mesh))
                 }
                 _ => Normals::Flat,
@@ -163,6 +163,10 @@ fn exact_tessellation(exact: &ExactMesh, detail: Detail) -> Tessellation {
         }
         // Made here: its count depends on what the booleans leave. A region cut away
         // wholly, or too far out for the overlay, is left to the isosurface mesher.
+        ExactMesh::Revolution { region, .. } => match crate::geom::region::revolution(region, detail.circle()) {
+            Some(mesh) => made(mesh),
+            None => Tessellation::Isosurface,
+        },
         ExactMesh::Extrusion { region, half_height } => {
             match crate::geom::region::extrusion(region, *half_height, detail.circle()) {
                 Some(mesh) => made(mesh),

@@ -112,6 +112,10 @@ fn curvature_radius(shape: &Shape, scale: f64) -> (f64, Option<f64>) {
         ShapeKind::Field { exact: Some(ExactMesh::Extrusion { region, .. }), .. } => {
             (region.largest_radius() * scale, None)
         }
+        // A revolved region: circles about `y` up to its widest point, its own circles.
+        ShapeKind::Field { exact: Some(ExactMesh::Revolution { region, radius }), .. } => {
+            (radius.max(region.largest_radius()) * scale, None)
+        }
         // A lathe is inscribed in circles of up to its widest corner's radius.
         ShapeKind::Field { exact: Some(ExactMesh::Lathe(corners)), .. } => {
             (corners.iter().fold(0.0f64, |r, c| r.max(c.x)) * scale, None)

@@ -600,3 +600,27 @@ fn elongated_and_mirrored_shapes_are_cut_from_their_childs_mesh() {
     assert!(n <= 28, "{n}");
     assert!((v - 1.5).abs() < 1e-6, "{v}");
 }
+
+/// A revolved circle or ring is meshed as lathes of its outlines (`geom::region`), not
+/// an isosurface: a disc off the axis exports as a torus of about the torus primitive's
+/// count (each is a lathe of a polygon), holding Pappus's volume as closely; a ring's
+/// hole is a torus turned inside out within it.
+#[test]
+fn revolved_circles_are_lathes() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = dir.path().join("lathe.scn");
+    let of = |text: &str, name: &str| {
+        std::fs::write(&scene, format!("light ambient(1)\nobject {text}\n")).expect("writing");
+        let tris = stl_triangles(&export(scene.to_str().expect("utf-8"), dir.path(), name, &["--tolerance", "0.001"]));
+        (tris.len(), measure(&tris).0)
+    };
+    let pappus = |r: f64, at: f64| std::f64::consts::PI * r * r * std::f64::consts::TAU * at;
+    let (n_torus, v_torus) = of("torus(1, 0.3)", "torus.stl");
+    let (n, v) = of("revolve(circle(0.3) at [1, 0])", "revolved.stl");
+    assert!(n <= 2 * n_torus, "{n} triangles where the torus has {n_torus}");
+    let exact = pappus(0.3, 1.0);
+    assert!((v - exact).abs() <= (v_torus - exact).abs().max(1e-3 * exact), "{v} against {exact}");
+    let (_, v) = of("revolve(subtract(circle(0.4), circle(0.2)) at [1, 0])", "ring.stl");
+    let exact = pappus(0.4, 1.0) - pappus(0.2, 1.0);
+    assert!((v - exact).abs() < 1e-3 * exact, "{v} against {exact}");
+}

@@ -423,13 +423,15 @@ impl Ctx<'_> {
                 let body = profile.body.substitute(&vec2(radius, y));
                 let r = profile.max.x;
                 let bounds = Aabb { min: DVec3::new(-r, profile.min.y, -r), max: DVec3::new(r, profile.max.y, r) };
-                // A polygon wholly at u ≥ 0 is tessellated as a lathe; anything else (a
-                // circle, a profile cut by the axis) by the isosurface mesher.
+                // A polygon wholly at u ≥ 0 is tessellated as a lathe here.
                 let lathe = match profile.region.as_deref() {
                     Some(Region::Polygon(corners)) if crate::geom::polygon::lathe_ok(corners) => {
                         Some(ExactMesh::Lathe(Arc::new(corners.clone())))
                     }
-                    _ => None,
+                    // A circle, a polygon cut by the axis, a region with holes: revolved at
+                    // lowering, each outline clipped to u ≥ 0.
+                    Some(region) => Some(ExactMesh::Revolution { region: Arc::new(region.clone()), radius: r }),
+                    None => None,
                 };
                 let sweep = profile.region.clone().map(|region| Sweep::Revolve { region });
                 Some(ShapeKind::Field { body, bounds: Some(bounds), lipschitz: exact, exact: lathe, sweep })
