@@ -538,6 +538,16 @@ fn an_export_leaves_out_render_only_warnings() {
     assert!(err.contains("W0001"), "{err}");
 }
 
+/// The triangles and volume of `object {text}` (under an ambient light) exported to STL
+/// with `extra` flags.
+fn exported(text: &str, extra: &[&str]) -> (usize, f64) {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = dir.path().join("s.scn");
+    std::fs::write(&scene, format!("light ambient(1)\nobject {text}\n")).expect("writing");
+    let tris = stl_triangles(&export(scene.to_str().expect("utf-8"), dir.path(), "s.stl", extra));
+    (tris.len(), measure(&tris).0)
+}
+
 /// An extruded polygon (a rectangle or polygon, moved or not) is meshed exactly, as its
 /// own flat faces: an L of 6 corners is 20 triangles holding exactly its volume, at any
 /// detail. So is a profile with holes (the booleans taken on its outlines, the caps
@@ -546,30 +556,23 @@ fn an_export_leaves_out_render_only_warnings() {
 /// detail (10 sides at `low`); a disc's `shell` is a pipe.
 #[test]
 fn extruded_polygons_mesh_exactly_and_holes_go_through() {
-    let dir = tempfile::tempdir().expect("temp dir");
-    let scene = dir.path().join("plates.scn");
-    let volume_of = |scene_text: &str, name: &str| {
-        std::fs::write(&scene, format!("light ambient(1)\n{scene_text}")).expect("writing");
-        let bytes = export(scene.to_str().expect("utf-8"), dir.path(), name, &["--detail", "low"]);
-        let tris = stl_triangles(&bytes);
-        (tris.len(), measure(&tris).0)
-    };
+    let volume_of = |text: &str| exported(text, &["--detail", "low"]);
     let l = "polygon([[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]])";
-    let (n, v) = volume_of(&format!("object extrude({l} rotate 30 at [0.5, 0], 0.25)\n"), "l.stl");
+    let (n, v) = volume_of(&format!("extrude({l} rotate 30 at [0.5, 0], 0.25)"));
     assert_eq!(n, 20);
     assert!((v - 3.0 * 0.5).abs() < 1e-5, "the L holds {v}, not 1.5");
-    let (n, v) = volume_of("object extrude(rect(0.5, 0.25) scale 2, 1)\n", "r.stl");
+    let (n, v) = volume_of("extrude(rect(0.5, 0.25) scale 2, 1)");
     assert_eq!(n, 12);
     assert!((v - 4.0).abs() < 1e-5, "{v}");
-    let (n, v) = volume_of("object extrude(subtract(rect(1, 1), rect(0.5, 0.25) rotate 30), 0.2)\n", "cut.stl");
+    let (n, v) = volume_of("extrude(subtract(rect(1, 1), rect(0.5, 0.25) rotate 30), 0.2)");
     assert!(n <= 32, "{n} triangles for two rectangles");
     assert!((v - 1.4).abs() < 1e-6, "the cut plate holds {v}, not 1.4");
     let polygon = |r: f64, n: f64| 0.5 * n * r * r * (std::f64::consts::TAU / n).sin();
-    let (n, v) = volume_of("object extrude(subtract(rect(1, 1), circle(0.4)), 0.2)\n", "holed.stl");
+    let (n, v) = volume_of("extrude(subtract(rect(1, 1), circle(0.4)), 0.2)");
     let exact = (4.0 - polygon(0.4, 10.0)) * 0.4;
     assert!(n <= 2 * (2 * 14 + 14), "{n} triangles for a square and a decagon");
     assert!((v - exact).abs() < 1e-6, "the holed plate holds {v}, not {exact}");
-    let (_, v) = volume_of("object extrude(shell(circle(0.5), 0.2), 0.5)\n", "pipe.stl");
+    let (_, v) = volume_of("extrude(shell(circle(0.5), 0.2), 0.5)");
     let exact = polygon(0.6, 10.0) - polygon(0.4, 10.0);
     assert!((v - exact).abs() < 1e-6, "the pipe holds {v}, not {exact}");
 }
@@ -580,22 +583,16 @@ fn extruded_polygons_mesh_exactly_and_holes_go_through() {
 /// closely, and a box mirrored across `x` holds exactly the wider box's volume.
 #[test]
 fn elongated_and_mirrored_shapes_are_cut_from_their_childs_mesh() {
-    let dir = tempfile::tempdir().expect("temp dir");
-    let scene = dir.path().join("cut.scn");
-    let of = |text: &str, name: &str| {
-        std::fs::write(&scene, format!("light ambient(1)\nobject {text}\n")).expect("writing");
-        let tris = stl_triangles(&export(scene.to_str().expect("utf-8"), dir.path(), name, &["--tolerance", "0.001"]));
-        (tris.len(), measure(&tris).0)
-    };
-    let (n_capsule, v_capsule) = of("capsule(0.5, 0.6)", "capsule.stl");
-    let (n, v) = of("elongate(sphere(0.5), [0, 0.6, 0])", "elongated.stl");
+    let of = |text: &str| exported(text, &["--tolerance", "0.001"]);
+    let (n_capsule, v_capsule) = of("capsule(0.5, 0.6)");
+    let (n, v) = of("elongate(sphere(0.5), [0, 0.6, 0])");
     let exact = std::f64::consts::PI * 0.25 * (4.0 / 3.0 * 0.5 + 1.2);
     assert!(n < 2 * n_capsule, "{n} triangles where the capsule has {n_capsule}");
     assert!(
         (v - exact).abs() < 2.0 * (v_capsule - exact).abs().max(1e-4 * exact),
         "{v} against {exact}; capsule {n_capsule} {v_capsule}, {n}"
     );
-    let (n, v) = of("symmetric(box(0.5) at [0.25, 0, 0], \"x\")", "mirrored.stl");
+    let (n, v) = of("symmetric(box(0.5) at [0.25, 0, 0], \"x\")");
     // The box cut across four faces: their kept halves split in three, twice over.
     assert!(n <= 28, "{n}");
     assert!((v - 1.5).abs() < 1e-6, "{v}");
@@ -607,20 +604,14 @@ fn elongated_and_mirrored_shapes_are_cut_from_their_childs_mesh() {
 /// hole is a torus turned inside out within it.
 #[test]
 fn revolved_circles_are_lathes() {
-    let dir = tempfile::tempdir().expect("temp dir");
-    let scene = dir.path().join("lathe.scn");
-    let of = |text: &str, name: &str| {
-        std::fs::write(&scene, format!("light ambient(1)\nobject {text}\n")).expect("writing");
-        let tris = stl_triangles(&export(scene.to_str().expect("utf-8"), dir.path(), name, &["--tolerance", "0.001"]));
-        (tris.len(), measure(&tris).0)
-    };
+    let of = |text: &str| exported(text, &["--tolerance", "0.001"]);
     let pappus = |r: f64, at: f64| std::f64::consts::PI * r * r * std::f64::consts::TAU * at;
-    let (n_torus, v_torus) = of("torus(1, 0.3)", "torus.stl");
-    let (n, v) = of("revolve(circle(0.3) at [1, 0])", "revolved.stl");
+    let (n_torus, v_torus) = of("torus(1, 0.3)");
+    let (n, v) = of("revolve(circle(0.3) at [1, 0])");
     assert!(n <= 2 * n_torus, "{n} triangles where the torus has {n_torus}");
     let exact = pappus(0.3, 1.0);
     assert!((v - exact).abs() <= (v_torus - exact).abs().max(1e-3 * exact), "{v} against {exact}");
-    let (_, v) = of("revolve(subtract(circle(0.4), circle(0.2)) at [1, 0])", "ring.stl");
+    let (_, v) = of("revolve(subtract(circle(0.4), circle(0.2)) at [1, 0])");
     let exact = pappus(0.4, 1.0) - pappus(0.2, 1.0);
     assert!((v - exact).abs() < 1e-3 * exact, "{v} against {exact}");
 }
