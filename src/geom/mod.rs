@@ -76,6 +76,13 @@ pub struct TriMesh {
 }
 
 impl TriMesh {
+    /// Adds `other`'s triangles and vertices (its own, not welded to these).
+    pub fn append(&mut self, other: TriMesh) {
+        let base = self.positions.len() as u32;
+        self.positions.extend(other.positions);
+        self.triangles.extend(other.triangles.into_iter().map(|t| t.map(|i| i + base)));
+    }
+
     /// Signed volume (positive for a closed mesh wound outward).
     pub fn signed_volume(&self) -> f64 {
         self.triangles

@@ -209,9 +209,7 @@ pub fn revolution(region: &Region, segments: u32) -> Option<TriMesh> {
             if k > 0 {
                 m.triangles.iter_mut().for_each(|t| t.swap(1, 2));
             }
-            let base = out.positions.len() as u32;
-            out.positions.extend(m.positions);
-            out.triangles.extend(m.triangles.iter().map(|t| t.map(|i| i + base)));
+            out.append(m);
         }
     }
     (!out.triangles.is_empty()).then_some(out)

@@ -44,11 +44,9 @@ pub fn twisted(mut mesh: TriMesh, k: f64, step: f64, max_rounds: u32) -> TriMesh
 pub fn copies_about_y(mesh: &TriMesh, count: u32) -> TriMesh {
     let mut out = TriMesh::default();
     for j in 0..count {
-        let base = out.positions.len() as u32;
         let (sin, cos) = (360.0 * f64::from(j) / f64::from(count)).to_radians().sin_cos();
-        out.positions
-            .extend(mesh.positions.iter().map(|p| DVec3::new(p.x * cos + p.z * sin, p.y, -p.x * sin + p.z * cos)));
-        out.triangles.extend(mesh.triangles.iter().map(|t| t.map(|i| i + base)));
+        let positions = mesh.positions.iter().map(|p| DVec3::new(p.x * cos + p.z * sin, p.y, -p.x * sin + p.z * cos));
+        out.append(TriMesh { positions: positions.collect(), triangles: mesh.triangles.clone() });
     }
     out
 }
