@@ -163,15 +163,11 @@ fn exact_tessellation(exact: &ExactMesh, detail: Detail) -> Tessellation {
         }
         // Made here: its count depends on what the booleans leave. A region cut away
         // wholly, or too far out for the overlay, is left to the isosurface mesher.
-        ExactMesh::Revolution { region, .. } => match crate::geom::region::revolution(region, detail.circle()) {
-            Some(mesh) => made(mesh),
-            None => Tessellation::Isosurface,
-        },
+        ExactMesh::Revolution { region, .. } => {
+            crate::geom::region::revolution(region, detail.circle()).map_or(Tessellation::Isosurface, made)
+        }
         ExactMesh::Extrusion { region, half_height } => {
-            match crate::geom::region::extrusion(region, *half_height, detail.circle()) {
-                Some(mesh) => made(mesh),
-                None => Tessellation::Isosurface,
-            }
+            crate::geom::region::extrusion(region, *half_height, detail.circle()).map_or(Tessellation::Isosurface, made)
         }
     }
 }
