@@ -144,13 +144,15 @@ fn elongated_along(mesh: &TriMesh, axis: usize, h: f64) -> TriMesh {
         });
     }
     // The rim: an upper edge on the plane whose twin is not upper. Its quad runs from the
-    // edge moved up to the edge moved down, wound against both halves' edges.
-    for &(a, b) in &above {
-        let on = |i: u32| cut.positions[i as usize][axis] == 0.0;
-        if on(a) && on(b) && !above.contains(&(b, a)) {
-            let (la, lb) = (lower(a, &mut positions), lower(b, &mut positions));
-            triangles.extend([[b, a, la], [b, la, lb]]);
-        }
+    // edge moved up to the edge moved down, wound against both halves' edges. Sorted, so
+    // an export is the same file every run (a set's order is not).
+    let on = |i: u32| cut.positions[i as usize][axis] == 0.0;
+    let mut rim: Vec<(u32, u32)> =
+        above.iter().copied().filter(|&(a, b)| on(a) && on(b) && !above.contains(&(b, a))).collect();
+    rim.sort_unstable();
+    for (a, b) in rim {
+        let (la, lb) = (lower(a, &mut positions), lower(b, &mut positions));
+        triangles.extend([[b, a, la], [b, la, lb]]);
     }
     // Copies (past `n`) are the lower half's, originals on the plane the upper's.
     for (i, p) in positions.iter_mut().enumerate() {
