@@ -2,6 +2,7 @@
 //! meshes and the parametric generators that make them.
 
 pub mod axes;
+pub mod hull;
 pub mod noise;
 pub mod polygon;
 pub mod region;

@@ -130,38 +130,54 @@ impl Region {
     pub fn hull_lines(&self) -> Vec<(DVec2, f64)> {
         let mut pts = Vec::new();
         self.hull_points(&mut pts);
-        pts.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
-        pts.dedup();
-        if pts.len() < 3 {
-            return Vec::new();
-        }
-        // Andrew's monotone chain: lower then upper hull, turning left throughout.
-        let mut hull: Vec<DVec2> = Vec::with_capacity(2 * pts.len());
-        for pass in 0..2 {
-            let start = hull.len();
-            let iter: Box<dyn Iterator<Item = &DVec2>> =
-                if pass == 0 { Box::new(pts.iter()) } else { Box::new(pts.iter().rev()) };
-            for &p in iter {
-                while hull.len() >= start + 2 {
-                    let (a, b) = (hull[hull.len() - 2], hull[hull.len() - 1]);
-                    if (b - a).perp_dot(p - a) > 0.0 {
-                        break;
-                    }
-                    hull.pop();
-                }
-                hull.push(p);
-            }
-            hull.pop();
-        }
-        (0..hull.len())
-            .filter_map(|i| {
-                let (a, b) = (hull[i], hull[(i + 1) % hull.len()]);
-                // The outward normal of a counter-clockwise edge is its direction turned right.
-                let n = DVec2::new(b.y - a.y, a.x - b.x).try_normalize()?;
-                Some((n, n.dot(a)))
-            })
-            .collect()
+        convex_lines(pts)
     }
+
+    /// Lines `n·[r, v] ≤ d` with `n.x ≥ 0` holding the region revolved about the `v`
+    /// axis (its part at `u ≥ 0`): the edges on the right of the hull of the region and
+    /// its mirror image, which is symmetric, so `r = |u|` meets them exactly where `u` does.
+    pub fn revolved_hull_lines(&self) -> Vec<(DVec2, f64)> {
+        let mut pts = Vec::new();
+        self.hull_points(&mut pts);
+        let mirrored = pts.iter().flat_map(|p| [DVec2::new(p.x.abs(), p.y), DVec2::new(-p.x.abs(), p.y)]).collect();
+        convex_lines(mirrored).into_iter().filter(|(n, _)| n.x >= 0.0).collect()
+    }
+}
+
+/// The edges of the convex hull of `pts` as lines `n·p ≤ d` (unit `n`),
+/// counter-clockwise; none when the points span no area.
+fn convex_lines(mut pts: Vec<DVec2>) -> Vec<(DVec2, f64)> {
+    pts.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    pts.dedup();
+    if pts.len() < 3 {
+        return Vec::new();
+    }
+    // Andrew's monotone chain: lower then upper hull, turning left throughout.
+    let mut hull: Vec<DVec2> = Vec::with_capacity(2 * pts.len());
+    for pass in 0..2 {
+        let start = hull.len();
+        let iter: Box<dyn Iterator<Item = &DVec2>> =
+            if pass == 0 { Box::new(pts.iter()) } else { Box::new(pts.iter().rev()) };
+        for &p in iter {
+            while hull.len() >= start + 2 {
+                let (a, b) = (hull[hull.len() - 2], hull[hull.len() - 1]);
+                if (b - a).perp_dot(p - a) > 0.0 {
+                    break;
+                }
+                hull.pop();
+            }
+            hull.push(p);
+        }
+        hull.pop();
+    }
+    (0..hull.len())
+        .filter_map(|i| {
+            let (a, b) = (hull[i], hull[(i + 1) % hull.len()]);
+            // The outward normal of a counter-clockwise edge is its direction turned right.
+            let n = DVec2::new(b.y - a.y, a.x - b.x).try_normalize()?;
+            Some((n, n.dot(a)))
+        })
+        .collect()
 }
 
 /// The prism of `region` from `y = -half_height` to `half_height` (its `[u, v]` as `x`,

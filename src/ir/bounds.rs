@@ -3,6 +3,8 @@
 use glam::{DAffine3, DMat3, DVec3};
 
 use super::{CsgOp, Geometry, Mesh, MeshSource, Shape, ShapeKind};
+pub use crate::geom::hull::{max_stretch, transform_half_space};
+use crate::geom::hull::{Hull, Round};
 use crate::geom::Aabb;
 
 /// Bounds of a shape tree; `None` when it is unbounded (it contains a half-space).
@@ -152,61 +154,61 @@ fn half_space_within(shape: &Shape, g: f64) -> Option<(DVec3, f64)> {
     }
 }
 
-/// Planes `n·p ≤ offset` whose intersection holds the shape, tight for a convex
-/// polyhedron under any affine map ([`Solid::faces`](crate::primitive::Solid::faces));
-/// `None` where there are none (anything with a curved or unbounded part outside them).
-pub fn shape_faces(shape: &Shape) -> Option<Vec<(DVec3, f64)>> {
-    faces_within(shape, 0.0)
+/// A convex set holding the shape ([`Solid::hull`](crate::primitive::Solid::hull)):
+/// exactly the solid for a convex polyhedron, a cylinder, a capped cone or an
+/// ellipsoid under any affine map, and for intersections of them; `None` where there is
+/// none that is cheap to find (a union, a repeat, a field).
+pub fn shape_hull(shape: &Shape) -> Option<Hull> {
+    hull_within(shape, 0.0)
 }
 
-/// Planes holding where the shape's field is at most `g`, by the rules of
-/// [`half_space_within`]: every operand's planes hold an intersection (all are kept),
-/// the first operand's a subtraction.
-fn faces_within(shape: &Shape, g: f64) -> Option<Vec<(DVec3, f64)>> {
-    let grown = |faces: Vec<(DVec3, f64)>, g: f64| faces.into_iter().map(|(n, o)| (n, o + g)).collect();
+/// A convex set holding where the shape's field is at most `g`, by the rules of
+/// [`half_space_within`]: every operand's hull holds an intersection (all planes are
+/// kept), the first operand's a subtraction.
+fn hull_within(shape: &Shape, g: f64) -> Option<Hull> {
     match &shape.kind {
-        ShapeKind::Primitive(p) => p.faces().map(|f| grown(f, g)),
+        ShapeKind::Primitive(p) => p.hull().map(|h| h.grown(g)),
         ShapeKind::Csg { op: CsgOp::Intersect, children, smooth } => {
-            let all: Vec<_> = children.iter().filter_map(|c| faces_within(c, g + smooth)).flatten().collect();
-            (!all.is_empty()).then_some(all)
+            children.iter().filter_map(|c| hull_within(c, g + smooth)).reduce(Hull::meet)
         }
-        ShapeKind::Csg { op: CsgOp::Subtract, children, smooth } => faces_within(children.first()?, g + smooth),
+        ShapeKind::Csg { op: CsgOp::Subtract, children, smooth } => hull_within(children.first()?, g + smooth),
         ShapeKind::Csg { op: CsgOp::Union, .. } | ShapeKind::Repeat { .. } => None,
-        ShapeKind::Round { child, radius } => faces_within(child, g + radius),
-        ShapeKind::Shell { child, thickness } => faces_within(child, g + thickness * 0.5),
-        ShapeKind::Transform { child, xf } => {
-            faces_within(child, within_child(g, xf))?.into_iter().map(|h| transform_half_space(h, xf)).collect()
-        }
-        ShapeKind::Paint { child, .. } => faces_within(child, g),
+        ShapeKind::Round { child, radius } => hull_within(child, g + radius),
+        ShapeKind::Shell { child, thickness } => hull_within(child, g + thickness * 0.5),
+        ShapeKind::Transform { child, xf } => hull_within(child, within_child(g, xf))?.transformed(xf),
+        ShapeKind::Paint { child, .. } => hull_within(child, g),
         // An extrusion lies within its slab and its profile's convex hull.
         ShapeKind::Field { sweep: Some(crate::ir::Sweep::Extrude { region, half_height }), .. } => {
             let lines = region.hull_lines();
             let sides = lines.into_iter().map(|(n, d)| (DVec3::new(n.x, 0.0, n.y), d));
             let caps = [(DVec3::Y, *half_height), (-DVec3::Y, *half_height)];
-            Some(grown(sides.chain(caps).collect(), g))
+            Some(Hull::planes(sides.chain(caps).collect()).grown(g))
+        }
+        // A revolved profile lies within the revolved hull of the profile and its mirror.
+        ShapeKind::Field { sweep: Some(crate::ir::Sweep::Revolve { region, .. }), .. } => {
+            let lines = region.revolved_hull_lines();
+            Some(Hull::about_y(lines.into_iter().map(|(n, d)| (n.x, n.y, d)))?.grown(g))
+        }
+        // A twisted shape stays within the cylinder about y that holds its child's
+        // corners (or box), between the same heights. Its field is the child's divided
+        // by the map's stretch, at most `g` where the child's is at most `g·L`.
+        ShapeKind::Warp { child, domain_op: Some(crate::ir::DomainOp::Twist(_)), lipschitz, .. } => {
+            let g = g * lipschitz.value.max(1.0);
+            let within = hull_within(child, g).filter(|h| h.round.is_none()).map(|h| h.corners());
+            let (radius, low, high) = match within.filter(|c| !c.is_empty()) {
+                Some(corners) => corners.iter().fold((0.0_f64, f64::INFINITY, f64::NEG_INFINITY), |(r, lo, hi), c| {
+                    (r.max(c.x.hypot(c.z)), lo.min(c.y), hi.max(c.y))
+                }),
+                None => {
+                    let b = bounds_within(child, g)?;
+                    (b.radius_about_y(), b.min.y, b.max.y)
+                }
+            };
+            let round = Round::about_y([(1.0, 0.0, radius)])?;
+            Some(Hull { planes: vec![(DVec3::Y, high), (-DVec3::Y, -low)], round: Some(round) })
         }
         ShapeKind::Field { .. } | ShapeKind::Warp { .. } | ShapeKind::Displace { .. } => None,
     }
-}
-
-/// The image of the half-space `n·p ≤ offset` under an invertible affine map, which is
-/// exactly a half-space: its normal is `M⁻ᵀ n`, through the image of a point on the
-/// plane. `None` if the map is too degenerate to say.
-pub fn transform_half_space((n, offset): (DVec3, f64), xf: &DAffine3) -> Option<(DVec3, f64)> {
-    let normal = (xf.matrix3.inverse().transpose() * n).try_normalize()?;
-    let on_plane = xf.transform_point3(n * offset);
-    let offset = normal.dot(on_plane);
-    (normal.is_finite() && offset.is_finite()).then_some((normal, offset))
-}
-
-/// An upper bound of the largest singular value (how far the map can stretch a
-/// vector): the largest column-norm sum bound, exact for rotations and scales.
-pub fn max_stretch(m: glam::DMat3) -> f64 {
-    let mtm = m.transpose() * m;
-    // The largest eigenvalue of the symmetric mᵀm is at most its largest absolute row sum.
-    let rows = [mtm.row(0), mtm.row(1), mtm.row(2)];
-    let bound = rows.iter().map(|r| r.abs().element_sum()).fold(0.0, f64::max);
-    bound.sqrt()
 }
 
 /// `Some(k)` when `m` is a rotation times a uniform scale `k`.

@@ -21,7 +21,7 @@ use glam::{DAffine3, DVec3};
 pub use crate::geom::Aabb;
 pub use crate::primitive::{Facets, Primitive};
 pub use bounds::{
-    bounding_sphere, max_stretch, mesh_bounds, min_singular_value, shape_bounds, shape_faces, shape_half_space,
+    bounding_sphere, max_stretch, mesh_bounds, min_singular_value, shape_bounds, shape_half_space, shape_hull,
     shape_sphere, similarity, transform_half_space,
 };
 pub use dump::dump;

@@ -4,6 +4,7 @@
 use glam::{DVec3, Vec2, Vec3A};
 
 use super::{profile, revolve, Facets, Field, Refusal, Resolution, Solid, Tessellation};
+use crate::geom::hull::Hull;
 use crate::geom::{tessellate, Aabb};
 use crate::sig::{Args, Param, Range};
 
@@ -52,8 +53,10 @@ impl Solid for CappedCone {
         None
     }
 
-    fn faces(&self) -> Option<Vec<(DVec3, f64)>> {
-        None
+    fn hull(&self) -> Option<Hull> {
+        // The side through (r_bottom, -h) and (r_top, h), and the caps.
+        let (r1, r2, h) = (self.r_bottom, self.r_top, self.half_height);
+        Hull::about_y([(2.0 * h, r1 - r2, h * (r1 + r2)), (0.0, 1.0, h), (0.0, -1.0, h)])
     }
 
     fn is_convex(&self) -> bool {

@@ -3,6 +3,7 @@
 use glam::{DVec3, Vec3A};
 
 use super::{Facets, Field, Refusal, Resolution, Solid, Tessellation};
+use crate::geom::hull::Hull;
 use crate::geom::{slab, tessellate, Aabb};
 use crate::sig::{Args, Param, Range};
 
@@ -38,8 +39,9 @@ impl Solid for Capsule {
         None
     }
 
-    fn faces(&self) -> Option<Vec<(DVec3, f64)>> {
-        None
+    fn hull(&self) -> Option<Hull> {
+        let (r, h) = (self.r, self.half_height + self.r);
+        Hull::about_y([(1.0, 0.0, r), (0.0, 1.0, h), (0.0, -1.0, h)])
     }
 
     fn is_convex(&self) -> bool {

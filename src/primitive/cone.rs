@@ -5,6 +5,7 @@ use glam::{DVec3, Vec3A};
 
 use super::capped_cone::{profile_distance, profile_gradient};
 use super::{profile, revolve, Facets, Field, Refusal, Resolution, Solid, Tessellation};
+use crate::geom::hull::Hull;
 use crate::geom::{tessellate, Aabb};
 use crate::sig::{Args, Param, Range};
 
@@ -40,8 +41,9 @@ impl Solid for Cone {
         None
     }
 
-    fn faces(&self) -> Option<Vec<(DVec3, f64)>> {
-        None
+    fn hull(&self) -> Option<Hull> {
+        let (r, h) = (self.r, self.half_height);
+        Hull::about_y([(2.0 * h, r, h * r), (0.0, 1.0, h), (0.0, -1.0, h)])
     }
 
     fn is_convex(&self) -> bool {

@@ -3,6 +3,7 @@
 use glam::{DVec3, Vec3A};
 
 use super::{Facets, Field, Refusal, Resolution, Solid, Tessellation};
+use crate::geom::hull::Hull;
 use crate::geom::{tessellate, Aabb};
 use crate::sig::{Args, Param, Range};
 
@@ -36,10 +37,10 @@ impl Solid for Cuboid {
         None
     }
 
-    fn faces(&self) -> Option<Vec<(DVec3, f64)>> {
+    fn hull(&self) -> Option<Hull> {
         let h = self.size;
         let axes = [DVec3::X, DVec3::Y, DVec3::Z];
-        Some(axes.iter().zip([h.x, h.y, h.z]).flat_map(|(&n, d)| [(n, d), (-n, d)]).collect())
+        Some(Hull::planes(axes.iter().zip([h.x, h.y, h.z]).flat_map(|(&n, d)| [(n, d), (-n, d)]).collect()))
     }
 
     fn is_convex(&self) -> bool {

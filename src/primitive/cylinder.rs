@@ -3,6 +3,7 @@
 use glam::{DVec3, Vec2, Vec3A};
 
 use super::{profile, revolve, Facets, Field, Refusal, Resolution, Solid, Tessellation};
+use crate::geom::hull::Hull;
 use crate::geom::{tessellate, Aabb};
 use crate::sig::{Args, Param, Range};
 
@@ -38,8 +39,9 @@ impl Solid for Cylinder {
         None
     }
 
-    fn faces(&self) -> Option<Vec<(DVec3, f64)>> {
-        None
+    fn hull(&self) -> Option<Hull> {
+        let (r, h) = (self.r, self.half_height);
+        Hull::about_y([(1.0, 0.0, r), (0.0, 1.0, h), (0.0, -1.0, h)])
     }
 
     fn is_convex(&self) -> bool {

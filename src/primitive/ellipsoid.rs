@@ -9,6 +9,7 @@
 use glam::{DVec3, Vec3A};
 
 use super::{Facets, Field, Refusal, Resolution, Solid, Tessellation};
+use crate::geom::hull::Hull;
 use crate::geom::{tessellate, Aabb};
 use crate::sig::{Args, Param, Range};
 
@@ -53,8 +54,8 @@ impl Solid for Ellipsoid {
         None
     }
 
-    fn faces(&self) -> Option<Vec<(DVec3, f64)>> {
-        None
+    fn hull(&self) -> Option<Hull> {
+        Hull::ellipsoid(DVec3::new(self.rx, self.ry, self.rz))
     }
 
     fn is_convex(&self) -> bool {

@@ -42,6 +42,7 @@ pub use pyramid::Pyramid;
 pub use sphere::Sphere;
 pub use torus::Torus;
 
+use crate::geom::hull::Hull;
 use crate::geom::{Aabb, TriMesh};
 use crate::sig::{Args, Param};
 
@@ -77,10 +78,12 @@ pub trait Solid: Clone + fmt::Debug + PartialEq + Send + Sync + 'static {
     /// sphere say more).
     fn half_space(&self) -> Option<(DVec3, f64)>;
 
-    /// The planes `n·p ≤ offset` (unit `n`) whose intersection is the solid, for a convex
-    /// polyhedron: a ray is clipped to them before it is marched, so a miss costs no
-    /// step and a hit starts on the surface. `None` for a curved or unbounded solid.
-    fn faces(&self) -> Option<Vec<(DVec3, f64)>>;
+    /// A convex set holding the solid, as tight as cheap (the solid itself when it is
+    /// a convex polyhedron, a cylinder, a capped cone or an ellipsoid): a ray is clipped
+    /// to it before it is marched, so a miss costs no step and a hit starts at or near
+    /// the surface. `None` where the bounding sphere is as good (a sphere) or there is
+    /// none (unbounded).
+    fn hull(&self) -> Option<Hull>;
 
     /// Whether the solid is convex (a half-space is).
     fn is_convex(&self) -> bool;
@@ -268,8 +271,8 @@ impl Primitive {
         sphere_radius -> Option<f64>;
         /// A half-space holding an unbounded solid ([`Solid::half_space`]).
         half_space -> Option<(DVec3, f64)>;
-        /// The planes whose intersection is a convex polyhedron ([`Solid::faces`]).
-        faces -> Option<Vec<(DVec3, f64)>>;
+        /// A convex set holding the solid ([`Solid::hull`]).
+        hull -> Option<Hull>;
         /// Whether the solid is convex (a half-space is).
         is_convex -> bool;
         /// Whether its distance is exact ([`Solid::is_exact`]).

@@ -3,6 +3,7 @@
 use glam::{DVec3, Vec3A};
 
 use super::{Facets, Field, Refusal, Resolution, Solid, Tessellation};
+use crate::geom::hull::Hull;
 use crate::geom::Aabb;
 use crate::sig::{Args, Param, Range};
 
@@ -41,7 +42,7 @@ impl Solid for Plane {
         Some((self.normal, self.offset))
     }
 
-    fn faces(&self) -> Option<Vec<(DVec3, f64)>> {
+    fn hull(&self) -> Option<Hull> {
         None
     }
 

@@ -131,8 +131,8 @@ macro_rules! polyhedron_facts {
             None
         }
 
-        fn faces(&self) -> Option<Vec<(glam::DVec3, f64)>> {
-            Some(self.solid().face_planes())
+        fn hull(&self) -> Option<crate::geom::hull::Hull> {
+            Some(crate::geom::hull::Hull::planes(self.solid().face_planes()))
         }
 
         fn is_convex(&self) -> bool {

@@ -3,6 +3,7 @@
 use glam::{DVec3, Vec3A};
 
 use super::{Facets, Field, Refusal, Resolution, Solid, Tessellation};
+use crate::geom::hull::Hull;
 use crate::geom::{tessellate, Aabb};
 use crate::sig::{Args, Param, Range};
 
@@ -36,7 +37,7 @@ impl Solid for Sphere {
         None
     }
 
-    fn faces(&self) -> Option<Vec<(DVec3, f64)>> {
+    fn hull(&self) -> Option<Hull> {
         None
     }
 

@@ -6,6 +6,7 @@
 use glam::{DVec3, Vec2, Vec3A};
 
 use super::{profile, revolve, Facets, Field, Refusal, Resolution, Solid, Tessellation};
+use crate::geom::hull::Hull;
 use crate::geom::{tessellate, Aabb};
 use crate::sig::{Args, Param, Range};
 
@@ -49,8 +50,10 @@ impl Solid for Torus {
         None
     }
 
-    fn faces(&self) -> Option<Vec<(DVec3, f64)>> {
-        None
+    fn hull(&self) -> Option<Hull> {
+        // The cylinder round the ring: a ray starts at it, not at the sphere.
+        let (r, h) = (self.major + self.minor, self.minor);
+        Hull::about_y([(1.0, 0.0, r), (0.0, 1.0, h), (0.0, -1.0, h)])
     }
 
     fn is_convex(&self) -> bool {

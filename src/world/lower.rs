@@ -7,7 +7,7 @@ use std::sync::Arc;
 use glam::{DAffine3, DVec3, Vec3A};
 use rayon::prelude::*;
 
-use super::{Mode, Object, ObjectKind, World};
+use super::{query, Mode, Object, ObjectKind, World};
 use crate::accel::{padded_sphere, Aabb, Bvh};
 use crate::diag::Diagnostic;
 use crate::ir;
@@ -31,7 +31,7 @@ struct Reach {
     bounds: Option<Aabb>,
     sphere: Option<(Vec3A, f32)>,
     half_space: Option<(Vec3A, f32)>,
-    faces: Option<Arc<[(Vec3A, f32)]>>,
+    hull: Option<Arc<query::Entry>>,
 }
 
 impl Reach {
@@ -44,14 +44,8 @@ impl Reach {
                 .and_then(|h| ir::transform_half_space(h, to_render))
                 .map(|(n, o)| (n.as_vec3a(), o as f32)),
         };
-        let faces = bounds.and(ir::shape_faces(shape)).and_then(|faces| {
-            let placed: Option<Vec<_>> = faces
-                .into_iter()
-                .map(|h| ir::transform_half_space(h, to_render).map(|(n, o)| (n.as_vec3a(), o as f32)))
-                .collect();
-            placed.map(Arc::from)
-        });
-        Reach { bounds, sphere, half_space, faces }
+        let hull = bounds.and(ir::shape_hull(shape)).and_then(|h| h.transformed(to_render)).map(query::Entry::new);
+        Reach { bounds, sphere, half_space, hull: hull.map(Arc::new) }
     }
 }
 
@@ -250,13 +244,13 @@ fn lower_reusing(
         .into_par_iter()
         .map(|(part, _, span)| {
             let object = match part {
-                Lowered::Sdf(s, Reach { bounds, sphere, half_space, faces }) => {
-                    Object { kind: ObjectKind::Sdf(s), bounds, sphere, half_space, faces, span }
+                Lowered::Sdf(s, Reach { bounds, sphere, half_space, hull }) => {
+                    Object { kind: ObjectKind::Sdf(s), bounds, sphere, half_space, hull, span }
                 }
                 Lowered::Mesh(job) => {
                     let m = job.build();
                     let (bounds, sphere) = (Some(m.bounds()), m.sphere());
-                    Object { bounds, sphere, half_space: None, faces: None, kind: ObjectKind::Mesh(Arc::new(m)), span }
+                    Object { bounds, sphere, half_space: None, hull: None, kind: ObjectKind::Mesh(Arc::new(m)), span }
                 }
                 Lowered::Kept(object) => object,
             };

@@ -51,11 +51,10 @@ pub(crate) struct Object {
     /// space: a ray from outside starts marching where it enters, which a grazing ray
     /// along a floor would otherwise spend its whole step budget reaching.
     half_space: Option<(Vec3A, f32)>,
-    /// For a bounded SDF object that is a convex polyhedron (or cut by one: an
-    /// intersection, a rounded box), planes `n·p ≤ offset` holding it, in render space:
-    /// a ray is clipped to them, so a miss is found without a step and a hit starts on
-    /// the surface (`ir::shape_faces`).
-    faces: Option<std::sync::Arc<[(Vec3A, f32)]>>,
+    /// For a bounded SDF object, a convex set holding it in render space (planes, and
+    /// cones or an ellipsoid about an axis: `ir::shape_hull`): a ray is clipped to it,
+    /// so a miss is found without a step and a hit starts at or near the surface.
+    hull: Option<std::sync::Arc<query::Entry>>,
     span: Span,
 }
 

@@ -5,6 +5,7 @@ use glam::Vec3A;
 
 use super::{Object, ObjectKind, World};
 use crate::accel::sphere_interval;
+use crate::geom::hull::{Hull, Round};
 use crate::mesh::{self, MeshObject};
 use crate::sdf::SdfObject;
 use crate::trace::{Counters, Geometry, Hit, Packet, Ray};
@@ -23,9 +24,9 @@ impl World {
         if ray.inside == i {
             return Some((t0, t1));
         }
-        match (o.half_space, &o.faces) {
+        match (o.half_space, &o.hull) {
             (Some(h), _) => clip_to_half_space(h, ray, (t0, t1)),
-            (None, Some(faces)) => clip_to_faces(faces, 2.0 * self.params.epsilon, ray, (t0, t1)),
+            (None, Some(hull)) => hull.clip(self.params.epsilon, ray, (t0, t1)),
             (None, None) => Some((t0, t1)),
         }
     }
@@ -212,40 +213,75 @@ fn clip_to_half_space((n, offset): (Vec3A, f32), ray: &Ray, (t0, t1): (f32, f32)
     (t0 <= t1).then_some((t0, t1))
 }
 
-/// `(t0, t1)` from where the ray enters the convex polyhedron `n·p ≤ offset` (every
-/// plane), or `None` if it never comes within the hit threshold of it; moved back by a
-/// millionth of the distance as for a half-space ([`clip_to_half_space`]). The
-/// threshold is at most `reach · t` (`sdf::march::threshold`) and a plane is never
-/// farther than the solid, so no hit the march would take is clipped away: a ray that
-/// misses the solid but grazes it within the threshold starts where it comes within
-/// reach of every plane. The far end is kept, for the march.
-#[inline]
-fn clip_to_faces(faces: &[(Vec3A, f32)], reach: f32, ray: &Ray, (t0, t1): (f32, f32)) -> Option<(f32, f32)> {
-    // [enter, leave] on the solid itself, and on it grown by the threshold.
-    let (mut solid, mut grown) = ((t0, t1), (t0, t1));
-    for &(n, offset) in faces {
-        let above = n.dot(ray.origin) - offset;
-        let closing = -n.dot(ray.dir);
-        for ((enter, leave), closing) in [(&mut solid, closing), (&mut grown, closing + reach)] {
-            // Inside the plane (grown by reach·t) at t: above ≤ t·closing.
-            if closing == 0.0 {
-                if above > 0.0 {
-                    *leave = f32::NEG_INFINITY;
+/// A convex set holding an SDF object, in render space: what its rays are clipped to
+/// before they are marched.
+pub(super) struct Entry {
+    /// Planes `n·p ≤ offset`.
+    planes: Box<[(Vec3A, f32)]>,
+    /// Cones or an ellipsoid about an axis, in f64: a quadratic's roots lose too much in
+    /// f32 where a ray grazes.
+    round: Option<Round>,
+}
+
+impl Entry {
+    /// The render-space hull of an object.
+    pub(super) fn new(hull: Hull) -> Entry {
+        let planes = hull.planes.iter().map(|(n, o)| (n.as_vec3a(), *o as f32)).collect();
+        Entry { planes, round: hull.round }
+    }
+
+    /// `(t0, t1)` from where the ray enters the set, or `None` if it never comes within
+    /// the hit threshold of it; the ends are moved out by a millionth of their distance
+    /// as for a half-space ([`clip_to_half_space`]). The set holds the solid and is
+    /// grown by the threshold (`sdf::march::threshold` with relative `epsilon`), so no
+    /// hit the march would take is clipped away. A ray that misses the set but comes
+    /// within the threshold of it can hit only there, so it is marched only where it is
+    /// within reach of the set, not on to `t1` (a grazing ray creeps along a surface).
+    #[inline]
+    fn clip(&self, epsilon: f32, ray: &Ray, (t0, t1): (f32, f32)) -> Option<(f32, f32)> {
+        // The threshold, ε·(t + min(t, |origin|)), is at most `reach·t`, and at most
+        // `far` before `t1`.
+        let reach = 2.0 * epsilon;
+        let far = crate::sdf::march::threshold(epsilon, ray.origin.length(), t1);
+        // [enter, leave] on the set itself, and on it grown by the threshold.
+        let (mut solid, mut grown) = ((t0, t1), (t0, t1));
+        for &(n, offset) in self.planes.iter() {
+            let above = n.dot(ray.origin) - offset;
+            let closing = -n.dot(ray.dir);
+            for ((enter, leave), closing) in [(&mut solid, closing), (&mut grown, closing + reach)] {
+                // Inside the plane (grown by reach·t) at t: above ≤ t·closing.
+                if closing == 0.0 {
+                    if above > 0.0 {
+                        *leave = f32::NEG_INFINITY;
+                    }
+                    continue;
                 }
-                continue;
-            }
-            let t = above / closing;
-            if closing > 0.0 {
-                *enter = enter.max(t - t.abs() * 1e-6);
-            } else {
-                *leave = leave.min(t + t.abs() * 1e-6);
+                let t = above / closing;
+                if closing > 0.0 {
+                    *enter = enter.max(t - t.abs() * 1e-6);
+                } else {
+                    *leave = leave.min(t + t.abs() * 1e-6);
+                }
             }
         }
-    }
-    match (solid, grown) {
-        ((enter, leave), _) if enter <= leave => Some((enter, t1)),
-        (_, (enter, leave)) if enter <= leave => Some((enter, t1)),
-        _ => None,
+        if let Some(round) = &self.round {
+            let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
+            for ((enter, leave), g) in [(&mut solid, 0.0), (&mut grown, f64::from(far))] {
+                let (lo, hi) = round.interval(o, d, g);
+                if lo > hi {
+                    // Empty (its ends may be infinite, which the slack below would make NaN).
+                    *leave = f32::NEG_INFINITY;
+                    continue;
+                }
+                *enter = enter.max((lo - lo.abs() * 1e-6) as f32);
+                *leave = leave.min((hi + hi.abs() * 1e-6) as f32);
+            }
+        }
+        match (solid, grown) {
+            ((enter, leave), _) if enter <= leave => Some((enter, t1)),
+            (_, (enter, leave)) if enter <= leave => Some((enter, leave)),
+            _ => None,
+        }
     }
 }
 

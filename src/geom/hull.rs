@@ -1,0 +1,324 @@
+//! Convex sets holding a solid, cheap to clip a ray to: planes, and cones and a ball
+//! about an axis of a frame of their own. A ray is clipped to its object's hull before
+//! it is marched, so a miss costs no step and a hit starts at (or near) the surface —
+//! exactly on it for a convex polyhedron, a cylinder, a capped cone or an ellipsoid.
+
+use glam::{DAffine3, DMat3, DVec3};
+
+/// A convex set holding a solid: where every plane and the round part hold.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct Hull {
+    /// Planes `n·p ≤ offset` (unit `n`).
+    pub planes: Vec<(DVec3, f64)>,
+    /// Constraints about an axis, in a frame of their own.
+    pub round: Option<Round>,
+}
+
+/// Cones and a ball about the `y` axis of a local frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Round {
+    /// From the hull's frame to the local one.
+    to_local: DAffine3,
+    /// How far `to_local` can stretch a length (a bound on its largest singular value):
+    /// a point within `g` of the set is within `g · stretch` of it in the local frame.
+    stretch: f64,
+    /// `a·r + b·y ≤ c` with `(a, b)` unit and `a ≥ 0`, `r` the local distance from the
+    /// `y` axis: a cone's side (`b ≠ 0`), a cylinder (`b = 0`) or a cap (`a = 0`).
+    cones: Vec<(f64, f64, f64)>,
+    /// `|p| ≤ ball` in the local frame.
+    ball: Option<f64>,
+}
+
+impl Round {
+    /// Cones `a·r + b·y ≤ c` about the `y` axis of the hull's own frame (`(a, b)` is
+    /// normalised; a cone with `a < 0` holds nothing a circle about the axis can cross,
+    /// so it is refused as `None`).
+    pub fn about_y(cones: impl IntoIterator<Item = (f64, f64, f64)>) -> Option<Round> {
+        let cones: Option<Vec<_>> = cones
+            .into_iter()
+            .map(|(a, b, c)| {
+                let k = a.hypot(b);
+                (a >= 0.0 && k > 0.0 && c.is_finite()).then(|| (a / k, b / k, c / k))
+            })
+            .collect();
+        Some(Round { to_local: DAffine3::IDENTITY, stretch: 1.0, cones: cones?, ball: None })
+    }
+
+    /// The ellipsoid of semi-axes `radii` along x, y and z.
+    pub fn ellipsoid(radii: DVec3) -> Option<Round> {
+        let to_local = DAffine3::from_scale(radii.recip());
+        let stretch = to_local.matrix3.x_axis.x.max(to_local.matrix3.y_axis.y).max(to_local.matrix3.z_axis.z);
+        (radii.min_element() > 0.0 && stretch.is_finite()).then_some(Round {
+            to_local,
+            stretch,
+            cones: Vec::new(),
+            ball: Some(1.0),
+        })
+    }
+
+    /// Holding every point within `g` of this set.
+    fn grown(mut self, g: f64) -> Round {
+        let g = g * self.stretch;
+        self.cones.iter_mut().for_each(|c| c.2 += g);
+        self.ball = self.ball.map(|b| b + g);
+        self
+    }
+
+    /// The image of the set under `xf`, or `None` if `xf` is too degenerate to invert.
+    fn transformed(&self, xf: &DAffine3) -> Option<Round> {
+        let to_local = self.to_local * xf.inverse();
+        let stretch = max_stretch(to_local.matrix3);
+        stretch.is_finite().then(|| Round { to_local, stretch, ..self.clone() })
+    }
+
+    /// Whether `p` is within `tol` of the set (in the local frame's units).
+    fn contains(&self, p: DVec3, tol: f64) -> bool {
+        let q = self.to_local.transform_point3(p);
+        let r = q.x.hypot(q.z);
+        self.cones.iter().all(|&(a, b, c)| a * r + b * q.y <= c + tol)
+            && self.ball.is_none_or(|b| q.length() <= b + tol)
+    }
+
+    /// The interval of `t` where `origin + t·dir` is in the set grown by `g` (in the
+    /// hull's frame): an interval, as the set is convex; possibly empty (`lo > hi`) or
+    /// unbounded.
+    pub fn interval(&self, origin: DVec3, dir: DVec3, g: f64) -> (f64, f64) {
+        let o = self.to_local.transform_point3(origin);
+        let d = self.to_local.transform_vector3(dir);
+        let g = g * self.stretch;
+        let mut span = (f64::NEG_INFINITY, f64::INFINITY);
+        for &(a, b, c) in &self.cones {
+            span = meet(span, cone_interval((a, b, c + g), o, d));
+            if span.0 > span.1 {
+                return span;
+            }
+        }
+        if let Some(ball) = self.ball {
+            let r = ball + g;
+            span = meet(span, below(d.length_squared(), o.dot(d), o.length_squared() - r * r).0);
+        }
+        span
+    }
+}
+
+/// Where `a·r(t) + b·y(t) ≤ c` along the local ray `o + t·d`: with `L(t) = c − b·y(t)`,
+/// where `L ≥ 0` and `a²·r² ≤ L²`. Squaring adds the mirror cone's side (where `L < 0`),
+/// which the half-line `L ≥ 0` cuts away; the hull of what is left is the answer (the
+/// set is convex, so it is one interval).
+fn cone_interval((a, b, c): (f64, f64, f64), o: DVec3, d: DVec3) -> (f64, f64) {
+    let (l0, l1) = (c - b * o.y, -b * d.y);
+    let ahead = linear_below(-l1, -l0);
+    if a == 0.0 {
+        return ahead;
+    }
+    let a2 = a * a;
+    let qa = a2 * (d.x * d.x + d.z * d.z) - l1 * l1;
+    let qb = a2 * (o.x * d.x + o.z * d.z) - l0 * l1;
+    let qc = a2 * (o.x * o.x + o.z * o.z) - l0 * l0;
+    let (first, second) = below(qa, qb, qc);
+    let pieces = [meet(first, ahead), second.map_or((1.0, 0.0), |s| meet(s, ahead))];
+    let kept = pieces.into_iter().filter(|p| p.0 <= p.1);
+    kept.fold((f64::INFINITY, f64::NEG_INFINITY), |acc, p| (acc.0.min(p.0), acc.1.max(p.1)))
+}
+
+/// Where `k1·t + k0 ≤ 0`.
+fn linear_below(k1: f64, k0: f64) -> (f64, f64) {
+    if k1 > 0.0 {
+        (f64::NEG_INFINITY, -k0 / k1)
+    } else if k1 < 0.0 {
+        (-k0 / k1, f64::INFINITY)
+    } else if k0 <= 0.0 {
+        (f64::NEG_INFINITY, f64::INFINITY)
+    } else {
+        (1.0, 0.0)
+    }
+}
+
+/// Where `qa·t² + 2·qb·t + qc ≤ 0`: one interval (possibly empty or unbounded), or two
+/// half-lines when the parabola opens downwards.
+fn below(qa: f64, qb: f64, qc: f64) -> ((f64, f64), Option<(f64, f64)>) {
+    if qa == 0.0 {
+        return (linear_below(2.0 * qb, qc), None);
+    }
+    let disc = qb * qb - qa * qc;
+    if disc < 0.0 {
+        let all = (f64::NEG_INFINITY, f64::INFINITY);
+        return (if qa > 0.0 { (1.0, 0.0) } else { all }, None);
+    }
+    // The two roots without cancellation: q/qa and qc/q.
+    let q = -(qb + disc.sqrt().copysign(qb));
+    let (r0, r1) = if q == 0.0 { (0.0, 0.0) } else { (q / qa, qc / q) };
+    let (lo, hi) = (r0.min(r1), r0.max(r1));
+    if qa > 0.0 {
+        ((lo, hi), None)
+    } else {
+        ((f64::NEG_INFINITY, lo), Some((hi, f64::INFINITY)))
+    }
+}
+
+/// The intersection of two intervals.
+fn meet(a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
+    (a.0.max(b.0), a.1.min(b.1))
+}
+
+impl Hull {
+    /// The hull of planes alone.
+    pub fn planes(planes: Vec<(DVec3, f64)>) -> Hull {
+        Hull { planes, round: None }
+    }
+
+    /// The cones `a·r + b·y ≤ c` about the `y` axis ([`Round::about_y`]).
+    pub fn about_y(cones: impl IntoIterator<Item = (f64, f64, f64)>) -> Option<Hull> {
+        Some(Hull { planes: Vec::new(), round: Some(Round::about_y(cones)?) })
+    }
+
+    /// The ellipsoid of semi-axes `radii` ([`Round::ellipsoid`]).
+    pub fn ellipsoid(radii: DVec3) -> Option<Hull> {
+        Some(Hull { planes: Vec::new(), round: Some(Round::ellipsoid(radii)?) })
+    }
+
+    /// Holding every point within `g` of this set.
+    pub fn grown(self, g: f64) -> Hull {
+        Hull {
+            planes: self.planes.into_iter().map(|(n, o)| (n, o + g)).collect(),
+            round: self.round.map(|r| r.grown(g)),
+        }
+    }
+
+    /// The image of the set under an invertible affine map; `None` if it is too
+    /// degenerate to say.
+    pub fn transformed(&self, xf: &DAffine3) -> Option<Hull> {
+        let planes: Option<Vec<_>> = self.planes.iter().map(|&h| transform_half_space(h, xf)).collect();
+        let round = match &self.round {
+            Some(r) => Some(r.transformed(xf)?),
+            None => None,
+        };
+        Some(Hull { planes: planes?, round })
+    }
+
+    /// Both sets' intersection: every plane, and the first round part (two frames'
+    /// constraints do not combine).
+    pub fn meet(mut self, other: Hull) -> Hull {
+        self.planes.extend(other.planes);
+        self.round = self.round.or(other.round);
+        self
+    }
+
+    /// Whether `p` is within `tol` of every plane and of the round part (in its frame).
+    pub fn contains(&self, p: DVec3, tol: f64) -> bool {
+        self.planes.iter().all(|(n, o)| n.dot(p) <= o + tol) && self.round.as_ref().is_none_or(|r| r.contains(p, tol))
+    }
+
+    /// The corners of the planes' polyhedron (where three planes meet within every
+    /// other), when the planes alone bound it; empty otherwise.
+    pub fn corners(&self) -> Vec<DVec3> {
+        let p = &self.planes;
+        let mut out = Vec::new();
+        for i in 0..p.len() {
+            for j in i + 1..p.len() {
+                for k in j + 1..p.len() {
+                    let (a, b, c) = (p[i].0, p[j].0, p[k].0);
+                    let det = a.dot(b.cross(c));
+                    if det.abs() < 1e-9 {
+                        continue;
+                    }
+                    let x = (b.cross(c) * p[i].1 + c.cross(a) * p[j].1 + a.cross(b) * p[k].1) / det;
+                    let scale = 1e-9 * (1.0 + x.abs().max_element());
+                    if p.iter().all(|(n, o)| n.dot(x) <= o + scale) {
+                        out.push(x);
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
+/// The image of the half-space `n·p ≤ offset` under an invertible affine map, which is
+/// exactly a half-space: its normal is `M⁻ᵀ n`, through the image of a point on the
+/// plane. `None` if the map is too degenerate to say.
+pub fn transform_half_space((n, offset): (DVec3, f64), xf: &DAffine3) -> Option<(DVec3, f64)> {
+    let normal = (xf.matrix3.inverse().transpose() * n).try_normalize()?;
+    let on_plane = xf.transform_point3(n * offset);
+    let offset = normal.dot(on_plane);
+    (normal.is_finite() && offset.is_finite()).then_some((normal, offset))
+}
+
+/// An upper bound of the largest singular value (how far the map can stretch a
+/// vector): the largest column-norm sum bound, exact for rotations and scales.
+pub fn max_stretch(m: DMat3) -> f64 {
+    let mtm = m.transpose() * m;
+    // The largest eigenvalue of the symmetric mᵀm is at most its largest absolute row sum.
+    let rows = [mtm.row(0), mtm.row(1), mtm.row(2)];
+    let bound = rows.iter().map(|r| r.abs().element_sum()).fold(0.0, f64::max);
+    bound.sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Points along random rays are inside the interval exactly where they are in the
+    /// set: a cylinder, a cone's frustum and an ellipsoid, turned and stretched.
+    #[test]
+    fn intervals_are_where_the_ray_is_inside() {
+        let frustum = Round::about_y([(1.0, 0.0, 0.5), (0.0, 1.0, 0.4), (0.0, -1.0, 0.4), (0.8, 0.3, 0.5)]).unwrap();
+        let ellipsoid = Round::ellipsoid(DVec3::new(0.3, 0.7, 0.5)).unwrap();
+        let xf = DAffine3::from_scale_rotation_translation(
+            DVec3::new(1.3, 0.6, 1.0),
+            glam::DQuat::from_euler(glam::EulerRot::XYZ, 0.4, 1.1, -0.3),
+            DVec3::new(0.1, -0.2, 0.3),
+        );
+        let mut seed = 0x5eed_u64;
+        let mut next = move || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let mut inside = 0;
+        for round in
+            [frustum.clone(), ellipsoid.clone(), frustum.transformed(&xf).unwrap(), ellipsoid.transformed(&xf).unwrap()]
+        {
+            for _ in 0..2_000 {
+                let o = DVec3::new(next(), next(), next()) * 2.0;
+                let d = DVec3::new(next(), next(), next());
+                let (lo, hi) = round.interval(o, d, 0.0);
+                for s in 0..=40 {
+                    let t = f64::from(s) / 10.0 - 2.0;
+                    let p = o + t * d;
+                    let slack = 1e-9 * (1.0 + t.abs());
+                    let within = t >= lo - slack && t <= hi + slack;
+                    let on_edge = (t - lo).abs() < 1e-6 || (t - hi).abs() < 1e-6;
+                    assert!(on_edge || within == round.contains(p, 0.0), "{round:?}: t {t} in ({lo}, {hi})");
+                    inside += usize::from(within);
+                }
+            }
+        }
+        assert!(inside > 1_500, "only {inside} points inside");
+    }
+
+    /// A grown set holds every point within `g` of the set.
+    #[test]
+    fn grown_sets_hold_their_neighbourhood() {
+        let ellipsoid = Round::ellipsoid(DVec3::new(0.3, 0.7, 0.5)).unwrap();
+        let grown = ellipsoid.clone().grown(0.1);
+        for i in 0..2_000 {
+            let (s, c) = (f64::from(i) * 0.37).sin_cos();
+            let (s2, c2) = (f64::from(i) * 0.11).sin_cos();
+            let n = DVec3::new(c * c2, s2, s * c2);
+            // The surface point whose normal is n: radii² n / |radii n|.
+            let r = DVec3::new(0.3, 0.7, 0.5);
+            let p = r * r * n / (r * n).length();
+            assert!(ellipsoid.contains(p, 1e-9));
+            assert!(grown.contains(p + 0.1 * n.normalize(), 1e-9), "{p}");
+        }
+    }
+
+    /// A box's planes meet at its eight corners.
+    #[test]
+    fn corners_of_a_box() {
+        let planes = [DVec3::X, DVec3::Y, DVec3::Z].iter().flat_map(|&n| [(n, 1.0), (-n, 2.0)]).collect();
+        let corners = Hull::planes(planes).corners();
+        assert_eq!(corners.len(), 8);
+        assert!(corners.iter().all(|c| c.to_array().iter().all(|&v| v == 1.0 || v == -2.0)));
+    }
+}
