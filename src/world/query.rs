@@ -234,9 +234,9 @@ impl Entry {
     /// the hit threshold of it; the ends are moved out by a millionth of their distance
     /// as for a half-space ([`clip_to_half_space`]). The set holds the solid and is
     /// grown by the threshold (`sdf::march::threshold` with relative `epsilon`), so no
-    /// hit the march would take is clipped away. A ray that misses the set but comes
-    /// within the threshold of it can hit only there, so it is marched only where it is
-    /// within reach of the set, not on to `t1` (a grazing ray creeps along a surface).
+    /// hit the march would take is clipped away. The march ends where the ray leaves
+    /// the grown set, not at `t1`: a grazing ray creeps along a surface, and a shadow
+    /// ray leaving one steps out slowly.
     #[inline]
     fn clip(&self, epsilon: f32, ray: &Ray, (t0, t1): (f32, f32)) -> Option<(f32, f32)> {
         // The threshold, ε·(t + min(t, |origin|)), is at most `reach·t`, and at most
@@ -277,9 +277,11 @@ impl Entry {
                 *leave = leave.min((hi + hi.abs() * 1e-6) as f32);
             }
         }
+        // A hit lies within the grown set, so the march ends where the ray leaves it: a
+        // ray leaving a surface (a shadow ray) stops at the hull, not the sphere.
         match (solid, grown) {
-            ((enter, leave), _) if enter <= leave => Some((enter, t1)),
-            (_, (enter, leave)) if enter <= leave => Some((enter, leave)),
+            ((enter, leave), (_, out)) if enter <= leave => Some((enter, out.min(t1))),
+            (_, (enter, leave)) if enter <= leave => Some((enter, leave.min(t1))),
             _ => None,
         }
     }
