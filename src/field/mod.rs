@@ -10,11 +10,13 @@
 mod flat;
 mod interval;
 mod lipschitz;
+mod support;
 mod tape;
 
 pub use flat::Flat;
 pub use interval::{Dir, Interval, Jet, Region, Slope};
 pub use lipschitz::{lipschitz, Estimate, SlopeDistances};
+pub use support::support_planes;
 pub use tape::{Distances, NoDistances, Op, Reg, Scalar, Tape};
 
 use glam::Vec3A;

@@ -10,6 +10,7 @@ use rayon::prelude::*;
 use super::{query, Mode, Object, ObjectKind, World};
 use crate::accel::{padded_sphere, Aabb, Bvh};
 use crate::diag::Diagnostic;
+use crate::geom::hull::Hull;
 use crate::ir;
 use crate::mesh;
 use crate::render::Frame;
@@ -35,7 +36,7 @@ struct Reach {
 }
 
 impl Reach {
-    fn of(shape: &ir::Shape, to_render: &DAffine3) -> Reach {
+    fn of(shape: &ir::Shape, to_render: &DAffine3, known: &mut FieldHulls) -> Reach {
         let bounds = ir::shape_bounds(shape).map(|b| Aabb::padded(b.transform(to_render)));
         let sphere = ir::shape_sphere(shape).map(|(c, r)| padded_sphere(to_render.transform_point3(c), r));
         let half_space = match bounds {
@@ -44,8 +45,43 @@ impl Reach {
                 .and_then(|h| ir::transform_half_space(h, to_render))
                 .map(|(n, o)| (n.as_vec3a(), o as f32)),
         };
-        let hull = bounds.and(ir::shape_hull(shape)).and_then(|h| h.transformed(to_render)).map(query::Entry::new);
+        let hull = bounds.and_then(|_| ir::shape_hull(shape).or_else(|| field_hull(shape, known)));
+        let hull = hull.and_then(|h| h.transformed(to_render)).map(query::Entry::new);
         Reach { bounds, sphere, half_space, hull: hull.map(Arc::new) }
+    }
+}
+
+/// The support planes of the fields lowered so far, by body and bounds: a scene's many
+/// copies of one field (a loop placing it) search once. Only the last 64 are looked
+/// through, so a scene of many different fields does not pay a square.
+type FieldHulls = Vec<(Arc<ir::field::Expr>, ir::Aabb, Option<Vec<(DVec3, f64)>>)>;
+
+/// A polyhedron holding a field at the object's root (under its transforms and paint),
+/// from intervals of its body (`field::support_planes`); `None` for anything else, or
+/// where no plane cuts the field's box.
+fn field_hull(shape: &ir::Shape, known: &mut FieldHulls) -> Option<Hull> {
+    let (mut xf, mut s) = (DAffine3::IDENTITY, shape);
+    loop {
+        match &s.kind {
+            ir::ShapeKind::Transform { child, xf: m } => (xf, s) = (xf * *m, child),
+            ir::ShapeKind::Paint { child, .. } => s = child,
+            ir::ShapeKind::Field { body, bounds: Some(b), sweep: None, .. } => {
+                let planes =
+                    match known.iter().rev().take(64).find(|(e, bb, _)| bb == b && (Arc::ptr_eq(e, body) || e == body))
+                    {
+                        Some((.., planes)) => planes.clone(),
+                        None => {
+                            let tape = crate::field::Tape::new(body);
+                            let planes = crate::field::support_planes(&tape, *b, &crate::field::NoDistances);
+                            known.push((body.clone(), *b, planes.clone()));
+                            planes
+                        }
+                    };
+                let planes = planes.filter(|p| !p.is_empty())?;
+                return Hull::planes(planes).transformed(&xf);
+            }
+            _ => return None,
+        }
     }
 }
 
@@ -188,6 +224,7 @@ fn lower_reusing(
     // In scene order: materials are interned and the triangle budget spent as objects
     // come, so ids and errors do not depend on timing. Meshes are built afterwards.
     let mut lowered = Vec::with_capacity(scene.objects.len());
+    let mut field_hulls = FieldHulls::new();
     let mut kept = Vec::with_capacity(scene.objects.len());
     for (i, obj) in scene.objects.iter().enumerate() {
         let table = &mut builder.materials.materials;
@@ -209,7 +246,7 @@ fn lower_reusing(
             }
             None => match (&obj.geometry, mode) {
                 (ir::Geometry::Shape(shape), Mode::Sdf) => {
-                    let reach = Reach::of(shape, &to_render);
+                    let reach = Reach::of(shape, &to_render, &mut field_hulls);
                     Lowered::Sdf(SdfObject::new(shape, to_render, &mut builder), reach)
                 }
                 (ir::Geometry::Shape(shape), Mode::Mesh(detail)) => Lowered::Mesh(mesh::lower::tessellate(

@@ -165,8 +165,10 @@ fn missed_hits(case: &Case, stated: Option<f64>, estimate: f64, rays: usize) -> 
 
 /// No missed hits: the first hit of 10,000 random rays on a gyroid sheet, a sphere with
 /// detached islands and a twisted box agrees with a march of ten times smaller steps.
-/// The test sees a bound that is too small: on the thin sheet, marching with half the
-/// estimate steps over it on some rays. On the solids, a step that overshoots lands
+/// The test sees a bound that is too small: on the thin sheet, marching with 0.35 of
+/// the estimate (under half the slope sampled) steps over it on some rays. (Half the
+/// estimate did too until rays were clipped to the field's support planes: starting
+/// nearer the sheet, they take fewer of the long steps that overshoot.) On the solids, a step that overshoots lands
 /// inside, where the march turns back, so only a bound below the true slope by more
 /// than a part's thickness loses it: a quarter of the estimate does, on both.
 #[test]
@@ -176,7 +178,7 @@ fn fields_miss_no_hit_a_finer_march_finds() {
         let divisor = lipschitz(&s);
         let missed = missed_hits(case, None, divisor, 10_000);
         assert_eq!(missed, 0, "{}: {missed} of 10,000 rays miss a hit the reference finds (L = {divisor})", case.name);
-        let fraction = if case.name == "gyroid sheet" { 0.5 } else { 0.25 };
+        let fraction = if case.name == "gyroid sheet" { 0.35 } else { 0.25 };
         // A displacement states the bound of `d`; the march divides by one more.
         let stated = if case.name == "displaced sphere" { divisor * fraction - 1.0 } else { divisor * fraction };
         let too_small = missed_hits(case, Some(stated), divisor, 10_000);

@@ -1,0 +1,102 @@
+//! A polyhedron holding a field's solid, from interval arithmetic: for each of 26
+//! directions (the cube's faces, edges and corners), the farthest the solid can reach
+//! that way, by branch and bound over boxes whose interval of the body is above zero
+//! (no point of the solid in them). Rays are clipped to it before the march
+//! (`geom::hull`), so a ray missing the polyhedron costs no step and one entering it
+//! starts near the surface, not at the corner of the field's bounds.
+
+use std::collections::BinaryHeap;
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::interval::Interval;
+use super::tape::{Distances, Tape};
+use crate::geom::Aabb;
+
+/// Interval evaluations one direction may spend.
+const BUDGET: usize = 256;
+
+/// A box of the search, ordered by how far it reaches along the direction.
+struct Cell {
+    reach: f64,
+    lo: DVec3,
+    hi: DVec3,
+}
+
+impl PartialEq for Cell {
+    fn eq(&self, o: &Cell) -> bool {
+        self.reach.total_cmp(&o.reach).is_eq()
+    }
+}
+impl Eq for Cell {}
+impl PartialOrd for Cell {
+    fn partial_cmp(&self, o: &Cell) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Cell {
+    fn cmp(&self, o: &Cell) -> std::cmp::Ordering {
+        self.reach.total_cmp(&o.reach)
+    }
+}
+
+/// The largest `n·p` over the box `lo..hi`.
+fn reach(n: DVec3, lo: DVec3, hi: DVec3) -> f64 {
+    n.dot(DVec3::select(n.cmpge(DVec3::ZERO), hi, lo))
+}
+
+/// Planes `n·p ≤ offset` (unit `n`) holding where the body is at most zero within `b`,
+/// for the directions where that is nearer than `b`'s own face; `None` when no point
+/// of `b` can be in the solid. Only an upper bound of each reach is taken (the largest
+/// reach of the boxes not ruled out), so the planes hold the solid whatever the budget.
+pub fn support_planes(tape: &Tape, b: Aabb, dist: &(dyn Distances<Interval> + Sync)) -> Option<Vec<(DVec3, f64)>> {
+    let tol = (b.max - b.min).length() / 256.0;
+    // A box is ruled out only where the body is clearly above zero: the march runs it
+    // in f32.
+    let slack = 1e-6 * (1.0 + b.min.abs().max(b.max.abs()).max_element());
+    let empty = |lo: DVec3, hi: DVec3| {
+        let at = [0, 1, 2].map(|i| Interval::new(lo[i], hi[i]));
+        tape.eval::<Interval>(&at, dist).lo > slack
+    };
+    if empty(b.min, b.max) {
+        return None;
+    }
+    // The cube's 26 directions, searched in parallel.
+    let dirs: Vec<DVec3> = (0..27)
+        .filter_map(|i| {
+            DVec3::new(f64::from(i % 3) - 1.0, f64::from(i / 3 % 3) - 1.0, f64::from(i / 9) - 1.0).try_normalize()
+        })
+        .collect();
+    let offsets: Option<Vec<(DVec3, f64)>> =
+        dirs.par_iter().map(|&n| Some((n, farthest(n, b, tol, &empty)?))).collect();
+    let planes = offsets?.into_iter().filter(|&(n, o)| o < reach(n, b.min, b.max) - tol).collect();
+    Some(planes)
+}
+
+/// An upper bound of the largest `n·p` over the boxes within `b` not ruled `empty`, to
+/// within `tol` or the budget; `None` if every box is.
+fn farthest(n: DVec3, b: Aabb, tol: f64, empty: &(dyn Fn(DVec3, DVec3) -> bool + Sync)) -> Option<f64> {
+    let mut heap = BinaryHeap::from([Cell { reach: reach(n, b.min, b.max), lo: b.min, hi: b.max }]);
+    let mut spent = 0;
+    while let Some(cell) = heap.pop() {
+        let extent = cell.reach + reach(-n, cell.lo, cell.hi);
+        if spent >= BUDGET || extent <= tol {
+            // Every box left reaches no farther than this one.
+            return Some(cell.reach);
+        }
+        spent += 1;
+        if empty(cell.lo, cell.hi) {
+            continue;
+        }
+        let axis = (cell.hi - cell.lo).max_position();
+        let mid = 0.5 * (cell.lo[axis] + cell.hi[axis]);
+        let (mut upper, mut lower) = (cell.hi, cell.lo);
+        upper[axis] = mid;
+        lower[axis] = mid;
+        for (lo, hi) in [(cell.lo, upper), (lower, cell.hi)] {
+            heap.push(Cell { reach: reach(n, lo, hi), lo, hi });
+        }
+    }
+    None
+}
