@@ -321,7 +321,7 @@ fn hulls_contain_their_solids() {
 /// where it misses, each hit within its threshold of the surface, for 4,000 rays aimed
 /// at and around each of a turned box, octahedron, pyramid, hex prism, extruded
 /// triangle, cylinder, capped cone, ellipsoid (stretched), revolved profile, twisted
-/// prism and a field's ball; and
+/// prism and a gyroid sheet cut by a ball (a field); and
 /// they take fewer steps. (Along a ray grazing an edge the two hits may be apart: the
 /// march stops where it first comes within the threshold, the clipped ray where it
 /// enters the solid.)
@@ -331,8 +331,8 @@ fn rays_clipped_to_hulls_hit_where_the_march_does() {
     let mut rng = Rng(0xc119);
     // Each with how many times fewer steps its clipped rays must take: a fifth for the
     // solids the hull is exactly (they take 10–35× fewer), half for a twist, whose
-    // cylinder only starts rays nearer (3.5×), two thirds for a field, whose 26 planes
-    // from intervals (`field::support_planes`) cut its box's corners and edges (2×).
+    // cylinder only starts rays nearer (3.5×), two thirds for a field, whose planes
+    // from intervals (`field::support_planes`) cut its box's corners and edges (2.3×).
     let solids = [
         ("box(0.9, 0.5, 0.7)", 5.0),
         ("octahedron(1)", 5.0),
@@ -344,7 +344,11 @@ fn rays_clipped_to_hulls_hit_where_the_march_does() {
         ("ellipsoid(0.9, 0.5, 0.7) scale [1, 1.5, 0.8]", 5.0),
         ("revolve(polygon([[0, -0.5], [0.8, -0.4], [0.3, 0.6], [0, 0.6]]))", 5.0),
         ("twist(hex_prism(0.5, 0.6), 60)", 2.0),
-        ("field(p => length(p) - 0.7, bounds = [[-0.7, -0.7, -0.7], [0.7, 0.7, 0.7]])", 1.5),
+        (
+            "field(p => max(abs(sin(450 * p.x) * cos(450 * p.y) + sin(450 * p.y) * cos(450 * p.z) + \
+             sin(450 * p.z) * cos(450 * p.x)) - 0.3, length(p) - 0.7), bounds = [[-0.7, -0.7, -0.7], [0.7, 0.7, 0.7]])",
+            1.5,
+        ),
     ];
     for (solid, fewer) in solids {
         // The camera at the origin looking along +z: render space is scene space.
