@@ -161,6 +161,9 @@ fn meet(a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
     (a.0.max(b.0), a.1.min(b.1))
 }
 
+/// The most planes [`Hull::corners`] searches: 64 planes are 41,664 triples.
+pub const MAX_CORNER_PLANES: usize = 64;
+
 impl Hull {
     /// The hull of planes alone.
     pub fn planes(planes: Vec<(DVec3, f64)>) -> Hull {
@@ -210,10 +213,14 @@ impl Hull {
     }
 
     /// The corners of the planes' polyhedron (where three planes meet within every
-    /// other), when the planes alone bound it; empty otherwise.
+    /// other), when the planes alone bound it; empty otherwise, and for more than
+    /// [`MAX_CORNER_PLANES`] planes (the search tries every triple against every plane).
     pub fn corners(&self) -> Vec<DVec3> {
         let p = &self.planes;
         let mut out = Vec::new();
+        if p.len() > MAX_CORNER_PLANES {
+            return out;
+        }
         for i in 0..p.len() {
             for j in i + 1..p.len() {
                 for k in j + 1..p.len() {
