@@ -56,6 +56,13 @@ impl Round {
         })
     }
 
+    /// Whether the set is about the hull's own `y` axis (its frame is the hull's), so a
+    /// turn about that axis leaves it as it is.
+    pub fn turns_with_y(&self) -> bool {
+        let t = self.to_local.translation;
+        self.to_local.matrix3 == DMat3::IDENTITY && t.x == 0.0 && t.z == 0.0
+    }
+
     /// Holding every point within `g` of this set.
     fn grown(mut self, g: f64) -> Round {
         let g = g * self.stretch;

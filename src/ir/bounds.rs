@@ -189,12 +189,20 @@ fn hull_within(shape: &Shape, g: f64) -> Option<Hull> {
             let lines = region.revolved_hull_lines();
             Some(Hull::about_y(lines.into_iter().map(|(n, d)| (n.x, n.y, d)))?.grown(g))
         }
-        // A twisted shape stays within the cylinder about y that holds its child's
-        // corners (or box), between the same heights. Its field is the child's divided
+        // A twisted shape stays within its child's cones about y, or else the cylinder
+        // about y that holds its child's corners (or box), between the same heights. Its field is the child's divided
         // by the map's stretch, at most `g` where the child's is at most `g·L`.
         ShapeKind::Warp { child, domain_op: Some(crate::ir::DomainOp::Twist(_)), lipschitz, .. } => {
             let g = g * lipschitz.value.max(1.0);
-            let within = hull_within(child, g).filter(|h| h.round.is_none()).map(|h| h.corners());
+            let hull = hull_within(child, g);
+            // Cones about the axis and planes across it are turned into themselves.
+            if let Some(Hull { planes, round: Some(round) }) = &hull {
+                if round.turns_with_y() {
+                    let across = planes.iter().filter(|(n, _)| n.x == 0.0 && n.z == 0.0).copied().collect();
+                    return Some(Hull { planes: across, round: Some(round.clone()) });
+                }
+            }
+            let within = hull.filter(|h| h.round.is_none()).map(|h| h.corners());
             let (radius, low, high) = match within.filter(|c| !c.is_empty()) {
                 Some(corners) => corners.iter().fold((0.0_f64, f64::INFINITY, f64::NEG_INFINITY), |(r, lo, hi), c| {
                     (r.max(c.x.hypot(c.z)), lo.min(c.y), hi.max(c.y))
