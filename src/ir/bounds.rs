@@ -202,21 +202,41 @@ fn hull_within(shape: &Shape, g: f64) -> Option<Hull> {
                     return Some(Hull { planes: across, round: Some(round.clone()) });
                 }
             }
-            let within = hull.filter(|h| h.round.is_none()).map(|h| h.corners());
-            let (radius, low, high) = match within.filter(|c| !c.is_empty()) {
-                Some(corners) => corners.iter().fold((0.0_f64, f64::INFINITY, f64::NEG_INFINITY), |(r, lo, hi), c| {
-                    (r.max(c.x.hypot(c.z)), lo.min(c.y), hi.max(c.y))
-                }),
-                None => {
-                    let b = bounds_within(child, g)?;
-                    (b.radius_about_y(), b.min.y, b.max.y)
-                }
-            };
+            let (radius, low, high) = extent_about(child, g, |c| (c.x.hypot(c.z), c.y))?;
             let round = Round::about_y([(1.0, 0.0, radius)])?;
             Some(Hull { planes: vec![(DVec3::Y, high), (-DVec3::Y, -low)], round: Some(round) })
         }
+        // A bend turns the point about z, so the bent shape stays within the cylinder
+        // about z that holds its child's corners (or box), between the same depths.
+        ShapeKind::Warp { child, domain_op: Some(crate::ir::DomainOp::Bend(_)), lipschitz, .. } => {
+            let g = g * lipschitz.value.max(1.0);
+            let (radius, low, high) = extent_about(child, g, |c| (c.x.hypot(c.y), c.z))?;
+            // The cylinder is about the y axis of a frame whose y is the scene's z.
+            let cones = [(1.0, 0.0, radius), (0.0, 1.0, high), (0.0, -1.0, -low)];
+            Hull::about_y(cones)?.transformed(&DAffine3::from_rotation_x(std::f64::consts::FRAC_PI_2))
+        }
         ShapeKind::Field { .. } | ShapeKind::Warp { .. } | ShapeKind::Displace { .. } => None,
     }
+}
+
+/// The largest distance from an axis and the range along it of where `shape`'s field
+/// is at most `g`: over the corners of its planes' polyhedron when it has one, else over
+/// its box's corners; `about(p)` is a point's distance from the axis and its place
+/// along it.
+fn extent_about(shape: &Shape, g: f64, about: impl Fn(DVec3) -> (f64, f64)) -> Option<(f64, f64, f64)> {
+    let corners = hull_within(shape, g).filter(|h| h.round.is_none()).map(|h| h.corners());
+    let corners = match corners.filter(|c| !c.is_empty()) {
+        Some(c) => c,
+        None => {
+            let b = bounds_within(shape, g)?;
+            (0..8).map(|i| DVec3::select(glam::BVec3::new(i & 1 != 0, i & 2 != 0, i & 4 != 0), b.max, b.min)).collect()
+        }
+    };
+    let extent = corners
+        .iter()
+        .map(|&c| about(c))
+        .fold((0.0_f64, f64::INFINITY, f64::NEG_INFINITY), |acc, (r, t)| (acc.0.max(r), acc.1.min(t), acc.2.max(t)));
+    Some(extent)
 }
 
 /// `Some(k)` when `m` is a rotation times a uniform scale `k`.

@@ -276,7 +276,7 @@ fn cut_about(rng: &mut Rng, mut tree: String, smooth_cut: bool) -> String {
 /// march) holds every point where its field is at or below zero: boxes, polyhedra,
 /// extrusions (an L, a holed plate with a disc beside), round solids (cylinder, cones,
 /// ellipsoid, torus, capsule), a revolved profile, a twisted prism and a twisted cone
-/// moved along its axis, turned,
+/// moved along its axis and a bent bar, turned,
 /// stretched, cut by random solids, rounded and shelled, sharp and smooth.
 #[test]
 fn hulls_contain_their_solids() {
@@ -298,6 +298,7 @@ fn hulls_contain_their_solids() {
         "revolve(union(polygon([[0, -0.5], [0.8, -0.4], [0.3, 0.6], [0, 0.6]]), circle(0.2) at [0.7, 0.5]))",
         "twist(hex_prism(0.5, 0.6), 60)",
         "twist(capped_cone(0.7, 0.3, 0.6) at [0, 0.2, 0], 45)",
+        "bend(box(0.2, 0.9, 0.3) rotate [0, 30, 0] at [0.1, 0, 0.2], 50)",
     ];
     for case in 0..240 {
         let tree = cut_about(&mut rng, polyhedra[case % polyhedra.len()].to_string(), true);
@@ -323,8 +324,8 @@ fn hulls_contain_their_solids() {
 /// where it misses, each hit within its threshold of the surface, for 4,000 rays aimed
 /// at and around each of a turned box, octahedron, pyramid, hex prism, extruded
 /// triangle, cylinder, capped cone, ellipsoid (stretched), revolved profile, twisted
-/// prism, twisted capped cone (its own cones) and a gyroid sheet cut by a ball (a
-/// field); and
+/// prism, twisted capped cone (its own cones), bent bar and a gyroid sheet cut by a
+/// ball (a field); and
 /// they take fewer steps. (Along a ray grazing an edge the two hits may be apart: the
 /// march stops where it first comes within the threshold, the clipped ray where it
 /// enters the solid.)
@@ -333,8 +334,8 @@ fn rays_clipped_to_hulls_hit_where_the_march_does() {
     use scnc::trace::{Counters, Geometry, Ray};
     let mut rng = Rng(0xc119);
     // Each with how many times fewer steps its clipped rays must take: a fifth for the
-    // solids the hull is exactly (they take 10–35× fewer), half for a twist, whose
-    // cylinder only starts rays nearer (3.5×), two thirds for a field, whose planes
+    // solids the hull is exactly (they take 10–55× fewer), half for a twist or a bend,
+    // whose cylinder only starts rays nearer (3.2–3.8×), two thirds for a field, whose planes
     // from intervals (`field::support_planes`) cut its box's corners and edges (2.3×).
     let solids = [
         ("box(0.9, 0.5, 0.7)", 5.0),
@@ -348,6 +349,7 @@ fn rays_clipped_to_hulls_hit_where_the_march_does() {
         ("revolve(polygon([[0, -0.5], [0.8, -0.4], [0.3, 0.6], [0, 0.6]]))", 5.0),
         ("twist(hex_prism(0.5, 0.6), 60)", 2.0),
         ("twist(capped_cone(0.9, 0.2, 0.6), 45)", 5.0),
+        ("bend(box(0.35, 0.9, 0.4) rotate [0, 30, 0], 50)", 2.0),
         (
             "field(p => max(abs(sin(450 * p.x) * cos(450 * p.y) + sin(450 * p.y) * cos(450 * p.z) + \
              sin(450 * p.z) * cos(450 * p.x)) - 0.3, length(p) - 0.7), bounds = [[-0.7, -0.7, -0.7], [0.7, 0.7, 0.7]])",
