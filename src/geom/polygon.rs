@@ -153,9 +153,91 @@ pub fn lathe_normals(m: &TriMesh) -> Vec<[DVec3; 3]> {
         .collect()
 }
 
+/// Corner normals for a prism's walls (an extrusion): each corner's normal is the
+/// mean of the planes of the facets meeting at its point whose normals are within
+/// `crease` (radians) of its own facet's, as Blender's auto smooth does, so the walls
+/// round a circle shade smooth while the caps' rims and a polygon's corners sharper
+/// than `crease` stay creased.
+pub fn smooth_within(m: &TriMesh, crease: f64) -> Vec<[DVec3; 3]> {
+    use std::collections::HashMap;
+    let facets: Vec<DVec3> = m
+        .triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| m.positions[i as usize]);
+            (b - a).cross(c - a)
+        })
+        .collect();
+    // The facets at each point (by position: a wall and a cap may not share indices).
+    let key = |p: DVec3| p.to_array().map(f64::to_bits);
+    let mut at: HashMap<[u64; 3], Vec<usize>> = HashMap::new();
+    for (f, t) in m.triangles.iter().enumerate() {
+        for &i in t {
+            at.entry(key(m.positions[i as usize])).or_default().push(f);
+        }
+    }
+    let cos = crease.cos();
+    m.triangles
+        .iter()
+        .enumerate()
+        .map(|(f, t)| {
+            let own = facets[f].normalize_or_zero();
+            t.map(|i| {
+                // Each plane once (a wall's quad is two triangles of one plane), so the
+                // corner between two walls is normal to neither more than the other.
+                let mut planes: Vec<DVec3> = Vec::new();
+                for &g in &at[&key(m.positions[i as usize])] {
+                    let n = facets[g].normalize_or_zero();
+                    if n.dot(own) >= cos && !planes.iter().any(|q| q.abs_diff_eq(n, 1e-9)) {
+                        planes.push(n);
+                    }
+                }
+                planes.iter().sum::<DVec3>().normalize_or(own)
+            })
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Smoothed within a circle's step, an extruded disc's walls take the radial
+    /// direction at their corners (a facet's own normal is half a step off) and its
+    /// caps stay flat; a triangle prism's corners are sharper than the crease and keep their
+    /// facets' normals.
+    #[test]
+    fn extruded_circles_shade_smooth_and_polygons_keep_their_creases() {
+        use crate::geom::region::{extrusion, Region};
+        let n = 32;
+        let step = std::f64::consts::TAU / f64::from(n);
+        let disc = extrusion(&Region::Circle { centre: DVec2::ZERO, r: 1.0 }, 0.5, n).expect("a prism");
+        let normals = smooth_within(&disc, 1.01 * step);
+        let (mut walls, mut caps) = (0, 0);
+        for (t, corners) in disc.triangles.iter().zip(&normals) {
+            let [a, b, c] = t.map(|i| disc.positions[i as usize]);
+            let facet = (b - a).cross(c - a).normalize();
+            for (&i, normal) in t.iter().zip(corners) {
+                let p = disc.positions[i as usize];
+                if facet.y.abs() > 0.99 {
+                    caps += 1;
+                    assert!(normal.abs_diff_eq(facet, 1e-12), "a cap corner {normal} against {facet}");
+                } else {
+                    walls += 1;
+                    let radial = DVec3::new(p.x, 0.0, p.z).normalize();
+                    assert!(normal.angle_between(radial) < 1e-6, "a wall corner at {p}: {normal}");
+                }
+            }
+        }
+        assert!(walls >= 6 * n as usize && caps > 0, "{walls} wall and {caps} cap corners");
+        let triangle = [[-0.8, -0.5], [0.9, -0.3], [0.1, 0.8]].map(DVec2::from);
+        let prism = prism(&triangle, 0.4);
+        for (t, corners) in prism.triangles.iter().zip(smooth_within(&prism, 1.01 * step)) {
+            let [a, b, c] = t.map(|i| prism.positions[i as usize]);
+            let facet = (b - a).cross(c - a).normalize();
+            assert!(corners.iter().all(|n| n.abs_diff_eq(facet, 1e-12)), "{corners:?} against {facet}");
+        }
+    }
 
     #[test]
     fn an_l_prism_is_closed_outward_and_holds_the_ls_volume() {

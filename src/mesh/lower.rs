@@ -66,6 +66,12 @@ pub fn tessellate(
                 ShapeKind::Field { exact: Some(ExactMesh::Lathe(_) | ExactMesh::Revolution { .. }), .. } => {
                     Normals::Corners(crate::geom::polygon::lathe_normals(&mesh))
                 }
+                // A circle's walls meet at its step's angle; a sharper corner is a crease.
+                ShapeKind::Field { exact: Some(ExactMesh::Extrusion { .. }), .. } => {
+                    let step = std::f64::consts::TAU / f64::from(detail.circle());
+                    let crease = (1.01 * step).min(std::f64::consts::FRAC_PI_4);
+                    Normals::Corners(crate::geom::polygon::smooth_within(&mesh, crease))
+                }
                 _ => Normals::Flat,
             };
             // A generator's polytope is convex exactly when its shape is (tested for each);
