@@ -77,12 +77,12 @@ impl Region {
         }
     }
 
-    /// The region as polygons with holes, circles inscribed with `segments` sides.
-    fn shapes(&self, segments: u32) -> Shapes {
+    /// The region as polygons with holes, each circle inscribed with `sides(r)` sides.
+    fn shapes(&self, sides: &dyn Fn(f64) -> u32) -> Shapes {
         match self {
             Region::Polygon(c) => vec![vec![c.iter().map(|p| p.to_array()).collect()]],
             Region::Circle { centre, r } => {
-                let n = segments.max(3);
+                let n = sides(*r).max(3);
                 let ring = (0..n).map(|i| {
                     let (sin, cos) = (std::f64::consts::TAU * f64::from(i) / f64::from(n)).sin_cos();
                     (*centre + DVec2::new(cos, sin) * *r).to_array()
@@ -95,7 +95,7 @@ impl Region {
                     Combine::Intersect => OverlayRule::Intersect,
                     Combine::Subtract => OverlayRule::Difference,
                 };
-                let mut parts = parts.iter().map(|p| p.shapes(segments));
+                let mut parts = parts.iter().map(|p| p.shapes(sides));
                 let first = parts.next().unwrap_or_default();
                 parts.fold(first, |acc, p| acc.overlay(&p, rule, FillRule::NonZero))
             }
@@ -189,7 +189,7 @@ pub fn extrusion(region: &Region, half_height: f64, segments: u32) -> Option<Tri
     }
     let mut points = Vec::new();
     let mut triangles = Vec::new();
-    for shape in region.shapes(segments) {
+    for shape in region.shapes(&|_| segments) {
         let t = shape.triangulate().to_triangulation::<u32>();
         let base = points.len() as u32;
         points.extend(t.points.iter().map(|p| DVec2::from_array(*p)));
@@ -200,14 +200,19 @@ pub fn extrusion(region: &Region, half_height: f64, segments: u32) -> Option<Tri
 
 /// The solid of `region` revolved about `y` in `segments` steps (its `[u, v]` the
 /// radius and the height; a part at `u < 0` clipped, as the distance clips it), circles
-/// with `segments` sides: each outline revolved as a lathe, each hole's turned inside
+/// with [`revolved_circle_sides`]: each outline revolved as a lathe, each hole's turned inside
 /// out. `None` when the region comes out empty, too far out, or with an outline that
 /// meets the axis other than along one edge or at one corner (`polygon::lathe_ok`).
 pub fn revolution(region: &Region, segments: u32) -> Option<TriMesh> {
     if !region.in_reach() {
         return None;
     }
-    let shapes = region.shapes(segments);
+    let reach = {
+        let mut pts = Vec::new();
+        region.hull_points(&mut pts);
+        pts.iter().fold(0.0f64, |m, p| m.max(p.x.abs()))
+    };
+    let shapes = region.shapes(&|r| revolved_circle_sides(segments, r, reach));
     let far = shapes.iter().flatten().flatten().fold(1.0f64, |m, p| m.max(p[0].abs()).max(p[1].abs())) * 2.0;
     let half_plane = vec![vec![[0.0, -far], [far, -far], [far, far], [0.0, far]]];
     let clipped = shapes.overlay(&half_plane, OverlayRule::Intersect, FillRule::NonZero);
@@ -229,6 +234,19 @@ pub fn revolution(region: &Region, segments: u32) -> Option<TriMesh> {
         }
     }
     (!out.triangles.is_empty()).then_some(out)
+}
+
+/// The sides of a circle of radius `r` in a profile revolved in `segments` steps, whose
+/// farthest point is `reach` from the axis: as many as keep the circle's sagitta within
+/// the revolution's at `reach` (`r/n² = reach/segments²`, so `segments·√(r/reach)`), as
+/// a torus's tube has fewer sides than its ring; never more than `segments`.
+pub fn revolved_circle_sides(segments: u32, r: f64, reach: f64) -> u32 {
+    let n = (f64::from(segments) * (r / reach).sqrt()).ceil();
+    if n.is_finite() {
+        (n as u32).clamp(3, segments.max(3))
+    } else {
+        segments
+    }
 }
 
 /// Corners this close to the axis, relative to the region's extent, are on it: the
@@ -330,14 +348,18 @@ mod tests {
     #[test]
     fn revolved_regions_are_closed_and_hold_pappus_volumes() {
         let n = 48;
-        let area = |r: f64| 0.5 * f64::from(n) * r * r * (std::f64::consts::TAU / f64::from(n)).sin();
         let disc = |centre: DVec2, r: f64| Region::Circle { centre, r };
         let torus = revolution(&disc(DVec2::new(1.0, 0.2), 0.3), n).expect("a torus");
         assert_eq!(torus.open_edges(), (0, 0));
+        // A circle has the sides that keep its sagitta within the revolution's.
+        let area = |r: f64, reach: f64| {
+            let k = revolved_circle_sides(n, r, reach);
+            0.5 * f64::from(k) * r * r * (std::f64::consts::TAU / f64::from(k)).sin()
+        };
         // The revolved polygon's path is itself a polygon of n sides: its centroid's
         // circle shrinks to the inscribed perimeter, n·sin(2π/n)/(2π) of it.
         let path = f64::from(n) * (std::f64::consts::TAU / f64::from(n)).sin() / std::f64::consts::TAU;
-        let want = area(0.3) * std::f64::consts::TAU * 1.0 * path;
+        let want = area(0.3, 1.3) * std::f64::consts::TAU * 1.0 * path;
         assert!((torus.signed_volume() - want).abs() < 1e-6 * want, "{} not {want}", torus.signed_volume());
         let ball = revolution(&disc(DVec2::ZERO, 0.5), n).expect("a ball");
         assert_eq!(ball.open_edges(), (0, 0));
@@ -346,7 +368,7 @@ mod tests {
             Region::Csg(Combine::Subtract, vec![disc(DVec2::new(1.0, 0.0), 0.4), disc(DVec2::new(1.0, 0.0), 0.2)]);
         let hollow = revolution(&ring, n).expect("a hollow torus");
         assert_eq!(hollow.open_edges(), (0, 0));
-        let want = (area(0.4) - area(0.2)) * std::f64::consts::TAU * path;
+        let want = (area(0.4, 1.4) - area(0.2, 1.4)) * std::f64::consts::TAU * path;
         assert!((hollow.signed_volume() - want).abs() < 1e-6 * want, "{} not {want}", hollow.signed_volume());
     }
 }

@@ -600,7 +600,7 @@ fn elongated_and_mirrored_shapes_are_cut_from_their_childs_mesh() {
 
 /// A revolved circle or ring is meshed as lathes of its outlines (`geom::region`), not
 /// an isosurface: a disc off the axis exports as a torus of about the torus primitive's
-/// count (each is a lathe of a polygon), holding Pappus's volume as closely; a ring's
+/// count and volume error (each is a lathe of a polygon); a ring's
 /// hole is a torus turned inside out within it.
 #[test]
 fn revolved_circles_are_lathes() {
@@ -608,9 +608,12 @@ fn revolved_circles_are_lathes() {
     let pappus = |r: f64, at: f64| std::f64::consts::PI * r * r * std::f64::consts::TAU * at;
     let (n_torus, v_torus) = of("torus(1, 0.3)");
     let (n, v) = of("revolve(circle(0.3) at [1, 0])");
-    assert!(n <= 2 * n_torus, "{n} triangles where the torus has {n_torus}");
+    // The profile's circle has the sides that keep its sagitta within the revolution's,
+    // as the torus's tube does: about the torus's count and error (25,272 triangles
+    // 0.13 % under against 26,244 0.12 % under; 52,488 with the revolution's sides).
+    assert!(10 * n <= 11 * n_torus, "{n} triangles where the torus has {n_torus}");
     let exact = pappus(0.3, 1.0);
-    assert!((v - exact).abs() <= (v_torus - exact).abs().max(1e-3 * exact), "{v} against {exact}");
+    assert!((v - exact).abs() <= 1.25 * (v_torus - exact).abs(), "{v} against {exact}; the torus {v_torus}");
     let (_, v) = of("revolve(subtract(circle(0.4), circle(0.2)) at [1, 0])");
     let exact = pappus(0.4, 1.0) - pappus(0.2, 1.0);
     assert!((v - exact).abs() < 1e-3 * exact, "{v} against {exact}");
