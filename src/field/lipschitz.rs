@@ -31,11 +31,12 @@ pub struct Estimate {
     pub range: Interval,
 }
 
-/// A box of the search with its slope bound, ordered by the bound.
-struct Cell {
-    bound: f64,
-    lo: DVec3,
-    hi: DVec3,
+/// A box of a branch-and-bound search with the bound it is ordered by (here its slope
+/// bound; in `support` how far it reaches along a direction).
+pub(super) struct Cell {
+    pub(super) bound: f64,
+    pub(super) lo: DVec3,
+    pub(super) hi: DVec3,
 }
 
 impl PartialEq for Cell {

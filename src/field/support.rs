@@ -11,35 +11,12 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::interval::Interval;
+use super::lipschitz::Cell;
 use super::tape::{Distances, Tape};
 use crate::geom::Aabb;
 
 /// Interval evaluations one direction may spend.
 const BUDGET: usize = 256;
-
-/// A box of the search, ordered by how far it reaches along the direction.
-struct Cell {
-    reach: f64,
-    lo: DVec3,
-    hi: DVec3,
-}
-
-impl PartialEq for Cell {
-    fn eq(&self, o: &Cell) -> bool {
-        self.reach.total_cmp(&o.reach).is_eq()
-    }
-}
-impl Eq for Cell {}
-impl PartialOrd for Cell {
-    fn partial_cmp(&self, o: &Cell) -> Option<std::cmp::Ordering> {
-        Some(self.cmp(o))
-    }
-}
-impl Ord for Cell {
-    fn cmp(&self, o: &Cell) -> std::cmp::Ordering {
-        self.reach.total_cmp(&o.reach)
-    }
-}
 
 /// The largest `n·p` over the box `lo..hi`.
 fn reach(n: DVec3, lo: DVec3, hi: DVec3) -> f64 {
@@ -77,13 +54,13 @@ pub fn support_planes(tape: &Tape, b: Aabb, dist: &(dyn Distances<Interval> + Sy
 /// An upper bound of the largest `n·p` over the boxes within `b` not ruled `empty`, to
 /// within `tol` or the budget; `None` if every box is.
 fn farthest(n: DVec3, b: Aabb, tol: f64, empty: &(dyn Fn(DVec3, DVec3) -> bool + Sync)) -> Option<f64> {
-    let mut heap = BinaryHeap::from([Cell { reach: reach(n, b.min, b.max), lo: b.min, hi: b.max }]);
+    let mut heap = BinaryHeap::from([Cell { bound: reach(n, b.min, b.max), lo: b.min, hi: b.max }]);
     let mut spent = 0;
     while let Some(cell) = heap.pop() {
-        let extent = cell.reach + reach(-n, cell.lo, cell.hi);
+        let extent = cell.bound + reach(-n, cell.lo, cell.hi);
         if spent >= BUDGET || extent <= tol {
             // Every box left reaches no farther than this one.
-            return Some(cell.reach);
+            return Some(cell.bound);
         }
         spent += 1;
         if empty(cell.lo, cell.hi) {
@@ -95,7 +72,7 @@ fn farthest(n: DVec3, b: Aabb, tol: f64, empty: &(dyn Fn(DVec3, DVec3) -> bool +
         upper[axis] = mid;
         lower[axis] = mid;
         for (lo, hi) in [(cell.lo, upper), (lower, cell.hi)] {
-            heap.push(Cell { reach: reach(n, lo, hi), lo, hi });
+            heap.push(Cell { bound: reach(n, lo, hi), lo, hi });
         }
     }
     None
