@@ -54,29 +54,9 @@ pub fn triangulate(v: &[u32], positions: &[DVec3]) -> Vec<[u32; 3]> {
 /// `x` and `z`, from `y = -half_height` to `half_height`: its two caps, ear-clipped, and a
 /// quad per edge, corners shared, wound outward. Exact: the solid's own flat faces.
 pub fn prism(corners: &[DVec2], half_height: f64) -> TriMesh {
-    let n = corners.len() as u32;
-    let mut m = TriMesh::default();
-    for y in [-half_height, half_height] {
-        m.positions.extend(corners.iter().map(|c| DVec3::new(c.x, y, c.y)));
-    }
-    let bottom: Vec<u32> = (0..n).collect();
-    let top: Vec<u32> = (n..2 * n).collect();
-    for [a, b, c] in triangulate(&bottom, &m.positions) {
-        m.triangles.push([a, b, c]);
-    }
-    for [a, b, c] in triangulate(&top, &m.positions) {
-        m.triangles.push([a, c, b]);
-    }
-    for i in 0..n {
-        let j = (i + 1) % n;
-        m.triangles.push([i, n + j, j]);
-        m.triangles.push([i, n + i, n + j]);
-    }
-    // Built for one winding of the outline; the other comes out inside out.
-    if m.signed_volume() < 0.0 {
-        m.triangles.iter_mut().for_each(|t| t.swap(1, 2));
-    }
-    m
+    let outline: Vec<u32> = (0..corners.len() as u32).collect();
+    let flat: Vec<DVec3> = corners.iter().map(|c| DVec3::new(c.x, 0.0, c.y)).collect();
+    super::region::prism_of_caps(corners, &triangulate(&outline, &flat), half_height)
 }
 
 /// Whether `corners` (`[radius, height]`) revolve into a closed, manifold lathe: none at
