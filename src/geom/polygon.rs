@@ -56,7 +56,47 @@ pub fn triangulate(v: &[u32], positions: &[DVec3]) -> Vec<[u32; 3]> {
 pub fn prism(corners: &[DVec2], half_height: f64) -> TriMesh {
     let outline: Vec<u32> = (0..corners.len() as u32).collect();
     let flat: Vec<DVec3> = corners.iter().map(|c| DVec3::new(c.x, 0.0, c.y)).collect();
-    super::region::prism_of_caps(corners, &triangulate(&outline, &flat), half_height)
+    prism_of_caps(corners, &triangulate(&outline, &flat), half_height)
+}
+
+/// A prism from a triangulated cap (`[u, v]` points, triangles of either winding): the
+/// cap at both heights and a quad on every edge of the cap's rim, so the walls meet the
+/// caps at the very same corners whatever the triangulation made of the outline.
+pub fn prism_of_caps(points: &[DVec2], triangles: &[[u32; 3]], half_height: f64) -> TriMesh {
+    let n = points.len() as u32;
+    let mut m = TriMesh::default();
+    for y in [-half_height, half_height] {
+        m.positions.extend(points.iter().map(|c| DVec3::new(c.x, y, c.y)));
+    }
+    // Counter-clockwise in `[u, v]` is clockwise seen from +y (`v` is `z`): so wound,
+    // a triangle faces down, as the bottom cap should.
+    let ccw: Vec<[u32; 3]> = triangles
+        .iter()
+        .filter_map(|&[a, b, c]| {
+            let [pa, pb, pc] = [a, b, c].map(|i| points[i as usize]);
+            let area = (pb - pa).perp_dot(pc - pa);
+            (area != 0.0).then_some(if area > 0.0 { [a, b, c] } else { [a, c, b] })
+        })
+        .collect();
+    let mut rim: std::collections::HashSet<(u32, u32)> = std::collections::HashSet::new();
+    for t in &ccw {
+        m.triangles.push(*t);
+        m.triangles.push([t[0] + n, t[2] + n, t[1] + n]);
+        for e in 0..3 {
+            let (a, b) = (t[e], t[(e + 1) % 3]);
+            if !rim.remove(&(b, a)) {
+                rim.insert((a, b));
+            }
+        }
+    }
+    // A rim edge a→b of the bottom cap: its wall runs up from it, wound against it.
+    let mut rim: Vec<(u32, u32)> = rim.into_iter().collect();
+    rim.sort_unstable();
+    for (a, b) in rim {
+        m.triangles.push([b, a, a + n]);
+        m.triangles.push([b, a + n, b + n]);
+    }
+    m
 }
 
 /// Whether `corners` (`[radius, height]`) revolve into a closed, manifold lathe: none at

@@ -5,7 +5,7 @@
 //! the engine behind the `geo` crate's, robust where edges meet or overlap), and each
 //! resulting outline with its holes is triangulated (iTriangle) into the prism's caps.
 
-use glam::{DVec2, DVec3};
+use glam::DVec2;
 use i_triangle::float::triangulatable::Triangulatable;
 use i_triangle::i_overlay::core::fill_rule::FillRule;
 use i_triangle::i_overlay::core::overlay_rule::OverlayRule;
@@ -195,7 +195,7 @@ pub fn extrusion(region: &Region, half_height: f64, segments: u32) -> Option<Tri
         points.extend(t.points.iter().map(|p| DVec2::from_array(*p)));
         triangles.extend(t.indices.chunks_exact(3).map(|c| [c[0] + base, c[1] + base, c[2] + base]));
     }
-    (!triangles.is_empty()).then(|| prism_of_caps(&points, &triangles, half_height))
+    (!triangles.is_empty()).then(|| super::polygon::prism_of_caps(&points, &triangles, half_height))
 }
 
 /// The solid of `region` revolved about `y` in `segments` steps (its `[u, v]` the
@@ -252,46 +252,6 @@ pub fn revolved_circle_sides(segments: u32, r: f64, reach: f64) -> u32 {
 /// Corners this close to the axis, relative to the region's extent, are on it: the
 /// overlay's integer grid leaves the clip's edge a rounding away from `u = 0`.
 const SNAP_TO_AXIS: f64 = 1e-9;
-
-/// A prism from a triangulated cap (`[u, v]` points, triangles of either winding): the
-/// cap at both heights and a quad on every edge of the cap's rim, so the walls meet the
-/// caps at the very same corners whatever the triangulation made of the outline.
-pub fn prism_of_caps(points: &[DVec2], triangles: &[[u32; 3]], half_height: f64) -> TriMesh {
-    let n = points.len() as u32;
-    let mut m = TriMesh::default();
-    for y in [-half_height, half_height] {
-        m.positions.extend(points.iter().map(|c| DVec3::new(c.x, y, c.y)));
-    }
-    // Counter-clockwise in `[u, v]` is clockwise seen from +y (`v` is `z`): so wound,
-    // a triangle faces down, as the bottom cap should.
-    let ccw: Vec<[u32; 3]> = triangles
-        .iter()
-        .filter_map(|&[a, b, c]| {
-            let [pa, pb, pc] = [a, b, c].map(|i| points[i as usize]);
-            let area = (pb - pa).perp_dot(pc - pa);
-            (area != 0.0).then_some(if area > 0.0 { [a, b, c] } else { [a, c, b] })
-        })
-        .collect();
-    let mut rim: std::collections::HashSet<(u32, u32)> = std::collections::HashSet::new();
-    for t in &ccw {
-        m.triangles.push(*t);
-        m.triangles.push([t[0] + n, t[2] + n, t[1] + n]);
-        for e in 0..3 {
-            let (a, b) = (t[e], t[(e + 1) % 3]);
-            if !rim.remove(&(b, a)) {
-                rim.insert((a, b));
-            }
-        }
-    }
-    // A rim edge a→b of the bottom cap: its wall runs up from it, wound against it.
-    let mut rim: Vec<(u32, u32)> = rim.into_iter().collect();
-    rim.sort_unstable();
-    for (a, b) in rim {
-        m.triangles.push([b, a, a + n]);
-        m.triangles.push([b, a + n, b + n]);
-    }
-    m
-}
 
 #[cfg(test)]
 mod tests {
