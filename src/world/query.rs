@@ -239,10 +239,8 @@ impl Entry {
     /// ray leaving one steps out slowly.
     #[inline]
     fn clip(&self, epsilon: f32, ray: &Ray, (t0, t1): (f32, f32)) -> Option<(f32, f32)> {
-        // The threshold, ε·(t + min(t, |origin|)), is at most `reach·t`, and at most
-        // `far` before `t1`.
+        // The threshold, ε·(t + min(t, |origin|)), is at most `reach·t`.
         let reach = 2.0 * epsilon;
-        let far = crate::sdf::march::threshold(epsilon, ray.origin.length(), t1);
         // [enter, leave] on the set itself, and on it grown by the threshold.
         let (mut solid, mut grown) = ((t0, t1), (t0, t1));
         for &(n, offset) in self.planes.iter() {
@@ -265,9 +263,10 @@ impl Entry {
             }
         }
         if let Some(round) = &self.round {
-            let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
-            for ((enter, leave), g) in [(&mut solid, 0.0), (&mut grown, f64::from(far))] {
-                let (lo, hi) = round.interval(o, d, g);
+            // The threshold is at most `far` before `t1`.
+            let far = crate::sdf::march::threshold(epsilon, ray.origin.length(), t1);
+            let spans = round.intervals(ray.origin.as_dvec3(), ray.dir.as_dvec3(), [0.0, f64::from(far)]);
+            for ((enter, leave), (lo, hi)) in [(&mut solid, spans[0]), (&mut grown, spans[1])] {
                 if lo > hi {
                     // Empty (its ends may be infinite, which the slack below would make NaN).
                     *leave = f32::NEG_INFINITY;
@@ -278,10 +277,11 @@ impl Entry {
             }
         }
         // A hit lies within the grown set, so the march ends where the ray leaves it: a
-        // ray leaving a surface (a shadow ray) stops at the hull, not the sphere.
+        // ray leaving a surface (a shadow ray) stops at the hull, not the sphere (both
+        // ends start at `t1` and only come nearer).
         match (solid, grown) {
-            ((enter, leave), (_, out)) if enter <= leave => Some((enter, out.min(t1))),
-            (_, (enter, leave)) if enter <= leave => Some((enter, leave.min(t1))),
+            ((enter, leave), (_, out)) if enter <= leave => Some((enter, out)),
+            (_, (enter, leave)) if enter <= leave => Some((enter, leave)),
             _ => None,
         }
     }
