@@ -47,7 +47,7 @@ impl Round {
     /// The ellipsoid of semi-axes `radii` along x, y and z.
     pub fn ellipsoid(radii: DVec3) -> Option<Round> {
         let to_local = DAffine3::from_scale(radii.recip());
-        let stretch = to_local.matrix3.x_axis.x.max(to_local.matrix3.y_axis.y).max(to_local.matrix3.z_axis.z);
+        let stretch = max_stretch(to_local.matrix3);
         (radii.min_element() > 0.0 && stretch.is_finite()).then_some(Round {
             to_local,
             stretch,

@@ -202,7 +202,7 @@ fn hull_within(shape: &Shape, g: f64) -> Option<Hull> {
                     return Some(Hull { planes: across, round: Some(round.clone()) });
                 }
             }
-            let (radius, low, high) = extent_about(child, g, |c| (c.x.hypot(c.z), c.y))?;
+            let (radius, low, high) = extent_about(child, hull, g, |c| (c.x.hypot(c.z), c.y))?;
             let round = Round::about_y([(1.0, 0.0, radius)])?;
             Some(Hull { planes: vec![(DVec3::Y, high), (-DVec3::Y, -low)], round: Some(round) })
         }
@@ -210,7 +210,7 @@ fn hull_within(shape: &Shape, g: f64) -> Option<Hull> {
         // about z that holds its child's corners (or box), between the same depths.
         ShapeKind::Warp { child, domain_op: Some(crate::ir::DomainOp::Bend(_)), lipschitz, .. } => {
             let g = g * lipschitz.value.max(1.0);
-            let (radius, low, high) = extent_about(child, g, |c| (c.x.hypot(c.y), c.z))?;
+            let (radius, low, high) = extent_about(child, hull_within(child, g), g, |c| (c.x.hypot(c.y), c.z))?;
             // The cylinder is about the y axis of a frame whose y is the scene's z.
             let cones = [(1.0, 0.0, radius), (0.0, 1.0, high), (0.0, -1.0, -low)];
             Hull::about_y(cones)?.transformed(&DAffine3::from_rotation_x(std::f64::consts::FRAC_PI_2))
@@ -220,11 +220,16 @@ fn hull_within(shape: &Shape, g: f64) -> Option<Hull> {
 }
 
 /// The largest distance from an axis and the range along it of where `shape`'s field
-/// is at most `g`: over the corners of its planes' polyhedron when it has one, else over
-/// its box's corners; `about(p)` is a point's distance from the axis and its place
-/// along it.
-fn extent_about(shape: &Shape, g: f64, about: impl Fn(DVec3) -> (f64, f64)) -> Option<(f64, f64, f64)> {
-    let corners = hull_within(shape, g).filter(|h| h.round.is_none()).map(|h| h.corners());
+/// is at most `g`: over the corners of its planes' polyhedron when its `hull` (at `g`)
+/// is one, else over its box's corners; `about(p)` is a point's distance from the axis
+/// and its place along it.
+fn extent_about(
+    shape: &Shape,
+    hull: Option<Hull>,
+    g: f64,
+    about: impl Fn(DVec3) -> (f64, f64),
+) -> Option<(f64, f64, f64)> {
+    let corners = hull.filter(|h| h.round.is_none()).map(|h| h.corners());
     let corners = match corners.filter(|c| !c.is_empty()) {
         Some(c) => c,
         None => {
