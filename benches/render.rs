@@ -1,4 +1,4 @@
-//! Criterion benchmarks: one SDF evaluation per primitive, primary rays (one by one, in
+//! Criterion benchmarks: one SDF evaluation per primitive and of the gyroid sheet's field, primary rays (one by one, in
 //! 2×2 packets and in 4×4 blocks, shading off) over seed scenes 1 and 6 and a frame-filling sphere, and
 //! whole renders of every seed scene at a reduced size on one thread, and unions of
 //! 10 to 10,000 spheres against the same spheres as objects.
@@ -61,6 +61,18 @@ fn primitives(c: &mut Criterion) {
             b.iter(|| points.iter().map(|p| g.sdf_eval(0, black_box(*p)).unwrap_or(0.0)).sum::<f32>())
         });
     }
+    // A field body whose cost is its interpreter's (field::flat): the gyroid sheet.
+    let (_, g) = lower("benches/scenes/gyroid.scn", 64, 64);
+    let points: Vec<Vec3A> = (0..256)
+        .map(|i| {
+            let i = i as f32;
+            Vec3A::new((i * 0.37).sin(), (i * 0.71).cos(), (i * 0.13).sin()) * 1.5
+        })
+        .collect();
+    group.throughput(Throughput::Elements(points.len() as u64));
+    group.bench_function("gyroid sheet (benches/scenes/gyroid.scn)", |b| {
+        b.iter(|| points.iter().map(|p| g.sdf_eval(0, black_box(*p)).unwrap_or(0.0)).sum::<f32>())
+    });
     group.finish();
 }
 

@@ -2,6 +2,13 @@
 //! a constant operand carried inline for the common arithmetic, registers in a fixed
 //! array indexed through a mask (so no bounds check), one `match` to dispatch. It
 //! computes exactly what [`Tape::run`] computes on `f32` (tested on every operation).
+//!
+//! Dispatch, not arithmetic, was much of an evaluation: the gyroid sheet ran 22
+//! instructions, for 3 sines with their cosines and 8 operations. Inputs and copies
+//! become register names, and the pairs bodies are made of become one instruction
+//! each ([`fused`]): 9 instructions, the same bits. `cargo bench --bench render --
+//! 'sdf eval/gyroid'`: 22 → 17 µs per 256 points; the gyroid's primary rays (its scene
+//! without lights, depth 0, `scnc render --stats`): trace 1.81 → 1.31 s.
 
 use glam::Vec3A;
 
@@ -35,8 +42,165 @@ enum Code {
     Noise,
     /// Sine into `out` and cosine into register `b`, of one angle.
     SinCos,
+    /// [`Code::SinCos`] of `a·k`.
+    SinCosK,
     /// A copy of register `a`.
     Copy,
+    /// `a·b + c`.
+    MulAdd,
+    /// `a·k + b`.
+    MulCAdd,
+    /// `|a| − k`.
+    AbsSubC,
+    /// `length(a, b, c) − k`.
+    LengthSubC,
+}
+
+impl Code {
+    /// Which of `a`, `b`, `c` it reads.
+    fn reads(self) -> [bool; 3] {
+        match self {
+            Code::Input(_) | Code::Const => [false; 3],
+            Code::AddC
+            | Code::SubC
+            | Code::CSub
+            | Code::MulC
+            | Code::DivC
+            | Code::CDiv
+            | Code::MinC
+            | Code::MaxC
+            | Code::Unary(_)
+            | Code::SinCos
+            | Code::SinCosK
+            | Code::Copy
+            | Code::AbsSubC => [true, false, false],
+            Code::Binary(_) | Code::MulCAdd => [true, true, false],
+            Code::Select | Code::Length | Code::Dist | Code::Noise | Code::MulAdd | Code::LengthSubC => [true; 3],
+        }
+    }
+}
+
+impl Ins {
+    /// The registers it writes: `out`, and `b` for a sine–cosine pair.
+    fn writes(&self) -> impl Iterator<Item = u16> {
+        let pair = matches!(self.code, Code::SinCos | Code::SinCosK);
+        std::iter::once(self.out).chain(pair.then_some(self.b))
+    }
+
+    /// The registers it reads.
+    fn operands(&self) -> impl Iterator<Item = u16> + '_ {
+        [self.a, self.b, self.c].into_iter().zip(self.code.reads()).filter_map(|(r, read)| read.then_some(r))
+    }
+
+    /// Its operands renamed by `f`.
+    fn renamed(mut self, f: impl Fn(u16) -> u16) -> Ins {
+        let [ra, rb, rc] = self.code.reads();
+        if ra {
+            self.a = f(self.a);
+        }
+        if rb {
+            self.b = f(self.b);
+        }
+        if rc {
+            self.c = f(self.c);
+        }
+        self
+    }
+}
+
+/// Drops the instructions that only name a value held elsewhere: an input (the point's
+/// coordinates sit in registers `inputs..inputs + 3` from the start) and a copy of a
+/// register written once. Their readers, and `out`, read the original instead.
+fn forward(ins: Vec<Ins>, regs: usize, inputs: u16, out: &mut [u16; 3]) -> Vec<Ins> {
+    let mut writes = vec![0u32; regs];
+    for i in &ins {
+        for w in i.writes() {
+            writes[w as usize] += 1;
+        }
+    }
+    // What each register's reader reads instead, until the register is written again.
+    let mut alias: Vec<u16> = (0..regs as u16).collect();
+    let mut kept = Vec::with_capacity(ins.len());
+    for i in ins {
+        let i = i.renamed(|r| alias[r as usize]);
+        match i.code {
+            Code::Input(axis) => alias[i.out as usize] = inputs + u16::from(axis),
+            Code::Copy if writes[i.a as usize] == 1 => alias[i.out as usize] = i.a,
+            _ => {
+                for w in i.writes() {
+                    alias[w as usize] = w;
+                }
+                kept.push(i);
+            }
+        }
+    }
+    for o in out.iter_mut() {
+        *o = alias[*o as usize];
+    }
+    kept
+}
+
+/// How many readers each instruction's result has (`out` counts as one).
+fn readers(ins: &[Ins], regs: usize, out: &[u16; 3]) -> Vec<u32> {
+    let mut last = vec![usize::MAX; regs];
+    let mut n = vec![0u32; ins.len()];
+    let mut read = |last: &[usize], r: u16| {
+        if let Some(d) = last.get(r as usize).copied().filter(|&d| d != usize::MAX) {
+            n[d] += 1;
+        }
+    };
+    for (j, i) in ins.iter().enumerate() {
+        for r in i.operands() {
+            read(&last, r);
+        }
+        for w in i.writes() {
+            last[w as usize] = j;
+        }
+    }
+    for &o in out {
+        read(&last, o);
+    }
+    n
+}
+
+/// One instruction doing the work of `p` and the `q` right after it that alone reads
+/// `p`'s result, where the pair is common in bodies (a gyroid's `sin(k·x)`, its sums of
+/// products; a distance less a radius). Each computes in the same order as the pair,
+/// so the result is the same to the bit.
+fn fused(p: &Ins, q: &Ins) -> Option<Ins> {
+    let other = |q: &Ins| match (q.a == p.out, q.b == p.out) {
+        (true, false) => Some(q.b),
+        (false, true) => Some(q.a),
+        _ => None,
+    };
+    let ins = |code, a, b, c, k| Some(Ins { code, out: q.out, a, b, c, k });
+    match (p.code, q.code) {
+        (Code::MulC, Code::SinCos) if q.a == p.out => {
+            Some(Ins { code: Code::SinCosK, out: q.out, a: p.a, b: q.b, c: 0, k: p.k })
+        }
+        (Code::Binary(Binary::Mul), Code::Binary(Binary::Add)) => ins(Code::MulAdd, p.a, p.b, other(q)?, 0.0),
+        (Code::MulC, Code::Binary(Binary::Add)) => ins(Code::MulCAdd, p.a, other(q)?, 0, p.k),
+        (Code::Unary(Unary::Abs), Code::SubC) if q.a == p.out => ins(Code::AbsSubC, p.a, 0, 0, q.k),
+        (Code::Length, Code::SubC) if q.a == p.out => ins(Code::LengthSubC, p.a, p.b, p.c, q.k),
+        _ => None,
+    }
+}
+
+/// Fuses the pairs [`fused`] knows.
+fn fuse(ins: Vec<Ins>, regs: usize, out: &[u16; 3]) -> Vec<Ins> {
+    let n = readers(&ins, regs, out);
+    let mut kept = Vec::with_capacity(ins.len());
+    let mut i = 0;
+    while i < ins.len() {
+        if let Some(f) = ins.get(i + 1).filter(|_| n[i] == 1).and_then(|q| fused(&ins[i], q)) {
+            kept.push(f);
+            i += 2;
+        } else {
+            kept.push(ins[i]);
+            i += 1;
+        }
+    }
+    kept
 }
 
 /// One instruction: `out = code(a, b, c)`, or with the constant `k`.
@@ -90,6 +254,8 @@ fn fuse_sincos(ins: &mut [Ins], extra: &mut usize) {
 pub struct Flat {
     ins: Vec<Ins>,
     out: [u16; 3],
+    /// The first of the three registers holding the point.
+    inputs: u16,
     /// Whether its registers fit [`SMALL_REGS`].
     small: bool,
 }
@@ -156,11 +322,16 @@ impl Flat {
             ins.push(next);
         }
         fuse_sincos(&mut ins, &mut extra);
+        let inputs = extra as u16;
+        extra += 3;
         if extra > FLAT_REGS {
             return None;
         }
         let o = |i: usize| tape.out[i.min(tape.out.len() - 1)] as u16;
-        Some(Flat { ins, out: [o(0), o(1), o(2)], small: extra <= SMALL_REGS })
+        let mut out = [o(0), o(1), o(2)];
+        let ins = forward(ins, extra, inputs, &mut out);
+        let ins = fuse(ins, extra, &out);
+        Some(Flat { ins, out, inputs, small: extra <= SMALL_REGS })
     }
 
     /// Runs the tape at `p`; `out` reads what it wants from the registers (returning
@@ -181,6 +352,9 @@ impl Flat {
     fn run_n<const N: usize>(&self, p: Vec3A, dist: &dyn Distances<f32>) -> [f32; N] {
         let mask = N as u16 - 1;
         let mut r = [0.0f32; N];
+        for axis in 0..3 {
+            r[(self.inputs + axis) as usize & (N - 1)] = p[axis as usize];
+        }
         for ins in &self.ins {
             let x = |i: u16| r[(i & mask) as usize];
             let (a, k) = (x(ins.a), ins.k);
@@ -202,7 +376,16 @@ impl Flat {
                     r[(ins.b & mask) as usize] = c;
                     s
                 }
+                Code::SinCosK => {
+                    let (s, c) = sincos_deg(a * k);
+                    r[(ins.b & mask) as usize] = c;
+                    s
+                }
                 Code::Copy => a,
+                Code::MulAdd => a * x(ins.b) + x(ins.c),
+                Code::MulCAdd => a * k + x(ins.b),
+                Code::AbsSubC => a.abs() - k,
+                Code::LengthSubC => (a * a + x(ins.b) * x(ins.b) + x(ins.c) * x(ins.c)).sqrt() - k,
                 Code::Unary(Unary::Abs) => a.abs(),
                 Code::Unary(Unary::Neg) => -a,
                 Code::Unary(f) => <f32 as super::Scalar>::unary(f, a),
@@ -226,6 +409,11 @@ impl Flat {
             r[(ins.out & mask) as usize] = v;
         }
         r
+    }
+
+    /// How many instructions an evaluation runs.
+    pub fn instructions(&self) -> usize {
+        self.ins.len()
     }
 
     /// The number at `p`.

@@ -30,6 +30,12 @@ fn gyroid(k: f64) -> Arc<Expr> {
     bin(Binary::Add, bin(Binary::Add, t(0, 1), t(1, 2)), t(2, 0))
 }
 
+/// The gyroid sheet of benches/scenes/gyroid.scn.
+fn sheet() -> Arc<Expr> {
+    let cut = bin(Binary::Sub, un(Unary::Length, Expr::point()), n(1.6));
+    bin(Binary::Max, bin(Binary::Sub, un(Unary::Abs, gyroid(450.0)), n(0.3)), cut)
+}
+
 fn sphere() -> Arc<Expr> {
     bin(Binary::Sub, un(Unary::Length, Expr::point()), n(1.0))
 }
@@ -37,7 +43,8 @@ fn sphere() -> Arc<Expr> {
 /// Every operation of the language in one body, each somewhere in its domain.
 fn everything() -> Vec<Arc<Expr>> {
     let (a, b, c) = (x(0), x(1), x(2));
-    let mut out = vec![sphere(), gyroid(450.0)];
+    let mut out =
+        vec![sphere(), gyroid(450.0), sheet(), bin(Binary::Add, bin(Binary::Mul, a.clone(), n(0.7)), b.clone())];
     for f in [
         Unary::Neg,
         Unary::Sin,
@@ -126,6 +133,18 @@ fn flat_tapes_equal_tapes() {
             assert!(a == b || (a.is_nan() && b.is_nan()), "{}: {a} vs {b}", e.source(200));
         }
     }
+}
+
+/// The march's body runs as few instructions as it has sines and sums: the point read
+/// from the registers it starts in, `sin(k·x)` with its cosine one instruction, a sum
+/// of products a multiply–add each, a distance less a radius one.
+#[test]
+fn flat_tapes_fuse_what_bodies_are_made_of() {
+    let flat = Flat::new(&Tape::new(&sheet())).unwrap();
+    // 3 sine–cosine pairs, a product and two multiply–adds, |g| − 0.3, length − 1.6, max.
+    assert_eq!(flat.instructions(), 9, "{flat:?}");
+    let flat = Flat::new(&Tape::new(&sphere())).unwrap();
+    assert_eq!(flat.instructions(), 1, "{flat:?}");
 }
 
 /// Dual numbers give the gradient: central differences of the f64 definition agree
