@@ -193,6 +193,13 @@ const FIRST_SEGMENT: f32 = 0.125;
 /// Plain sphere-tracing steps before segments.
 const PLAIN_STEPS: u32 = 128;
 
+/// How much longer than its bound a plain step is tried (Keinert et al. suggest 1.2
+/// to 1.6; 1.5 then 1.2 took the fewest steps on the gyroid of benches/scenes).
+const OMEGA: f32 = 1.5;
+
+/// The same after a longer step has failed on a ray: near a surface seen at a slant.
+const OMEGA_AFTER_MISS: f32 = 1.2;
+
 impl RayField {
     /// The first hit along `ray` within `[t0, t1]`, and the threshold there.
     pub fn march(
@@ -225,18 +232,43 @@ impl RayField {
         // Plain sphere tracing first: most rays meet the surface in a few of its cheap
         // steps. One that crawls (grazing, or where the body is shallow beside its
         // steepest parts) goes on by segments, whose bound follows the body along it.
+        // Over-relaxed (Keinert et al., "Enhanced Sphere Tracing", 2014): a step of
+        // OMEGA times the bound is kept when the bounds at both of its ends cover it
+        // (the spheres overlap); else the march goes back to the plain step and relaxes
+        // less from there. A field is rarely as steep near its surface as its bound, so
+        // the plain step lands a slope ratio short of the surface and converges to it
+        // geometrically; the longer step shortens that (28.6 → 22.0 evaluations per ray
+        // on the gyroid's primary rays, docs/fields.md).
+        let mut omega = OMEGA;
+        let (mut prev_t, mut prev_r, mut relaxed) = (t, 0.0f32, false);
         while steps < PLAIN_STEPS.min(params.max_steps) {
             let v = self.body.num(o + d * t);
             *evals += 1;
             steps += 1;
+            let r = v * self.scale;
+            if relaxed && r < t - prev_t - prev_r {
+                // A gap the bounds do not cover: it may hold a surface.
+                (t, relaxed, omega) = (prev_t + prev_r, false, OMEGA_AFTER_MISS);
+                continue;
+            }
             let threshold = super::march::threshold(params.epsilon, base, t);
-            if v * self.scale < threshold {
+            if r < threshold {
                 return Some((t, threshold));
             }
-            t += v * self.scale;
+            (prev_t, prev_r) = (t, r);
+            t += r * omega;
+            relaxed = omega > 1.0;
             if t > end {
-                return None;
+                if !relaxed || prev_t + prev_r > end {
+                    return None;
+                }
+                // The long step may have jumped a surface just before the end.
+                (t, relaxed, omega) = (prev_t + prev_r, false, OMEGA_AFTER_MISS);
             }
+        }
+        if relaxed {
+            // The segments start where the bounds have reached.
+            t = prev_t + prev_r;
         }
         if steps >= params.max_steps {
             c.budget_misses += 1;
