@@ -249,6 +249,12 @@ fn fuse_sincos(ins: &mut [Ins], extra: &mut usize) {
     }
 }
 
+/// Lane `l` of `W` is `f(l)`.
+#[inline(always)]
+fn each<const W: usize>(f: impl Fn(usize) -> f32) -> [f32; W] {
+    std::array::from_fn(f)
+}
+
 /// A tape flattened for f32.
 #[derive(Clone, Debug)]
 pub struct Flat {
@@ -339,76 +345,139 @@ impl Flat {
     #[inline]
     fn run<R>(&self, p: Vec3A, dist: &dyn Distances<f32>, out: impl FnOnce(&dyn Fn(u16) -> f32) -> R) -> R {
         if self.small {
-            let r = self.run_n::<SMALL_REGS>(p, dist);
-            out(&|i| r[i as usize & (SMALL_REGS - 1)])
+            let r = self.run_n::<SMALL_REGS, 1>(&[p], 1, dist);
+            out(&|i| r[i as usize & (SMALL_REGS - 1)][0])
         } else {
-            let r = self.run_n::<FLAT_REGS>(p, dist);
-            out(&|i| r[i as usize & (FLAT_REGS - 1)])
+            let r = self.run_n::<FLAT_REGS, 1>(&[p], 1, dist);
+            out(&|i| r[i as usize & (FLAT_REGS - 1)][0])
         }
     }
 
-    /// [`run`](Self::run) with `N` registers (a power of two the tape fits).
+    /// The tape with `N` registers (a power of two the tape fits) run for `W` points at
+    /// once, lane by lane in each instruction: one dispatch serves every lane, and the
+    /// lanes' arithmetic is one vector loop. The first `live` lanes are wanted; the
+    /// others repeat a point (so a shape's distance is asked only for the live ones).
     #[inline(always)]
-    fn run_n<const N: usize>(&self, p: Vec3A, dist: &dyn Distances<f32>) -> [f32; N] {
+    fn run_n<const N: usize, const W: usize>(
+        &self,
+        p: &[Vec3A; W],
+        live: usize,
+        dist: &dyn Distances<f32>,
+    ) -> [[f32; W]; N] {
         let mask = N as u16 - 1;
-        let mut r = [0.0f32; N];
-        for axis in 0..3 {
-            r[(self.inputs + axis) as usize & (N - 1)] = p[axis as usize];
+        let mut r = [[0.0f32; W]; N];
+        for axis in 0..3u16 {
+            let reg = &mut r[(self.inputs + axis) as usize & (N - 1)];
+            for (x, p) in reg.iter_mut().zip(p) {
+                *x = p[axis as usize];
+            }
         }
         for ins in &self.ins {
             let x = |i: u16| r[(i & mask) as usize];
             let (a, k) = (x(ins.a), ins.k);
-            let v = match ins.code {
-                Code::Input(axis) => p[axis as usize],
-                Code::Const => k,
-                Code::AddC => a + k,
-                Code::SubC => a - k,
-                Code::CSub => k - a,
-                Code::MulC => a * k,
-                Code::DivC => a / k,
-                Code::CDiv => k / a,
-                Code::MinC => a.min(k),
-                Code::MaxC => a.max(k),
-                Code::Unary(Unary::Sin) => sin_deg(a),
-                Code::Unary(Unary::Cos) => cos_deg(a),
-                Code::SinCos => {
-                    let (s, c) = sincos_deg(a);
-                    r[(ins.b & mask) as usize] = c;
-                    s
-                }
-                Code::SinCosK => {
-                    let (s, c) = sincos_deg(a * k);
+            let v: [f32; W] = match ins.code {
+                Code::Input(axis) => each(|l| p[l][axis as usize]),
+                Code::Const => [k; W],
+                Code::AddC => a.map(|a| a + k),
+                Code::SubC => a.map(|a| a - k),
+                Code::CSub => a.map(|a| k - a),
+                Code::MulC => a.map(|a| a * k),
+                Code::DivC => a.map(|a| a / k),
+                Code::CDiv => a.map(|a| k / a),
+                Code::MinC => a.map(|a| a.min(k)),
+                Code::MaxC => a.map(|a| a.max(k)),
+                Code::Unary(Unary::Sin) => a.map(sin_deg),
+                Code::Unary(Unary::Cos) => a.map(cos_deg),
+                Code::SinCos | Code::SinCosK => {
+                    let scale = if ins.code == Code::SinCosK { k } else { 1.0 };
+                    let (mut s, mut c) = ([0.0; W], [0.0; W]);
+                    for l in 0..W {
+                        (s[l], c[l]) = sincos_deg(a[l] * scale);
+                    }
                     r[(ins.b & mask) as usize] = c;
                     s
                 }
                 Code::Copy => a,
-                Code::MulAdd => a * x(ins.b) + x(ins.c),
-                Code::MulCAdd => a * k + x(ins.b),
-                Code::AbsSubC => a.abs() - k,
-                Code::LengthSubC => (a * a + x(ins.b) * x(ins.b) + x(ins.c) * x(ins.c)).sqrt() - k,
-                Code::Unary(Unary::Abs) => a.abs(),
-                Code::Unary(Unary::Neg) => -a,
-                Code::Unary(f) => <f32 as super::Scalar>::unary(f, a),
-                Code::Binary(Binary::Add) => a + x(ins.b),
-                Code::Binary(Binary::Sub) => a - x(ins.b),
-                Code::Binary(Binary::Mul) => a * x(ins.b),
-                Code::Binary(Binary::Min) => a.min(x(ins.b)),
-                Code::Binary(Binary::Max) => a.max(x(ins.b)),
-                Code::Binary(f) => <f32 as super::Scalar>::binary(f, a, x(ins.b)),
-                Code::Select => {
-                    if x(ins.c) != 0.0 {
-                        a
-                    } else {
-                        x(ins.b)
+                Code::MulAdd => {
+                    let (b, c) = (x(ins.b), x(ins.c));
+                    each(|l| a[l] * b[l] + c[l])
+                }
+                Code::MulCAdd => {
+                    let b = x(ins.b);
+                    each(|l| a[l] * k + b[l])
+                }
+                Code::AbsSubC => a.map(|a| a.abs() - k),
+                Code::LengthSubC => {
+                    let (b, c) = (x(ins.b), x(ins.c));
+                    each(|l| (a[l] * a[l] + b[l] * b[l] + c[l] * c[l]).sqrt() - k)
+                }
+                Code::Unary(Unary::Abs) => a.map(f32::abs),
+                Code::Unary(Unary::Neg) => a.map(|a| -a),
+                Code::Unary(f) => a.map(|a| <f32 as super::Scalar>::unary(f, a)),
+                Code::Binary(f) => {
+                    let b = x(ins.b);
+                    match f {
+                        Binary::Add => each(|l| a[l] + b[l]),
+                        Binary::Sub => each(|l| a[l] - b[l]),
+                        Binary::Mul => each(|l| a[l] * b[l]),
+                        Binary::Min => each(|l| a[l].min(b[l])),
+                        Binary::Max => each(|l| a[l].max(b[l])),
+                        f => each(|l| <f32 as super::Scalar>::binary(f, a[l], b[l])),
                     }
                 }
-                Code::Length => (a * a + x(ins.b) * x(ins.b) + x(ins.c) * x(ins.c)).sqrt(),
-                Code::Dist => dist.dist(k.to_bits(), [a, x(ins.b), x(ins.c)]),
-                Code::Noise => <f32 as super::Scalar>::noise([a, x(ins.b), x(ins.c)], k.to_bits()),
+                Code::Select => {
+                    let (b, c) = (x(ins.b), x(ins.c));
+                    each(|l| if c[l] != 0.0 { a[l] } else { b[l] })
+                }
+                Code::Length => {
+                    let (b, c) = (x(ins.b), x(ins.c));
+                    each(|l| (a[l] * a[l] + b[l] * b[l] + c[l] * c[l]).sqrt())
+                }
+                Code::Dist | Code::Noise => {
+                    let (b, c) = (x(ins.b), x(ins.c));
+                    let mut v = [0.0; W];
+                    for l in 0..live {
+                        let q = [a[l], b[l], c[l]];
+                        v[l] = if ins.code == Code::Dist {
+                            dist.dist(k.to_bits(), q)
+                        } else {
+                            <f32 as super::Scalar>::noise(q, k.to_bits())
+                        };
+                    }
+                    v
+                }
             };
             r[(ins.out & mask) as usize] = v;
         }
         r
+    }
+
+    /// The number at each of up to 16 points, into `out`: [`eval`](Self::eval) point by
+    /// point, to the bit, for less than a quarter of the dispatch.
+    pub fn eval_lanes(&self, p: &[Vec3A], dist: &dyn Distances<f32>, out: &mut [f32]) {
+        match p.len() {
+            0 => {}
+            1..=4 => self.lanes::<4>(p, dist, out),
+            5..=8 => self.lanes::<8>(p, dist, out),
+            _ => {
+                for (p, out) in p.chunks(16).zip(out.chunks_mut(16)) {
+                    self.lanes::<16>(p, dist, out);
+                }
+            }
+        }
+    }
+
+    /// [`eval_lanes`](Self::eval_lanes) in `W` lanes, `p.len()` ≤ `W` of them live.
+    fn lanes<const W: usize>(&self, p: &[Vec3A], dist: &dyn Distances<f32>, out: &mut [f32]) {
+        let live = p.len();
+        let pts: [Vec3A; W] = std::array::from_fn(|l| p[l.min(live - 1)]);
+        let o = self.out[0] as usize;
+        let v = if self.small {
+            self.run_n::<SMALL_REGS, W>(&pts, live, dist)[o & (SMALL_REGS - 1)]
+        } else {
+            self.run_n::<FLAT_REGS, W>(&pts, live, dist)[o & (FLAT_REGS - 1)]
+        };
+        out[..live].copy_from_slice(&v[..live]);
     }
 
     /// How many instructions an evaluation runs.

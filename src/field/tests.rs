@@ -127,10 +127,21 @@ fn flat_tapes_equal_tapes() {
     for e in everything() {
         let tape = Tape::new(&e);
         let flat = Flat::new(&tape).expect("a small tape flattens");
-        for p in points(200) {
-            let p = p.as_vec3a();
+        let pts: Vec<Vec3A> = points(200).iter().map(|p| p.as_vec3a()).collect();
+        for &p in &pts {
             let (a, b) = (tape.eval::<f32>(&p, &NoDistances), flat.eval(p, &NoDistances));
             assert!(a == b || (a.is_nan() && b.is_nan()), "{}: {a} vs {b}", e.source(200));
+        }
+        // Many points at once, in every width of lanes.
+        for n in [1, 3, 4, 7, 8, 13, 16] {
+            for chunk in pts.chunks(n) {
+                let mut out = vec![0.0; chunk.len()];
+                flat.eval_lanes(chunk, &NoDistances, &mut out);
+                for (&p, &b) in chunk.iter().zip(&out) {
+                    let a = flat.eval(p, &NoDistances);
+                    assert!(a == b || (a.is_nan() && b.is_nan()), "{} in {n} lanes: {a} vs {b}", e.source(200));
+                }
+            }
         }
     }
 }

@@ -73,6 +73,24 @@ impl Body {
         }
     }
 
+    /// The number at each of `p` into `out`: [`num`](Self::num) point by point.
+    #[inline]
+    pub fn num_lanes(&self, p: &[Vec3A], out: &mut [f32]) {
+        match &self.flat {
+            Some(f) => f.eval_lanes(p, &self.shapes, out),
+            None => {
+                for (o, p) in out.iter_mut().zip(p) {
+                    *o = self.tape.eval::<f32>(p, &self.shapes);
+                }
+            }
+        }
+        for v in out.iter_mut() {
+            if v.is_nan() {
+                *v = f32::MAX;
+            }
+        }
+    }
+
     /// The number at `p` with its gradient.
     pub fn dual(&self, p: Vec3A) -> Dual {
         let d = self.tape.eval::<Dual>(&p, &self.shapes);
@@ -200,19 +218,44 @@ const OMEGA: f32 = 1.5;
 /// The same after a longer step has failed on a ray: near a surface seen at a slant.
 const OMEGA_AFTER_MISS: f32 = 1.2;
 
+/// A ray in a field's frame and where its plain march has got to.
+#[derive(Clone, Copy)]
+struct Lane {
+    o: Vec3A,
+    d: Vec3A,
+    /// The ray origin's distance from the camera, for the hit threshold.
+    base: f32,
+    t: f32,
+    end: f32,
+    steps: u32,
+    /// Where the last step started, how far its bound reached, and whether the step
+    /// went further than that.
+    prev_t: f32,
+    prev_reach: f32,
+    relaxed: bool,
+    omega: f32,
+}
+
+/// What a plain step found.
+enum Step {
+    Hit(f32, f32),
+    Miss,
+    On,
+}
+
+impl Lane {
+    fn at(&self) -> Vec3A {
+        self.o + self.d * self.t
+    }
+}
+
 impl RayField {
-    /// The first hit along `ray` within `[t0, t1]`, and the threshold there.
-    pub fn march(
-        &self,
-        ray: &crate::trace::Ray,
-        (t0, t1): (f32, f32),
-        params: super::MarchParams,
-        c: &mut crate::trace::Counters,
-        evals: &mut u64,
-    ) -> Option<(f32, f32)> {
+    /// `ray` over `[t0, t1]` in the field's frame, cut to its box; `None` if it misses
+    /// the box.
+    fn lane(&self, ray: &crate::trace::Ray, (t0, t1): (f32, f32)) -> Option<Lane> {
         let o = self.inv.transform_point3a(ray.origin);
         let d = self.inv.transform_vector3a(ray.dir);
-        let (mut t, end) = match self.bounds {
+        let (t, end) = match self.bounds {
             Some((lo, hi)) => {
                 // The slab test in the field's frame: outside the box is empty.
                 let inv_d = d.recip();
@@ -228,48 +271,152 @@ impl RayField {
             None => (t0, t1),
         };
         let base = ray.origin.length();
-        let mut steps = 0u32;
-        // Plain sphere tracing first: most rays meet the surface in a few of its cheap
-        // steps. One that crawls (grazing, or where the body is shallow beside its
-        // steepest parts) goes on by segments, whose bound follows the body along it.
-        // Over-relaxed (Keinert et al., "Enhanced Sphere Tracing", 2014): a step of
-        // OMEGA times the bound is kept when the bounds at both of its ends cover it
-        // (the spheres overlap); else the march goes back to the plain step and relaxes
-        // less from there. A field is rarely as steep near its surface as its bound, so
-        // the plain step lands a slope ratio short of the surface and converges to it
-        // geometrically; the longer step shortens that (28.6 → 22.0 evaluations per ray
-        // on the gyroid's primary rays, docs/fields.md).
-        let mut omega = OMEGA;
-        let (mut prev_t, mut prev_r, mut relaxed) = (t, 0.0f32, false);
-        while steps < PLAIN_STEPS.min(params.max_steps) {
-            let v = self.body.num(o + d * t);
+        Some(Lane { o, d, base, t, end, steps: 0, prev_t: t, prev_reach: 0.0, relaxed: false, omega: OMEGA })
+    }
+
+    /// Plain steps a lane takes before segments.
+    fn plain_steps(params: super::MarchParams) -> u32 {
+        PLAIN_STEPS.min(params.max_steps)
+    }
+
+    /// One plain step of `lane`, the body being `v` where it stands.
+    ///
+    /// Plain sphere tracing first: most rays meet the surface in a few of its cheap
+    /// steps. One that crawls (grazing, or where the body is shallow beside its
+    /// steepest parts) goes on by segments ([`segments`](Self::segments)), whose bound
+    /// follows the body along it.
+    ///
+    /// Over-relaxed (Keinert et al., "Enhanced Sphere Tracing", 2014): a step of OMEGA
+    /// times the bound is kept when the bounds at both of its ends cover it (the
+    /// spheres overlap); else the march goes back to the plain step and relaxes less
+    /// from there. A field is rarely as steep near its surface as its bound, so the
+    /// plain step lands a slope ratio short of the surface and converges to it
+    /// geometrically; the longer step shortens that (28.6 → 22.0 evaluations per ray
+    /// on the gyroid's primary rays, docs/fields.md).
+    #[inline]
+    fn plain_step(&self, lane: &mut Lane, v: f32, params: super::MarchParams) -> Step {
+        lane.steps += 1;
+        let (t, r) = (lane.t, v * self.scale);
+        if lane.relaxed && r < t - lane.prev_t - lane.prev_reach {
+            // A gap the bounds do not cover: it may hold a surface.
+            (lane.t, lane.relaxed, lane.omega) = (lane.prev_t + lane.prev_reach, false, OMEGA_AFTER_MISS);
+            return Step::On;
+        }
+        let threshold = super::march::threshold(params.epsilon, lane.base, t);
+        if r < threshold {
+            return Step::Hit(t, threshold);
+        }
+        (lane.prev_t, lane.prev_reach) = (t, r);
+        lane.t = t + r * lane.omega;
+        lane.relaxed = lane.omega > 1.0;
+        if lane.t > lane.end {
+            if !lane.relaxed || t + r > lane.end {
+                return Step::Miss;
+            }
+            // The long step may have jumped a surface just before the end.
+            (lane.t, lane.relaxed, lane.omega) = (t + r, false, OMEGA_AFTER_MISS);
+        }
+        Step::On
+    }
+
+    /// The first hit along `ray` within `[t0, t1]`, and the threshold there.
+    pub fn march(
+        &self,
+        ray: &crate::trace::Ray,
+        span: (f32, f32),
+        params: super::MarchParams,
+        c: &mut crate::trace::Counters,
+        evals: &mut u64,
+    ) -> Option<(f32, f32)> {
+        let mut lane = self.lane(ray, span)?;
+        while lane.steps < Self::plain_steps(params) {
+            let v = self.body.num(lane.at());
             *evals += 1;
-            steps += 1;
-            let r = v * self.scale;
-            if relaxed && r < t - prev_t - prev_r {
-                // A gap the bounds do not cover: it may hold a surface.
-                (t, relaxed, omega) = (prev_t + prev_r, false, OMEGA_AFTER_MISS);
+            match self.plain_step(&mut lane, v, params) {
+                Step::Hit(t, threshold) => return Some((t, threshold)),
+                Step::Miss => return None,
+                Step::On => {}
+            }
+        }
+        self.segments(lane, params, c, evals)
+    }
+
+    /// [`march`](Self::march) for the lanes `mask` of `N` packets of camera rays, lane
+    /// `l` of packet `g` over `spans[g][l]`: the plain steps of all lanes still
+    /// marching evaluate the body together ([`Body::num_lanes`]), the same steps to the
+    /// bit as one by one.
+    pub fn march_packet<const N: usize>(
+        &self,
+        quads: &[crate::trace::Packet; N],
+        mask: u32,
+        spans: &[[(f32, f32); 4]; N],
+        params: super::MarchParams,
+        c: &mut crate::trace::Counters,
+        evals: &mut [[u64; 4]; N],
+    ) -> [[Option<(f32, f32)>; 4]; N] {
+        let mut hits = [[None; 4]; N];
+        // At most 16 lanes: the rest, if any, one by one.
+        let mut lanes = [None::<Lane>; 16];
+        let mut active = [0u8; 16];
+        let mut m = 0;
+        for k in crate::trace::lanes(mask) {
+            let (g, l) = (k / 4, k % 4);
+            if m == 16 {
+                hits[g][l] = self.march(&quads[g].rays[l], spans[g][l], params, c, &mut evals[g][l]);
                 continue;
             }
-            let threshold = super::march::threshold(params.epsilon, base, t);
-            if r < threshold {
-                return Some((t, threshold));
+            lanes[k] = self.lane(&quads[g].rays[l], spans[g][l]);
+            if lanes[k].is_some() {
+                active[m] = k as u8;
+                m += 1;
             }
-            (prev_t, prev_r) = (t, r);
-            t += r * omega;
-            relaxed = omega > 1.0;
-            if t > end {
-                if !relaxed || prev_t + prev_r > end {
-                    return None;
+        }
+        let mut later = 0u32;
+        let (mut points, mut values) = ([Vec3A::ZERO; 16], [0.0f32; 16]);
+        while m > 0 {
+            for (p, &k) in points.iter_mut().zip(&active[..m]) {
+                *p = lanes[k as usize].as_ref().map_or(Vec3A::ZERO, Lane::at);
+            }
+            self.body.num_lanes(&points[..m], &mut values[..m]);
+            let mut kept = 0;
+            for j in 0..m {
+                let k = active[j] as usize;
+                let (g, l) = (k / 4, k % 4);
+                let Some(lane) = lanes[k].as_mut() else { continue };
+                evals[g][l] += 1;
+                match self.plain_step(lane, values[j], params) {
+                    Step::Hit(t, threshold) => hits[g][l] = Some((t, threshold)),
+                    Step::Miss => {}
+                    Step::On if lane.steps >= Self::plain_steps(params) => later |= 1 << k,
+                    Step::On => {
+                        active[kept] = k as u8;
+                        kept += 1;
+                    }
                 }
-                // The long step may have jumped a surface just before the end.
-                (t, relaxed, omega) = (prev_t + prev_r, false, OMEGA_AFTER_MISS);
+            }
+            m = kept;
+        }
+        for k in crate::trace::lanes(later) {
+            let (g, l) = (k / 4, k % 4);
+            if let Some(lane) = lanes[k] {
+                hits[g][l] = self.segments(lane, params, c, &mut evals[g][l]);
             }
         }
-        if relaxed {
-            // The segments start where the bounds have reached.
-            t = prev_t + prev_r;
-        }
+        hits
+    }
+
+    /// The march of `lane` after its plain steps: by segments, each with a bound of
+    /// the body's slope along it.
+    fn segments(
+        &self,
+        lane: Lane,
+        params: super::MarchParams,
+        c: &mut crate::trace::Counters,
+        evals: &mut u64,
+    ) -> Option<(f32, f32)> {
+        let Lane { o, d, base, end, mut steps, .. } = lane;
+        // The segments start where the bounds have reached.
+        let mut t = if lane.relaxed { lane.prev_t + lane.prev_reach } else { lane.t };
         if steps >= params.max_steps {
             c.budget_misses += 1;
             return None;

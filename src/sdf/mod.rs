@@ -82,16 +82,16 @@ impl SdfObject {
         }
     }
 
-    /// Whether packets of camera rays share one walk of this object's parts: a sharp
-    /// union's ([`closest_packet`](Self::closest_packet)).
+    /// Whether packets of camera rays are marched together: a sharp union's walk of
+    /// its parts, a field's evaluations ([`closest_packet`](Self::closest_packet)).
     pub fn walks_packets(&self) -> bool {
-        self.parts.as_ref().is_some_and(|p| p.k == 0.0)
+        self.field.is_some() || self.parts.as_ref().is_some_and(|p| p.k == 0.0)
     }
 
     /// [`closest`](Self::closest) for the lanes `mask` of `N` packets of rays starting
     /// outside the solid, lane `l` of packet `g` over `spans[g][l]`, with `evals` per lane:
-    /// a sharp union's lanes share one walk of its parts, any other object marches each
-    /// lane alone.
+    /// a sharp union's lanes share one walk of its parts, a field's evaluate its body
+    /// together, any other object marches each lane alone.
     pub fn closest_packet<const N: usize>(
         &self,
         quads: &[Packet; N],
@@ -101,6 +101,9 @@ impl SdfObject {
         c: &mut Counters,
         evals: &mut [[u64; 4]; N],
     ) -> [[Option<(f32, f32)>; 4]; N] {
+        if let Some(field) = &self.field {
+            return field.march_packet(quads, mask, spans, params, c, evals);
+        }
         if let Some(parts) = self.parts.as_ref().filter(|p| p.k == 0.0) {
             return parts.march_packet(quads, mask, spans, params, c, evals);
         }
