@@ -23,18 +23,24 @@ fn reach(n: DVec3, lo: DVec3, hi: DVec3) -> f64 {
     n.dot(DVec3::select(n.cmpge(DVec3::ZERO), hi, lo))
 }
 
-/// Planes `n·p ≤ offset` (unit `n`) holding where the body is at most zero within `b`,
-/// for the directions where that is nearer than `b`'s own face; `None` when no point
-/// of `b` can be in the solid. Only an upper bound of each reach is taken (the largest
-/// reach of the boxes not ruled out), so the planes hold the solid whatever the budget.
-pub fn support_planes(tape: &Tape, b: Aabb, dist: &(dyn Distances<Interval> + Sync)) -> Option<Vec<(DVec3, f64)>> {
+/// Planes `n·p ≤ offset` (unit `n`) holding where the body is at most `level` within
+/// `b`, for the directions where that is nearer than `b`'s own face; `None` when no
+/// point of `b` can be in the solid. Only an upper bound of each reach is taken (the
+/// largest reach of the boxes not ruled out), so the planes hold the solid whatever the
+/// budget.
+pub fn support_planes(
+    tape: &Tape,
+    b: Aabb,
+    level: f64,
+    dist: &(dyn Distances<Interval> + Sync),
+) -> Option<Vec<(DVec3, f64)>> {
     let tol = (b.max - b.min).length() / 256.0;
-    // A box is ruled out only where the body is clearly above zero: the march runs it
-    // in f32.
+    // A box is ruled out only where the body is clearly above the level: the march runs
+    // it in f32.
     let slack = 1e-6 * (1.0 + b.min.abs().max(b.max.abs()).max_element());
     let empty = |lo: DVec3, hi: DVec3| {
         let at = [0, 1, 2].map(|i| Interval::new(lo[i], hi[i]));
-        tape.eval::<Interval>(&at, dist).lo > slack
+        tape.eval::<Interval>(&at, dist).lo > level + slack
     };
     if empty(b.min, b.max) {
         return None;

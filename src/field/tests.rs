@@ -306,7 +306,7 @@ fn support_planes_hold_the_solid_and_are_tight() {
     let mut inside = 0;
     for body in &bodies {
         let tape = Tape::new(body);
-        let Some(planes) = support_planes(&tape, b, &NoDistances) else { continue };
+        let Some(planes) = support_planes(&tape, b, 0.0, &NoDistances) else { continue };
         for _ in 0..4_000 {
             let p = b.min + (b.max - b.min) * DVec3::new(unit(), unit(), unit());
             if tape.eval::<f32>(&p.as_vec3a(), &NoDistances) > 0.0 {
@@ -319,7 +319,7 @@ fn support_planes_hold_the_solid_and_are_tight() {
         }
     }
     assert!(inside > 20_000, "only {inside} points inside");
-    let planes = support_planes(&Tape::new(&sphere()), Aabb::centred(DVec3::splat(1.0)), &NoDistances).unwrap();
+    let planes = support_planes(&Tape::new(&sphere()), Aabb::centred(DVec3::splat(1.0)), 0.0, &NoDistances).unwrap();
     assert_eq!(planes.len(), 20, "the box holds the six faces; {planes:?}");
     assert!(planes.iter().all(|(_, o)| (1.0..1.1).contains(o)), "{planes:?}");
 }

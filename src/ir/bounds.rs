@@ -1,5 +1,7 @@
 //! Conservative axis-aligned bounds of shapes and meshes, in world units.
 
+use std::sync::Arc;
+
 use glam::{DAffine3, DMat3, DVec3};
 
 use super::{CsgOp, Geometry, Mesh, MeshSource, Shape, ShapeKind};
@@ -159,24 +161,35 @@ fn half_space_within(shape: &Shape, g: f64) -> Option<(DVec3, f64)> {
 /// ellipsoid under any affine map, and for intersections of them; `None` where there is
 /// none that is cheap to find (a union, a repeat, a field).
 pub fn shape_hull(shape: &Shape) -> Option<Hull> {
-    hull_within(shape, 0.0)
+    shape_hull_with(shape, &mut |_, _, _| None)
+}
+
+/// Planes `n·p ≤ offset` holding where a field's body is at most `level` within a box,
+/// for the directions where that is nearer than the box's face (`field::support_planes`,
+/// which `ir` cannot call: its caller hands the search in); `None` for none.
+pub type FieldPlanes<'a> = dyn FnMut(&Arc<super::field::Expr>, Aabb, f64) -> Option<Vec<(DVec3, f64)>> + 'a;
+
+/// [`shape_hull`], with a field's hull from `fields` wherever the field is in the tree
+/// (under transforms, intersections, rounding, a twist).
+pub fn shape_hull_with(shape: &Shape, fields: &mut FieldPlanes<'_>) -> Option<Hull> {
+    hull_within(shape, 0.0, fields)
 }
 
 /// A convex set holding where the shape's field is at most `g`, by the rules of
 /// [`half_space_within`]: every operand's hull holds an intersection (all planes are
 /// kept), the first operand's a subtraction.
-fn hull_within(shape: &Shape, g: f64) -> Option<Hull> {
+fn hull_within(shape: &Shape, g: f64, fields: &mut FieldPlanes<'_>) -> Option<Hull> {
     match &shape.kind {
         ShapeKind::Primitive(p) => p.hull().map(|h| h.grown(g)),
         ShapeKind::Csg { op: CsgOp::Intersect, children, smooth } => {
-            children.iter().filter_map(|c| hull_within(c, g + smooth)).reduce(Hull::meet)
+            children.iter().filter_map(|c| hull_within(c, g + smooth, fields)).reduce(Hull::meet)
         }
-        ShapeKind::Csg { op: CsgOp::Subtract, children, smooth } => hull_within(children.first()?, g + smooth),
+        ShapeKind::Csg { op: CsgOp::Subtract, children, smooth } => hull_within(children.first()?, g + smooth, fields),
         ShapeKind::Csg { op: CsgOp::Union, .. } | ShapeKind::Repeat { .. } => None,
-        ShapeKind::Round { child, radius } => hull_within(child, g + radius),
-        ShapeKind::Shell { child, thickness } => hull_within(child, g + thickness * 0.5),
-        ShapeKind::Transform { child, xf } => hull_within(child, within_child(g, xf))?.transformed(xf),
-        ShapeKind::Paint { child, .. } => hull_within(child, g),
+        ShapeKind::Round { child, radius } => hull_within(child, g + radius, fields),
+        ShapeKind::Shell { child, thickness } => hull_within(child, g + thickness * 0.5, fields),
+        ShapeKind::Transform { child, xf } => hull_within(child, within_child(g, xf), fields)?.transformed(xf),
+        ShapeKind::Paint { child, .. } => hull_within(child, g, fields),
         // An extrusion lies within its slab and its profile's convex hull.
         ShapeKind::Field { sweep: Some(crate::ir::Sweep::Extrude { region, half_height }), .. } => {
             let lines = region.hull_lines();
@@ -194,7 +207,7 @@ fn hull_within(shape: &Shape, g: f64) -> Option<Hull> {
         // by the map's stretch, at most `g` where the child's is at most `g·L`.
         ShapeKind::Warp { child, domain_op: Some(crate::ir::DomainOp::Twist(_)), lipschitz, .. } => {
             let g = g * lipschitz.value.max(1.0);
-            let hull = hull_within(child, g);
+            let hull = hull_within(child, g, fields);
             // Cones about the axis and planes across it are turned into themselves.
             if let Some(Hull { planes, round: Some(round) }) = &hull {
                 if round.turns_with_y() {
@@ -210,10 +223,22 @@ fn hull_within(shape: &Shape, g: f64) -> Option<Hull> {
         // about z that holds its child's corners (or box), between the same depths.
         ShapeKind::Warp { child, domain_op: Some(crate::ir::DomainOp::Bend(_)), lipschitz, .. } => {
             let g = g * lipschitz.value.max(1.0);
-            let (radius, low, high) = extent_about(child, hull_within(child, g), g, |c| (c.x.hypot(c.y), c.z))?;
+            let (radius, low, high) = extent_about(child, hull_within(child, g, fields), g, |c| (c.x.hypot(c.y), c.z))?;
             // The cylinder is about the y axis of a frame whose y is the scene's z.
             let cones = [(1.0, 0.0, radius), (0.0, 1.0, high), (0.0, -1.0, -low)];
             Hull::about_y(cones)?.transformed(&DAffine3::from_rotation_x(std::f64::consts::FRAC_PI_2))
+        }
+        // A field is its body over its bound `L`, cut to its box: where it is at most
+        // `g`, the body is at most `g·L` within the box grown by `g`.
+        ShapeKind::Field { body, bounds: Some(b), sweep: None, lipschitz, .. } => {
+            let grown = Aabb { min: b.min - g, max: b.max + g };
+            let mut planes = fields(body, grown, g * lipschitz.value).filter(|p| !p.is_empty())?;
+            // The box's own faces, so the polyhedron is bounded (a twist takes its corners).
+            for axis in 0..3 {
+                let n = DVec3::AXES[axis];
+                planes.extend([(n, grown.max[axis]), (-n, -grown.min[axis])]);
+            }
+            Some(Hull::planes(planes))
         }
         ShapeKind::Field { .. } | ShapeKind::Warp { .. } | ShapeKind::Displace { .. } => None,
     }

@@ -10,7 +10,6 @@ use rayon::prelude::*;
 use super::{query, Mode, Object, ObjectKind, World};
 use crate::accel::{padded_sphere, Aabb, Bvh};
 use crate::diag::Diagnostic;
-use crate::geom::hull::Hull;
 use crate::ir;
 use crate::mesh;
 use crate::render::Frame;
@@ -45,16 +44,25 @@ impl Reach {
                 .and_then(|h| ir::transform_half_space(h, to_render))
                 .map(|(n, o)| (n.as_vec3a(), o as f32)),
         };
-        let hull = bounds.and_then(|_| ir::shape_hull(shape).or_else(|| field_hull(shape, known)));
+        let hull = bounds.and_then(|_| ir::shape_hull_with(shape, &mut |body, b, level| known.planes(body, b, level)));
         let hull = hull.and_then(|h| h.transformed(to_render)).map(query::Entry::new);
         Reach { bounds, sphere, half_space, hull: hull.map(Arc::new) }
     }
 }
 
-/// The support planes of the fields lowered so far, by body and bounds: a scene's many
-/// copies of one field (a loop placing it) search once. Only the last 64 are looked
-/// through, so a scene of many different fields does not pay a square.
-type FieldHulls = Vec<(Arc<ir::field::Expr>, ir::Aabb, Option<Vec<(DVec3, f64)>>)>;
+/// The support planes of the fields lowered so far, by body, box and level: a scene's
+/// many copies of one field (a loop placing it) search once. Only the last 64 are
+/// looked through, so a scene of many different fields does not pay a square.
+#[derive(Default)]
+struct FieldHulls(Vec<KnownPlanes>);
+
+/// A body, box and level with the planes found for them.
+struct KnownPlanes {
+    body: Arc<ir::field::Expr>,
+    bounds: ir::Aabb,
+    level: f64,
+    planes: Option<Vec<(DVec3, f64)>>,
+}
 
 /// The fewest operations a field's body has for its rays to be clipped to its support
 /// planes: below that a step costs less than the clip. 64 spheres written as fields
@@ -63,37 +71,30 @@ type FieldHulls = Vec<(Arc<ir::field::Expr>, ir::Aabb, Option<Vec<(DVec3, f64)>>
 /// benches/scenes/field-spheres-64.scn --width 1000 --height 1000 --stats`).
 const MIN_OPS: usize = 12;
 
-/// A polyhedron holding a field at the object's root (under its transforms and paint),
-/// from intervals of its body (`field::support_planes`); `None` for anything else, or
-/// where no plane cuts the field's box.
-fn field_hull(shape: &ir::Shape, known: &mut FieldHulls) -> Option<Hull> {
-    let (mut xf, mut s) = (DAffine3::IDENTITY, shape);
-    loop {
-        match &s.kind {
-            ir::ShapeKind::Transform { child, xf: m } => (xf, s) = (xf * *m, child),
-            ir::ShapeKind::Paint { child, .. } => s = child,
-            ir::ShapeKind::Field { body, bounds: Some(b), sweep: None, .. } => {
-                let planes =
-                    match known.iter().rev().take(64).find(|(e, bb, _)| bb == b && (Arc::ptr_eq(e, body) || e == body))
-                    {
-                        Some((.., planes)) => planes.clone(),
-                        None => {
-                            let tape = crate::field::Tape::new(body);
-                            // A body of a few operations steps more cheaply than a ray
-                            // is clipped to twenty planes (see MIN_OPS).
-                            let worth = tape.ops.len() >= MIN_OPS;
-                            let planes = worth
-                                .then(|| crate::field::support_planes(&tape, *b, &crate::field::NoDistances))
-                                .flatten();
-                            known.push((body.clone(), *b, planes.clone()));
-                            planes
-                        }
-                    };
-                let planes = planes.filter(|p| !p.is_empty())?;
-                return Hull::planes(planes).transformed(&xf);
-            }
-            _ => return None,
+/// The convex set an object of `shape`'s rays are clipped to: [`ir::shape_hull`] with
+/// the support planes of the fields in it (of a dozen operations or more).
+pub fn shape_hull(shape: &ir::Shape) -> Option<crate::geom::hull::Hull> {
+    let mut known = FieldHulls::default();
+    ir::shape_hull_with(shape, &mut |body, b, level| known.planes(body, b, level))
+}
+
+impl FieldHulls {
+    /// [`ir::FieldPlanes`]: the planes holding where `body` is at most `level` within
+    /// `b` (`field::support_planes`), for a body of at least [`MIN_OPS`] operations.
+    fn planes(&mut self, body: &Arc<ir::field::Expr>, b: ir::Aabb, level: f64) -> Option<Vec<(DVec3, f64)>> {
+        let same =
+            |k: &&KnownPlanes| k.bounds == b && k.level == level && (Arc::ptr_eq(&k.body, body) || k.body == *body);
+        if let Some(k) = self.0.iter().rev().take(64).find(same) {
+            return k.planes.clone();
         }
+        let tape = crate::field::Tape::new(body);
+        // A body of a few operations steps more cheaply than a ray is clipped to twenty
+        // planes (see MIN_OPS).
+        let planes = (tape.ops.len() >= MIN_OPS)
+            .then(|| crate::field::support_planes(&tape, b, level, &crate::field::NoDistances))
+            .flatten();
+        self.0.push(KnownPlanes { body: body.clone(), bounds: b, level, planes: planes.clone() });
+        planes
     }
 }
 
@@ -236,7 +237,7 @@ fn lower_reusing(
     // In scene order: materials are interned and the triangle budget spent as objects
     // come, so ids and errors do not depend on timing. Meshes are built afterwards.
     let mut lowered = Vec::with_capacity(scene.objects.len());
-    let mut field_hulls = FieldHulls::new();
+    let mut field_hulls = FieldHulls::default();
     let mut kept = Vec::with_capacity(scene.objects.len());
     for (i, obj) in scene.objects.iter().enumerate() {
         let table = &mut builder.materials.materials;
