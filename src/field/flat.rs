@@ -9,6 +9,11 @@
 //! each ([`fused`]): 9 instructions, the same bits. `cargo bench --bench render --
 //! 'sdf eval/gyroid'`: 22 → 17 µs per 256 points; the gyroid's primary rays (its scene
 //! without lights, depth 0, `scnc render --stats`): trace 1.81 → 1.31 s.
+//!
+//! Every instruction runs over `W` lanes ([`Flat::eval_lanes`]): a block of camera
+//! rays marching a field evaluates its points together, one dispatch for all of them
+//! and the lanes' arithmetic in one loop (gyroid primary rays: trace 1.055 → 0.478 s,
+//! the same image); a single point is one lane.
 
 use glam::Vec3A;
 
