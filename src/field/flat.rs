@@ -29,7 +29,6 @@ const SMALL_REGS: usize = 16;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Code {
-    Input(u8),
     Const,
     Unary(Unary),
     Binary(Binary),
@@ -65,7 +64,7 @@ impl Code {
     /// Which of `a`, `b`, `c` it reads.
     fn reads(self) -> [bool; 3] {
         match self {
-            Code::Input(_) | Code::Const => [false; 3],
+            Code::Const => [false; 3],
             Code::AddC
             | Code::SubC
             | Code::CSub
@@ -113,10 +112,10 @@ impl Ins {
     }
 }
 
-/// Drops the instructions that only name a value held elsewhere: an input (the point's
-/// coordinates sit in registers `inputs..inputs + 3` from the start) and a copy of a
-/// register written once. Their readers, and `out`, read the original instead.
-fn forward(ins: Vec<Ins>, regs: usize, inputs: u16, out: &mut [u16; 3]) -> Vec<Ins> {
+/// Drops the copies of a register written at most once (the point's coordinates, which
+/// sit in registers of their own from the start and are never written; a cosine's spare
+/// register): their readers, and `out`, read the original instead.
+fn forward(ins: Vec<Ins>, regs: usize, out: &mut [u16; 3]) -> Vec<Ins> {
     let mut writes = vec![0u32; regs];
     for i in &ins {
         for w in i.writes() {
@@ -129,8 +128,7 @@ fn forward(ins: Vec<Ins>, regs: usize, inputs: u16, out: &mut [u16; 3]) -> Vec<I
     for i in ins {
         let i = i.renamed(|r| alias[r as usize]);
         match i.code {
-            Code::Input(axis) => alias[i.out as usize] = inputs + u16::from(axis),
-            Code::Copy if writes[i.a as usize] == 1 => alias[i.out as usize] = i.a,
+            Code::Copy if writes[i.a as usize] <= 1 => alias[i.out as usize] = i.a,
             _ => {
                 for w in i.writes() {
                     alias[w as usize] = w;
@@ -274,7 +272,9 @@ pub struct Flat {
 impl Flat {
     /// `tape` flattened, or `None` if it needs more than `FLAT_REGS` registers.
     pub fn new(tape: &Tape) -> Option<Flat> {
-        let mut extra = tape.regs;
+        // The point's coordinates first, in registers no instruction writes.
+        let inputs = tape.regs as u16;
+        let mut extra = tape.regs + 3;
         let mut ins = Vec::with_capacity(tape.ops.len());
         let mut constant = |ins: &mut Vec<Ins>, k: f64| {
             let r = extra as u16;
@@ -293,7 +293,7 @@ impl Flat {
                 k: k as f32,
             };
             let next = match op {
-                Op::Input(a) => i(Code::Input(a), 0, 0, 0, 0.0),
+                Op::Input(a) => i(Code::Copy, u32::from(inputs) + u32::from(a), 0, 0, 0.0),
                 Op::Const(k) => i(Code::Const, 0, 0, 0, k),
                 Op::Unary(f, a) => i(Code::Unary(f), a, 0, 0, 0.0),
                 Op::Binary(f, a, b) => i(Code::Binary(f), a, b, 0, 0.0),
@@ -333,14 +333,12 @@ impl Flat {
             ins.push(next);
         }
         fuse_sincos(&mut ins, &mut extra);
-        let inputs = extra as u16;
-        extra += 3;
         if extra > FLAT_REGS {
             return None;
         }
         let o = |i: usize| tape.out[i.min(tape.out.len() - 1)] as u16;
         let mut out = [o(0), o(1), o(2)];
-        let ins = forward(ins, extra, inputs, &mut out);
+        let ins = forward(ins, extra, &mut out);
         let ins = fuse(ins, extra, &out);
         Some(Flat { ins, out, inputs, small: extra <= SMALL_REGS })
     }
@@ -381,7 +379,6 @@ impl Flat {
             let x = |i: u16| r[(i & mask) as usize];
             let (a, k) = (x(ins.a), ins.k);
             let v: [f32; W] = match ins.code {
-                Code::Input(axis) => each(|l| p[l][axis as usize]),
                 Code::Const => [k; W],
                 Code::AddC => a.map(|a| a + k),
                 Code::SubC => a.map(|a| a - k),
