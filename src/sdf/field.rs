@@ -219,7 +219,7 @@ const OMEGA: f32 = 1.5;
 const OMEGA_AFTER_MISS: f32 = 1.2;
 
 /// A ray in a field's frame and where its plain march has got to.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Default)]
 struct Lane {
     o: Vec3A,
     d: Vec3A,
@@ -354,35 +354,31 @@ impl RayField {
         c: &mut crate::trace::Counters,
         evals: &mut [[u64; 4]; N],
     ) -> [[Option<(f32, f32)>; 4]; N] {
+        // Up to 4×4 camera rays: a block is four packets of four.
+        const { assert!(N <= 4, "a packet march takes at most 16 lanes") };
         let mut hits = [[None; 4]; N];
-        // At most 16 lanes: the rest, if any, one by one.
-        let mut lanes = [None::<Lane>; 16];
-        let mut active = [0u8; 16];
-        let mut m = 0;
+        // Each lane's march by its number `4·g + l`; `active` lists those still taking
+        // plain steps, `later` those going on by segments.
+        let mut lanes = [Lane::default(); 16];
+        let (mut active, mut m, mut later) = ([0u8; 16], 0, 0u32);
         for k in crate::trace::lanes(mask) {
             let (g, l) = (k / 4, k % 4);
-            if m == 16 {
-                hits[g][l] = self.march(&quads[g].rays[l], spans[g][l], params, c, &mut evals[g][l]);
-                continue;
-            }
-            lanes[k] = self.lane(&quads[g].rays[l], spans[g][l]);
-            if lanes[k].is_some() {
+            if let Some(lane) = self.lane(&quads[g].rays[l], spans[g][l]) {
+                lanes[k] = lane;
                 active[m] = k as u8;
                 m += 1;
             }
         }
-        let mut later = 0u32;
         let (mut points, mut values) = ([Vec3A::ZERO; 16], [0.0f32; 16]);
         while m > 0 {
             for (p, &k) in points.iter_mut().zip(&active[..m]) {
-                *p = lanes[k as usize].as_ref().map_or(Vec3A::ZERO, Lane::at);
+                *p = lanes[k as usize].at();
             }
             self.body.num_lanes(&points[..m], &mut values[..m]);
             let mut kept = 0;
             for j in 0..m {
                 let k = active[j] as usize;
-                let (g, l) = (k / 4, k % 4);
-                let Some(lane) = lanes[k].as_mut() else { continue };
+                let (g, l, lane) = (k / 4, k % 4, &mut lanes[k]);
                 evals[g][l] += 1;
                 match self.plain_step(lane, values[j], params) {
                     Step::Hit(t, threshold) => hits[g][l] = Some((t, threshold)),
@@ -398,9 +394,7 @@ impl RayField {
         }
         for k in crate::trace::lanes(later) {
             let (g, l) = (k / 4, k % 4);
-            if let Some(lane) = lanes[k] {
-                hits[g][l] = self.segments(lane, params, c, &mut evals[g][l]);
-            }
+            hits[g][l] = self.segments(lanes[k], params, c, &mut evals[g][l]);
         }
         hits
     }
