@@ -3,6 +3,7 @@
 //! it is marched, so a miss costs no step and a hit starts at (or near) the surface —
 //! exactly on it for a convex polyhedron, a cylinder, a capped cone or an ellipsoid.
 
+use super::Aabb;
 use glam::{DAffine3, DMat3, DVec3};
 
 /// A convex set holding a solid: where every plane and the round part hold.
@@ -180,6 +181,15 @@ fn meet(a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
 pub const MAX_CORNER_PLANES: usize = 64;
 
 impl Hull {
+    /// The six planes of the box `b`.
+    pub fn box_planes(b: Aabb) -> Vec<(DVec3, f64)> {
+        [DVec3::X, DVec3::Y, DVec3::Z]
+            .into_iter()
+            .zip(0..3)
+            .flat_map(|(n, a)| [(n, b.max[a]), (-n, -b.min[a])])
+            .collect()
+    }
+
     /// The hull of planes alone.
     pub fn planes(planes: Vec<(DVec3, f64)>) -> Hull {
         Hull { planes, round: None }

@@ -234,10 +234,7 @@ fn hull_within(shape: &Shape, g: f64, fields: &mut FieldPlanes<'_>) -> Option<Hu
             let grown = Aabb { min: b.min - g, max: b.max + g };
             let mut planes = fields(body, grown, g * lipschitz.value).filter(|p| !p.is_empty())?;
             // The box's own faces, so the polyhedron is bounded (a twist takes its corners).
-            for axis in 0..3 {
-                let n = DVec3::AXES[axis];
-                planes.extend([(n, grown.max[axis]), (-n, -grown.min[axis])]);
-            }
+            planes.extend(Hull::box_planes(grown));
             Some(Hull::planes(planes))
         }
         ShapeKind::Field { .. } | ShapeKind::Warp { .. } | ShapeKind::Displace { .. } => None,

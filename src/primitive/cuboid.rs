@@ -38,9 +38,7 @@ impl Solid for Cuboid {
     }
 
     fn hull(&self) -> Option<Hull> {
-        let h = self.size;
-        let axes = [DVec3::X, DVec3::Y, DVec3::Z];
-        Some(Hull::planes(axes.iter().zip([h.x, h.y, h.z]).flat_map(|(&n, d)| [(n, d), (-n, d)]).collect()))
+        Some(Hull::planes(Hull::box_planes(crate::geom::Aabb::centred(self.size))))
     }
 
     fn is_convex(&self) -> bool {

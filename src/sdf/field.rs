@@ -46,6 +46,16 @@ pub struct Body {
     pub shapes: Shapes,
 }
 
+/// A body undefined at a point (∞ − ∞) is taken as far outside there, never as a hit.
+#[inline]
+fn far_if_undefined(v: f32) -> f32 {
+    if v.is_nan() {
+        f32::MAX
+    } else {
+        v
+    }
+}
+
 impl Body {
     /// The body of `tape`, its shapes lowered to `shapes`.
     pub fn new(tape: Tape, shapes: Shapes) -> Body {
@@ -65,12 +75,7 @@ impl Body {
             Some(f) => f.eval(p, &self.shapes),
             None => self.tape.eval::<f32>(&p, &self.shapes),
         };
-        // A body undefined at a point (∞ − ∞) is taken as far outside, never as a hit.
-        if v.is_nan() {
-            f32::MAX
-        } else {
-            v
-        }
+        far_if_undefined(v)
     }
 
     /// The number at each of `p` into `out`: [`num`](Self::num) point by point.
@@ -85,9 +90,7 @@ impl Body {
             }
         }
         for v in out.iter_mut() {
-            if v.is_nan() {
-                *v = f32::MAX;
-            }
+            *v = far_if_undefined(*v);
         }
     }
 
