@@ -156,22 +156,17 @@ fn half_space_within(shape: &Shape, g: f64) -> Option<(DVec3, f64)> {
     }
 }
 
-/// A convex set holding the shape ([`Solid::hull`](crate::primitive::Solid::hull)):
-/// exactly the solid for a convex polyhedron, a cylinder, a capped cone or an
-/// ellipsoid under any affine map, and for intersections of them; `None` where there is
-/// none that is cheap to find (a union, a repeat, a field).
-pub fn shape_hull(shape: &Shape) -> Option<Hull> {
-    shape_hull_with(shape, &mut |_, _, _| None)
-}
-
 /// Planes `n·p ≤ offset` holding where a field's body is at most `level` within a box,
 /// for the directions where that is nearer than the box's face (`field::support_planes`,
 /// which `ir` cannot call: its caller hands the search in); `None` for none.
 pub type FieldPlanes<'a> = dyn FnMut(&Arc<super::field::Expr>, Aabb, f64) -> Option<Vec<(DVec3, f64)>> + 'a;
 
-/// [`shape_hull`], with a field's hull from `fields` wherever the field is in the tree
-/// (under transforms, intersections, rounding, a twist).
-pub fn shape_hull_with(shape: &Shape, fields: &mut FieldPlanes<'_>) -> Option<Hull> {
+/// A convex set holding the shape ([`Solid::hull`](crate::primitive::Solid::hull)):
+/// exactly the solid for a convex polyhedron, a cylinder, a capped cone or an
+/// ellipsoid under any affine map, and for intersections of them; for a field, wherever
+/// it is in the tree (under transforms, intersections, rounding, a twist), the planes
+/// `fields` finds; `None` where there is none that is cheap to find (a union, a repeat).
+pub fn shape_hull(shape: &Shape, fields: &mut FieldPlanes<'_>) -> Option<Hull> {
     hull_within(shape, 0.0, fields)
 }
 

@@ -44,7 +44,7 @@ impl Reach {
                 .and_then(|h| ir::transform_half_space(h, to_render))
                 .map(|(n, o)| (n.as_vec3a(), o as f32)),
         };
-        let hull = bounds.and_then(|_| ir::shape_hull_with(shape, &mut |body, b, level| known.planes(body, b, level)));
+        let hull = bounds.and_then(|_| known.hull(shape));
         let hull = hull.and_then(|h| h.transformed(to_render)).map(query::Entry::new);
         Reach { bounds, sphere, half_space, hull: hull.map(Arc::new) }
     }
@@ -74,11 +74,15 @@ const MIN_OPS: usize = 12;
 /// The convex set an object of `shape`'s rays are clipped to: [`ir::shape_hull`] with
 /// the support planes of the fields in it (of a dozen operations or more).
 pub fn shape_hull(shape: &ir::Shape) -> Option<crate::geom::hull::Hull> {
-    let mut known = FieldHulls::default();
-    ir::shape_hull_with(shape, &mut |body, b, level| known.planes(body, b, level))
+    FieldHulls::default().hull(shape)
 }
 
 impl FieldHulls {
+    /// [`shape_hull`], searching each field's planes once per body, box and level.
+    fn hull(&mut self, shape: &ir::Shape) -> Option<crate::geom::hull::Hull> {
+        ir::shape_hull(shape, &mut |body, b, level| self.planes(body, b, level))
+    }
+
     /// [`ir::FieldPlanes`]: the planes holding where `body` is at most `level` within
     /// `b` (`field::support_planes`), for a body of at least [`MIN_OPS`] operations.
     fn planes(&mut self, body: &Arc<ir::field::Expr>, b: ir::Aabb, level: f64) -> Option<Vec<(DVec3, f64)>> {

@@ -52,7 +52,7 @@ pub(crate) struct Object {
     /// along a floor would otherwise spend its whole step budget reaching.
     half_space: Option<(Vec3A, f32)>,
     /// For a bounded SDF object, a convex set holding it in render space (planes, and
-    /// cones or an ellipsoid about an axis: `ir::shape_hull`): a ray is clipped to it,
+    /// cones or an ellipsoid about an axis: `world::shape_hull`): a ray is clipped to it,
     /// so a miss is found without a step and a hit starts at or near the surface.
     hull: Option<std::sync::Arc<query::Entry>>,
     span: Span,
