@@ -44,10 +44,9 @@ enum Code {
     Length,
     Dist,
     Noise,
-    /// Sine into `out` and cosine into register `b`, of one angle.
+    /// Sine of `a·k` into `out` and its cosine into register `b` (`k` is 1 for an
+    /// angle alone).
     SinCos,
-    /// [`Code::SinCos`] of `a·k`.
-    SinCosK,
     /// A copy of register `a`.
     Copy,
     /// `a·b + c`.
@@ -75,7 +74,6 @@ impl Code {
             | Code::MaxC
             | Code::Unary(_)
             | Code::SinCos
-            | Code::SinCosK
             | Code::Copy
             | Code::AbsSubC => [true, false, false],
             Code::Binary(_) | Code::MulCAdd => [true, true, false],
@@ -87,7 +85,7 @@ impl Code {
 impl Ins {
     /// The registers it writes: `out`, and `b` for a sine–cosine pair.
     fn writes(&self) -> impl Iterator<Item = u16> {
-        let pair = matches!(self.code, Code::SinCos | Code::SinCosK);
+        let pair = self.code == Code::SinCos;
         std::iter::once(self.out).chain(pair.then_some(self.b))
     }
 
@@ -178,8 +176,8 @@ fn fused(p: &Ins, q: &Ins) -> Option<Ins> {
     };
     let ins = |code, a, b, c, k| Some(Ins { code, out: q.out, a, b, c, k });
     match (p.code, q.code) {
-        (Code::MulC, Code::SinCos) if q.a == p.out => {
-            Some(Ins { code: Code::SinCosK, out: q.out, a: p.a, b: q.b, c: 0, k: p.k })
+        (Code::MulC, Code::SinCos) if q.a == p.out && q.k == 1.0 => {
+            Some(Ins { code: Code::SinCos, out: q.out, a: p.a, b: q.b, c: 0, k: p.k })
         }
         (Code::Binary(Binary::Mul), Code::Binary(Binary::Add)) => ins(Code::MulAdd, p.a, p.b, other(q)?, 0.0),
         (Code::MulC, Code::Binary(Binary::Add)) => ins(Code::MulCAdd, p.a, other(q)?, 0, p.k),
@@ -244,9 +242,9 @@ fn fuse_sincos(ins: &mut [Ins], extra: &mut usize) {
         *extra += 1;
         let mine = ins[i].out;
         ins[i] = if code == Code::Unary(Unary::Sin) {
-            Ins { code: Code::SinCos, out: mine, a, b: spare, c: 0, k: 0.0 }
+            Ins { code: Code::SinCos, out: mine, a, b: spare, c: 0, k: 1.0 }
         } else {
-            Ins { code: Code::SinCos, out: spare, a, b: mine, c: 0, k: 0.0 }
+            Ins { code: Code::SinCos, out: spare, a, b: mine, c: 0, k: 1.0 }
         };
         ins[j] = Ins { code: Code::Copy, out: ins[j].out, a: spare, b: 0, c: 0, k: 0.0 };
     }
@@ -390,11 +388,10 @@ impl Flat {
                 Code::MaxC => a.map(|a| a.max(k)),
                 Code::Unary(Unary::Sin) => a.map(sin_deg),
                 Code::Unary(Unary::Cos) => a.map(cos_deg),
-                Code::SinCos | Code::SinCosK => {
-                    let scale = if ins.code == Code::SinCosK { k } else { 1.0 };
+                Code::SinCos => {
                     let (mut s, mut c) = ([0.0; W], [0.0; W]);
                     for l in 0..W {
-                        (s[l], c[l]) = sincos_deg(a[l] * scale);
+                        (s[l], c[l]) = sincos_deg(a[l] * k);
                     }
                     r[(ins.b & mask) as usize] = c;
                     s
