@@ -9,6 +9,7 @@
 //! guarantees it, so back-ends never re-validate. Every node keeps its source span.
 
 mod bounds;
+mod convex;
 mod dump;
 pub mod field;
 mod paint;
@@ -480,8 +481,9 @@ impl Shape {
 
     /// Whether the solid is convex, so a ray leaving its surface outward never meets it
     /// again. Conservative: `false` unless it follows from the shape's form (primitives
-    /// other than the torus, a half-space, sharp intersections of convex solids, and
-    /// rounding, painting or transforming one).
+    /// other than the torus, a half-space, a field whose body is a convex function of
+    /// the point by disciplined convex programming's composition rules, sharp intersections of convex
+    /// solids, and rounding, painting or transforming one).
     pub fn is_convex(&self) -> bool {
         match &self.kind {
             ShapeKind::Primitive(p) => p.is_convex(),
@@ -494,11 +496,13 @@ impl Shape {
             ShapeKind::Round { child, .. } | ShapeKind::Paint { child, .. } | ShapeKind::Transform { child, .. } => {
                 child.is_convex()
             }
-            // A shell is hollow and repeated copies leave gaps between them; a field may
-            // be any set at all.
+            // A shell is hollow and repeated copies leave gaps between them; a warp or a
+            // displacement may make any set at all.
+            // A field is when its body is a convex function of the point (cut to a box,
+            // still convex).
+            ShapeKind::Field { body, .. } => convex::is_convex(body),
             ShapeKind::Shell { .. }
             | ShapeKind::Repeat { .. }
-            | ShapeKind::Field { .. }
             | ShapeKind::Warp { .. }
             | ShapeKind::Displace { .. } => false,
         }

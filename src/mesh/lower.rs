@@ -75,14 +75,15 @@ pub fn tessellate(
                 _ => Normals::Flat,
             };
             // A generator's polytope is convex exactly when its shape is (tested for each);
-            // isosurfaces (below) may dent even a convex shape, so they are never marked.
+            // isosurfaces (below) may dent even a convex shape, so they are never marked,
+            // nor is a field's exact mesh (a lathe's rings are not tested to be convex).
             Ok(MeshJob {
                 mesh,
                 xf,
                 material,
                 per_triangle: None,
                 normals,
-                convex: node.is_convex(),
+                convex: node.is_convex() && !matches!(node.kind, ShapeKind::Field { .. }),
                 warnings: Vec::new(),
                 isosurface: None,
             })
