@@ -136,6 +136,7 @@ impl<'a> Builder<'a> {
                     scale: (stretch / lipschitz.value) as f32,
                     body,
                     bounds: bounds.map(|b| (b.min.as_vec3a(), b.max.as_vec3a())),
+                    convex: node.is_convex(),
                 })
             }
             _ => None,

@@ -205,6 +205,9 @@ pub struct RayField {
     pub body: Body,
     /// The box it is cut to, in its frame.
     pub bounds: Option<(Vec3A, Vec3A)>,
+    /// Whether the body is a convex function of the point ([`crate::ir::Shape::is_convex`]):
+    /// then a ray's plain steps may go as far as the secant through its last two points.
+    pub convex: bool,
 }
 
 /// The first stretch a derivative bound is asked for, as a share of what is left of
@@ -237,6 +240,9 @@ struct Lane {
     prev_reach: f32,
     relaxed: bool,
     omega: f32,
+    /// A secant step of a convex body went past the surface (by f32 rounding): the
+    /// lane takes plain steps from then on.
+    plain: bool,
 }
 
 /// What a plain step found.
@@ -274,7 +280,19 @@ impl RayField {
             None => (t0, t1),
         };
         let base = ray.origin.length();
-        Some(Lane { o, d, base, t, end, steps: 0, prev_t: t, prev_reach: 0.0, relaxed: false, omega: OMEGA })
+        Some(Lane {
+            o,
+            d,
+            base,
+            t,
+            end,
+            steps: 0,
+            prev_t: t,
+            prev_reach: 0.0,
+            relaxed: false,
+            omega: OMEGA,
+            plain: false,
+        })
     }
 
     /// Plain steps a lane takes before segments.
@@ -298,6 +316,9 @@ impl RayField {
     /// on the gyroid's primary rays, docs/fields.md).
     #[inline]
     fn plain_step(&self, lane: &mut Lane, v: f32, params: super::MarchParams) -> Step {
+        if self.convex {
+            return self.convex_step(lane, v, params);
+        }
         lane.steps += 1;
         let (t, r) = (lane.t, v * self.scale);
         if lane.relaxed && r < t - lane.prev_t - lane.prev_reach {
@@ -319,6 +340,45 @@ impl RayField {
             // The long step may have jumped a surface just before the end.
             (lane.t, lane.relaxed, lane.omega) = (t + r, false, OMEGA_AFTER_MISS);
         }
+        Step::On
+    }
+
+    /// [`plain_step`](Self::plain_step) for a convex body: the step goes as far as
+    /// the secant through the lane's last two points meets zero, when that is further
+    /// than the bound. Along a line a convex body is a convex function, which lies above
+    /// every secant beyond the secant's points, so no surface comes before that zero
+    /// (and with two points outside, the body is falling there, the secant converging on
+    /// the surface faster than the geometric approach of sphere tracing). Where the body
+    /// rises instead, it rises from there on: the ray has passed the solid.
+    ///
+    /// The secant is taken only where the body fell by more than the hit threshold since
+    /// the last point, so f32 rounding (far under the threshold) barely moves it; a step
+    /// that still lands inside beyond the threshold goes back to the plain step, and the
+    /// lane keeps to plain steps.
+    #[inline]
+    fn convex_step(&self, lane: &mut Lane, v: f32, params: super::MarchParams) -> Step {
+        lane.steps += 1;
+        let (t, r) = (lane.t, v * self.scale);
+        let threshold = super::march::threshold(params.epsilon, lane.base, t);
+        if r < threshold {
+            if lane.relaxed && r < -threshold {
+                (lane.t, lane.relaxed, lane.plain) = (lane.prev_t + lane.prev_reach, false, true);
+                return Step::On;
+            }
+            return Step::Hit(t, threshold);
+        }
+        let fell = lane.prev_reach - r;
+        if fell < -threshold && lane.steps > 1 {
+            // Rising: beyond here the body is above the secant, which only rises.
+            return Step::Miss;
+        }
+        let secant = if !lane.plain && fell > threshold { r * (t - lane.prev_t) / fell } else { 0.0 };
+        (lane.prev_t, lane.prev_reach, lane.relaxed) = (t, r, secant > r);
+        // Past the end only by the bound: a secant past it is checked at the end.
+        if t + r > lane.end {
+            return Step::Miss;
+        }
+        lane.t = (t + r.max(secant)).min(lane.end);
         Step::On
     }
 
