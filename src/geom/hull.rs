@@ -180,6 +180,9 @@ fn meet(a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
 /// The most planes [`Hull::corners`] searches: 64 planes are 41,664 triples.
 pub const MAX_CORNER_PLANES: usize = 64;
 
+/// The directions about `z` of a bent solid's planes ([`Hull::bent`]).
+pub const BEND_PLANES: usize = 16;
+
 impl Hull {
     /// The six planes of the box `b`.
     pub fn box_planes(b: Aabb) -> Vec<(DVec3, f64)> {
@@ -203,6 +206,54 @@ impl Hull {
     /// The ellipsoid of semi-axes `radii` ([`Round::ellipsoid`]).
     pub fn ellipsoid(radii: DVec3) -> Option<Hull> {
         Some(Hull { planes: Vec::new(), round: Some(Round::ellipsoid(radii)?) })
+    }
+
+    /// Planes holding `bend` of a solid whose corners are `corners` (a convex polyhedron
+    /// holding it), bent by `k` radians per unit: the point `p` reads the solid at
+    /// `p`'s `(x, y)` turned by `k·p.y` about `z` (`sdf::domain::Map::Bend`), so the bent
+    /// solid's point is a solid's point `q` turned back by `θ = k·p.y`, at the height
+    /// `p.y = θ / k` that angle fixes. Split the angles `|θ| ≤ |k|·r` that can occur (`r`
+    /// the corners' largest distance from `z`) into short stretches: over one, the turned
+    /// corners stay within the triangles their arcs span (the ends and the tangents'
+    /// meeting point), and the point within that stretch's slab of heights. The
+    /// corners of those pieces give [`BEND_PLANES`] planes about `z` (a polygon
+    /// circumscribing their convex hull) and the corners' range of `z`. `None` when the
+    /// angles reach further than half a turn each way: the drum about `z` holds as much.
+    pub fn bent(corners: &[DVec3], k: f64) -> Option<Hull> {
+        use glam::DVec2;
+        let r = corners.iter().map(|c| c.truncate().length()).fold(0.0, f64::max);
+        let (low, high) = corners.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), c| (l.min(c.z), h.max(c.z)));
+        let flat = super::polygon::convex_hull(corners.iter().map(|c| c.truncate()).collect());
+        let reach = k.abs() * r;
+        if flat.len() < 3 || !reach.is_finite() || reach > std::f64::consts::PI || low > high || low.is_nan() {
+            return None;
+        }
+        let turned = |v: DVec2, a: f64| DVec2::from_angle(-a).rotate(v);
+        let pieces = ((2.0 * reach / 0.01).ceil() as usize).clamp(1, 1024);
+        let half = reach / pieces as f64;
+        let mut points = Vec::new();
+        for i in 0..pieces {
+            let (a, b) = (-reach + 2.0 * half * i as f64, -reach + 2.0 * half * (i + 1) as f64);
+            let mid = 0.5 * (a + b);
+            let span: Vec<DVec2> =
+                flat.iter().flat_map(|&v| [turned(v, a), turned(v, b), turned(v, mid) / half.cos()]).collect();
+            let mut piece = super::polygon::convex_hull(span);
+            if k != 0.0 {
+                let (y0, y1) = ((a / k).min(b / k), (a / k).max(b / k));
+                piece = super::polygon::clip_convex(&piece, DVec2::Y, y1);
+                piece = super::polygon::clip_convex(&piece, -DVec2::Y, -y0);
+            }
+            points.extend(piece);
+        }
+        let mut planes: Vec<(DVec3, f64)> = (0..BEND_PLANES)
+            .map(|j| {
+                let u = DVec2::from_angle(std::f64::consts::TAU * j as f64 / BEND_PLANES as f64);
+                let offset = points.iter().map(|p| u.dot(*p)).fold(f64::NEG_INFINITY, f64::max);
+                (u.extend(0.0), offset)
+            })
+            .collect();
+        planes.extend([(DVec3::Z, high), (-DVec3::Z, -low)]);
+        planes.iter().all(|(_, o)| o.is_finite()).then_some(Hull::planes(planes))
     }
 
     /// Holding every point within `g` of this set.
@@ -289,6 +340,41 @@ pub fn max_stretch(m: DMat3) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A bent box lies within its planes (every point whose turned reading falls in the
+    /// box, over a grid), for bends either way, near half a turn and none; for a bend
+    /// of 50° or 120° a unit they hold under half of what the drum about `z` holds.
+    #[test]
+    fn bent_planes_hold_the_bent_box() {
+        let half = DVec3::new(0.2, 0.9, 0.3);
+        let corners: Vec<DVec3> = (0..8)
+            .map(|i| half * DVec3::new([-1.0, 1.0][i & 1], [-1.0, 1.0][(i >> 1) & 1], [-1.0, 1.0][i >> 2]))
+            .collect();
+        let r = corners.iter().map(|c| c.truncate().length()).fold(0.0, f64::max);
+        for deg in [50.0_f64, -120.0, 190.0, 0.0] {
+            let k = deg.to_radians();
+            let hull = Hull::bent(&corners, k).unwrap();
+            let (mut inside, mut in_planes, mut in_drum) = (0, 0, 0);
+            let n = 120;
+            for i in 0..n * n {
+                let p = DVec3::new((i % n) as f64, (i / n) as f64, 0.5 * n as f64) / n as f64 * 2.2 - 1.1;
+                let (s, c) = (k * p.y).sin_cos();
+                let q = DVec3::new(p.x * c - p.y * s, p.x * s + p.y * c, p.z);
+                if q.abs().cmple(half).all() {
+                    inside += 1;
+                    assert!(hull.contains(p, 1e-9), "{deg}°: {p} reads {q} in the box, outside the planes");
+                }
+                in_planes += usize::from(hull.contains(p, 0.0));
+                in_drum += usize::from(p.truncate().length() <= r);
+            }
+            assert!(inside > 500, "{deg}°: only {inside} points in the bent box");
+            if (50.0..=120.0).contains(&deg.abs()) {
+                assert!(2 * in_planes < in_drum, "{deg}°: {in_planes} points in the planes, {in_drum} in the drum");
+            }
+        }
+        // Bent further than half a turn each way: the drum serves.
+        assert!(Hull::bent(&corners, 250f64.to_radians()).is_none());
+    }
 
     /// Points along random rays are inside the interval exactly where they are in the
     /// set: a cylinder, a cone's frustum and an ellipsoid, turned and stretched.

@@ -1,5 +1,5 @@
-//! Polygons: triangulation by ear clipping, and the prism of a polygon (an extruded
-//! profile's exact mesh).
+//! Polygons: triangulation by ear clipping, convex hulls and their clipping, and the
+//! prism of a polygon (an extruded profile's exact mesh).
 
 use glam::{DVec2, DVec3};
 
@@ -216,6 +216,52 @@ pub fn smooth_within(m: &TriMesh, crease: f64) -> Vec<[DVec3; 3]> {
             })
         })
         .collect()
+}
+
+/// The corners of the convex hull of `pts`, counter-clockwise, by Andrew's monotone
+/// chain; fewer than three when the points span no area.
+pub fn convex_hull(mut pts: Vec<DVec2>) -> Vec<DVec2> {
+    pts.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    pts.dedup();
+    if pts.len() < 3 {
+        return pts;
+    }
+    // Lower then upper hull, turning left throughout.
+    let mut hull: Vec<DVec2> = Vec::with_capacity(2 * pts.len());
+    for pass in 0..2 {
+        let start = hull.len();
+        let iter: Box<dyn Iterator<Item = &DVec2>> =
+            if pass == 0 { Box::new(pts.iter()) } else { Box::new(pts.iter().rev()) };
+        for &p in iter {
+            while hull.len() >= start + 2 {
+                let (a, b) = (hull[hull.len() - 2], hull[hull.len() - 1]);
+                if (b - a).perp_dot(p - a) > 0.0 {
+                    break;
+                }
+                hull.pop();
+            }
+            hull.push(p);
+        }
+        hull.pop();
+    }
+    hull
+}
+
+/// The part of the convex polygon `poly` (corners in order) where `n·p ≤ d`
+/// (Sutherland–Hodgman against one line).
+pub fn clip_convex(poly: &[DVec2], n: DVec2, d: f64) -> Vec<DVec2> {
+    let mut out = Vec::with_capacity(poly.len() + 1);
+    for i in 0..poly.len() {
+        let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+        let (da, db) = (n.dot(a) - d, n.dot(b) - d);
+        if da <= 0.0 {
+            out.push(a);
+        }
+        if (da < 0.0) != (db < 0.0) && da != db {
+            out.push(a + (b - a) * (da / (da - db)));
+        }
+    }
+    out
 }
 
 #[cfg(test)]

@@ -146,30 +146,8 @@ impl Region {
 
 /// The edges of the convex hull of `pts` as lines `n·p ≤ d` (unit `n`),
 /// counter-clockwise; none when the points span no area.
-fn convex_lines(mut pts: Vec<DVec2>) -> Vec<(DVec2, f64)> {
-    pts.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
-    pts.dedup();
-    if pts.len() < 3 {
-        return Vec::new();
-    }
-    // Andrew's monotone chain: lower then upper hull, turning left throughout.
-    let mut hull: Vec<DVec2> = Vec::with_capacity(2 * pts.len());
-    for pass in 0..2 {
-        let start = hull.len();
-        let iter: Box<dyn Iterator<Item = &DVec2>> =
-            if pass == 0 { Box::new(pts.iter()) } else { Box::new(pts.iter().rev()) };
-        for &p in iter {
-            while hull.len() >= start + 2 {
-                let (a, b) = (hull[hull.len() - 2], hull[hull.len() - 1]);
-                if (b - a).perp_dot(p - a) > 0.0 {
-                    break;
-                }
-                hull.pop();
-            }
-            hull.push(p);
-        }
-        hull.pop();
-    }
+fn convex_lines(pts: Vec<DVec2>) -> Vec<(DVec2, f64)> {
+    let hull = super::polygon::convex_hull(pts);
     (0..hull.len())
         .filter_map(|i| {
             let (a, b) = (hull[i], hull[(i + 1) % hull.len()]);

@@ -210,15 +210,21 @@ fn hull_within(shape: &Shape, g: f64, fields: &mut FieldPlanes<'_>) -> Option<Hu
                     return Some(Hull { planes: across, round: Some(round.clone()) });
                 }
             }
-            let (radius, low, high) = extent_about(child, hull, g, |c| (c.x.hypot(c.z), c.y))?;
+            let (radius, low, high) = extent_about(&corners_within(child, hull, g)?, |c| (c.x.hypot(c.z), c.y));
             let round = Round::about_y([(1.0, 0.0, radius)])?;
             Some(Hull { planes: vec![(DVec3::Y, high), (-DVec3::Y, -low)], round: Some(round) })
         }
-        // A bend turns the point about z, so the bent shape stays within the cylinder
-        // about z that holds its child's corners (or box), between the same depths.
-        ShapeKind::Warp { child, domain_op: Some(crate::ir::DomainOp::Bend(_)), lipschitz, .. } => {
+        // A bend turns the point about z by an angle its height fixes: the bent shape
+        // stays within the planes `Hull::bent` finds from its child's corners (or box),
+        // or where the angles reach too far for those, the cylinder about z that holds
+        // the corners, between the same depths.
+        ShapeKind::Warp { child, domain_op: Some(crate::ir::DomainOp::Bend(k)), lipschitz, .. } => {
             let g = g * lipschitz.value.max(1.0);
-            let (radius, low, high) = extent_about(child, hull_within(child, g, fields), g, |c| (c.x.hypot(c.y), c.z))?;
+            let corners = corners_within(child, hull_within(child, g, fields), g)?;
+            if let Some(bent) = Hull::bent(&corners, k.to_radians()) {
+                return Some(bent);
+            }
+            let (radius, low, high) = extent_about(&corners, |c| (c.x.hypot(c.y), c.z));
             // The cylinder is about the y axis of a frame whose y is the scene's z.
             let cones = [(1.0, 0.0, radius), (0.0, 1.0, high), (0.0, -1.0, -low)];
             Hull::about_y(cones)?.transformed(&DAffine3::from_rotation_x(std::f64::consts::FRAC_PI_2))
@@ -236,29 +242,27 @@ fn hull_within(shape: &Shape, g: f64, fields: &mut FieldPlanes<'_>) -> Option<Hu
     }
 }
 
-/// The largest distance from an axis and the range along it of where `shape`'s field
-/// is at most `g`: over the corners of its planes' polyhedron when its `hull` (at `g`)
-/// is one, else over its box's corners; `about(p)` is a point's distance from the axis
-/// and its place along it.
-fn extent_about(
-    shape: &Shape,
-    hull: Option<Hull>,
-    g: f64,
-    about: impl Fn(DVec3) -> (f64, f64),
-) -> Option<(f64, f64, f64)> {
+/// Points whose convex hull holds where `shape`'s field is at most `g`: the corners of
+/// its planes' polyhedron when its `hull` (at `g`) is one, else its box's corners.
+fn corners_within(shape: &Shape, hull: Option<Hull>, g: f64) -> Option<Vec<DVec3>> {
     let corners = hull.filter(|h| h.round.is_none()).map(|h| h.corners());
-    let corners = match corners.filter(|c| !c.is_empty()) {
-        Some(c) => c,
+    match corners.filter(|c| !c.is_empty()) {
+        Some(c) => Some(c),
         None => {
             let b = bounds_within(shape, g)?;
-            (0..8).map(|i| DVec3::select(glam::BVec3::new(i & 1 != 0, i & 2 != 0, i & 4 != 0), b.max, b.min)).collect()
+            let corner = |i: i32| DVec3::select(glam::BVec3::new(i & 1 != 0, i & 2 != 0, i & 4 != 0), b.max, b.min);
+            Some((0..8).map(corner).collect())
         }
-    };
-    let extent = corners
+    }
+}
+
+/// The largest distance from an axis and the range along it of `corners`; `about(p)` is
+/// a point's distance from the axis and its place along it.
+fn extent_about(corners: &[DVec3], about: impl Fn(DVec3) -> (f64, f64)) -> (f64, f64, f64) {
+    corners
         .iter()
         .map(|&c| about(c))
-        .fold((0.0_f64, f64::INFINITY, f64::NEG_INFINITY), |acc, (r, t)| (acc.0.max(r), acc.1.min(t), acc.2.max(t)));
-    Some(extent)
+        .fold((0.0_f64, f64::INFINITY, f64::NEG_INFINITY), |acc, (r, t)| (acc.0.max(r), acc.1.min(t), acc.2.max(t)))
 }
 
 /// `Some(k)` when `m` is a rotation times a uniform scale `k`.
