@@ -113,7 +113,10 @@ impl Dumper<'_> {
                 self.shape(indent + 1, child);
             }
             ShapeKind::Field { body, bounds, lipschitz, .. } => {
-                self.line(indent, &format!("field{}{}", Self::bounds(bounds), Self::lipschitz(lipschitz)), span);
+                // Said because it changes how the field is marched and shadowed.
+                let convex = if super::convex::is_convex(body) { " convex" } else { "" };
+                let head = format!("field{}{}{convex}", Self::bounds(bounds), Self::lipschitz(lipschitz));
+                self.line(indent, &head, span);
                 self.body(indent + 1, body);
             }
             ShapeKind::Warp { child, map, bounds, lipschitz, .. } => {
