@@ -60,7 +60,8 @@ impl Map {
     pub fn stretch(&self, p: Vec3A, reach: f32) -> Option<f32> {
         match *self {
             Map::Twist(k) => {
-                let a = k.abs() * (p.x.hypot(p.z) + reach);
+                // Not `hypot`, a libm call (3 % of a twisted prism's time under `perf`).
+                let a = k.abs() * ((p.x * p.x + p.z * p.z).sqrt() + reach);
                 Some(0.5 * (a + (a * a + 4.0).sqrt()))
             }
             // J = R(θ)·M in x, y, with M = [[1, −k·y], [0, 1 + k·x]]; M's largest singular

@@ -118,7 +118,8 @@ impl Swept {
                 let ga = Vec3A::new(ga.x, 0.0, ga.y);
                 let (b, gb) = (p.y.abs() - h, Vec3A::new(0.0, if p.y < 0.0 { -1.0 } else { 1.0 }, 0.0));
                 if a > 0.0 && b > 0.0 {
-                    let len = a.hypot(b);
+                    // Not `hypot`: its overflow guard is a libm call, and these are scene-sized.
+                    let len = (a * a + b * b).sqrt();
                     (len, (ga * a + gb * b) / len)
                 } else if a >= b {
                     (a, ga)
@@ -127,7 +128,7 @@ impl Swept {
                 }
             }
             None => {
-                let r = p.x.hypot(p.z);
+                let r = (p.x * p.x + p.z * p.z).sqrt();
                 let (d, g) = self.flat.eval(Vec2::new(r, p.y));
                 let radial = if r > 0.0 { Vec3A::new(p.x / r, 0.0, p.z / r) } else { Vec3A::X };
                 (d, radial * g.x + Vec3A::Y * g.y)
