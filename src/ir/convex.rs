@@ -183,10 +183,14 @@ fn facts(e: &Arc<Expr>, memo: &mut HashMap<*const Expr, [Fact; 3]>) -> [Fact; 3]
         }
         Kind::Binary(op, x, y) => {
             let (a, b) = (f(x), f(y));
-            let constant = |e: &Arc<Expr>| match &e.kind {
-                Kind::Num(c) => Some([*c; 3]),
-                Kind::Vec(c) => Some(c.to_array()),
-                _ => None,
+            // A finite constant operand (a product with an infinite one is no function).
+            let constant = |e: &Arc<Expr>| {
+                let c = match &e.kind {
+                    Kind::Num(c) => [*c; 3],
+                    Kind::Vec(c) => c.to_array(),
+                    _ => return None,
+                };
+                c.iter().all(|x| x.is_finite()).then_some(c)
             };
             let scaled = |a: [Fact; 3], c: [f64; 3]| [0, 1, 2].map(|i| a[i].scale(c[i]));
             match (op, constant(x), constant(y)) {
@@ -194,7 +198,7 @@ fn facts(e: &Arc<Expr>, memo: &mut HashMap<*const Expr, [Fact; 3]>) -> [Fact; 3]
                 (Binary::Sub, ..) => both(a, b, &|a, b| a.add(b.neg())),
                 (Binary::Mul, Some(c), _) => scaled(b, c),
                 (Binary::Mul, _, Some(c)) => scaled(a, c),
-                (Binary::Div, _, Some(c)) => scaled(a, c.map(f64::recip)),
+                (Binary::Div, _, Some(c)) if c.iter().all(|&x| x != 0.0) => scaled(a, c.map(f64::recip)),
                 (Binary::Max, ..) => both(a, b, &Fact::max),
                 (Binary::Min, ..) => both(a, b, &Fact::min),
                 (Binary::Dot, Some(c), _) | (Binary::Dot, _, Some(c)) => {
@@ -289,6 +293,7 @@ mod tests {
         let cubic = bin(Binary::Pow, x(0), c(3.0));
         let wave = bin(Binary::Sub, un(Unary::Sin, x(0)), x(1));
         let product = bin(Binary::Mul, x(0), x(1));
+        let by_zero = bin(Binary::Div, un(Unary::Length, p()), c(0.0));
         vec![
             ("sphere", sphere.clone(), true, true),
             ("box as slabs", slabs, true, true),
@@ -308,6 +313,8 @@ mod tests {
             ("cubic", cubic, false, false),
             ("wave", wave, false, false),
             ("product", product, false, false),
+            // Infinite everywhere: no line bends the wrong way, but it is no function to march.
+            ("over zero", by_zero, false, true),
         ]
     }
 
