@@ -183,6 +183,11 @@ pub const MAX_CORNER_PLANES: usize = 64;
 /// The directions about `z` of a bent solid's planes ([`Hull::bent`]).
 pub const BEND_PLANES: usize = 16;
 
+/// The angle, in radians, over which [`Hull::bent`] bounds a bent solid's turned
+/// corners by one piece: the pieces' triangles stand out of the arcs by at most
+/// `r·(1/cos(θ/2) − 1)`, under 1.3e-5 of the radius.
+const BEND_STRETCH: f64 = 0.01;
+
 impl Hull {
     /// The six planes of the box `b`.
     pub fn box_planes(b: Aabb) -> Vec<(DVec3, f64)> {
@@ -208,28 +213,31 @@ impl Hull {
         Some(Hull { planes: Vec::new(), round: Some(Round::ellipsoid(radii)?) })
     }
 
-    /// Planes holding `bend` of a solid whose corners are `corners` (a convex polyhedron
-    /// holding it), bent by `k` radians per unit: the point `p` reads the solid at
-    /// `p`'s `(x, y)` turned by `k·p.y` about `z` (`sdf::domain::Map::Bend`), so the bent
+    /// A convex set holding a solid whose corners are `corners` (a convex polyhedron
+    /// holding it) bent by `k` radians per unit: the point `p` reads the solid at `p`'s
+    /// `(x, y)` turned by `k·p.y` about `z` (`sdf::domain::Map::Bend`), so the bent
     /// solid's point is a solid's point `q` turned back by `θ = k·p.y`, at the height
     /// `p.y = θ / k` that angle fixes. Split the angles `|θ| ≤ |k|·r` that can occur (`r`
-    /// the corners' largest distance from `z`) into short stretches: over one, the turned
-    /// corners stay within the triangles their arcs span (the ends and the tangents'
-    /// meeting point), and the point within that stretch's slab of heights. The
-    /// corners of those pieces give [`BEND_PLANES`] planes about `z` (a polygon
-    /// circumscribing their convex hull) and the corners' range of `z`. `None` when the
-    /// angles reach further than half a turn each way: the drum about `z` holds as much.
+    /// the corners' largest distance from `z`) into stretches of [`BEND_STRETCH`]: over
+    /// one, the turned corners stay within the triangles their arcs span (the ends and
+    /// the tangents' meeting point), and the point within that stretch's slab of
+    /// heights. The corners of those pieces give [`BEND_PLANES`] planes about `z` (a
+    /// polygon circumscribing their convex hull) and the corners' range of `z`. Where
+    /// the angles reach further than half a turn each way, the cylinder about `z` round
+    /// the corners holds as much, between the same depths. `None` for no corners.
     pub fn bent(corners: &[DVec3], k: f64) -> Option<Hull> {
         use glam::DVec2;
         let r = corners.iter().map(|c| c.truncate().length()).fold(0.0, f64::max);
         let (low, high) = corners.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), c| (l.min(c.z), h.max(c.z)));
         let flat = super::polygon::convex_hull(corners.iter().map(|c| c.truncate()).collect());
         let reach = k.abs() * r;
-        if flat.len() < 3 || !reach.is_finite() || reach > std::f64::consts::PI || low > high || low.is_nan() {
-            return None;
+        if flat.len() < 3 || !reach.is_finite() || reach > std::f64::consts::PI {
+            // The cylinder is about the y axis of a frame whose y is the scene's z.
+            let cones = [(1.0, 0.0, r), (0.0, 1.0, high), (0.0, -1.0, -low)];
+            return Hull::about_y(cones)?.transformed(&DAffine3::from_rotation_x(std::f64::consts::FRAC_PI_2));
         }
         let turned = |v: DVec2, a: f64| DVec2::from_angle(-a).rotate(v);
-        let pieces = ((2.0 * reach / 0.01).ceil() as usize).clamp(1, 1024);
+        let pieces = ((2.0 * reach / BEND_STRETCH).ceil() as usize).clamp(1, 1024);
         let half = reach / pieces as f64;
         let mut points = Vec::new();
         for i in 0..pieces {
@@ -372,8 +380,10 @@ mod tests {
                 assert!(2 * in_planes < in_drum, "{deg}°: {in_planes} points in the planes, {in_drum} in the drum");
             }
         }
-        // Bent further than half a turn each way: the drum serves.
-        assert!(Hull::bent(&corners, 250f64.to_radians()).is_none());
+        // Bent further than half a turn each way: the drum about z, which holds every
+        // point of the corners' radius and depth.
+        let drum = Hull::bent(&corners, 250f64.to_radians()).unwrap();
+        assert!(drum.round.is_some() && drum.contains(DVec3::new(-0.9, 0.0, 0.2), 1e-9));
     }
 
     /// Points along random rays are inside the interval exactly where they are in the

@@ -215,19 +215,10 @@ fn hull_within(shape: &Shape, g: f64, fields: &mut FieldPlanes<'_>) -> Option<Hu
             Some(Hull { planes: vec![(DVec3::Y, high), (-DVec3::Y, -low)], round: Some(round) })
         }
         // A bend turns the point about z by an angle its height fixes: the bent shape
-        // stays within the planes `Hull::bent` finds from its child's corners (or box),
-        // or where the angles reach too far for those, the cylinder about z that holds
-        // the corners, between the same depths.
+        // stays within what `Hull::bent` finds from its child's corners (or box).
         ShapeKind::Warp { child, domain_op: Some(crate::ir::DomainOp::Bend(k)), lipschitz, .. } => {
             let g = g * lipschitz.value.max(1.0);
-            let corners = corners_within(child, hull_within(child, g, fields), g)?;
-            if let Some(bent) = Hull::bent(&corners, k.to_radians()) {
-                return Some(bent);
-            }
-            let (radius, low, high) = extent_about(&corners, |c| (c.x.hypot(c.y), c.z));
-            // The cylinder is about the y axis of a frame whose y is the scene's z.
-            let cones = [(1.0, 0.0, radius), (0.0, 1.0, high), (0.0, -1.0, -low)];
-            Hull::about_y(cones)?.transformed(&DAffine3::from_rotation_x(std::f64::consts::FRAC_PI_2))
+            Hull::bent(&corners_within(child, hull_within(child, g, fields), g)?, k.to_radians())
         }
         // A field is its body over its bound `L`, cut to its box: where it is at most
         // `g`, the body is at most `g·L` within the box grown by `g`.
