@@ -150,7 +150,8 @@ pub fn is_convex(body: &Arc<Expr>) -> bool {
     body.ty == Ty::Num && facts(body, &mut HashMap::new())[0].convexish()
 }
 
-/// What is known of each of the value's components (a number's in the first).
+/// What is known of each of the value's components (a number's in the first; nothing
+/// reads the other two).
 fn facts(e: &Arc<Expr>, memo: &mut HashMap<*const Expr, [Fact; 3]>) -> [Fact; 3] {
     if let Some(f) = memo.get(&Arc::as_ptr(e)) {
         return *f;
@@ -159,7 +160,6 @@ fn facts(e: &Arc<Expr>, memo: &mut HashMap<*const Expr, [Fact; 3]>) -> [Fact; 3]
     let num = |x: Fact| [x, OTHER, OTHER];
     let per = |a: [Fact; 3], g: &dyn Fn(Fact) -> Fact| a.map(g);
     let both = |a: [Fact; 3], b: [Fact; 3], g: &dyn Fn(Fact, Fact) -> Fact| [0, 1, 2].map(|i| g(a[i], b[i]));
-    let vector = e.ty == Ty::Vec3;
     let out = match &e.kind {
         Kind::Point => [Fact { curv: Curv::Affine, sign: Sign::Any }; 3],
         Kind::Num(c) => num(Fact::constant(*c)),
@@ -227,8 +227,6 @@ fn facts(e: &Arc<Expr>, memo: &mut HashMap<*const Expr, [Fact; 3]>) -> [Fact; 3]
         }
         Kind::Select(..) | Kind::Dist(..) | Kind::Noise { .. } => [OTHER; 3],
     };
-    // A number's unused components say nothing.
-    let out = if vector { out } else { [out[0], OTHER, OTHER] };
     memo.insert(Arc::as_ptr(e), out);
     out
 }

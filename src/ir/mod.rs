@@ -482,8 +482,8 @@ impl Shape {
     /// Whether the solid is convex, so a ray leaving its surface outward never meets it
     /// again. Conservative: `false` unless it follows from the shape's form (primitives
     /// other than the torus, a half-space, a field whose body is a convex function of
-    /// the point by disciplined convex programming's composition rules, sharp intersections of convex
-    /// solids, and rounding, painting or transforming one).
+    /// the point by disciplined convex programming's composition rules, sharp
+    /// intersections of convex solids, and rounding, painting or transforming one).
     pub fn is_convex(&self) -> bool {
         match &self.kind {
             ShapeKind::Primitive(p) => p.is_convex(),
@@ -496,11 +496,11 @@ impl Shape {
             ShapeKind::Round { child, .. } | ShapeKind::Paint { child, .. } | ShapeKind::Transform { child, .. } => {
                 child.is_convex()
             }
-            // A shell is hollow and repeated copies leave gaps between them; a warp or a
-            // displacement may make any set at all.
             // A field is when its body is a convex function of the point (cut to a box,
             // still convex).
             ShapeKind::Field { body, .. } => convex::is_convex(body),
+            // A shell is hollow and repeated copies leave gaps between them; a warp or a
+            // displacement may make any set at all.
             ShapeKind::Shell { .. }
             | ShapeKind::Repeat { .. }
             | ShapeKind::Warp { .. }

@@ -83,7 +83,7 @@ pub fn tessellate(
                 material,
                 per_triangle: None,
                 normals,
-                convex: node.is_convex() && !matches!(node.kind, ShapeKind::Field { .. }),
+                convex: !matches!(node.kind, ShapeKind::Field { .. }) && node.is_convex(),
                 warnings: Vec::new(),
                 isosurface: None,
             })

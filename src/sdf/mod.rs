@@ -47,13 +47,9 @@ impl SdfObject {
     /// Lowers a shape seen through `xf` (render from world) into closures.
     pub fn new(shape: &ir::Shape, xf: DAffine3, builder: &mut Builder<'_>) -> SdfObject {
         let root = builder.build_root(shape, xf, 0);
-        SdfObject {
-            dist: root.dist,
-            mat: root.surf,
-            parts: root.parts,
-            field: root.field.map(Box::new),
-            convex: shape.is_convex(),
-        }
+        // A field at the root has asked already (its march steps by it).
+        let convex = root.field.as_ref().map_or_else(|| shape.is_convex(), |f| f.convex);
+        SdfObject { dist: root.dist, mat: root.surf, parts: root.parts, field: root.field.map(Box::new), convex }
     }
 
     /// Marches the ray over `[t0, t1]`; on a hit, its distance and the threshold there
