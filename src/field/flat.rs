@@ -406,10 +406,6 @@ impl Flat {
                     each(|l| a[l] * k + b[l])
                 }
                 Code::AbsSubC => a.map(|a| a.abs() - k),
-                Code::LengthSubC => {
-                    let (b, c) = (x(ins.b), x(ins.c));
-                    each(|l| (a[l] * a[l] + b[l] * b[l] + c[l] * c[l]).sqrt() - k)
-                }
                 Code::Unary(Unary::Abs) => a.map(f32::abs),
                 Code::Unary(Unary::Neg) => a.map(|a| -a),
                 Code::Unary(f) => a.map(|a| <f32 as super::Scalar>::unary(f, a)),
@@ -428,9 +424,10 @@ impl Flat {
                     let (b, c) = (x(ins.b), x(ins.c));
                     each(|l| if c[l] != 0.0 { a[l] } else { b[l] })
                 }
-                Code::Length => {
+                // A length alone carries `k` = 0, which subtracts to the same bits.
+                Code::Length | Code::LengthSubC => {
                     let (b, c) = (x(ins.b), x(ins.c));
-                    each(|l| (a[l] * a[l] + b[l] * b[l] + c[l] * c[l]).sqrt())
+                    each(|l| (a[l] * a[l] + b[l] * b[l] + c[l] * c[l]).sqrt() - k)
                 }
                 Code::Dist | Code::Noise => {
                     let (b, c) = (x(ins.b), x(ins.c));
