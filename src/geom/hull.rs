@@ -186,7 +186,7 @@ pub const BEND_PLANES: usize = 16;
 /// The angle, in radians, over which [`Hull::bent`] bounds a bent solid's turned
 /// corners by one piece: the pieces' triangles stand out of the arcs by at most
 /// `r·(1/cos(θ/2) − 1)`, under 1.3e-5 of the radius.
-const BEND_STRETCH: f64 = 0.01;
+pub const BEND_STRETCH: f64 = 0.01;
 
 impl Hull {
     /// The six planes of the box `b`.
