@@ -508,6 +508,31 @@ impl Shape {
         }
     }
 
+    /// Whether the shape's distance bound is a convex function of the point with slope
+    /// at most 1: the exact distance of a convex solid (a convex primitive whose distance
+    /// is exact), rounded, painted, moved by an affine map (whose closure scales by the
+    /// map's smallest stretch) or sharply intersected with others such. Along a curve
+    /// through space such a distance is convex up to the curve's bending, which lets a
+    /// twist or a bend of it be marched by a bound on that bending (`sdf::warp`).
+    pub fn has_convex_distance(&self) -> bool {
+        match &self.kind {
+            ShapeKind::Primitive(p) => p.is_convex() && p.is_exact(),
+            ShapeKind::Csg { op: CsgOp::Intersect, children, smooth } => {
+                *smooth == 0.0 && children.iter().all(|c| c.has_convex_distance())
+            }
+            ShapeKind::Round { child, .. } | ShapeKind::Paint { child, .. } | ShapeKind::Transform { child, .. } => {
+                child.has_convex_distance()
+            }
+            // A field's value is divided by an estimated slope, not a proven one.
+            ShapeKind::Csg { .. }
+            | ShapeKind::Shell { .. }
+            | ShapeKind::Repeat { .. }
+            | ShapeKind::Field { .. }
+            | ShapeKind::Warp { .. }
+            | ShapeKind::Displace { .. } => false,
+        }
+    }
+
     /// The node's children, in order (none for a primitive).
     pub fn children(&self) -> &[Arc<Shape>] {
         match &self.kind {

@@ -27,6 +27,8 @@ pub struct Root {
     pub parts: Option<RayParts>,
     /// A field's body.
     pub field: Option<field::RayField>,
+    /// A twist's or bend's map and child, when its child's distance is convex.
+    pub warp: Option<super::warp::RayWarp>,
 }
 
 /// Builds closures and counts the bytes they capture.
@@ -44,6 +46,10 @@ pub struct Builder<'a> {
     /// The field built last (its node's address and body), for
     /// [`build_root`](Self::build_root).
     last_field: Option<(usize, field::Body)>,
+    /// The twist or bend built last of a child with a convex distance (its node's
+    /// address, the map, the child's closure and the cut), for
+    /// [`build_root`](Self::build_root).
+    last_warp: Option<(usize, super::domain::Map, Sdf, Option<BoxCut>)>,
     /// Render space from the frame the node being built is in: operators that work in
     /// their own units restart `xf` at the identity, and a pattern still needs the
     /// whole map to its object's space.
@@ -87,7 +93,15 @@ const ARC_HEADER: usize = 16;
 impl<'a> Builder<'a> {
     /// A builder interning materials into `materials`.
     pub fn new(materials: &'a mut MaterialTable) -> Builder<'a> {
-        Builder { materials, bytes: 0, prune: true, last_union: None, last_field: None, frame: DAffine3::IDENTITY }
+        Builder {
+            materials,
+            bytes: 0,
+            prune: true,
+            last_union: None,
+            last_field: None,
+            last_warp: None,
+            frame: DAffine3::IDENTITY,
+        }
     }
 
     /// [`build`](Self::build), and when the shape is a union of bounded parts (under
@@ -95,6 +109,7 @@ impl<'a> Builder<'a> {
     pub fn build_root(&mut self, shape: &Shape, xf: DAffine3, mat: u32) -> Root {
         self.last_union = None;
         self.last_field = None;
+        self.last_warp = None;
         let (d, m) = self.build(shape, xf, mat);
         let mut node = shape;
         let mut acc = xf;
@@ -141,7 +156,20 @@ impl<'a> Builder<'a> {
             }
             _ => None,
         };
-        Root { dist: d, surf: m, parts, field }
+        let warp = match self.last_warp.take() {
+            Some((addr, map, child, cut)) if addr == node as *const Shape as usize => {
+                let inv = acc.inverse();
+                Some(super::warp::RayWarp {
+                    inv: Affine3A::from_mat3_translation(inv.matrix3.as_mat3(), inv.translation.as_vec3()),
+                    scale: if acc.matrix3 == DMat3::IDENTITY { 1.0 } else { min_singular_value(acc.matrix3) as f32 },
+                    map,
+                    child,
+                    cut,
+                })
+            }
+            _ => None,
+        };
+        Root { dist: d, surf: m, parts, field, warp }
     }
 
     fn sdf<F: Fn(Vec3A) -> f32 + Send + Sync + 'static>(&mut self, f: F) -> Sdf {
@@ -364,6 +392,9 @@ impl<'a> Builder<'a> {
                 let (d, m) = self.build(child, id, mat);
                 let (k, cut) = (1.0 / lipschitz.value as f32, bounds.as_ref().map(BoxCut::new));
                 if let Some(map) = domain_op.and_then(super::domain::Map::new) {
+                    if child.has_convex_distance() && map.is_smooth() {
+                        self.last_warp = Some((shape as *const Shape as usize, map, d.clone(), cut));
+                    }
                     return (
                         self.sdf(move |p| {
                             // A step of at most |v| stays within the ball where the

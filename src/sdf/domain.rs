@@ -76,6 +76,32 @@ impl Map {
         }
     }
 
+    /// Whether the map is smooth, so that [`curvature`](Self::curvature) bounds it.
+    pub fn is_smooth(&self) -> bool {
+        self.curvature(Vec3A::ZERO, Vec3A::ZERO, Vec3A::ZERO).is_some()
+    }
+
+    /// A bound of how sharply the map bends the line `a + d·t` between `a` and `b`: the
+    /// largest `|q''(t)|` of `q(t) = apply(a + d·t)` there, or `None` for a map that is
+    /// not smooth (a mirror, an elongation). A turn by `θ = k·y` of the two components it
+    /// turns, `q = R(θ)·p`, has `q'' = θ'²·R''·p + 2θ'·R'·d` with `θ' = k·d_y`, so
+    /// `|q''| ≤ θ'²·ρ + 2|θ'|·|d|` in the turned plane, `ρ` the point's distance from
+    /// the axis, which is largest at an end of the segment (a distance from a line is
+    /// convex along another).
+    #[inline]
+    pub fn curvature(&self, a: Vec3A, b: Vec3A, d: Vec3A) -> Option<f32> {
+        // The two components the map turns, and the rate it turns them along the line.
+        let (plane, k) = match *self {
+            Map::Twist(k) => (Vec3A::new(1.0, 0.0, 1.0), k),
+            Map::Bend(k) => (Vec3A::new(1.0, 1.0, 0.0), k),
+            Map::Elongate(_) | Map::Mirror(_) => return None,
+        };
+        let turned = |v: Vec3A| (v * plane).length_squared();
+        let rate = k * d.y;
+        let rho = turned(a).max(turned(b)).sqrt();
+        Some(rate * rate * rho + 2.0 * rate.abs() * turned(d).sqrt())
+    }
+
     /// The gradient at `p` of the shape read through the map, from the shape's gradient
     /// `g` at `q = apply(p)`: `Jᵀ g`.
     #[inline]

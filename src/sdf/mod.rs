@@ -16,6 +16,7 @@ mod sweep;
 #[cfg(test)]
 mod testing;
 pub mod union;
+mod warp;
 
 use glam::{DAffine3, Vec3A};
 
@@ -41,6 +42,9 @@ pub struct SdfObject {
     /// A field at the root, marched by segments ([`field::RayField`]); boxed, as
     /// most objects have none.
     field: Option<Box<field::RayField>>,
+    /// A twist or bend of a convex solid at the root, marched by its bending
+    /// ([`warp::RayWarp`]); boxed, as most objects have none.
+    warp: Option<Box<warp::RayWarp>>,
 }
 
 impl SdfObject {
@@ -49,7 +53,14 @@ impl SdfObject {
         let root = builder.build_root(shape, xf, 0);
         // A field at the root has asked already (its march steps by it).
         let convex = root.field.as_ref().map_or_else(|| shape.is_convex(), |f| f.convex);
-        SdfObject { dist: root.dist, mat: root.surf, parts: root.parts, field: root.field.map(Box::new), convex }
+        SdfObject {
+            dist: root.dist,
+            mat: root.surf,
+            parts: root.parts,
+            field: root.field.map(Box::new),
+            warp: root.warp.map(Box::new),
+            convex,
+        }
     }
 
     /// Marches the ray over `[t0, t1]`; on a hit, its distance and the threshold there
@@ -71,6 +82,9 @@ impl SdfObject {
         }
         if let Some(field) = &self.field {
             return field.march(ray, (t0, t1), params, c, evals);
+        }
+        if let Some(warp) = &self.warp {
+            return warp.march(ray, (t0, t1), params, c, evals);
         }
         match &self.parts {
             Some(parts) => parts.march(ray, (t0, t1), params, c, evals),
