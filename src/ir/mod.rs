@@ -508,6 +508,23 @@ impl Shape {
         }
     }
 
+    /// Whether the shape's hull (`ir::shape_hull`) is the solid itself: a primitive
+    /// whose hull is ([`crate::primitive::Solid::hull_is_solid`]), moved or painted.
+    pub fn hull_is_solid(&self) -> bool {
+        match &self.kind {
+            ShapeKind::Primitive(p) => p.hull_is_solid(),
+            ShapeKind::Paint { child, .. } | ShapeKind::Transform { child, .. } => child.hull_is_solid(),
+            // Hulls of operators hold their solids; none is one.
+            ShapeKind::Csg { .. }
+            | ShapeKind::Round { .. }
+            | ShapeKind::Shell { .. }
+            | ShapeKind::Repeat { .. }
+            | ShapeKind::Field { .. }
+            | ShapeKind::Warp { .. }
+            | ShapeKind::Displace { .. } => false,
+        }
+    }
+
     /// Whether the shape's distance bound is a convex function of the point with slope
     /// at most 1: the exact distance of a convex solid (a convex primitive whose distance
     /// is exact), rounded, painted, moved by an affine map (whose closure scales by the

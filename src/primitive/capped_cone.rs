@@ -63,6 +63,10 @@ impl Solid for CappedCone {
         true
     }
 
+    fn hull_is_solid(&self) -> bool {
+        true
+    }
+
     fn is_exact(&self) -> bool {
         true
     }

@@ -48,6 +48,11 @@ impl Solid for Capsule {
         true
     }
 
+    fn hull_is_solid(&self) -> bool {
+        // Its hull is the cylinder round it, not its round ends.
+        false
+    }
+
     fn is_exact(&self) -> bool {
         true
     }

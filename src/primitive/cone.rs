@@ -50,6 +50,10 @@ impl Solid for Cone {
         true
     }
 
+    fn hull_is_solid(&self) -> bool {
+        true
+    }
+
     fn is_exact(&self) -> bool {
         true
     }

@@ -45,6 +45,10 @@ impl Solid for Cuboid {
         true
     }
 
+    fn hull_is_solid(&self) -> bool {
+        true
+    }
+
     fn is_exact(&self) -> bool {
         true
     }

@@ -48,6 +48,10 @@ impl Solid for Cylinder {
         true
     }
 
+    fn hull_is_solid(&self) -> bool {
+        true
+    }
+
     fn is_exact(&self) -> bool {
         true
     }

@@ -62,6 +62,10 @@ impl Solid for Ellipsoid {
         true
     }
 
+    fn hull_is_solid(&self) -> bool {
+        true
+    }
+
     fn is_exact(&self) -> bool {
         false
     }

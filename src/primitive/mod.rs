@@ -88,6 +88,10 @@ pub trait Solid: Clone + fmt::Debug + PartialEq + Send + Sync + 'static {
     /// Whether the solid is convex (a half-space is).
     fn is_convex(&self) -> bool;
 
+    /// Whether [`hull`](Self::hull) is the solid itself, not only a set holding it: then
+    /// a ray from outside that enters the hull hits the solid there, with no step to take.
+    fn hull_is_solid(&self) -> bool;
+
     /// Whether [`distance`](Self::distance) is the exact Euclidean distance to the
     /// surface, not only a bound on it.
     fn is_exact(&self) -> bool;
@@ -275,6 +279,8 @@ impl Primitive {
         hull -> Option<Hull>;
         /// Whether the solid is convex (a half-space is).
         is_convex -> bool;
+        /// Whether its hull is the solid itself ([`Solid::hull_is_solid`]).
+        hull_is_solid -> bool;
         /// Whether its distance is exact ([`Solid::is_exact`]).
         is_exact -> bool;
         /// How the mesh back-end approximates it (tested against the generators in

@@ -50,6 +50,11 @@ impl Solid for Plane {
         true
     }
 
+    fn hull_is_solid(&self) -> bool {
+        // It has none: a half-space clips its rays instead.
+        false
+    }
+
     fn is_exact(&self) -> bool {
         true
     }

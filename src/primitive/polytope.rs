@@ -139,6 +139,10 @@ macro_rules! polyhedron_facts {
             true
         }
 
+        fn hull_is_solid(&self) -> bool {
+            true
+        }
+
         fn is_exact(&self) -> bool {
             true
         }

@@ -45,6 +45,11 @@ impl Solid for Sphere {
         true
     }
 
+    fn hull_is_solid(&self) -> bool {
+        // It has none: its bounding sphere clips its rays, padded.
+        false
+    }
+
     fn is_exact(&self) -> bool {
         true
     }

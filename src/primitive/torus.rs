@@ -60,6 +60,11 @@ impl Solid for Torus {
         false
     }
 
+    fn hull_is_solid(&self) -> bool {
+        // Its hull is the cylinder round the ring.
+        false
+    }
+
     fn is_exact(&self) -> bool {
         self.is_ring()
     }

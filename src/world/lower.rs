@@ -45,7 +45,8 @@ impl Reach {
                 .map(|(n, o)| (n.as_vec3a(), o as f32)),
         };
         let hull = bounds.and_then(|_| known.hull(shape));
-        let hull = hull.and_then(|h| h.transformed(to_render)).map(query::Entry::new);
+        let solid = shape.hull_is_solid();
+        let hull = hull.and_then(|h| h.transformed(to_render)).map(|h| query::Entry::new(h, solid));
         Reach { bounds, sphere, half_space, hull: hull.map(Arc::new) }
     }
 }

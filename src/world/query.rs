@@ -14,6 +14,13 @@ impl World {
     /// The interval of the ray inside object `i`'s bounds, clipped to `[ray.t_min, t_max]`.
     #[inline]
     pub(super) fn interval(&self, i: u32, ray: &Ray, t_max: f32) -> Option<(f32, f32)> {
+        self.reach(i, ray, t_max).map(|(span, _)| span)
+    }
+
+    /// [`interval`](Self::interval), and whether the ray, from outside, enters a hull
+    /// that is the solid itself at the interval's start: a hit there, with no step.
+    #[inline]
+    fn reach(&self, i: u32, ray: &Ray, t_max: f32) -> Option<((f32, f32), bool)> {
         let o = &self.objects[i as usize];
         let (t0, t1) = match o.bounds {
             Some(b) => b.slab(ray.origin, ray.inv_dir, ray.t_min, t_max)?,
@@ -22,13 +29,22 @@ impl World {
         let (t0, t1) = clip_to_sphere(o, ray, (t0, t1))?;
         // A ray marching out of the solid needs its whole interval.
         if ray.inside == i {
-            return Some((t0, t1));
+            return Some(((t0, t1), false));
         }
         match (o.half_space, &o.hull) {
-            (Some(h), _) => clip_to_half_space(h, ray, (t0, t1)),
-            (None, Some(hull)) => hull.clip(self.params.epsilon, ray, (t0, t1)),
-            (None, None) => Some((t0, t1)),
+            (Some(h), _) => clip_to_half_space(h, ray, (t0, t1)).map(|span| (span, false)),
+            (None, Some(hull)) => {
+                hull.clip(self.params.epsilon, ray, (t0, t1)).map(|(span, enters)| (span, enters && span.0 > ray.t_min))
+            }
+            (None, None) => Some(((t0, t1), false)),
         }
+    }
+
+    /// A hit where the ray enters the solid's hull, which is the solid ([`World::reach`]).
+    #[inline]
+    fn entered<'w>(&self, i: u32, sdf: &'w SdfObject, ray: &Ray, t: f32) -> Found<'w> {
+        let error = crate::sdf::march::threshold(self.params.epsilon, ray.origin.length(), t);
+        Found::Sdf { object: i, sdf, t, error, leaving: false }
     }
 
     /// Whether the ray can reach mesh object `o` before `t_max`. Only its sphere is
@@ -62,7 +78,10 @@ impl World {
         let o = &self.objects[i as usize];
         match &o.kind {
             ObjectKind::Sdf(s) => {
-                let interval = self.interval(i, q.ray, t_max)?;
+                let (interval, entered) = self.reach(i, q.ray, t_max)?;
+                if entered {
+                    return Some(self.entered(i, s, q.ray, interval.0));
+                }
                 let leaving = self.leaving(i, s, q.ray, interval, &mut q.evals);
                 s.closest(q.ray, interval, leaving, self.params, c, &mut q.evals).map(|(t, error)| Found::Sdf {
                     object: i,
@@ -106,7 +125,10 @@ impl World {
         }
         let o = &self.objects[i as usize];
         match &o.kind {
-            ObjectKind::Sdf(s) => self.interval(i, q.ray, t_max).is_some_and(|interval| {
+            ObjectKind::Sdf(s) => self.reach(i, q.ray, t_max).is_some_and(|(interval, entered)| {
+                if entered {
+                    return true;
+                }
                 let leaving = self.leaving(i, s, q.ray, interval, &mut q.evals);
                 s.closest(q.ray, interval, leaving, self.params, c, &mut q.evals).is_some()
             }),
@@ -221,13 +243,15 @@ pub(super) struct Entry {
     /// Cones or an ellipsoid about an axis, in f64: a quadratic's roots lose too much in
     /// f32 where a ray grazes.
     round: Option<Round>,
+    /// Whether the set is the solid itself ([`crate::ir::Shape::hull_is_solid`]).
+    solid: bool,
 }
 
 impl Entry {
-    /// The render-space hull of an object.
-    pub(super) fn new(hull: Hull) -> Entry {
+    /// The render-space hull of an object; `solid` when it is the solid itself.
+    pub(super) fn new(hull: Hull, solid: bool) -> Entry {
         let planes = hull.planes.iter().map(|(n, o)| (n.as_vec3a(), *o as f32)).collect();
-        Entry { planes, round: hull.round }
+        Entry { planes, round: hull.round, solid }
     }
 
     /// `(t0, t1)` from where the ray enters the set, or `None` if it never comes within
@@ -236,9 +260,10 @@ impl Entry {
     /// grown by the threshold (`sdf::march::threshold` with relative `epsilon`), so no
     /// hit the march would take is clipped away. The march ends where the ray leaves
     /// the grown set, not at `t1`: a grazing ray creeps along a surface, and a shadow
-    /// ray leaving one steps out slowly.
+    /// ray leaving one steps out slowly. With it, whether the ray enters the set itself
+    /// and the set is the solid: then its start is a hit.
     #[inline]
-    fn clip(&self, epsilon: f32, ray: &Ray, (t0, t1): (f32, f32)) -> Option<(f32, f32)> {
+    fn clip(&self, epsilon: f32, ray: &Ray, (t0, t1): (f32, f32)) -> Option<((f32, f32), bool)> {
         // The threshold, ε·(t + min(t, |origin|)), is at most `reach·t`.
         let reach = 2.0 * epsilon;
         // [enter, leave] on the set itself, and on it grown by the threshold.
@@ -280,8 +305,8 @@ impl Entry {
         // ray leaving a surface (a shadow ray) stops at the hull, not the sphere (both
         // ends start at `t1` and only come nearer).
         match (solid, grown) {
-            ((enter, leave), (_, out)) if enter <= leave => Some((enter, out)),
-            (_, (enter, leave)) if enter <= leave => Some((enter, leave)),
+            ((enter, leave), (_, out)) if enter <= leave => Some(((enter, out), self.solid)),
+            (_, (enter, leave)) if enter <= leave => Some(((enter, leave), false)),
             _ => None,
         }
     }

@@ -660,3 +660,39 @@ fn samples_respect_their_ranges() {
         }
     }
 }
+
+/// A primitive that says its hull is the solid itself (so a ray entering the hull from
+/// outside is taken to hit there, `world::query`) means it: at random points, inside
+/// the hull exactly where the distance is at most zero (away from the surface by more
+/// than f32 rounding); one that says otherwise has a hull holding the solid.
+#[test]
+fn every_hull_said_to_be_the_solid_is() {
+    let mut rng = Rng(0x4011);
+    let mut failures = Vec::new();
+    let mut solids = 0;
+    for (call, p) in primitives(&mut rng) {
+        let Some(hull) = p.hull() else {
+            if p.hull_is_solid() {
+                failures.push(format!("{call}: no hull, but it is said to be the solid"));
+            }
+            continue;
+        };
+        solids += usize::from(p.hull_is_solid());
+        let (f, _, _) = p.visit(Functions);
+        let size = p.sphere_radius().unwrap_or(1.0) as f32;
+        for _ in 0..4000 {
+            let x = Vec3A::new(rng.f32() - 0.5, rng.f32() - 0.5, rng.f32() - 0.5) * (2.4 * size);
+            let d = f(x);
+            if d.abs() < 1e-4 * size {
+                continue;
+            }
+            let within = hull.contains(x.as_dvec3(), 0.0);
+            if d < 0.0 && !within || p.hull_is_solid() && d > 0.0 && within {
+                failures.push(format!("{call}: at {x}, distance {d}, but the hull holds it: {within}"));
+                break;
+            }
+        }
+    }
+    assert!(solids >= 40, "only {solids} primitives whose hull is the solid");
+    crate::support::finish(failures);
+}
