@@ -144,6 +144,44 @@ impl Region {
     }
 }
 
+impl Region {
+    /// Whether the region is one convex polygon, so that its extrusion is exactly the
+    /// prism of [`hull_lines`](Self::hull_lines): its hull has no more area than it has.
+    pub fn is_convex_polygon(&self) -> bool {
+        match self {
+            Region::Polygon(c) => is_convex_union(c.clone(), area(c)),
+            Region::Circle { .. } | Region::Csg(..) => false,
+        }
+    }
+
+    /// Whether the region revolved about the `v` axis is exactly what
+    /// [`revolved_hull_lines`](Self::revolved_hull_lines) revolve: one polygon at `u ≥ 0`
+    /// (so it and its mirror image overlap nowhere) whose union with its mirror image is
+    /// convex, the hull of the two having no more area than both.
+    pub fn revolves_convex(&self) -> bool {
+        match self {
+            Region::Polygon(c) if c.iter().all(|p| p.x >= 0.0) => {
+                let both = c.iter().flat_map(|p| [*p, DVec2::new(-p.x, p.y)]).collect();
+                is_convex_union(both, 2.0 * area(c))
+            }
+            Region::Polygon(_) | Region::Circle { .. } | Region::Csg(..) => false,
+        }
+    }
+}
+
+/// A simple polygon's area, either winding.
+fn area(c: &[DVec2]) -> f64 {
+    let twice: f64 = (0..c.len()).map(|i| c[i].perp_dot(c[(i + 1) % c.len()])).sum();
+    0.5 * twice.abs()
+}
+
+/// Whether points covering `area` between them (simple polygons overlapping nowhere)
+/// cover their convex hull: its area is theirs, to rounding.
+fn is_convex_union(pts: Vec<DVec2>, area_covered: f64) -> bool {
+    let hull = super::polygon::convex_hull(pts);
+    area_covered > 0.0 && area(&hull) <= area_covered * (1.0 + 1e-9)
+}
+
 /// The edges of the convex hull of `pts` as lines `n·p ≤ d` (unit `n`),
 /// counter-clockwise; none when the points span no area.
 fn convex_lines(pts: Vec<DVec2>) -> Vec<(DVec2, f64)> {

@@ -509,12 +509,15 @@ impl Shape {
     }
 
     /// Whether the shape's hull (`ir::shape_hull`) is the solid itself: a primitive
-    /// whose hull is ([`crate::primitive::Solid::hull_is_solid`]), moved or painted.
+    /// whose hull is ([`crate::primitive::Solid::hull_is_solid`]), an extruded convex
+    /// polygon or a revolved polygon that makes a convex solid, moved or painted.
     pub fn hull_is_solid(&self) -> bool {
         match &self.kind {
             ShapeKind::Primitive(p) => p.hull_is_solid(),
             ShapeKind::Paint { child, .. } | ShapeKind::Transform { child, .. } => child.hull_is_solid(),
-            // Hulls of operators hold their solids; none is one.
+            ShapeKind::Field { sweep: Some(Sweep::Extrude { region, .. }), .. } => region.is_convex_polygon(),
+            ShapeKind::Field { sweep: Some(Sweep::Revolve { region }), .. } => region.revolves_convex(),
+            // Hulls of operators and fields hold their solids; none is one.
             ShapeKind::Csg { .. }
             | ShapeKind::Round { .. }
             | ShapeKind::Shell { .. }

@@ -663,3 +663,45 @@ fn convex_distances_are_told_from_others() {
         }
     }
 }
+
+/// Sweeps whose hull is the solid itself (a ray entering it from outside hits there,
+/// `world::query`): an extruded convex polygon and a revolved polygon whose union with
+/// its mirror image is convex, and no other; where it is said, random points are inside
+/// the hull exactly where the distance is at most zero (away from the surface).
+#[test]
+fn sweeps_whose_hull_is_the_solid_are_told() {
+    let cases = [
+        ("extrude(polygon([[-0.2, -0.2], [0.25, -0.1], [0, 0.22]]), 0.18)", true),
+        ("extrude(polygon([[0.5, 0], [0.1, 0.1], [0, 0.5], [-0.5, 0], [0, -0.5]]), 0.3)", false),
+        ("extrude(rect(0.4, 0.3), 0.5)", true),
+        ("extrude(union(polygon([[0, 0], [1, 0], [0, 1]]), polygon([[0, 0], [-1, 0], [0, -1]])), 0.3)", false),
+        ("revolve(polygon([[0, -0.22], [0.2, -0.22], [0.1, 0.22], [0, 0.22]]))", true),
+        ("revolve(polygon([[0, -0.5], [0.5, -0.3], [0.6, 0.2], [0, 0.5]]))", true),
+        // Not touching the axis: a ring.
+        ("revolve(polygon([[0.2, -0.2], [0.5, -0.2], [0.5, 0.2], [0.2, 0.2]]))", false),
+        // Touching it only at the bottom: a cone's cup.
+        ("revolve(polygon([[0, -0.5], [0.5, 0.3], [0.1, 0.4]]))", false),
+        ("revolve(polygon([[0, -0.5], [0.5, -0.5], [0.2, 0], [0.5, 0.5], [0, 0.5]]))", false),
+    ];
+    let mut rng = Rng(0x5e1d);
+    for (text, expected) in cases {
+        let shape = shape_of(&format!("light ambient(1)\nobject {text} rotate [20, 30, 0]\n"));
+        assert_eq!(shape.hull_is_solid(), expected, "{text}");
+        if !expected {
+            continue;
+        }
+        let hull = scnc::world::shape_hull(&shape).expect("a hull");
+        let (f, _) = build(&shape, true);
+        let mut inside = 0;
+        for _ in 0..8_000 {
+            let p = Vec3A::new(rng.f32(), rng.f32(), rng.f32()) - 0.5;
+            let d = f(p);
+            if d.abs() < 1e-4 {
+                continue;
+            }
+            inside += usize::from(d < 0.0);
+            assert_eq!(hull.contains(p.as_dvec3(), 0.0), d < 0.0, "{text}: at {p}, distance {d}");
+        }
+        assert!(inside > 100, "{text}: only {inside} points inside");
+    }
+}
