@@ -91,29 +91,29 @@ impl Round {
     /// hull's frame): an interval, as the set is convex; possibly empty (`lo > hi`) or
     /// unbounded.
     pub fn interval(&self, origin: DVec3, dir: DVec3, g: f64) -> (f64, f64) {
-        self.intervals(origin, dir, [g])[0]
+        self.interval_local(self.local(origin, dir), g)
     }
 
-    /// [`interval`](Self::interval) for each growth in `gs`, the ray taken into the
-    /// local frame once.
-    pub fn intervals<const N: usize>(&self, origin: DVec3, dir: DVec3, gs: [f64; N]) -> [(f64, f64); N] {
-        let o = self.to_local.transform_point3(origin);
-        let d = self.to_local.transform_vector3(dir);
-        gs.map(|g| {
-            let g = g * self.stretch;
-            let mut span = (f64::NEG_INFINITY, f64::INFINITY);
-            for &(a, b, c) in &self.cones {
-                span = meet(span, cone_interval((a, b, c + g), o, d));
-                if span.0 > span.1 {
-                    return span;
-                }
+    /// The ray `origin + t·dir` in the set's frame, for [`interval_local`](Self::interval_local).
+    pub fn local(&self, origin: DVec3, dir: DVec3) -> (DVec3, DVec3) {
+        (self.to_local.transform_point3(origin), self.to_local.transform_vector3(dir))
+    }
+
+    /// [`interval`](Self::interval) of a ray already in the set's frame ([`local`](Self::local)).
+    pub fn interval_local(&self, (o, d): (DVec3, DVec3), g: f64) -> (f64, f64) {
+        let g = g * self.stretch;
+        let mut span = (f64::NEG_INFINITY, f64::INFINITY);
+        for &(a, b, c) in &self.cones {
+            span = meet(span, cone_interval((a, b, c + g), o, d));
+            if span.0 > span.1 {
+                return span;
             }
-            if let Some(ball) = self.ball {
-                let r = ball + g;
-                span = meet(span, below(d.length_squared(), o.dot(d), o.length_squared() - r * r).0);
-            }
-            span
-        })
+        }
+        if let Some(ball) = self.ball {
+            let r = ball + g;
+            span = meet(span, below(d.length_squared(), o.dot(d), o.length_squared() - r * r).0);
+        }
+        span
     }
 }
 

@@ -261,7 +261,8 @@ impl Entry {
     /// hit the march would take is clipped away. The march ends where the ray leaves
     /// the grown set, not at `t1`: a grazing ray creeps along a surface, and a shadow
     /// ray leaving one steps out slowly. With it, whether the ray enters the set itself
-    /// and the set is the solid: then its start is a hit.
+    /// from outside and the set is the solid: then its start is a hit (and the interval
+    /// may end where the ray leaves the solid).
     #[inline]
     fn clip(&self, epsilon: f32, ray: &Ray, (t0, t1): (f32, f32)) -> Option<((f32, f32), bool)> {
         // The threshold, ε·(t + min(t, |origin|)), is at most `reach·t`.
@@ -288,24 +289,45 @@ impl Entry {
             }
         }
         if let Some(round) = &self.round {
-            // The threshold is at most `far` before `t1`.
-            let far = crate::sdf::march::threshold(epsilon, ray.origin.length(), t1);
-            let spans = round.intervals(ray.origin.as_dvec3(), ray.dir.as_dvec3(), [0.0, f64::from(far)]);
-            for ((enter, leave), (lo, hi)) in [(&mut solid, spans[0]), (&mut grown, spans[1])] {
+            // Where the planes leave no room for the grown set, the round part cannot.
+            if grown.0 > grown.1 {
+                return None;
+            }
+            let local = round.local(ray.origin.as_dvec3(), ray.dir.as_dvec3());
+            let cut = |(enter, leave): &mut (f32, f32), (lo, hi): (f64, f64)| {
                 if lo > hi {
                     // Empty (its ends may be infinite, which the slack below would make NaN).
                     *leave = f32::NEG_INFINITY;
-                    continue;
+                    return;
                 }
                 *enter = enter.max((lo - lo.abs() * 1e-6) as f32);
                 *leave = leave.min((hi + hi.abs() * 1e-6) as f32);
+            };
+            let mut solid_cut = false;
+            if self.solid && solid.0 <= solid.1 {
+                // A ray from outside entering a set that is the solid hits there: the
+                // grown set (where a march would end) is not asked for.
+                cut(&mut solid, round.interval_local(local, 0.0));
+                if solid.0 <= solid.1 && solid.0 > t0 {
+                    return Some((solid, true));
+                }
+                solid_cut = true;
+            }
+            // The threshold is at most `far` before `t1`.
+            let far = crate::sdf::march::threshold(epsilon, ray.origin.length(), t1);
+            cut(&mut grown, round.interval_local(local, f64::from(far)));
+            if grown.0 > grown.1 {
+                return None;
+            }
+            if !solid_cut {
+                cut(&mut solid, round.interval_local(local, 0.0));
             }
         }
         // A hit lies within the grown set, so the march ends where the ray leaves it: a
         // ray leaving a surface (a shadow ray) stops at the hull, not the sphere (both
         // ends start at `t1` and only come nearer).
         match (solid, grown) {
-            ((enter, leave), (_, out)) if enter <= leave => Some(((enter, out), self.solid)),
+            ((enter, leave), (_, out)) if enter <= leave => Some(((enter, out), self.solid && enter > t0)),
             (_, (enter, leave)) if enter <= leave => Some(((enter, leave), false)),
             _ => None,
         }
