@@ -531,7 +531,7 @@ fn a_smooth_subtraction_of_many_cutters_is_pruned() {
 /// rays leaving the surface as shadow rays do hit where the plain march of the same
 /// closure (the solid in a union of one) hits, within its threshold; where only one of
 /// them hits, the ray grazes the solid within that threshold and never enters it. The
-/// rays leaving the surface take at least 2.5× fewer steps (5–15× here): they are what
+/// rays leaving the surface take at least 5× fewer steps (8–12× here): they are what
 /// the bound is for. Halving the bound fails this test; so does dropping it.
 #[test]
 fn twists_and_bends_marched_by_their_bending_miss_nothing() {
@@ -612,7 +612,7 @@ fn twists_and_bends_marched_by_their_bending_miss_nothing() {
         assert!(hits > 1_000, "{solid}: only {hits} hits");
         assert!(grazes * 100 < hits, "{solid}: {grazes} grazes in {hits} hits");
         assert!(
-            leaving_bent.sdf_evals as f64 * 2.5 < leaving_plain.sdf_evals as f64,
+            leaving_bent.sdf_evals as f64 * 5.0 < leaving_plain.sdf_evals as f64,
             "{solid}: {} steps leaving against {} by the stretch",
             leaving_bent.sdf_evals,
             leaving_plain.sdf_evals
