@@ -33,9 +33,7 @@ impl World {
         }
         match (o.half_space, &o.hull) {
             (Some(h), _) => clip_to_half_space(h, ray, (t0, t1)).map(|span| (span, false)),
-            (None, Some(hull)) => {
-                hull.clip(self.params.epsilon, ray, (t0, t1)).map(|(span, enters)| (span, enters && span.0 > ray.t_min))
-            }
+            (None, Some(hull)) => hull.clip(self.params.epsilon, ray, (t0, t1)),
             (None, None) => Some(((t0, t1), false)),
         }
     }
@@ -303,15 +301,14 @@ impl Entry {
                 *enter = enter.max((lo - lo.abs() * 1e-6) as f32);
                 *leave = leave.min((hi + hi.abs() * 1e-6) as f32);
             };
-            let mut solid_cut = false;
-            if self.solid && solid.0 <= solid.1 {
+            let solid_first = self.solid && solid.0 <= solid.1;
+            if solid_first {
                 // A ray from outside entering a set that is the solid hits there: the
                 // grown set (where a march would end) is not asked for.
                 cut(&mut solid, round.interval_local(local, 0.0));
                 if solid.0 <= solid.1 && solid.0 > t0 {
                     return Some((solid, true));
                 }
-                solid_cut = true;
             }
             // The threshold is at most `far` before `t1`.
             let far = crate::sdf::march::threshold(epsilon, ray.origin.length(), t1);
@@ -319,7 +316,7 @@ impl Entry {
             if grown.0 > grown.1 {
                 return None;
             }
-            if !solid_cut {
+            if !solid_first {
                 cut(&mut solid, round.interval_local(local, 0.0));
             }
         }
