@@ -23,12 +23,22 @@ pub struct Root {
     pub dist: Sdf,
     /// The surface closure.
     pub surf: SurfSdf,
-    /// A union's parts.
-    pub parts: Option<RayParts>,
-    /// A field's body.
-    pub field: Option<field::RayField>,
-    /// A twist's or bend's map and child, when its child's distance is convex.
-    pub warp: Option<super::warp::RayWarp>,
+    /// How a ray marches it.
+    pub walk: Walk,
+}
+
+/// How an object's rays are marched, by what is at its root (under transforms and paint).
+#[derive(Clone)]
+pub enum Walk {
+    /// Sphere traced on its distance closure.
+    Plain,
+    /// A union, part by part ([`RayParts`]).
+    Parts(RayParts),
+    /// A field, by segments (`field::RayField`); boxed, as most objects have none.
+    Field(Box<field::RayField>),
+    /// A twist or bend of a convex solid, by its bending (`sdf::warp::RayWarp`);
+    /// boxed, as most objects have none.
+    Warp(Box<super::warp::RayWarp>),
 }
 
 /// Builds closures and counts the bytes they capture.
@@ -47,9 +57,9 @@ pub struct Builder<'a> {
     /// [`build_root`](Self::build_root).
     last_field: Option<(usize, field::Body)>,
     /// The twist or bend built last of a child with a convex distance (its node's
-    /// address, the map, the child's closure and the cut), for
+    /// address, the map, the child's closure, the cut and the closure's `1/L`), for
     /// [`build_root`](Self::build_root).
-    last_warp: Option<(usize, super::domain::Map, Sdf, Option<BoxCut>)>,
+    last_warp: Option<(usize, super::domain::Map, Sdf, Option<BoxCut>, f32)>,
     /// Render space from the frame the node being built is in: operators that work in
     /// their own units restart `xf` at the identity, and a pattern still needs the
     /// whole map to its object's space.
@@ -85,6 +95,16 @@ impl Visit for Leaf<'_, '_> {
         });
         (d, m)
     }
+}
+
+/// Render space to the frame `acc` maps into render space, in f32, and the frame's
+/// smallest stretch (1 for a translation): what a closure built in that frame reads
+/// the point through and scales its value by.
+fn frame_of(acc: DAffine3) -> (Affine3A, f64) {
+    let inv = acc.inverse();
+    let inv32 = Affine3A::from_mat3_translation(inv.matrix3.as_mat3(), inv.translation.as_vec3());
+    let stretch = if acc.matrix3 == DMat3::IDENTITY { 1.0 } else { min_singular_value(acc.matrix3) };
+    (inv32, stretch)
 }
 
 /// Arc header (two counts) that every closure allocation carries.
@@ -123,53 +143,35 @@ impl<'a> Builder<'a> {
                 _ => break,
             }
         }
-        let parts = match self.last_union.take() {
-            Some(LastUnion { node: addr, tree, parts, surfs, k }) if addr == node as *const Shape as usize => {
-                // Sharp unions are built in render space; smooth ones in their own frame.
-                let (inv, scale) = if k == 0.0 || acc == DAffine3::IDENTITY {
-                    (Affine3A::IDENTITY, 1.0)
-                } else {
-                    let inv = acc.inverse();
-                    let inv32 = Affine3A::from_mat3_translation(inv.matrix3.as_mat3(), inv.translation.as_vec3());
-                    let scale =
-                        if acc.matrix3 == DMat3::IDENTITY { 1.0 } else { min_singular_value(acc.matrix3) as f32 };
-                    (inv32, scale)
-                };
-                Some(RayParts { inv, scale, tree, parts, surfs, k })
-            }
-            _ => None,
+        let at_root = |addr: usize| addr == node as *const Shape as usize;
+        let union = self.last_union.take().filter(|u| at_root(u.node));
+        let field = self.last_field.take().filter(|f| at_root(f.0));
+        let warp = self.last_warp.take().filter(|w| at_root(w.0));
+        let walk = if let Some(LastUnion { tree, parts, surfs, k, .. }) = union {
+            // Sharp unions are built in render space; smooth ones in their own frame.
+            let (inv, scale) = if k == 0.0 || acc == DAffine3::IDENTITY {
+                (Affine3A::IDENTITY, 1.0)
+            } else {
+                let (inv, stretch) = frame_of(acc);
+                (inv, stretch as f32)
+            };
+            Walk::Parts(RayParts { inv, scale, tree, parts, surfs, k })
+        } else if let (ShapeKind::Field { bounds, lipschitz, .. }, Some((_, body))) = (&node.kind, field) {
+            let (inv, stretch) = frame_of(acc);
+            Walk::Field(Box::new(field::RayField {
+                inv,
+                scale: (stretch / lipschitz.value) as f32,
+                body,
+                bounds: bounds.map(|b| (b.min.as_vec3a(), b.max.as_vec3a())),
+                convex: node.is_convex(),
+            }))
+        } else if let Some((_, map, child, cut, k)) = warp {
+            let (inv, stretch) = frame_of(acc);
+            Walk::Warp(Box::new(super::warp::RayWarp { inv, scale: stretch as f32, map, child, cut, k }))
+        } else {
+            Walk::Plain
         };
-        let field = match (&node.kind, self.last_field.take()) {
-            (ShapeKind::Field { bounds, lipschitz, .. }, Some((addr, body)))
-                if addr == node as *const Shape as usize =>
-            {
-                let inv = acc.inverse();
-                let inv = Affine3A::from_mat3_translation(inv.matrix3.as_mat3(), inv.translation.as_vec3());
-                let stretch = if acc.matrix3 == DMat3::IDENTITY { 1.0 } else { min_singular_value(acc.matrix3) };
-                Some(field::RayField {
-                    inv,
-                    scale: (stretch / lipschitz.value) as f32,
-                    body,
-                    bounds: bounds.map(|b| (b.min.as_vec3a(), b.max.as_vec3a())),
-                    convex: node.is_convex(),
-                })
-            }
-            _ => None,
-        };
-        let warp = match self.last_warp.take() {
-            Some((addr, map, child, cut)) if addr == node as *const Shape as usize => {
-                let inv = acc.inverse();
-                Some(super::warp::RayWarp {
-                    inv: Affine3A::from_mat3_translation(inv.matrix3.as_mat3(), inv.translation.as_vec3()),
-                    scale: if acc.matrix3 == DMat3::IDENTITY { 1.0 } else { min_singular_value(acc.matrix3) as f32 },
-                    map,
-                    child,
-                    cut,
-                })
-            }
-            _ => None,
-        };
-        Root { dist: d, surf: m, parts, field, warp }
+        Root { dist: d, surf: m, walk }
     }
 
     fn sdf<F: Fn(Vec3A) -> f32 + Send + Sync + 'static>(&mut self, f: F) -> Sdf {
@@ -289,11 +291,10 @@ impl<'a> Builder<'a> {
             let mm = self.mat(move |p| m(p - t));
             return (dd, mm);
         }
-        let inv = xf.inverse();
-        let inv32 = Affine3A::from_mat3_translation(inv.matrix3.as_mat3(), inv.translation.as_vec3());
-        let k = min_singular_value(xf.matrix3) as f32;
+        let (inv32, k) = frame_of(xf);
+        let k = k as f32;
         // The chain rule: the gradient of k·f(M⁻¹p) is k·M⁻ᵀ∇f.
-        let to_world = glam::Mat3A::from(inv.matrix3.transpose().as_mat3()) * k;
+        let to_world = inv32.matrix3.transpose() * k;
         let dd = self.sdf(move |p| d(inv32.transform_point3a(p)) * k);
         let mm = self.mat(move |p| {
             let s = m(inv32.transform_point3a(p));
@@ -393,15 +394,14 @@ impl<'a> Builder<'a> {
                 let (k, cut) = (1.0 / lipschitz.value as f32, bounds.as_ref().map(BoxCut::new));
                 if let Some(map) = domain_op.and_then(super::domain::Map::new) {
                     if child.has_convex_distance() && map.is_smooth() {
-                        self.last_warp = Some((shape as *const Shape as usize, map, d.clone(), cut));
+                        self.last_warp = Some((shape as *const Shape as usize, map, d.clone(), cut, k));
                     }
                     return (
                         self.sdf(move |p| {
                             // A step of at most |v| stays within the ball where the
                             // local stretch holds.
                             let v = d(map.apply(p));
-                            let local = map.stretch(p, v.abs()).map_or(k, |s| 1.0 / s);
-                            field::cut(&cut, p, v * local)
+                            field::cut(&cut, p, map.bound(p, v, k))
                         }),
                         self.mat(move |p| {
                             let q = map.apply(p);

@@ -76,6 +76,14 @@ impl Map {
         }
     }
 
+    /// The warp's distance bound at `p` from its shape's value `v` at `apply(p)`: `v`
+    /// over the map's stretch near `p`, or times `k` (the warp's `1/L`) where the
+    /// global estimate serves.
+    #[inline]
+    pub fn bound(&self, p: Vec3A, v: f32, k: f32) -> f32 {
+        v * self.stretch(p, v.abs()).map_or(k, |s| 1.0 / s)
+    }
+
     /// Whether the map is smooth, so that [`curvature`](Self::curvature) bounds it.
     pub fn is_smooth(&self) -> bool {
         self.curvature(Vec3A::ZERO, Vec3A::ZERO, Vec3A::ZERO).is_some()

@@ -21,7 +21,7 @@ mod warp;
 use glam::{DAffine3, Vec3A};
 
 pub use crate::ir::min_singular_value;
-pub use build::{Builder, Root};
+pub use build::{Builder, Root, Walk};
 pub use march::MarchParams;
 pub use surf::{Sdf, Surf, SurfSdf};
 
@@ -37,30 +37,20 @@ pub struct SdfObject {
     pub mat: SurfSdf,
     /// Whether the shape is a convex solid ([`ir::Shape::is_convex`]).
     convex: bool,
-    /// A union at the root, marched part by part ([`union::RayParts`]).
-    parts: Option<union::RayParts>,
-    /// A field at the root, marched by segments ([`field::RayField`]); boxed, as
-    /// most objects have none.
-    field: Option<Box<field::RayField>>,
-    /// A twist or bend of a convex solid at the root, marched by its bending
-    /// ([`warp::RayWarp`]); boxed, as most objects have none.
-    warp: Option<Box<warp::RayWarp>>,
+    /// How its rays are marched.
+    walk: Walk,
 }
 
 impl SdfObject {
     /// Lowers a shape seen through `xf` (render from world) into closures.
     pub fn new(shape: &ir::Shape, xf: DAffine3, builder: &mut Builder<'_>) -> SdfObject {
         let root = builder.build_root(shape, xf, 0);
-        // A field at the root has asked already (its march steps by it).
-        let convex = root.field.as_ref().map_or_else(|| shape.is_convex(), |f| f.convex);
-        SdfObject {
-            dist: root.dist,
-            mat: root.surf,
-            parts: root.parts,
-            field: root.field.map(Box::new),
-            warp: root.warp.map(Box::new),
-            convex,
-        }
+        let convex = match &root.walk {
+            // A field at the root has asked already (its march steps by it).
+            Walk::Field(f) => f.convex,
+            Walk::Plain | Walk::Parts(_) | Walk::Warp(_) => shape.is_convex(),
+        };
+        SdfObject { dist: root.dist, mat: root.surf, walk: root.walk, convex }
     }
 
     /// Marches the ray over `[t0, t1]`; on a hit, its distance and the threshold there
@@ -80,22 +70,22 @@ impl SdfObject {
         if inside {
             return march::march_out(&*self.dist, ray, t0, t1, params, c, evals);
         }
-        if let Some(field) = &self.field {
-            return field.march(ray, (t0, t1), params, c, evals);
-        }
-        if let Some(warp) = &self.warp {
-            return warp.march(ray, (t0, t1), params, c, evals);
-        }
-        match &self.parts {
-            Some(parts) => parts.march(ray, (t0, t1), params, c, evals),
-            None => march::march(&*self.dist, ray, t0, t1, params, c, evals),
+        match &self.walk {
+            Walk::Field(field) => field.march(ray, (t0, t1), params, c, evals),
+            Walk::Warp(warp) => warp.march(ray, (t0, t1), params, c, evals),
+            Walk::Parts(parts) => parts.march(ray, (t0, t1), params, c, evals),
+            Walk::Plain => march::march(&*self.dist, ray, t0, t1, params, c, evals),
         }
     }
 
     /// Whether packets of camera rays are marched together: a sharp union's walk of
     /// its parts, a field's evaluations ([`closest_packet`](Self::closest_packet)).
     pub fn walks_packets(&self) -> bool {
-        self.field.is_some() || self.parts.as_ref().is_some_and(|p| p.k == 0.0)
+        match &self.walk {
+            Walk::Field(_) => true,
+            Walk::Parts(p) => p.k == 0.0,
+            Walk::Plain | Walk::Warp(_) => false,
+        }
     }
 
     /// [`closest`](Self::closest) for the lanes `mask` of `N` packets of rays starting
@@ -111,11 +101,10 @@ impl SdfObject {
         c: &mut Counters,
         evals: &mut [[u64; 4]; N],
     ) -> [[Option<(f32, f32)>; 4]; N] {
-        if let Some(field) = &self.field {
-            return field.march_packet(quads, mask, spans, params, c, evals);
-        }
-        if let Some(parts) = self.parts.as_ref().filter(|p| p.k == 0.0) {
-            return parts.march_packet(quads, mask, spans, params, c, evals);
+        match &self.walk {
+            Walk::Field(field) => return field.march_packet(quads, mask, spans, params, c, evals),
+            Walk::Parts(parts) if parts.k == 0.0 => return parts.march_packet(quads, mask, spans, params, c, evals),
+            Walk::Plain | Walk::Parts(_) | Walk::Warp(_) => {}
         }
         let mut hits = [[None; 4]; N];
         for lane in crate::trace::lanes(mask) {
@@ -137,9 +126,9 @@ impl SdfObject {
     #[inline(never)]
     pub fn surface(&self, ray: &Ray, t: f32, error: f32, object: u32, leaving: bool, c: &mut Counters) -> Hit {
         let point = ray.at(t);
-        let Surf { d, g, mat: material } = match &self.parts {
-            Some(parts) => parts.surface(point, error),
-            None => (self.mat)(point),
+        let Surf { d, g, mat: material } = match &self.walk {
+            Walk::Parts(parts) => parts.surface(point, error),
+            Walk::Plain | Walk::Field(_) | Walk::Warp(_) => (self.mat)(point),
         };
         // A flat gradient (at a crease or a cusp) gets a defined, finite normal.
         let normal = g.try_normalize().unwrap_or(Vec3A::Y);

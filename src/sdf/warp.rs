@@ -34,6 +34,8 @@ pub struct RayWarp {
     pub child: Sdf,
     /// The box the warp is cut to, in its frame.
     pub cut: Option<BoxCut>,
+    /// The warp's `1/L`, for [`Map::bound`].
+    pub k: f32,
 }
 
 impl RayWarp {
@@ -62,9 +64,8 @@ impl RayWarp {
             let p = o + d * t;
             let v = (self.child)(self.map.apply(p));
             *evals += 1;
-            // The object's closure: the child's value over the map's stretch near `p`.
-            let stretch = self.map.stretch(p, v.abs()).unwrap_or(f32::INFINITY);
-            let r = cut(&self.cut, p, v / stretch) * self.scale;
+            // The object's closure.
+            let r = cut(&self.cut, p, self.map.bound(p, v, self.k)) * self.scale;
             let threshold = threshold(params.epsilon, base, t);
             if r < threshold {
                 return Some((t, threshold));
