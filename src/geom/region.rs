@@ -186,6 +186,11 @@ fn is_convex_union(pts: Vec<DVec2>, area_covered: f64) -> bool {
 /// counter-clockwise; none when the points span no area.
 fn convex_lines(pts: Vec<DVec2>) -> Vec<(DVec2, f64)> {
     let hull = super::polygon::convex_hull(pts);
+    // `convex_hull` hands back fewer than three points as they are: two would make a
+    // slab of no width.
+    if hull.len() < 3 {
+        return Vec::new();
+    }
     (0..hull.len())
         .filter_map(|i| {
             let (a, b) = (hull[i], hull[(i + 1) % hull.len()]);
