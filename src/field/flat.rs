@@ -17,8 +17,8 @@
 
 use glam::Vec3A;
 
-use super::tape::{Distances, Op, Tape};
-use super::{cos_deg, sin_deg, sincos_deg};
+use super::tape::{Distances, Op, Scalar, Tape};
+use super::{cos_deg, sin_deg, sincos_deg, Dual};
 use crate::ir::field::{Binary, Unary};
 
 /// Registers of a flat tape; a tape needing more runs as a [`Tape`].
@@ -341,16 +341,14 @@ impl Flat {
         Some(Flat { ins, out, inputs, small: extra <= SMALL_REGS })
     }
 
-    /// Runs the tape at `p`; `out` reads what it wants from the registers (returning
-    /// them all would copy them).
-    #[inline]
-    fn run<R>(&self, p: Vec3A, dist: &dyn Distances<f32>, out: impl FnOnce(&dyn Fn(u16) -> f32) -> R) -> R {
+    /// The tape run for `W` points at once in as many registers as it needs, `live` of
+    /// the lanes wanted: the lanes of its three results (a number's in the first).
+    #[inline(always)]
+    fn outs<const W: usize>(&self, p: &[Vec3A; W], live: usize, dist: &dyn Distances<f32>) -> [[f32; W]; 3] {
         if self.small {
-            let r = self.run_n::<SMALL_REGS, 1>(&[p], 1, dist);
-            out(&|i| r[i as usize & (SMALL_REGS - 1)][0])
+            self.run_n::<SMALL_REGS, W>(p, live, dist)
         } else {
-            let r = self.run_n::<FLAT_REGS, 1>(&[p], 1, dist);
-            out(&|i| r[i as usize & (FLAT_REGS - 1)][0])
+            self.run_n::<FLAT_REGS, W>(p, live, dist)
         }
     }
 
@@ -358,13 +356,15 @@ impl Flat {
     /// once, lane by lane in each instruction: one dispatch serves every lane, and the
     /// lanes' arithmetic is one vector loop. The first `live` lanes are wanted; the
     /// others repeat a point (so a shape's distance is asked only for the live ones).
+    /// It gives only the three result registers' lanes: returning all `N` would copy
+    /// them.
     #[inline(always)]
     fn run_n<const N: usize, const W: usize>(
         &self,
         p: &[Vec3A; W],
         live: usize,
         dist: &dyn Distances<f32>,
-    ) -> [[f32; W]; N] {
+    ) -> [[f32; W]; 3] {
         let mask = N as u16 - 1;
         let mut r = [[0.0f32; W]; N];
         for axis in 0..3u16 {
@@ -408,7 +408,7 @@ impl Flat {
                 Code::AbsSubC => a.map(|a| a.abs() - k),
                 Code::Unary(Unary::Abs) => a.map(f32::abs),
                 Code::Unary(Unary::Neg) => a.map(|a| -a),
-                Code::Unary(f) => a.map(|a| <f32 as super::Scalar>::unary(f, a)),
+                Code::Unary(f) => a.map(|a| <f32 as Scalar>::unary(f, a)),
                 Code::Binary(f) => {
                     let b = x(ins.b);
                     match f {
@@ -417,7 +417,7 @@ impl Flat {
                         Binary::Mul => each(|l| a[l] * b[l]),
                         Binary::Min => each(|l| a[l].min(b[l])),
                         Binary::Max => each(|l| a[l].max(b[l])),
-                        f => each(|l| <f32 as super::Scalar>::binary(f, a[l], b[l])),
+                        f => each(|l| <f32 as Scalar>::binary(f, a[l], b[l])),
                     }
                 }
                 Code::Select => {
@@ -437,7 +437,7 @@ impl Flat {
                         v[l] = if ins.code == Code::Dist {
                             dist.dist(k.to_bits(), q)
                         } else {
-                            <f32 as super::Scalar>::noise(q, k.to_bits())
+                            <f32 as Scalar>::noise(q, k.to_bits())
                         };
                     }
                     v
@@ -445,7 +445,7 @@ impl Flat {
             };
             r[(ins.out & mask) as usize] = v;
         }
-        r
+        self.out.map(|o| r[(o & mask) as usize])
     }
 
     /// The number at each of up to 16 points, into `out`: [`eval`](Self::eval) point by
@@ -467,13 +467,71 @@ impl Flat {
     fn lanes<const W: usize>(&self, p: &[Vec3A], dist: &dyn Distances<f32>, out: &mut [f32]) {
         let live = p.len();
         let pts: [Vec3A; W] = std::array::from_fn(|l| p[l.min(live - 1)]);
-        let o = self.out[0] as usize;
-        let v = if self.small {
-            self.run_n::<SMALL_REGS, W>(&pts, live, dist)[o & (SMALL_REGS - 1)]
-        } else {
-            self.run_n::<FLAT_REGS, W>(&pts, live, dist)[o & (FLAT_REGS - 1)]
-        };
+        let [v, ..] = self.outs::<W>(&pts, live, dist);
         out[..live].copy_from_slice(&v[..live]);
+    }
+
+    /// The tape with `N` registers run on dual numbers at `p`: what [`Tape::run`] gives
+    /// for [`Dual`], to the bit, each fused instruction differentiated as the pair it
+    /// stands for (so a sphere's normal is one instruction, not five).
+    fn run_dual<const N: usize>(&self, p: Vec3A, dist: &dyn Distances<Dual>) -> [Dual; 3] {
+        let mask = N as u16 - 1;
+        let mut r = [Dual::default(); N];
+        for axis in 0..3u8 {
+            r[(self.inputs + u16::from(axis)) as usize & (N - 1)] = Dual::input(&p, axis);
+        }
+        let k = |k: f32| Dual { v: k, g: Vec3A::ZERO };
+        for ins in &self.ins {
+            let x = |i: u16| r[(i & mask) as usize];
+            let (a, c) = (x(ins.a), k(ins.k));
+            let v = match ins.code {
+                Code::Const => c,
+                Code::AddC => Dual::binary(Binary::Add, a, c),
+                Code::SubC => Dual::binary(Binary::Sub, a, c),
+                Code::CSub => Dual::binary(Binary::Sub, c, a),
+                Code::MulC => Dual::binary(Binary::Mul, a, c),
+                Code::DivC => Dual::binary(Binary::Div, a, c),
+                Code::CDiv => Dual::binary(Binary::Div, c, a),
+                Code::MinC => Dual::binary(Binary::Min, a, c),
+                Code::MaxC => Dual::binary(Binary::Max, a, c),
+                Code::Unary(f) => Dual::unary(f, a),
+                Code::Binary(f) => Dual::binary(f, a, x(ins.b)),
+                Code::Select => Dual::select(x(ins.c), a, x(ins.b)),
+                Code::Length => Dual::length([a, x(ins.b), x(ins.c)]),
+                Code::LengthSubC => Dual::binary(Binary::Sub, Dual::length([a, x(ins.b), x(ins.c)]), c),
+                Code::Dist => dist.dist(ins.k.to_bits(), [a, x(ins.b), x(ins.c)]),
+                Code::Noise => Dual::noise([a, x(ins.b), x(ins.c)], ins.k.to_bits()),
+                Code::SinCos => {
+                    // `k` is 1 where no multiply was fused in.
+                    let angle = if ins.k == 1.0 { a } else { Dual::binary(Binary::Mul, a, c) };
+                    r[(ins.b & mask) as usize] = Dual::unary(Unary::Cos, angle);
+                    Dual::unary(Unary::Sin, angle)
+                }
+                Code::Copy => a,
+                Code::MulAdd => Dual::binary(Binary::Add, Dual::binary(Binary::Mul, a, x(ins.b)), x(ins.c)),
+                Code::MulCAdd => Dual::binary(Binary::Add, Dual::binary(Binary::Mul, a, c), x(ins.b)),
+                Code::AbsSubC => Dual::binary(Binary::Sub, Dual::unary(Unary::Abs, a), c),
+            };
+            r[(ins.out & mask) as usize] = v;
+        }
+        self.out.map(|o| r[(o & mask) as usize])
+    }
+
+    /// The number at `p` with its gradient: `Tape::eval::<Dual>`, to the bit.
+    #[inline]
+    pub fn dual(&self, p: Vec3A, dist: &dyn Distances<Dual>) -> Dual {
+        self.dual3(p, dist)[0]
+    }
+
+    /// The vector at `p`, each component with its gradient: `Tape::eval3::<Dual>`, to
+    /// the bit.
+    #[inline]
+    pub fn dual3(&self, p: Vec3A, dist: &dyn Distances<Dual>) -> [Dual; 3] {
+        if self.small {
+            self.run_dual::<SMALL_REGS>(p, dist)
+        } else {
+            self.run_dual::<FLAT_REGS>(p, dist)
+        }
     }
 
     /// How many instructions an evaluation runs.
@@ -484,12 +542,13 @@ impl Flat {
     /// The number at `p`.
     #[inline]
     pub fn eval(&self, p: Vec3A, dist: &dyn Distances<f32>) -> f32 {
-        self.run(p, dist, |r| r(self.out[0]))
+        self.outs::<1>(&[p], 1, dist)[0][0]
     }
 
     /// The vector at `p`.
     #[inline]
     pub fn eval3(&self, p: Vec3A, dist: &dyn Distances<f32>) -> Vec3A {
-        self.run(p, dist, |r| Vec3A::new(r(self.out[0]), r(self.out[1]), r(self.out[2])))
+        let [x, y, z] = self.outs::<1>(&[p], 1, dist);
+        Vec3A::new(x[0], y[0], z[0])
     }
 }

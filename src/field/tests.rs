@@ -146,6 +146,37 @@ fn flat_tapes_equal_tapes() {
     }
 }
 
+/// The flat tape on dual numbers computes what the tape computes on them, value and
+/// gradient bit for bit: numbers, and vectors (a warp's map) component by component.
+#[test]
+fn flat_duals_equal_tape_duals() {
+    let same = |a: Dual, b: Dual| {
+        let bits = |d: Dual| [d.v, d.g.x, d.g.y, d.g.z].map(|x| if x.is_nan() { u32::MAX } else { x.to_bits() });
+        bits(a) == bits(b)
+    };
+    let twist = {
+        let turn = bin(Binary::Mul, x(1), n(40.0));
+        let (s, c) = (un(Unary::Sin, turn.clone()), un(Unary::Cos, turn));
+        let u = bin(Binary::Sub, bin(Binary::Mul, x(0), c.clone()), bin(Binary::Mul, x(2), s.clone()));
+        let w = bin(Binary::Add, bin(Binary::Mul, x(0), s), bin(Binary::Mul, x(2), c));
+        Expr::new(Kind::Vector([u, x(1), w]), Ty::Vec3)
+    };
+    let vectors = [bin(Binary::Cross, Expr::point(), Expr::vec(DVec3::new(1.0, 2.0, 3.0))), twist];
+    for e in everything().into_iter().chain(vectors) {
+        let tape = Tape::new(&e);
+        let flat = Flat::new(&tape).expect("a small tape flattens");
+        for p in points(200) {
+            let p = p.as_vec3a();
+            let (a, b) = (tape.eval3::<Dual>(&p, &NoDistances), flat.dual3(p, &NoDistances));
+            for i in 0..3 {
+                assert!(same(a[i], b[i]), "{} at {p}, component {i}: {:?} vs {:?}", e.source(200), a[i], b[i]);
+            }
+            let (a, b) = (tape.eval::<Dual>(&p, &NoDistances), flat.dual(p, &NoDistances));
+            assert!(same(a, b), "{} at {p}: {a:?} vs {b:?}", e.source(200));
+        }
+    }
+}
+
 /// The march's body runs as few instructions as it has sines and sums: the point read
 /// from the registers it starts in, `sin(k·x)` with its cosine one instruction, a sum
 /// of products a multiply–add each, a distance less a radius one.

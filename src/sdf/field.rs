@@ -96,7 +96,10 @@ impl Body {
 
     /// The number at `p` with its gradient.
     pub fn dual(&self, p: Vec3A) -> Dual {
-        let d = self.tape.eval::<Dual>(&p, &self.shapes);
+        let d = match &self.flat {
+            Some(f) => f.dual(p, &self.shapes),
+            None => self.tape.eval::<Dual>(&p, &self.shapes),
+        };
         if d.v.is_nan() {
             Dual { v: f32::MAX, g: Vec3A::Y }
         } else {
@@ -115,7 +118,10 @@ impl Body {
 
     /// The vector at `p`, each component with its gradient (the map's Jacobian by rows).
     pub fn vec_dual(&self, p: Vec3A) -> [Dual; 3] {
-        self.tape.eval3::<Dual>(&p, &self.shapes)
+        match &self.flat {
+            Some(f) => f.dual3(p, &self.shapes),
+            None => self.tape.eval3::<Dual>(&p, &self.shapes),
+        }
     }
 }
 
