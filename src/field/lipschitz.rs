@@ -141,15 +141,14 @@ pub struct SlopeDistances {
     pub spheres: Vec<Option<(DVec3, f64)>>,
 }
 
-impl Distances<Slope> for SlopeDistances {
-    fn dist(&self, i: u32, q: [Slope; 3]) -> Slope {
-        let col = |a: usize| (0..3).map(|k| q[k].g[a].mag().powi(2)).sum::<f64>().sqrt();
-        let g = [0, 1, 2].map(|a| Interval::new(-col(a), col(a)));
-        let v = match self.spheres.get(i as usize).copied().flatten() {
+impl SlopeDistances {
+    /// The values shape `i`'s distance bound can take over the box `q`.
+    fn value(&self, i: u32, q: [Interval; 3]) -> Interval {
+        match self.spheres.get(i as usize).copied().flatten() {
             Some((c, r)) => {
                 let (mut near, mut far) = (0.0f64, 0.0f64);
                 for a in 0..3 {
-                    let (lo, hi) = (q[a].v.lo - c[a], q[a].v.hi - c[a]);
+                    let (lo, hi) = (q[a].lo - c[a], q[a].hi - c[a]);
                     let gap = if lo > 0.0 {
                         lo
                     } else if hi < 0.0 {
@@ -164,7 +163,23 @@ impl Distances<Slope> for SlopeDistances {
                 Interval::new(lo, far.sqrt() + r)
             }
             None => Interval::ALL,
-        };
+        }
+    }
+}
+
+/// The same spheres answer interval evaluations: a field's support planes
+/// (`support_planes`) see a `dist` as the values it can take, never as absent.
+impl Distances<Interval> for SlopeDistances {
+    fn dist(&self, i: u32, q: [Interval; 3]) -> Interval {
+        self.value(i, q)
+    }
+}
+
+impl Distances<Slope> for SlopeDistances {
+    fn dist(&self, i: u32, q: [Slope; 3]) -> Slope {
+        let col = |a: usize| (0..3).map(|k| q[k].g[a].mag().powi(2)).sum::<f64>().sqrt();
+        let g = [0, 1, 2].map(|a| Interval::new(-col(a), col(a)));
+        let v = self.value(i, q.map(|q| q.v));
         let by_g = g.iter().map(|d| d.mag().powi(2)).sum::<f64>().sqrt();
         Slope { v, g, n: Slope::stretch(&q).min(by_g) }
     }

@@ -93,11 +93,13 @@ impl FieldHulls {
             return k.planes.clone();
         }
         let tape = crate::field::Tape::new(body);
+        // Each `dist` as the values its shape's distance bound can take.
+        let shapes =
+            crate::field::SlopeDistances { spheres: tape.shapes.iter().map(|s| ir::shape_sphere(s)).collect() };
         // A body of a few operations steps more cheaply than a ray is clipped to twenty
         // planes (see MIN_OPS).
-        let planes = (tape.ops.len() >= MIN_OPS)
-            .then(|| crate::field::support_planes(&tape, b, level, &crate::field::NoDistances))
-            .flatten();
+        let planes =
+            (tape.ops.len() >= MIN_OPS).then(|| crate::field::support_planes(&tape, b, level, &shapes)).flatten();
         self.0.push(KnownPlanes { body: body.clone(), bounds: b, level, planes: planes.clone() });
         planes
     }

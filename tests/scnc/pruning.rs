@@ -281,7 +281,7 @@ const GYROID_BALL: &str = "field(p => max(abs(sin(450 * p.x) * cos(450 * p.y) + 
 /// extrusions (an L, a holed plate with a disc beside), round solids (cylinder, cones,
 /// ellipsoid, torus, capsule), a revolved profile, a twisted prism and a twisted cone
 /// moved along its axis, a bent bar, and fields (their support planes, found at the
-/// level a rounding or a smooth operator above them asks for), turned,
+/// level a rounding or a smooth operator above them asks for; a body with a `dist`), turned,
 /// stretched, cut by random solids, rounded and shelled, sharp and smooth.
 #[test]
 fn hulls_contain_their_solids() {
@@ -305,6 +305,9 @@ fn hulls_contain_their_solids() {
         "twist(capped_cone(0.7, 0.3, 0.6) at [0, 0.2, 0], 45)",
         "bend(box(0.2, 0.9, 0.3) rotate [0, 30, 0] at [0.1, 0, 0.2], 50)",
         GYROID_BALL,
+        // A body reading a shape through `dist`: its planes must see the box.
+        "field(p => min(dist(box(0.4), p - [0.4, 0, 0]), length(p + [0.4, 0, 0]) - 0.4 + 0.01 * sin(900 * p.x) * \
+         sin(900 * p.y) * sin(900 * p.z)), bounds = [[-0.9, -0.9, -0.9], [0.9, 0.9, 0.9]], lipschitz = 1.5)",
         "twist(intersect(box(0.5, 0.7, 0.5), field(p => sin(450 * p.x) * cos(450 * p.y) + sin(450 * p.y) * cos(450 * p.z) + 0.5 * length(p) - 0.2, bounds = [[-0.9, -0.9, -0.9], [0.9, 0.9, 0.9]], lipschitz = 16)), 40)",
     ];
     for case in 0..288 {
