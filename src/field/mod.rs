@@ -16,7 +16,7 @@ mod tape;
 pub use flat::Flat;
 pub use interval::{Dir, Interval, Jet, Region, Slope};
 pub use lipschitz::{lipschitz, Estimate, SlopeDistances};
-pub use support::support_planes;
+pub use support::{support_planes, support_radius};
 pub use tape::{Distances, NoDistances, Op, Reg, Scalar, Tape};
 
 use glam::Vec3A;

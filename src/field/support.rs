@@ -57,14 +57,68 @@ pub fn support_planes(
     Some(planes)
 }
 
+/// Interval evaluations the ball's search ([`support_radius`]) spends in each eighth
+/// of the box. Over a round solid the bound closes in only as the boxes across the
+/// whole surface shrink: on a ball of radius 0.4 in its box, 8 × 512 evaluations
+/// bound it by 0.448, 8 × 2048 by 0.423 (3 ms), against the box's 0.69 (unit test
+/// `support_radius_holds_the_solid_and_is_tight`).
+const RADIAL_BUDGET: usize = 2048;
+
+/// The radius of a ball about `centre` holding where the body is at most `level`
+/// within `b`, from interval arithmetic as for [`support_planes`]: the farthest from
+/// `centre` that a box not ruled out reaches, each eighth of `b` searched on its own
+/// (in parallel). `None` when no point of `b` can be in the solid.
+pub fn support_radius(
+    tape: &Tape,
+    b: Aabb,
+    level: f64,
+    centre: DVec3,
+    dist: &(dyn Distances<Interval> + Sync),
+) -> Option<f64> {
+    let tol = (b.max - b.min).length() / 1024.0;
+    let slack = 1e-6 * (1.0 + b.min.abs().max(b.max.abs()).max_element());
+    let empty = |lo: DVec3, hi: DVec3| {
+        let at = [0, 1, 2].map(|i| Interval::new(lo[i], hi[i]));
+        tape.eval::<Interval>(&at, dist).lo > level + slack
+    };
+    let far = |lo: DVec3, hi: DVec3| (lo - centre).abs().max((hi - centre).abs()).length();
+    let near = |lo: DVec3, hi: DVec3| (lo - centre).max(centre - hi).max(DVec3::ZERO).length();
+    let mid = centre.clamp(b.min, b.max);
+    let eighths: Vec<Aabb> = (0..8)
+        .map(|i| {
+            let pick = |a: usize, bit: u32| if i >> bit & 1 == 0 { (b.min[a], mid[a]) } else { (mid[a], b.max[a]) };
+            let [(x0, x1), (y0, y1), (z0, z1)] = [pick(0, 0), pick(1, 1), pick(2, 2)];
+            Aabb { min: DVec3::new(x0, y0, z0), max: DVec3::new(x1, y1, z1) }
+        })
+        .filter(|e| e.min.cmplt(e.max).all())
+        .collect();
+    let found: Vec<f64> =
+        eighths.par_iter().filter_map(|&e| search(e, tol, RADIAL_BUDGET, &far, &near, &empty)).collect();
+    found.into_iter().reduce(f64::max)
+}
+
 /// An upper bound of the largest `n·p` over the boxes within `b` not ruled `empty`, to
 /// within `tol` or the budget; `None` if every box is.
 fn farthest(n: DVec3, b: Aabb, tol: f64, empty: &(dyn Fn(DVec3, DVec3) -> bool + Sync)) -> Option<f64> {
-    let mut heap = BinaryHeap::from([Cell { bound: reach(n, b.min, b.max), lo: b.min, hi: b.max }]);
+    search(b, tol, BUDGET, &|lo, hi| reach(n, lo, hi), &|lo, hi| -reach(-n, lo, hi), empty)
+}
+
+/// Branch and bound: an upper bound of the largest `far` of the boxes within `b` not
+/// ruled `empty`, to within `tol` (a box whose `far` and `near` are that close) or
+/// `budget` evaluations; `None` if every box is.
+fn search(
+    b: Aabb,
+    tol: f64,
+    budget: usize,
+    far: &(dyn Fn(DVec3, DVec3) -> f64 + Sync),
+    near: &(dyn Fn(DVec3, DVec3) -> f64 + Sync),
+    empty: &(dyn Fn(DVec3, DVec3) -> bool + Sync),
+) -> Option<f64> {
+    let mut heap = BinaryHeap::from([Cell { bound: far(b.min, b.max), lo: b.min, hi: b.max }]);
     let mut spent = 0;
     while let Some(cell) = heap.pop() {
-        let extent = cell.bound + reach(-n, cell.lo, cell.hi);
-        if spent >= BUDGET || extent <= tol {
+        let extent = cell.bound - near(cell.lo, cell.hi);
+        if spent >= budget || extent <= tol {
             // Every box left reaches no farther than this one.
             return Some(cell.bound);
         }
@@ -78,7 +132,7 @@ fn farthest(n: DVec3, b: Aabb, tol: f64, empty: &(dyn Fn(DVec3, DVec3) -> bool +
         upper[axis] = mid;
         lower[axis] = mid;
         for (lo, hi) in [(cell.lo, upper), (lower, cell.hi)] {
-            heap.push(Cell { bound: reach(n, lo, hi), lo, hi });
+            heap.push(Cell { bound: far(lo, hi), lo, hi });
         }
     }
     None

@@ -93,16 +93,28 @@ fn within_child(g: f64, xf: &DAffine3) -> f64 {
 /// A bounding sphere (centre, radius) of a shape tree, tight for primitives under
 /// similarities (a sphere's bound is the sphere itself); `None` when unbounded.
 pub fn shape_sphere(shape: &Shape) -> Option<(DVec3, f64)> {
-    sphere_within(shape, 0.0)
+    sphere_within(shape, 0.0, &mut |_, _, _| None)
+}
+
+/// A sphere holding where a field's body is at most `level` within a box, found by a
+/// search `ir` cannot run (`world` hands it in, as for [`FieldPlanes`]); `None` for none
+/// better than the box's own.
+pub type FieldSphere<'a> = dyn FnMut(&Arc<super::field::Expr>, Aabb, f64) -> Option<(DVec3, f64)> + 'a;
+
+/// [`shape_sphere`] with a field's sphere from `fields` where it is smaller than its
+/// box's.
+pub fn shape_sphere_with(shape: &Shape, fields: &mut FieldSphere<'_>) -> Option<(DVec3, f64)> {
+    sphere_within(shape, 0.0, fields)
 }
 
 /// A sphere around where the shape's field is at most `g` (see [`bounds_within`]).
-fn sphere_within(shape: &Shape, g: f64) -> Option<(DVec3, f64)> {
+fn sphere_within(shape: &Shape, g: f64, fields: &mut FieldSphere<'_>) -> Option<(DVec3, f64)> {
     let from_box = |b: Aabb| (b.centre(), (b.max - b.min).length() * 0.5);
     match &shape.kind {
         ShapeKind::Primitive(p) => p.sphere_radius().map(|r| (DVec3::ZERO, r + g)),
         ShapeKind::Csg { op: CsgOp::Union, children, smooth } => {
-            let spheres: Option<Vec<(DVec3, f64)>> = children.iter().map(|c| sphere_within(c, g + smooth)).collect();
+            let spheres: Option<Vec<(DVec3, f64)>> =
+                children.iter().map(|c| sphere_within(c, g + smooth, fields)).collect();
             let spheres = spheres?;
             let boxes = spheres.iter().map(|(c, r)| Aabb { min: *c - *r, max: *c + *r });
             let centre = boxes.reduce(Aabb::union)?.centre();
@@ -110,17 +122,26 @@ fn sphere_within(shape: &Shape, g: f64) -> Option<(DVec3, f64)> {
             Some((centre, radius))
         }
         ShapeKind::Csg { op: CsgOp::Intersect, children, smooth } => {
-            children.iter().filter_map(|c| sphere_within(c, g + smooth)).min_by(|a, b| a.1.total_cmp(&b.1))
+            children.iter().filter_map(|c| sphere_within(c, g + smooth, fields)).min_by(|a, b| a.1.total_cmp(&b.1))
         }
-        ShapeKind::Csg { op: CsgOp::Subtract, children, smooth } => sphere_within(children.first()?, g + smooth),
-        ShapeKind::Round { child, radius } => sphere_within(child, g + radius),
-        ShapeKind::Shell { child, thickness } => sphere_within(child, g + thickness * 0.5),
+        ShapeKind::Csg { op: CsgOp::Subtract, children, smooth } => {
+            sphere_within(children.first()?, g + smooth, fields)
+        }
+        ShapeKind::Round { child, radius } => sphere_within(child, g + radius, fields),
+        ShapeKind::Shell { child, thickness } => sphere_within(child, g + thickness * 0.5, fields),
         ShapeKind::Repeat { .. } => bounds_within(shape, g).map(from_box),
         ShapeKind::Transform { child, xf } => {
-            let (c, r) = sphere_within(child, within_child(g, xf))?;
+            let (c, r) = sphere_within(child, within_child(g, xf), fields)?;
             Some((xf.transform_point3(c), r * max_stretch(xf.matrix3)))
         }
-        ShapeKind::Paint { child, .. } => sphere_within(child, g),
+        ShapeKind::Paint { child, .. } => sphere_within(child, g, fields),
+        // As for its hull: where the field is at most `g`, the body is at most `g·L`
+        // within the box grown by `g`.
+        ShapeKind::Field { body, bounds: Some(b), sweep: None, lipschitz, .. } => {
+            let grown = Aabb { min: b.min - g, max: b.max + g };
+            let boxed = from_box(grown);
+            Some(fields(body, grown, g * lipschitz.value).filter(|s| s.1 < boxed.1).unwrap_or(boxed))
+        }
         ShapeKind::Field { .. } | ShapeKind::Warp { .. } | ShapeKind::Displace { .. } => {
             bounds_within(shape, g).map(from_box)
         }

@@ -23,7 +23,7 @@ pub use crate::geom::Aabb;
 pub use crate::primitive::{Facets, Primitive};
 pub use bounds::{
     bounding_sphere, max_stretch, mesh_bounds, min_singular_value, shape_bounds, shape_half_space, shape_hull,
-    shape_sphere, similarity, transform_half_space, FieldPlanes,
+    shape_sphere, shape_sphere_with, similarity, transform_half_space, FieldPlanes, FieldSphere,
 };
 pub use dump::dump;
 pub(crate) use dump::{num as dump_num, vec as dump_vec};

@@ -37,7 +37,8 @@ struct Reach {
 impl Reach {
     fn of(shape: &ir::Shape, to_render: &DAffine3, known: &mut FieldHulls) -> Reach {
         let bounds = ir::shape_bounds(shape).map(|b| Aabb::padded(b.transform(to_render)));
-        let sphere = ir::shape_sphere(shape).map(|(c, r)| padded_sphere(to_render.transform_point3(c), r));
+        let sphere = ir::shape_sphere_with(shape, &mut |body, b, level| known.sphere(body, b, level))
+            .map(|(c, r)| padded_sphere(to_render.transform_point3(c), r));
         let half_space = match bounds {
             Some(_) => None,
             None => ir::shape_half_space(shape)
@@ -57,25 +58,40 @@ impl Reach {
 #[derive(Default)]
 struct FieldHulls(Vec<KnownPlanes>);
 
-/// A body, box and level with the planes found for them.
+/// A body, box and level with the planes found for them and the sphere holding its
+/// solid.
 struct KnownPlanes {
     body: Arc<ir::field::Expr>,
     bounds: ir::Aabb,
     level: f64,
     planes: Option<Vec<(DVec3, f64)>>,
+    sphere: Option<(DVec3, f64)>,
 }
+
+/// How many bodies of a scene are searched for the ball holding their solid
+/// (`field::support_radius`, a few milliseconds each).
+const RADIAL_BODIES: usize = 16;
 
 /// The fewest operations a field's body has for its rays to be clipped to its support
 /// planes: below that a step costs less than the clip. 64 spheres written as fields
-/// (three operations) traced in 0.137 s without their planes and 0.185 s with them
-/// (smallest of five runs at 1000×1000, `scnc render
-/// benches/scenes/field-spheres-64.scn --width 1000 --height 1000 --stats`).
+/// (three operations) traced in 0.051 s without their planes and 0.079 s with them
+/// (medians of 11 interleaved runs at 1000×1000, `scnc render
+/// benches/scenes/field-spheres-64.scn --width 1000 --height 1000 --stats`). Their
+/// sphere ([`FieldHulls::sphere`]) is clipped to at every size: it costs what a
+/// native object's does.
 const MIN_OPS: usize = 12;
 
 /// The convex set an object of `shape`'s rays are clipped to: [`ir::shape_hull`] with
 /// the support planes of the fields in it (of a dozen operations or more).
 pub fn shape_hull(shape: &ir::Shape) -> Option<crate::geom::hull::Hull> {
     FieldHulls::default().hull(shape)
+}
+
+/// The sphere an object of `shape`'s rays are clipped to: [`ir::shape_sphere`] with
+/// the ball each field's solid is found in (`field::support_radius`).
+pub fn shape_sphere(shape: &ir::Shape) -> Option<(DVec3, f64)> {
+    let mut known = FieldHulls::default();
+    ir::shape_sphere_with(shape, &mut |body, b, level| known.sphere(body, b, level))
 }
 
 impl FieldHulls {
@@ -85,12 +101,27 @@ impl FieldHulls {
     }
 
     /// [`ir::FieldPlanes`]: the planes holding where `body` is at most `level` within
-    /// `b` (`field::support_planes`), for a body of at least [`MIN_OPS`] operations.
+    /// `b` (`field::support_planes`), for a body of at least [`MIN_OPS`] operations: a
+    /// body of a few steps more cheaply than a ray is clipped to twenty planes.
     fn planes(&mut self, body: &Arc<ir::field::Expr>, b: ir::Aabb, level: f64) -> Option<Vec<(DVec3, f64)>> {
+        self.known(body, b, level).planes.clone()
+    }
+
+    /// [`ir::FieldSphere`]: a sphere holding the solid, for a body of any size: the
+    /// smaller of the ball `field::support_radius` finds and the sphere about the
+    /// support planes' polyhedron (within `b`) through its corners. A ray misses it, or
+    /// enters it near the surface, for the cost of a native object's sphere test.
+    fn sphere(&mut self, body: &Arc<ir::field::Expr>, b: ir::Aabb, level: f64) -> Option<(DVec3, f64)> {
+        self.known(body, b, level).sphere
+    }
+
+    /// What is known of `body` within `b` at `level`, searched once.
+    fn known(&mut self, body: &Arc<ir::field::Expr>, b: ir::Aabb, level: f64) -> &KnownPlanes {
         let same =
-            |k: &&KnownPlanes| k.bounds == b && k.level == level && (Arc::ptr_eq(&k.body, body) || k.body == *body);
-        if let Some(k) = self.0.iter().rev().take(64).find(same) {
-            return k.planes.clone();
+            |k: &KnownPlanes| k.bounds == b && k.level == level && (Arc::ptr_eq(&k.body, body) || k.body == *body);
+        let n = self.0.len();
+        if let Some(i) = (n.saturating_sub(64)..n).rev().find(|&i| same(&self.0[i])) {
+            return &self.0[i];
         }
         let tape = crate::field::Tape::new(body);
         // Each `dist` as the values its shape's distance bound can take.
@@ -100,9 +131,37 @@ impl FieldHulls {
         // planes (see MIN_OPS).
         let planes =
             (tape.ops.len() >= MIN_OPS).then(|| crate::field::support_planes(&tape, b, level, &shapes)).flatten();
-        self.0.push(KnownPlanes { body: body.clone(), bounds: b, level, planes: planes.clone() });
-        planes
+        let hull = |p: &Vec<(DVec3, f64)>| {
+            let mut all = p.clone();
+            all.extend(crate::geom::hull::Hull::box_planes(b));
+            corner_sphere(&crate::geom::hull::Hull::planes(all).corners())
+        };
+        let corners = planes.as_ref().and_then(hull);
+        // The first few bodies are searched for the ball holding their solid too, about
+        // the middle of their polyhedron or box: a scene of many different fields
+        // lowers in bounded time, its later ones keeping their polyhedron's sphere.
+        let centre = corners.map_or(b.centre(), |c| c.0);
+        let radial = (self.0.len() < RADIAL_BODIES)
+            .then(|| crate::field::support_radius(&tape, b, level, centre, &shapes))
+            .flatten();
+        let sphere = match (corners, radial) {
+            (Some((c, r)), Some(w)) => Some((c, r.min(w))),
+            (Some(s), None) => Some(s),
+            (None, Some(w)) => Some((centre, w)),
+            (None, None) => None,
+        };
+        self.0.push(KnownPlanes { body: body.clone(), bounds: b, level, planes, sphere });
+        &self.0[n]
     }
+}
+
+/// The sphere about the middle of `corners`' box through the farthest of them; `None`
+/// for no corners.
+fn corner_sphere(corners: &[DVec3]) -> Option<(DVec3, f64)> {
+    let (lo, hi) = corners.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &c| (lo.min(c), hi.max(c)));
+    let centre = (lo + hi) * 0.5;
+    let radius = corners.iter().map(|c| (*c - centre).length()).fold(f64::NEG_INFINITY, f64::max);
+    (radius.is_finite()).then_some((centre, radius))
 }
 
 /// Builds the frame for `effects` and lowers the scene into a world, with the scene's

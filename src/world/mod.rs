@@ -17,7 +17,9 @@ mod query;
 
 use glam::Vec3A;
 
-pub use lower::{lower, lowering_steps, prepare, prepare_reusing, prepare_within, shape_hull, FrameCache};
+pub use lower::{
+    lower, lowering_steps, prepare, prepare_reusing, prepare_within, shape_hull, shape_sphere, FrameCache,
+};
 
 use crate::accel::{Aabb, Bvh};
 use crate::mesh::{Detail, MeshMemory, MeshObject};
