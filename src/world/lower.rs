@@ -68,10 +68,6 @@ struct KnownPlanes {
     sphere: Option<(DVec3, f64)>,
 }
 
-/// How many bodies of a scene are searched for the ball holding their solid
-/// (`field::support_radius`, a few milliseconds each).
-const RADIAL_BODIES: usize = 16;
-
 /// The fewest operations a field's body has for its rays to be clipped to its support
 /// planes: below that a step costs less than the clip. 64 spheres written as fields
 /// (three operations) traced in 0.051 s without their planes and 0.079 s with them
@@ -137,13 +133,12 @@ impl FieldHulls {
             corner_sphere(&crate::geom::hull::Hull::planes(all).corners())
         };
         let corners = planes.as_ref().and_then(hull);
-        // The first few bodies are searched for the ball holding their solid too, about
-        // the middle of their polyhedron or box: a scene of many different fields
-        // lowers in bounded time, its later ones keeping their polyhedron's sphere.
+        // The ball holding the solid, about the middle of its polyhedron or box: about
+        // 0.6 ms of lowering per distinct body (`field::support_radius`). Every body
+        // is searched, so an object's sphere depends on nothing but the object, as an
+        // animation's reuse of objects needs (`FrameCache`).
         let centre = corners.map_or(b.centre(), |c| c.0);
-        let radial = (self.0.len() < RADIAL_BODIES)
-            .then(|| crate::field::support_radius(&tape, b, level, centre, &shapes))
-            .flatten();
+        let radial = crate::field::support_radius(&tape, b, level, centre, &shapes);
         let sphere = match (corners, radial) {
             (Some((c, r)), Some(w)) => Some((c, r.min(w))),
             (Some(s), None) => Some(s),

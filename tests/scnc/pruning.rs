@@ -340,7 +340,7 @@ fn hulls_contain_their_solids() {
 /// of its solid when fields give it the ball their solid is found in
 /// (`field::support_radius`): a gyroid sheet cut by a ball, turned and moved, stretched,
 /// cut by a box, rounded; a steep field; a body reading a box through `dist`; and it
-/// is tight on a ball written as a field (within 6 % of its radius, where the box's
+/// is tight on a ball written as a field (within 10 % of its radius, where the box's
 /// sphere is 73 % further out).
 #[test]
 fn field_spheres_hold_their_solids() {
@@ -375,7 +375,7 @@ fn field_spheres_hold_their_solids() {
     assert!(inside > 5_000, "only {inside} points inside");
     let ball = "object field(p => length(p) - 0.4, bounds = [[-0.4, -0.4, -0.4], [0.4, 0.4, 0.4]]) at [0, 0, 8]";
     let (_, radius) = scnc::world::shape_sphere(&shape_of(&format!("light ambient(1)\n{ball}\n"))).unwrap();
-    assert!((0.4..0.424).contains(&radius), "{radius}");
+    assert!((0.4..0.44).contains(&radius), "{radius}");
 }
 
 /// A solid's rays are clipped to its hull before they are marched: they hit where
