@@ -315,12 +315,9 @@ fn fast_trig_is_accurate() {
     assert!((sin_deg(90.0) - 1.0).abs() < 1e-7 && sin_deg(180.0).abs() < 1e-6);
 }
 
-/// A field's support planes (`support_planes`) hold every point where its body is at
-/// most zero, for every body of the language and a gyroid sheet cut by a ball, and
-/// they are tight on a ball: within 10 % of its radius along the cube's corners and
-/// edges (6–8 % at the search's budget), where its box reaches 1.41–1.73 times as far.
-#[test]
-fn support_planes_hold_the_solid_and_are_tight() {
+/// The box the support searches are tried in, off centre, and every body of the
+/// language with a gyroid sheet cut by a ball.
+fn support_cases() -> (Aabb, Vec<Arc<Expr>>) {
     let b = Aabb { min: DVec3::splat(-1.3), max: DVec3::new(1.1, 1.3, 1.2) };
     let sheet = bin(
         Binary::Max,
@@ -329,6 +326,16 @@ fn support_planes_hold_the_solid_and_are_tight() {
     );
     let mut bodies = everything();
     bodies.push(sheet);
+    (b, bodies)
+}
+
+/// A field's support planes (`support_planes`) hold every point where its body is at
+/// most zero, for every body of the language and a gyroid sheet cut by a ball, and
+/// they are tight on a ball: within 10 % of its radius along the cube's corners and
+/// edges (6–8 % at the search's budget), where its box reaches 1.41–1.73 times as far.
+#[test]
+fn support_planes_hold_the_solid_and_are_tight() {
+    let (b, bodies) = support_cases();
     let mut state = 0x5eed_u64;
     let mut unit = move || {
         state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
@@ -361,14 +368,7 @@ fn support_planes_hold_the_solid_and_are_tight() {
 /// radius (1.08 at the search's budget), where the box's corners are 1.73 times as far.
 #[test]
 fn support_radius_holds_the_solid_and_is_tight() {
-    let b = Aabb { min: DVec3::splat(-1.3), max: DVec3::new(1.1, 1.3, 1.2) };
-    let sheet = bin(
-        Binary::Max,
-        bin(Binary::Sub, un(Unary::Abs, gyroid(450.0)), n(0.3)),
-        bin(Binary::Sub, un(Unary::Length, Expr::point()), n(1.2)),
-    );
-    let mut bodies = everything();
-    bodies.push(sheet);
+    let (b, bodies) = support_cases();
     let centre = DVec3::new(0.1, -0.2, 0.05);
     let mut inside = 0;
     for (i, body) in bodies.iter().enumerate() {

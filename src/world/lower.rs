@@ -97,8 +97,7 @@ impl FieldHulls {
     }
 
     /// [`ir::FieldPlanes`]: the planes holding where `body` is at most `level` within
-    /// `b` (`field::support_planes`), for a body of at least [`MIN_OPS`] operations: a
-    /// body of a few steps more cheaply than a ray is clipped to twenty planes.
+    /// `b` (`field::support_planes`), for a body of at least [`MIN_OPS`] operations.
     fn planes(&mut self, body: &Arc<ir::field::Expr>, b: ir::Aabb, level: f64) -> Option<Vec<(DVec3, f64)>> {
         self.known(body, b, level).planes.clone()
     }
