@@ -23,6 +23,22 @@ fn reach(n: DVec3, lo: DVec3, hi: DVec3) -> f64 {
     n.dot(DVec3::select(n.cmpge(DVec3::ZERO), hi, lo))
 }
 
+/// Whether a box within `b` holds no point where the body is at most `level`, by
+/// interval arithmetic. A box is ruled out only where the body is clearly above the
+/// level: the march runs it in f32.
+fn ruled_out<'a>(
+    tape: &'a Tape,
+    b: Aabb,
+    level: f64,
+    dist: &'a (dyn Distances<Interval> + Sync),
+) -> impl Fn(DVec3, DVec3) -> bool + Sync + 'a {
+    let slack = 1e-6 * (1.0 + b.min.abs().max(b.max.abs()).max_element());
+    move |lo: DVec3, hi: DVec3| {
+        let at = [0, 1, 2].map(|i| Interval::new(lo[i], hi[i]));
+        tape.eval::<Interval>(&at, dist).lo > level + slack
+    }
+}
+
 /// Planes `n·p ≤ offset` (unit `n`) holding where the body is at most `level` within
 /// `b`, for the directions where that is nearer than `b`'s own face; `None` when no
 /// point of `b` can be in the solid. Only an upper bound of each reach is taken (the
@@ -35,13 +51,7 @@ pub fn support_planes(
     dist: &(dyn Distances<Interval> + Sync),
 ) -> Option<Vec<(DVec3, f64)>> {
     let tol = (b.max - b.min).length() / 256.0;
-    // A box is ruled out only where the body is clearly above the level: the march runs
-    // it in f32.
-    let slack = 1e-6 * (1.0 + b.min.abs().max(b.max.abs()).max_element());
-    let empty = |lo: DVec3, hi: DVec3| {
-        let at = [0, 1, 2].map(|i| Interval::new(lo[i], hi[i]));
-        tape.eval::<Interval>(&at, dist).lo > level + slack
-    };
+    let empty = ruled_out(tape, b, level, dist);
     if empty(b.min, b.max) {
         return None;
     }
@@ -77,11 +87,7 @@ pub fn support_radius(
     dist: &(dyn Distances<Interval> + Sync),
 ) -> Option<f64> {
     let tol = (b.max - b.min).length() / 1024.0;
-    let slack = 1e-6 * (1.0 + b.min.abs().max(b.max.abs()).max_element());
-    let empty = |lo: DVec3, hi: DVec3| {
-        let at = [0, 1, 2].map(|i| Interval::new(lo[i], hi[i]));
-        tape.eval::<Interval>(&at, dist).lo > level + slack
-    };
+    let empty = ruled_out(tape, b, level, dist);
     let far = |lo: DVec3, hi: DVec3| (lo - centre).abs().max((hi - centre).abs()).length();
     let near = |lo: DVec3, hi: DVec3| (lo - centre).max(centre - hi).max(DVec3::ZERO).length();
     let mid = centre.clamp(b.min, b.max);

@@ -149,12 +149,8 @@ impl<'a> Builder<'a> {
         let warp = self.last_warp.take().filter(|w| at_root(w.0));
         let walk = if let Some(LastUnion { tree, parts, surfs, k, .. }) = union {
             // Sharp unions are built in render space; smooth ones in their own frame.
-            let (inv, scale) = if k == 0.0 || acc == DAffine3::IDENTITY {
-                (Affine3A::IDENTITY, 1.0)
-            } else {
-                let (inv, stretch) = frame_of(acc);
-                (inv, stretch as f32)
-            };
+            let (inv, scale) = if k == 0.0 { (Affine3A::IDENTITY, 1.0) } else { frame_of(acc) };
+            let scale = scale as f32;
             Walk::Parts(RayParts { inv, scale, tree, parts, surfs, k })
         } else if let (ShapeKind::Field { bounds, lipschitz, .. }, Some((_, body))) = (&node.kind, field) {
             let (inv, stretch) = frame_of(acc);

@@ -37,8 +37,7 @@ struct Reach {
 impl Reach {
     fn of(shape: &ir::Shape, to_render: &DAffine3, known: &mut FieldHulls) -> Reach {
         let bounds = ir::shape_bounds(shape).map(|b| Aabb::padded(b.transform(to_render)));
-        let sphere = ir::shape_sphere_with(shape, &mut |body, b, level| known.sphere(body, b, level))
-            .map(|(c, r)| padded_sphere(to_render.transform_point3(c), r));
+        let sphere = known.sphere_of(shape).map(|(c, r)| padded_sphere(to_render.transform_point3(c), r));
         let half_space = match bounds {
             Some(_) => None,
             None => ir::shape_half_space(shape)
@@ -86,14 +85,18 @@ pub fn shape_hull(shape: &ir::Shape) -> Option<crate::geom::hull::Hull> {
 /// The sphere an object of `shape`'s rays are clipped to: [`ir::shape_sphere`] with
 /// the ball each field's solid is found in (`field::support_radius`).
 pub fn shape_sphere(shape: &ir::Shape) -> Option<(DVec3, f64)> {
-    let mut known = FieldHulls::default();
-    ir::shape_sphere_with(shape, &mut |body, b, level| known.sphere(body, b, level))
+    FieldHulls::default().sphere_of(shape)
 }
 
 impl FieldHulls {
     /// [`shape_hull`], searching each field's planes once per body, box and level.
     fn hull(&mut self, shape: &ir::Shape) -> Option<crate::geom::hull::Hull> {
         ir::shape_hull(shape, &mut |body, b, level| self.planes(body, b, level))
+    }
+
+    /// [`shape_sphere`], searching each field's ball once per body, box and level.
+    fn sphere_of(&mut self, shape: &ir::Shape) -> Option<(DVec3, f64)> {
+        ir::shape_sphere_with(shape, &mut |body, b, level| self.sphere(body, b, level))
     }
 
     /// [`ir::FieldPlanes`]: the planes holding where `body` is at most `level` within
