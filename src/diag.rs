@@ -8,6 +8,8 @@ use std::fmt::Write as _;
 
 use ariadne::{Config, IndexType, Label as ALabel, Report, ReportKind};
 
+pub mod guesses;
+
 use crate::source::SourceMap;
 use crate::span::Span;
 
@@ -382,6 +384,8 @@ pub mod codes {
     pub const CROSSES_SECTOR: &str = "W0008";
     /// A CSG node whose parts crowd one place: every step of a ray there evaluates them all.
     pub const CROWDED_CSG: &str = "W0009";
+    /// Trigonometry in a field body whose argument barely turns: radians written for degrees.
+    pub const SMALL_TURN: &str = "W0010";
     /// Parts of a shape too small for its isosurface's cell, left out of the mesh.
     pub const LOST_PARTS: &str = "W0801";
     /// Isosurface edges left on four triangles where parts are thinner than the cell.

@@ -7,6 +7,7 @@ use super::builtins::{self, Builtin, Ctor, Kind, Ty};
 use super::expr::{ArgVal, BoundArgs, SYNONYMS};
 use super::field::has_sym;
 use super::{Bound, Ctx, Env, Func, Value, MAX_CALL_DEPTH};
+use crate::diag::guesses::guess;
 use crate::diag::{codes, suggest, Diagnostic};
 use crate::ir::dump_num;
 use crate::span::Span;
@@ -81,6 +82,12 @@ impl Ctx<'_> {
             );
             if builtins::lookup(&callee.name, Kind::MeshGenerator).is_some() {
                 d = d.with_hint(format!("`{}` is a mesh generator: try `mesh {}(…)`", callee.name, callee.name));
+            } else if let Some(g) = guess(&callee.name) {
+                // A call of `translate(…)` is OpenSCAD's form, not a misspelling of `at`.
+                match g.replacement.filter(|r| *r != "at") {
+                    Some(r) => d = d.with_replacement(callee.span, r).with_note(g.hint),
+                    None => d = d.with_hint(g.hint),
+                }
             } else if let Some(s) = suggest(&callee.name, candidates.iter().map(String::as_str)) {
                 d = d.with_replacement(callee.span, s);
             } else if matches!(callee.name.as_str(), "camera" | "render") {
@@ -475,6 +482,12 @@ impl Ctx<'_> {
             (Ty::Color | Ty::Paint, Value::Vec3(c)) => {
                 d = d.with_hint(format!("try `rgb({}, {}, {})`", dump_num(c.x), dump_num(c.y), dump_num(c.z)))
             }
+            (Ty::Color | Ty::Paint, Value::Str(name)) => {
+                d = match named_colour(name) {
+                    Some(hex) => d.with_replacement(span, hex),
+                    None => d.with_hint("a colour is written `#rrggbb` or `rgb(r, g, b)`, not as a string"),
+                }
+            }
             (Ty::Color, Value::Pattern(_)) => {
                 d = d.with_note("a pattern paints the surface of the object its material is on; this needs one colour")
             }
@@ -614,4 +627,47 @@ fn first_arg<'a>(o: &Builtin, args: &'a [ArgVal]) -> Option<&'a ArgVal> {
     args.iter()
         .find(|a| a.name.as_ref().is_some_and(|n| n.name == first))
         .or_else(|| args.iter().find(|a| a.name.is_none()))
+}
+
+/// The `#rrggbb` of a colour named as CSS names it, for a colour written as a string.
+fn named_colour(name: &str) -> Option<&'static str> {
+    const NAMES: &[(&str, &str)] = &[
+        ("black", "#000000"),
+        ("white", "#ffffff"),
+        ("red", "#ff0000"),
+        ("green", "#008000"),
+        ("lime", "#00ff00"),
+        ("blue", "#0000ff"),
+        ("yellow", "#ffff00"),
+        ("cyan", "#00ffff"),
+        ("magenta", "#ff00ff"),
+        ("orange", "#ffa500"),
+        ("purple", "#800080"),
+        ("pink", "#ffc0cb"),
+        ("brown", "#a52a2a"),
+        ("gray", "#808080"),
+        ("grey", "#808080"),
+        ("silver", "#c0c0c0"),
+        ("gold", "#ffd700"),
+    ];
+    let name = name.trim().to_ascii_lowercase();
+    NAMES.iter().find(|(n, _)| *n == name).map(|(_, hex)| *hex)
+}
+
+#[cfg(test)]
+mod guess_tests {
+    use super::builtins::{self, Kind};
+    use crate::diag::guesses::GUESSES;
+
+    /// Advice for a word scnc itself defines would hide the real thing; no guess is one,
+    /// and every replacement offered is a word scnc knows.
+    #[test]
+    fn no_guess_is_a_builtin_and_every_replacement_is() {
+        for g in GUESSES {
+            assert!(builtins::overloads(g.word, Kind::Function).is_empty(), "{} is a builtin", g.word);
+            if let Some(r) = g.replacement {
+                assert!(r == "at" || !builtins::overloads(r, Kind::Function).is_empty(), "{} → {r}", g.word);
+            }
+        }
+    }
 }

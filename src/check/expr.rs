@@ -216,7 +216,9 @@ impl Ctx<'_> {
             format!("unknown name `{}`", id.name),
             "not found in this scope",
         );
-        if let Some(s) = suggest(&id.name, candidates.iter().map(String::as_str)) {
+        if let Some(g) = crate::diag::guesses::guess(&id.name) {
+            d = d.with_hint(g.hint);
+        } else if let Some(s) = suggest(&id.name, candidates.iter().map(String::as_str)) {
             d = d.with_replacement(id.span, s);
         } else if builtins::lookup(&id.name, Kind::MeshGenerator).is_some() {
             d = d.with_hint(format!("`{}` is a mesh generator: try `mesh {}(…)`", id.name, id.name));

@@ -10,7 +10,7 @@ use chumsky::input::Input as _;
 use chumsky::prelude::*;
 use logos::Logos;
 
-use crate::diag::{codes, Diagnostic};
+use crate::diag::{codes, guesses, Diagnostic};
 use crate::span::Span;
 pub use token::Token;
 
@@ -230,6 +230,21 @@ fn to_diagnostic(err: &parser::ParseError<'_, '_>) -> Diagnostic {
             }
             if let Some(Token::Ident(word @ ("elif" | "elsif" | "elseif"))) = err.found() {
                 d = d.with_hint(format!("scnc writes `else if`, not `{word}`"));
+            }
+            // A word from another tool where scnc wants its own (`translate` for `at`).
+            if let Some(Token::Ident(word)) = err.found() {
+                if let Some(g) = guesses::guess(word) {
+                    d = d.with_hint(g.hint);
+                    if let Some(r) = g.replacement.filter(|r| *r == "at") {
+                        d = d.with_fix(span, r);
+                    }
+                }
+            }
+            // OpenSCAD's `rotate([…]) shape`: a transform where an expression must start.
+            if let Some(kw @ (Token::Rotate | Token::Scale | Token::At | Token::With)) = err.found() {
+                if expected.contains("expression") {
+                    d = d.with_hint(guesses::postfix_hint(&kw.to_string()));
+                }
             }
             let keyword = err.found().map(|t| t.to_string()).filter(|t| Token::KEYWORDS.contains(&t.as_str()));
             if let (Some(kw), true) = (keyword, expected.contains("identifier")) {

@@ -96,6 +96,45 @@ fn round_up(x: f64) -> f64 {
 /// Slope bounds above this or below its inverse are reported (W0007).
 const STEEP: f64 = 2.5;
 
+/// Trigonometry in a body whose argument turns by less than this many degrees over the
+/// body's domain was most likely written in radians (W0010).
+const SMALL_TURN: f64 = 45.0;
+
+/// The first `sin`, `cos` or `tan` in `body` whose argument depends on the point but
+/// turns by less than [`SMALL_TURN`] over `domain` (the cube from −1 to 1 without one),
+/// with the turn it makes there, sampled on a 5×5×5 grid. Arguments that read `dist`
+/// are left alone: their turn depends on shapes, not on how the author wrote angles.
+fn radians_for_degrees(body: &Arc<Expr>, domain: Option<Aabb>) -> Option<(Arc<Expr>, f64)> {
+    use crate::ir::field::Unary;
+    let (lo, hi) = domain.map_or((DVec3::splat(-1.0), DVec3::splat(1.0)), |b| (b.min, b.max));
+    let mut stack = vec![body];
+    while let Some(e) = stack.pop() {
+        if let Kind::Unary(Unary::Sin | Unary::Cos | Unary::Tan, x) = &e.kind {
+            if x.uses_point() && x.shapes().is_empty() {
+                let (mut min, mut max) = (f64::INFINITY, f64::NEG_INFINITY);
+                for i in 0..125 {
+                    let t = DVec3::new((i % 5) as f64, (i / 5 % 5) as f64, (i / 25) as f64) / 4.0;
+                    let v = x.eval(lo + (hi - lo) * t, &|_, _| 0.0);
+                    let parts = match x.ty {
+                        Ty::Vec3 => v.vec().to_array().to_vec(),
+                        _ => vec![v.num()],
+                    };
+                    for c in parts {
+                        min = min.min(c);
+                        max = max.max(c);
+                    }
+                }
+                let turn = max - min;
+                if turn.is_finite() && turn > 0.0 && turn < SMALL_TURN {
+                    return Some((e.clone(), turn));
+                }
+            }
+        }
+        stack.extend(e.operands());
+    }
+    None
+}
+
 /// Most operations one field body may have after folding (shared ones once).
 pub const MAX_FIELD_OPS: usize = 100_000;
 
@@ -110,6 +149,7 @@ impl Ctx<'_> {
                 let bounds = self.bounds(bounds, a.span_of("bounds"))?;
                 let tape = self.field_tape(&lit.body, lit.span)?;
                 let l = self.field_slope(&tape, bounds, given, lit.span, "this field")?;
+                self.check_angles(&lit.body, bounds, lit.span);
                 Some(ShapeKind::Field { body: lit.body.clone(), bounds, lipschitz: l, exact: None, sweep: None })
             }
             FieldFn::Warp => {
@@ -121,6 +161,7 @@ impl Ctx<'_> {
                 let bounds = self.bounds(bounds, a.span_of("bounds"))?;
                 let tape = self.field_tape(&lit.body, lit.span)?;
                 let l = self.field_slope(&tape, bounds, given, lit.span, "this warp")?;
+                self.check_angles(&lit.body, bounds, lit.span);
                 Some(ShapeKind::Warp { child, map: lit.body.clone(), bounds, lipschitz: l, domain_op: None })
             }
             FieldFn::Twist | FieldFn::Bend | FieldFn::Elongate | FieldFn::Symmetric | FieldFn::Polar => None,
@@ -134,6 +175,7 @@ impl Ctx<'_> {
                 let tape = self.field_tape(&lit.body, lit.span)?;
                 let (region, reach) = self.reach(&tape, &child, bounds, lit.span)?;
                 let l = self.field_slope(&tape, region, given, lit.span, "this displacement")?;
+                self.check_angles(&lit.body, region, lit.span);
                 // A displacement's slope adds to the shape's 1: only the sum is far from 1.
                 Some(ShapeKind::Displace { child, by: lit.body.clone(), bounds, lipschitz: l, reach })
             }
@@ -220,6 +262,29 @@ impl Ctx<'_> {
             return None;
         }
         Some(tape)
+    }
+
+    /// Warns (W0010) when the body's trigonometry barely turns over `domain`.
+    fn check_angles(&mut self, body: &Arc<Expr>, domain: Option<Aabb>, span: Span) {
+        let Some((call, turn)) = radians_for_degrees(body, domain) else { return };
+        let shown = call.source(60);
+        let over = if domain.is_some() { "its `bounds`" } else { "the cube from -1 to 1" };
+        let (name, arg) = match &call.kind {
+            Kind::Unary(f, x) => (f.name(), x.source(60)),
+            _ => ("sin", String::new()),
+        };
+        self.report(
+            Diagnostic::warning(
+                codes::SMALL_TURN,
+                span,
+                format!("`{shown}` turns by only {}° over {over}: `{name}` takes degrees", crate::sig::short(turn)),
+                "in this body",
+            )
+            .with_note("trigonometry in scnc takes degrees, as in OpenSCAD and POV-Ray; shaders take radians")
+            .with_hint(format!(
+                "for radians write `{name}(({arg}) * 180 / pi)`; for a wave of period T, `{name}(360 * … / T)`"
+            )),
+        );
     }
 
     /// What the body's slope is bounded by: `given`, or estimated over `domain`;

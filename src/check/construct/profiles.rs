@@ -5,6 +5,7 @@
 //! expression of the point `[u, v, 0]`; a sweep substitutes the solid's point into it
 //! and is a `field` with bound 1, exact where the profile is.
 
+use crate::ir::dump_num;
 use std::sync::Arc;
 
 use glam::{DVec2, DVec3};
@@ -499,11 +500,21 @@ impl Ctx<'_> {
                     segments_meet(a0, a1, b0, b1)
                 };
                 if meet {
-                    return bad(
-                        self,
-                        format!("edges {} and {} of the polygon cross", i + 1, j + 1),
-                        "a polygon's edges may meet only at shared corners",
+                    // Name each edge by its corners, index and place, so the crossing can be
+                    // found in a list a comprehension made.
+                    // Four decimals: enough to find the corner, short enough to read.
+                    let c = |x: f64| dump_num((x * 1e4).round() / 1e4 + 0.0);
+                    let corner = |k: usize| format!("{} [{}, {}]", k + 1, c(corners[k].x), c(corners[k].y));
+                    let what = format!(
+                        "edges {} and {} of the polygon cross: corners {} → {} and {} → {}",
+                        i + 1,
+                        j + 1,
+                        corner(i),
+                        corner((i + 1) % n),
+                        corner(j),
+                        corner((j + 1) % n)
                     );
+                    return bad(self, what, "a polygon's edges may meet only at shared corners");
                 }
             }
         }
