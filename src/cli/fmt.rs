@@ -9,10 +9,12 @@ use scnc::source::{FsLoader, Loader};
 use super::files::{cannot_write, write_text};
 use super::{report_in, MessageFormat};
 
-/// Formats each file in place, or with `check` lists those that would change.
-pub(crate) fn fmt_cmd(files: &[PathBuf], check: bool) -> ExitCode {
+/// Formats each file in place, or with `check` lists those that would change; then says
+/// how many changed unless `quiet`.
+pub(crate) fn fmt_cmd(files: &[PathBuf], check: bool, quiet: bool) -> ExitCode {
     let mut failed = false;
     let mut unformatted = false;
+    let mut changed = 0;
     for path in files {
         let name = path.display().to_string();
         let text = match FsLoader.read(path) {
@@ -43,7 +45,12 @@ pub(crate) fn fmt_cmd(files: &[PathBuf], check: bool) -> ExitCode {
         } else if let Err(e) = write_text(path, &formatted) {
             let _ = writeln!(std::io::stderr(), "error: {}", cannot_write(path, &e));
             failed = true;
+        } else {
+            changed += 1;
         }
+    }
+    if !quiet && !check {
+        let _ = writeln!(std::io::stderr(), "{changed} of {} changed", super::plural(files.len(), "file"));
     }
     if failed || unformatted {
         ExitCode::from(1)

@@ -59,6 +59,9 @@ enum Command {
         /// How to print diagnostics.
         #[arg(long, value_enum, default_value = "human")]
         message_format: MessageFormat,
+        /// Print nothing on success (no summary line).
+        #[arg(long, short)]
+        quiet: bool,
     },
     /// Render a scene to an image (written whole or not at all).
     Render(RenderArgs),
@@ -90,6 +93,9 @@ enum Command {
         /// Change nothing; list the files that would change and exit 1 if there are any.
         #[arg(long)]
         check: bool,
+        /// Print nothing but errors (no summary line).
+        #[arg(long, short)]
+        quiet: bool,
     },
     /// Print the evaluated scene IR.
     Ir {
@@ -207,7 +213,7 @@ fn run(cli: Cli) -> ExitCode {
         Command::Studio(args) => studio::studio_cmd(args),
         Command::Merge(args) => merge::merge_cmd(args),
         Command::Encode(args) => encode::encode_cmd(args),
-        Command::Fmt { files, check } => fmt::fmt_cmd(&files, check),
+        Command::Fmt { files, check, quiet } => fmt::fmt_cmd(&files, check, quiet),
         Command::Lsp => match scnc::lsp::run_stdio(|why| {
             let _ = writeln!(std::io::stderr(), "scnc lsp: {why}");
         }) {
@@ -217,16 +223,37 @@ fn run(cli: Cli) -> ExitCode {
                 ExitCode::from(1)
             }
         },
-        Command::Check { files, message_format } => {
+        Command::Check { files, message_format, quiet } => {
             let mut failed = false;
+            let (mut objects, mut lights, mut warnings) = (0, 0, 0);
             for file in &files {
-                failed |= compile(file, message_format).is_none_or(|c| report(&c, message_format));
+                match compile(file, message_format) {
+                    Some(c) => {
+                        failed |= report(&c, message_format);
+                        warnings += c.diagnostics.iter().filter(|d| !d.is_error()).count();
+                        if let Some(scene) = &c.scene {
+                            objects += scene.objects.len();
+                            lights += scene.lights.len();
+                        }
+                    }
+                    None => failed = true,
+                }
             }
             if failed {
-                ExitCode::from(1)
-            } else {
-                ExitCode::SUCCESS
+                return ExitCode::from(1);
             }
+            // One line on success, as cargo says `Finished`: silence reads as "did it run?".
+            if !quiet && message_format == MessageFormat::Human {
+                let files = if files.len() > 1 { format!("{} files, ", files.len()) } else { String::new() };
+                let _ = writeln!(
+                    std::io::stderr(),
+                    "ok: {files}{}, {}, {}",
+                    plural(objects, "object"),
+                    plural(lights, "light"),
+                    plural(warnings, "warning")
+                );
+            }
+            ExitCode::SUCCESS
         }
         Command::Ir { file, frame, message_format } => {
             let Some(mut compiled) = compile(&file, message_format) else { return ExitCode::from(1) };
@@ -257,6 +284,11 @@ fn run(cli: Cli) -> ExitCode {
             ExitCode::SUCCESS
         }
     }
+}
+
+/// `n thing` or `n things`.
+pub(crate) fn plural(n: usize, thing: &str) -> String {
+    format!("{n} {thing}{}", if n == 1 { "" } else { "s" })
 }
 
 /// Parses the arguments and runs the command.

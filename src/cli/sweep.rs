@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use scnc::source::FsLoader;
-use scnc::study::sweep::{Options, PeakMemory, Setting};
+use scnc::study::sweep::{Options, PeakMemory, Step};
 use scnc::study::tolerance::Tolerance;
 use scnc::study::{chart, report as table, sweep};
 
@@ -60,17 +60,35 @@ pub(crate) fn sweep_cmd(args: SweepArgs) -> ExitCode {
         Some(tol) => sweep::picked(&scene, tol),
         None => sweep::ladder(args.quick),
     };
+    // A bar on a terminal; elsewhere (CI, a pipe) one line per step, so a long sweep is
+    // never silent.
     let bar = std::io::stderr().is_terminal().then(|| {
         let bar = indicatif::ProgressBar::new(ladder.len() as u64);
-        if let Ok(style) = indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} settings, {msg}") {
+        if let Ok(style) = indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} settings, {msg} ({elapsed})") {
             bar.set_style(style);
         }
+        bar.enable_steady_tick(std::time::Duration::from_millis(200));
         bar
     });
-    let progress = |s: &Setting| {
-        if let Some(bar) = &bar {
-            bar.set_message(format!("{} {}", s.backend(), s.label()));
-            bar.inc(1);
+    let started = std::time::Instant::now();
+    let progress = |step: Step<'_>| {
+        let what = match step {
+            Step::Reference => "the reference render (SDF, epsilon 1e-6)".to_string(),
+            Step::Measured { setting, done, total } => {
+                format!("measured {done}/{total}: {} {}", setting.backend(), setting.label())
+            }
+            Step::Timing { round, open } => format!("timing round {round}: {open} settings"),
+        };
+        match &bar {
+            Some(bar) => {
+                if let Step::Measured { done, .. } = step {
+                    bar.set_position(done as u64);
+                }
+                bar.set_message(what);
+            }
+            None => {
+                let _ = writeln!(std::io::stderr(), "sweep: {what} ({:.1} s)", started.elapsed().as_secs_f64());
+            }
         }
     };
     let opts = Options {

@@ -220,6 +220,7 @@ fn time_rounds(settings: &[(Scene, Mode)], opts: &Options<'_>) -> Result<Vec<Tim
     let mut cpu: Vec<Option<f64>> = vec![Some(0.0); settings.len()];
     let started = Instant::now();
     let cap = opts.cap * settings.len() as f64;
+    let mut round = 0;
     loop {
         let open: Vec<usize> = (0..settings.len())
             .filter(|&i| {
@@ -231,6 +232,8 @@ fn time_rounds(settings: &[(Scene, Mode)], opts: &Options<'_>) -> Result<Vec<Tim
         if open.is_empty() || capped {
             break;
         }
+        round += 1;
+        (opts.progress)(Step::Timing { round, open: open.len() });
         for i in open {
             let (scene, mode) = &settings[i];
             let before = (opts.cpu_seconds)();
@@ -285,14 +288,38 @@ pub struct Options<'a> {
     pub loader: &'a dyn Loader,
     /// Measures peak memory per setting.
     pub memory: &'a dyn PeakMemory,
-    /// Called after each setting's first render (its accuracy is known; its timing
-    /// comes after all of them, in rounds).
-    pub progress: &'a dyn Fn(&Setting),
+    /// Told where the sweep is: the reference render, each setting's first render (its
+    /// accuracy known), then each round of timing.
+    pub progress: &'a dyn Fn(Step<'_>),
+}
+
+/// A point a sweep reports reaching, for a progress display.
+#[derive(Clone, Copy, Debug)]
+pub enum Step<'a> {
+    /// The many-step reference render is starting.
+    Reference,
+    /// Setting `done` of `total` has had its first render (accuracy measured).
+    Measured {
+        /// The setting.
+        setting: &'a Setting,
+        /// How many settings are measured, this one included.
+        done: usize,
+        /// How many there are.
+        total: usize,
+    },
+    /// A round of timing renders is starting, with `open` settings still unsettled.
+    Timing {
+        /// The round, from 1.
+        round: usize,
+        /// Settings timed in this round.
+        open: usize,
+    },
 }
 
 /// Runs the ladder on `scene` (already sized).
 pub fn run(scene: &Scene, settings: &[Setting], opts: &Options<'_>) -> Result<Vec<Row>, Diagnostic> {
     let Options { loader, memory, progress, .. } = *opts;
+    progress(Step::Reference);
     let (reference_scene, _) = with_setting(scene, Setting::Sdf { epsilon: 1e-6, max_steps: 100_000 });
     let (ref_frame, ref_world) =
         world::prepare(&reference_scene, effects::derive(&reference_scene), Mode::Sdf, loader)?;
@@ -333,7 +360,7 @@ pub fn run(scene: &Scene, settings: &[Setting], opts: &Options<'_>) -> Result<Ve
             rmse,
             psnr: accuracy::psnr(rmse),
         });
-        progress(&setting);
+        progress(Step::Measured { setting: &setting, done: rows.len(), total: settings.len() });
     }
     // Then how long each takes, all timed in rounds; rays per second from the median.
     for (row, (times, cpu_ms)) in rows.iter_mut().zip(time_rounds(&variants, opts)?) {

@@ -6,7 +6,13 @@ use crate::support::{ok, refused, scnc};
 fn check_clean_file_exits_0() {
     let out = scnc(&["check", "examples/seed/07-box-sphere-cylinder.scn"]);
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
-    assert!(out.stderr.is_empty());
+    // One summary line, on stderr; nothing with `--quiet`.
+    assert_eq!(String::from_utf8_lossy(&out.stderr), "ok: 3 objects, 3 lights, 0 warnings\n");
+    assert!(out.stdout.is_empty());
+    let out = scnc(&["check", "--quiet", "examples/seed/07-box-sphere-cylinder.scn"]);
+    assert!(out.status.success() && out.stderr.is_empty() && out.stdout.is_empty());
+    let two = ["check", "examples/seed/07-box-sphere-cylinder.scn", "examples/tour.scn"];
+    assert!(String::from_utf8_lossy(&scnc(&two).stderr).starts_with("ok: 2 files, "));
 }
 
 #[test]
@@ -164,6 +170,16 @@ fn sweep_writes_csv_with_monotone_errors() {
         "--quick",
     ]);
     assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    // Not a terminal: a line per step instead of a bar, so a long sweep is never silent.
+    let said = String::from_utf8_lossy(&o.stderr);
+    for step in [
+        "sweep: the reference render",
+        "sweep: measured 1/4: sdf",
+        "sweep: measured 4/4: mesh",
+        "sweep: timing round 1: 4 settings",
+    ] {
+        assert!(said.contains(step), "no `{step}` in:\n{said}");
+    }
     let csv = std::fs::read_to_string(dir.path().join("sweep.csv")).expect("sweep.csv");
     let mut lines = csv.lines();
     // The documented columns (README, "scnc sweep"), in order.
@@ -388,6 +404,8 @@ fn fmt_rewrites_in_place_and_check_lists_what_would_change() {
 
     let out = scnc(&["fmt", &path(&messy), &path(&clean)]);
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(String::from_utf8_lossy(&out.stderr), "1 of 2 files changed\n");
+    assert!(scnc(&["fmt", "-q", &path(&clean)]).stderr.is_empty());
     let formatted = std::fs::read_to_string(&messy).expect("reading");
     assert_eq!(formatted, "light ambient(1)\nobject sphere(1) at [0, 0, 5]\n");
     assert_eq!(scnc(&["fmt", "--check", &path(&messy)]).status.code(), Some(0));
