@@ -111,6 +111,12 @@ impl Memory {
 }
 
 impl World {
+    /// The `object` statement of the object a [`Hit`](crate::trace::Hit) names, if any
+    /// (the studio's click on the preview selects it).
+    pub fn span_of(&self, object: u32) -> Option<Span> {
+        self.objects.get(object as usize).map(|o| o.span)
+    }
+
     /// Memory by structure.
     pub fn memory(&self) -> Memory {
         let mut m = Memory { closure_bytes: self.closure_bytes, top_bvh_bytes: self.bvh.bytes(), ..Memory::default() };

@@ -1,10 +1,10 @@
 // The editor of `scnc studio`: CodeMirror 6 with scn highlighting, and hooks through which
 // the page (studio.js) pushes diagnostics and answers hover and completion from the
 // server. Rebuild with `npm ci && npm run build` (see ../README.md, "Studio").
-import { EditorState } from "@codemirror/state";
+import { EditorState, StateEffect, StateField } from "@codemirror/state";
 import {
   EditorView, keymap, lineNumbers, highlightActiveLine, highlightActiveLineGutter,
-  drawSelection, hoverTooltip,
+  drawSelection, hoverTooltip, showTooltip,
 } from "@codemirror/view";
 import { defaultKeymap, history, historyKeymap, indentWithTab } from "@codemirror/commands";
 import {
@@ -42,9 +42,105 @@ const scn = StreamLanguage.define({
 });
 
 /**
+ * The hover docs' Markdown as DOM nodes (never as HTML text): fenced code blocks,
+ * paragraphs, "- " lists, and `code` and **bold** within them, which is all the
+ * builtins' docs use.
+ */
+export function markdown(text) {
+  const root = document.createElement("div");
+  // Even pieces are prose, odd ones code (split on the fences).
+  const pieces = text.split(/```[a-z]*\n?/);
+  pieces.forEach((piece, i) => {
+    if (i % 2 === 1) {
+      const pre = document.createElement("pre");
+      pre.className = "scn-hover-code";
+      pre.textContent = piece.replace(/\n$/, "");
+      root.append(pre);
+      return;
+    }
+    for (const para of piece.split(/\n\s*\n/)) {
+      if (!para.trim()) continue;
+      // Runs of lines starting "- " are lists; the lines between them, paragraphs.
+      let list = null, prose = [];
+      const flush = () => {
+        if (prose.length) { const p = document.createElement("p"); inline(p, prose.join(" ")); root.append(p); prose = []; }
+      };
+      for (const line of para.trim().split("\n")) {
+        if (line.trimStart().startsWith("- ")) {
+          flush();
+          if (!list) { list = document.createElement("ul"); root.append(list); }
+          const li = document.createElement("li");
+          inline(li, line.trimStart().slice(2));
+          list.append(li);
+        } else {
+          list = null;
+          prose.push(line.trim());
+        }
+      }
+      flush();
+    }
+  });
+  return root;
+}
+
+/** Appends `text` to `el` with its `code` and **bold** spans as elements. */
+function inline(el, text) {
+  for (const part of text.split(/(`[^`]+`|\*\*[^*]+\*\*)/)) {
+    if (!part) continue;
+    if (part.startsWith("`") && part.endsWith("`") && part.length > 1) {
+      const c = document.createElement("code");
+      c.textContent = part.slice(1, -1);
+      el.append(c);
+    } else if (part.startsWith("**") && part.endsWith("**") && part.length > 3) {
+      const b = document.createElement("strong");
+      b.textContent = part.slice(2, -2);
+      el.append(b);
+    } else {
+      el.append(document.createTextNode(part));
+    }
+  }
+}
+
+/** The signature shown while the cursor is in a builtin's call (null when none). */
+const setSignature = StateEffect.define();
+const signatureField = StateField.define({
+  create: () => null,
+  update(value, tr) {
+    for (const e of tr.effects) if (e.is(setSignature)) value = e.value;
+    if (value && tr.docChanged) value = { ...value, pos: tr.changes.mapPos(value.pos) };
+    return value;
+  },
+  provide: (field) => showTooltip.from(field, (sig) => sig && {
+    pos: sig.pos, above: true, strictSide: false,
+    create() {
+      const dom = document.createElement("div");
+      dom.className = "scn-signature";
+      dom.dataset.testid = "signature";
+      const head = document.createElement("div");
+      // The label with the active parameter in bold.
+      const active = sig.active !== null && sig.active !== undefined ? sig.params[sig.active] : null;
+      const at = active ? sig.label.indexOf(active.label) : -1;
+      if (at >= 0) {
+        const b = document.createElement("strong");
+        b.textContent = active.label;
+        head.append(sig.label.slice(0, at), b, sig.label.slice(at + active.label.length));
+      } else {
+        head.textContent = sig.label;
+      }
+      dom.append(head);
+      const doc = document.createElement("div");
+      doc.className = "scn-signature-doc";
+      doc.textContent = active ? active.doc : sig.doc;
+      dom.append(doc);
+      return { dom };
+    },
+  }),
+});
+
+/**
  * Makes the editor in `parent` holding `text`. `hooks`: `change(text)` after every edit,
- * `save()` on Mod-s, `format()` on Shift-Alt-f, `hover(pos)` and `complete(pos)` returning
- * promises of the server's answers.
+ * `save()` on Mod-s, `format()` on Shift-Alt-f, `hover(pos)`, `complete(pos)` and
+ * `signature(pos)` returning promises of the server's answers.
  */
 export function create(parent, text, hooks) {
   const hover = hoverTooltip(async (view, pos) => {
@@ -55,7 +151,8 @@ export function create(parent, text, hooks) {
       create() {
         const dom = document.createElement("div");
         dom.className = "scn-hover";
-        dom.textContent = h.text;
+        dom.dataset.testid = "hover";
+        dom.append(markdown(h.text));
         return { dom };
       },
     };
@@ -81,9 +178,27 @@ export function create(parent, text, hooks) {
       syntaxHighlighting(defaultHighlightStyle, { fallback: true }), scn, lintGutter(), hover,
       autocompletion({ override: [complete] }),
       keymap.of([...keys, ...closeBracketsKeymap, ...defaultKeymap, ...searchKeymap, ...historyKeymap, indentWithTab]),
-      EditorView.updateListener.of((u) => { if (u.docChanged) hooks.change(u.state.doc.toString()); }),
+      EditorView.updateListener.of((u) => {
+        if (u.docChanged) hooks.change(u.state.doc.toString());
+        if (u.docChanged || u.selectionSet) askSignature(u.view);
+      }),
+      EditorView.lineWrapping, signatureField,
     ],
   });
+  // The signature of the call the cursor is in, asked for once typing pauses.
+  let timer = null;
+  let asked = 0;
+  function askSignature(view) {
+    clearTimeout(timer);
+    timer = setTimeout(async () => {
+      const pos = view.state.selection.main.head;
+      const seq = ++asked;
+      let sig = null;
+      try { sig = await hooks.signature(pos); } catch (e) { sig = null; }
+      if (seq !== asked || view.state.selection.main.head !== pos) return;
+      view.dispatch({ effects: setSignature.of(sig ? { ...sig, pos } : null) });
+    }, 120);
+  }
   return new EditorView({ state, parent });
 }
 

@@ -18,6 +18,8 @@ use super::Studio;
 pub(crate) fn file(studio: &Studio) -> Reply {
     match studio.files.text() {
         Ok(text) => Reply::json(&serde_json::json!({
+            // A new or empty file opens with a scene to start from (unsaved until saved).
+            "starter": text.trim().is_empty().then_some(super::examples::STARTER),
             "text": text,
             "name": studio.files.root.file_name().map(|n| n.to_string_lossy().into_owned()),
             "path": studio.files.root.display().to_string(),
@@ -46,6 +48,20 @@ pub(crate) fn hover(studio: &Studio, text: String, pos: u32) -> Reply {
         let root = a.text();
         serde_json::json!({
             "from": to_utf16(root, span.start as usize), "to": to_utf16(root, span.end as usize), "text": doc,
+        })
+    });
+    Reply::json(&answer.unwrap_or(serde_json::Value::Null))
+}
+
+/// The signature of the builtin call at UTF-16 position `pos`: its label, doc, each
+/// parameter's text and doc, and the one the cursor is at; `null` outside a call.
+pub(crate) fn signature(studio: &Studio, text: String, pos: u32) -> Reply {
+    let at = to_byte(&text, pos);
+    let a = analyse(studio, text);
+    let answer = a.signature_help(at).map(|h| {
+        serde_json::json!({
+            "label": h.label, "doc": h.doc, "active": h.active,
+            "params": h.params.iter().map(|(p, doc)| serde_json::json!({ "label": p, "doc": doc })).collect::<Vec<_>>(),
         })
     });
     Reply::json(&answer.unwrap_or(serde_json::Value::Null))

@@ -7,6 +7,7 @@
 //! - [`diagnostics`]: diagnostics and text positions as the page counts them;
 //! - [`edit`]: the editor's questions (check, hover, completion, format, save, the
 //!   camera line) and export;
+//! - [`examples`]: the Examples menu and the scene a new file starts from;
 //! - [`preview`]: renders, coarse first then the full frame in bands, the newest
 //!   request winning;
 //! - [`files`]: the one file it edits, the includes below its directory, and the
@@ -14,6 +15,7 @@
 
 mod diagnostics;
 mod edit;
+mod examples;
 mod files;
 mod http;
 mod preview;
@@ -157,6 +159,8 @@ const STUDIO_JS: &str = include_str!("assets/studio.js");
 const STUDIO_CSS: &str = include_str!("assets/studio.css");
 /// CodeMirror 6, bundled by `studio/` (`npm ci && npm run build`).
 const EDITOR_JS: &str = include_str!("assets/editor.js");
+/// The tab's icon (browsers ask for `/favicon.ico` when a page names none).
+const FAVICON: &str = include_str!("assets/favicon.svg");
 
 fn handle(studio: &Arc<Studio>, request: tiny_http::Request) {
     let mut req = Req::new(request);
@@ -170,7 +174,9 @@ fn handle(studio: &Arc<Studio>, request: tiny_http::Request) {
         ("GET", "/assets/studio.js") => Reply::asset("text/javascript; charset=utf-8", STUDIO_JS),
         ("GET", "/assets/studio.css") => Reply::asset("text/css; charset=utf-8", STUDIO_CSS),
         ("GET", "/assets/editor.js") => Reply::asset("text/javascript; charset=utf-8", EDITOR_JS),
+        ("GET", "/favicon.svg" | "/favicon.ico") => Reply::asset("image/svg+xml", FAVICON),
         ("GET", "/api/file") => edit::file(studio),
+        ("GET", "/api/examples") => Reply::json(&examples::json()),
         ("GET", "/api/events") => return studio.files.subscribe(req),
         ("POST", "/api/render") => return preview::render(studio, req),
         ("POST", path) if path.starts_with("/api/") => match req.body() {
@@ -178,6 +184,11 @@ fn handle(studio: &Arc<Studio>, request: tiny_http::Request) {
                 "/api/check" => edit::check(studio, text),
                 "/api/hover" => edit::hover(studio, text, req.query_u32("pos")),
                 "/api/complete" => edit::complete(studio, text, req.query_u32("pos")),
+                "/api/signature" => edit::signature(studio, text, req.query_u32("pos")),
+                "/api/pick" => {
+                    let at = |k: &str| req.query(k).and_then(|v| v.parse::<f64>().ok()).unwrap_or(-1.0);
+                    preview::pick(studio, text, &preview::View::from_query(&req), at("x"), at("y"))
+                }
                 "/api/format" => edit::format(text),
                 "/api/save" => edit::save(studio, text),
                 "/api/camera" => edit::camera_line(studio, text, &preview::View::from_query(&req)),

@@ -20,9 +20,9 @@ use scnc::render::{Frame, Image, Region};
 use scnc::trace::Counters;
 use scnc::world::{Mode, World};
 
-use super::diagnostics::diagnostics_json;
+use super::diagnostics::{diagnostics_json, to_utf16};
 use super::files::lock;
-use super::http::{Req, Stream};
+use super::http::{Reply, Req, Stream};
 use super::Studio;
 
 /// The hit thresholds of the accuracy slider, coarse to fine (the last is the reference).
@@ -36,6 +36,8 @@ const BAND_ROWS: u32 = 16;
 /// Longest full frame the studio starts, as estimated from the coarse one: past it the
 /// preview stays coarse and says so.
 const MAX_FULL_SECONDS: f64 = 30.0;
+/// A full frame estimated to take longer than this is announced with its estimate.
+const SLOW_FULL_SECONDS: f64 = 1.0;
 /// A pixel "differs" from the reference past this many steps of 255 in any channel.
 const DIFF_THRESHOLD: u8 = 16;
 
@@ -139,6 +141,26 @@ pub(crate) fn render(studio: &Arc<Studio>, mut req: Req) {
     let _ = run(studio, &text, &ask, &mut out, &current);
 }
 
+/// The object under the point `(x, y)` of the preview (fractions of its width and
+/// height) with the page's view: the span of its `object` statement, in the page's
+/// UTF-16 offsets, or `null` where the ray meets nothing (or the text has errors).
+pub(crate) fn pick(studio: &Studio, text: String, view: &View, x: f64, y: f64) -> Reply {
+    let mut compiled = studio.files.compile(text);
+    let Some(mut scene) = compiled.scene.take() else { return Reply::json(&serde_json::Value::Null) };
+    scene.camera = view.apply(&scene.camera);
+    let Ok((frame, world)) = lower(studio, &scene, Mode::Sdf) else { return Reply::json(&serde_json::Value::Null) };
+    let (px, py) = ((x.clamp(0.0, 1.0) * frame.width as f64) as f32, (y.clamp(0.0, 1.0) * frame.height as f64) as f32);
+    let ray = scnc::trace::Ray::new(glam::Vec3A::ZERO, frame.direction(px, py), frame.max_distance);
+    let hit = scnc::trace::Geometry::intersect(&world, &ray, &mut Counters::default());
+    let span = hit.and_then(|h| world.span_of(h.object)).filter(|s| compiled.map.file_of(*s).0 == 0);
+    let answer = span.map(|s| {
+        let root = compiled.map.file(scnc::source::FileId(0));
+        let at = |b: u32| to_utf16(&root.text, (b - root.base) as usize);
+        serde_json::json!({ "from": at(s.start), "to": at(s.end) })
+    });
+    Reply::json(&answer.unwrap_or(serde_json::Value::Null))
+}
+
 /// What the page asked for.
 struct Ask {
     view: View,
@@ -234,6 +256,13 @@ fn run(studio: &Studio, text: &str, ask: &Ask, out: &mut Stream, current: &dyn F
         trace_s = t.elapsed().as_secs_f64();
         send_band(out, 0, &image)?;
         let estimate = trace_s * (ask.coarse * ask.coarse) as f64;
+        if estimate > SLOW_FULL_SECONDS && estimate <= MAX_FULL_SECONDS {
+            // Said before the wait, not after it: an edit that makes the scene slow (a
+            // camera moved into a mirror sphere) is seen as such at once.
+            let note =
+                format!("the full frame will take about {estimate:.1} s: it replaces this coarse image band by band");
+            json_message(out, b'N', serde_json::json!({ "note": note, "estimate_s": estimate }))?;
+        }
         if estimate > MAX_FULL_SECONDS {
             let note = format!(
                 "the full frame would take about {estimate:.0} s: showing the coarse preview; `scnc render` makes it"

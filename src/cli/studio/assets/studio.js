@@ -116,10 +116,17 @@ async function render(sourceText, opts = {}) {
   const controller = new AbortController();
   state.render = controller;
   const started = performance.now();
+  const view = JSON.stringify(state.view);
   let level = null;
   let firstImageMs = null;
   canvas.dataset.busy = "1";
   $("note").textContent = "";
+  // Never show an older render's figures as this one's: they wait, greyed, until this
+  // render's own arrive.
+  $("busy").hidden = false;
+  $("status").classList.add("stale");
+  $("accuracy-result").classList.add("stale");
+  if (state.rung !== null) $("accuracy-result").textContent = `rung ${state.rung + 1} of 6: measuring…`;
   try {
     const r = await fetch(`/api/render?${query({ coarse: opts.coarse ?? 4 })}`, {
       method: "POST", body: sourceText, signal: controller.signal,
@@ -164,6 +171,7 @@ async function render(sourceText, opts = {}) {
           const total = performance.now() - started;
           canvas.dataset.fullMs = total.toFixed(1);
           canvas.dataset.renders = String(Number(canvas.dataset.renders || 0) + 1);
+          $("status").classList.remove("stale");
           $("status").textContent =
             `${s.setting}: first image ${firstImageMs.toFixed(0)} ms after the edit, full frame ${total.toFixed(0)} ms ` +
             `(lower ${s.lower_ms.toFixed(0)} ms, trace ${s.full_ms.toFixed(0)} ms, ${s.rays} rays)`;
@@ -173,24 +181,36 @@ async function render(sourceText, opts = {}) {
         }
         case "A": {
           const a = json(payload);
+          $("accuracy-result").classList.remove("stale");
+          $("accuracy-result").dataset.rung = String(a.rung);
           $("accuracy-result").textContent =
             `rung ${a.rung + 1} of ${a.rungs}: ${a.ms.toFixed(0)} ms, ${a.differing_percent.toFixed(2)} % of pixels off by more than ` +
             `${a.threshold}/255 and RMSE ${a.rmse.toFixed(4)} against the finest rung (${a.reference_ms.toFixed(0)} ms)`;
           break;
         }
         case "N": $("note").textContent = json(payload).note; break;
-        case "E": showDiagnostics(json(payload)); $("status").textContent = "not rendered: the scene has errors (the last image stays)"; break;
+        case "E":
+          showDiagnostics(json(payload));
+          $("status").classList.remove("stale");
+          $("status").textContent = "not rendered: the scene has errors (the last image stays)";
+          break;
         case "X": break;
       }
     });
     if (!controller.signal.aborted) {
       // Hooks for tests and automation: renders finished, and whether one is running.
       canvas.dataset.finished = String(Number(canvas.dataset.finished || 0) + 1);
+      canvas.dataset.view = view;
       canvas.dataset.busy = "0";
+      $("busy").hidden = true;
       if (state.playing) scheduleNextFrame();
     }
   } catch (e) {
-    if (e.name !== "AbortError") $("status").textContent = `render failed: ${e.message}`;
+    if (e.name !== "AbortError") {
+      $("status").classList.remove("stale");
+      $("status").textContent = `render failed: ${e.message}`;
+      $("busy").hidden = true;
+    }
   }
 }
 
@@ -237,9 +257,18 @@ async function exportAs(format) {
 
 function viewChanged() { render(ScnEditor.textOf(editor)); }
 
+/** Selects the source of the object under the preview's point `(x, y)` (fractions). */
+async function pick(x, y) {
+  const r = await (await post(`/api/pick?${query({ x, y })}`, ScnEditor.textOf(editor))).json();
+  $("note").textContent = r ? "" : "no object there";
+  if (!r) return;
+  editor.dispatch({ selection: { anchor: r.from, head: r.to }, scrollIntoView: true });
+  editor.focus();
+}
+
 let drag = null;
 canvas.addEventListener("pointerdown", (e) => {
-  drag = { x: e.clientX, y: e.clientY, pan: e.shiftKey };
+  drag = { x: e.clientX, y: e.clientY, pan: e.shiftKey, startX: e.clientX, startY: e.clientY, moved: false };
   canvas.setPointerCapture(e.pointerId);
   canvas.classList.add("dragging");
 });
@@ -247,6 +276,8 @@ canvas.addEventListener("pointermove", (e) => {
   if (!drag) return;
   const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
   drag.x = e.clientX; drag.y = e.clientY;
+  if (Math.abs(e.clientX - drag.startX) + Math.abs(e.clientY - drag.startY) < 3 && !drag.moved) return;
+  drag.moved = true;
   const size = canvas.getBoundingClientRect();
   if (drag.pan) {
     state.view.panx -= dx / size.width * state.view.zoom;
@@ -258,7 +289,14 @@ canvas.addEventListener("pointermove", (e) => {
   viewChanged();
 });
 const endDrag = () => { drag = null; canvas.classList.remove("dragging"); };
-canvas.addEventListener("pointerup", endDrag);
+// A click that did not drag selects the object's line in the editor.
+canvas.addEventListener("pointerup", (e) => {
+  const clicked = drag && !drag.moved;
+  endDrag();
+  if (!clicked) return;
+  const r = canvas.getBoundingClientRect();
+  pick((e.clientX - r.left) / r.width, (e.clientY - r.top) / r.height);
+});
 canvas.addEventListener("pointercancel", endDrag);
 canvas.addEventListener("wheel", (e) => {
   e.preventDefault();
@@ -312,21 +350,47 @@ function rungChanged() {
 $("accuracy-on").onchange = rungChanged;
 $("accuracy").oninput = rungChanged;
 
+// --- examples ------------------------------------------------------------------------
+
+async function loadExamples() {
+  const list = await (await fetch("/api/examples")).json();
+  const menu = $("examples");
+  for (const [i, e] of list.entries()) {
+    const o = document.createElement("option");
+    o.value = String(i);
+    o.textContent = e.name;
+    menu.append(o);
+  }
+  menu.onchange = () => {
+    const e = list[Number(menu.value)];
+    menu.value = "";
+    if (!e) return;
+    state.view = { yaw: 0, pitch: 0, zoom: 1, panx: 0, pany: 0 };
+    ScnEditor.replaceText(editor, e.text);
+    $("saved").textContent = `${e.name}: not saved (Ctrl-S writes it to the file)`;
+  };
+}
+
 // --- start ---------------------------------------------------------------------------
 
 (async () => {
   const file = await (await fetch("/api/file")).json();
   $("file").textContent = file.path;
   document.title = `${file.name} — scnc studio`;
-  editor = ScnEditor.create($("editor"), file.text, {
+  // A new or empty file starts from the tour, unsaved: the file is written on save.
+  const opening = file.starter ?? file.text;
+  editor = ScnEditor.create($("editor"), opening, {
     change: edited,
     save,
     format,
     hover: async (pos) => (await post(`/api/hover?pos=${pos}`, ScnEditor.textOf(editor))).json(),
     complete: async (pos) => (await post(`/api/complete?pos=${pos}`, ScnEditor.textOf(editor))).json(),
+    signature: async (pos) => (await post(`/api/signature?pos=${pos}`, ScnEditor.textOf(editor))).json(),
   });
   window.scnStudio = { editor, state, ScnEditor };
-  edited(file.text);
+  if (file.starter) $("saved").textContent = "new file: a starter scene, not saved yet";
+  edited(opening);
+  loadExamples();
   // The file on disk is the truth: an edit made elsewhere replaces the page's text.
   const events = new EventSource("/api/events");
   events.addEventListener("file", (e) => {
