@@ -1,7 +1,6 @@
 //! The single integration-test binary: every test module links into it.
 
 mod animation;
-mod browser;
 mod budget;
 mod cli;
 mod conformance;
@@ -28,7 +27,7 @@ mod render;
 mod skip;
 mod stability;
 mod studio;
+mod studio_server;
 mod support;
 mod tiles;
-mod validators;
 mod watch;

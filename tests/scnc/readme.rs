@@ -62,7 +62,7 @@ fn shell_commands(markdown: &str) -> Vec<String> {
 
 /// Commands the test does not run itself, and why: it is one (`cargo test`), and an
 /// install builds the release binary the test already has.
-const NOT_RUN: &[&str] = &["cargo test", "cargo install --path ."];
+const NOT_RUN: &[&str] = &["cargo test --release", "cargo install --locked --path ."];
 
 #[test]
 fn every_readme_command_works_on_a_fresh_clone() {
@@ -210,4 +210,50 @@ fn every_scene_shown_is_the_file_it_names() {
         }
     }
     assert!(shown >= 2, "the README's and the language's tours name their files");
+}
+
+/// Every `scn` block of the README and the docs is a scene that compiles without errors
+/// where it stands (an `include` is read from beside the page), so a snippet
+/// pasted into a file works. A block that is only part of a scene says so on the line
+/// before it, `<!-- scn fragment: PREAMBLE -->`, and is checked after that preamble.
+/// A block that names its file (`// examples/tour.scn: …`) is compiled where that file
+/// is, as its includes are relative to it.
+#[test]
+fn every_scene_snippet_compiles() {
+    let mut pages: Vec<PathBuf> = clone_files()
+        .into_iter()
+        .filter(|p| p.starts_with("docs") && p.extension().is_some_and(|e| e == "md"))
+        .collect();
+    pages.push(PathBuf::from("README.md"));
+    let (mut checked, mut failures) = (0, Vec::new());
+    for page in pages {
+        let text = std::fs::read_to_string(&page).expect("reading a page");
+        let mut rest = text.as_str();
+        while let Some(at) = rest.find("```scn\n") {
+            let before = rest[..at].trim_end().lines().last().unwrap_or("");
+            let preamble = before
+                .strip_prefix("<!-- scn fragment:")
+                .and_then(|p| p.strip_suffix("-->"))
+                .map(|p| format!("{}\n", p.trim()))
+                .unwrap_or_default();
+            let body = &rest[at + 7..];
+            let end = body.find("```").expect("a closed block");
+            let block = &body[..end];
+            rest = &body[end + 3..];
+            let line = text[..text.len() - rest.len()].lines().count() - block.lines().count();
+            // A block that names its file is compiled where that file is (its includes
+            // are relative to it); any other as if it stood beside its page.
+            let named = block.strip_prefix("// ").and_then(|l| l.split(':').next()).filter(|n| n.ends_with(".scn"));
+            let path = named.map_or_else(|| page.with_file_name("snippet.scn"), PathBuf::from);
+            let source = format!("{preamble}{block}");
+            let name = format!("{}:{line}", page.display());
+            let c = scnc::with_big_stack(|| scnc::compile_source(&name, &path, source, &scnc::source::FsLoader));
+            if c.diagnostics.iter().any(|d| d.is_error()) || c.scene.is_none() {
+                failures.push(scnc::diag::render_all(&c.diagnostics, &c.map));
+            }
+            checked += 1;
+        }
+    }
+    assert!(failures.is_empty(), "snippets that do not compile:\n{}", failures.join("\n"));
+    assert!(checked >= 3, "only {checked} snippets found");
 }

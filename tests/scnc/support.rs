@@ -177,38 +177,6 @@ impl Rng {
     }
 }
 
-/// Whether the program `name` can be run (a tool some tests drive, such as `nvim` or
-/// `chromium`). Where it cannot, those tests are skipped with a note, unless
-/// `SCNC_REQUIRE_TOOLS=1` (set by `.ci/run`, which installs them) makes that a failure.
-pub fn have_tool(name: &str) -> bool {
-    available(name, std::process::Command::new(name).arg("--version"))
-}
-
-/// Whether Python 3 can import `module` (a validator some tests drive, such as
-/// `lib3mf`), skipped or required as [`have_tool`] says.
-pub fn have_python_module(module: &str) -> bool {
-    available(module, std::process::Command::new("python3").args(["-c", &format!("import {module}")]))
-}
-
-fn available(name: &str, probe: &mut std::process::Command) -> bool {
-    let found = probe
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success());
-    if !found {
-        assert!(
-            std::env::var_os("SCNC_REQUIRE_TOOLS").is_none_or(|v| v != "1"),
-            "`{name}` is required (SCNC_REQUIRE_TOOLS=1) but cannot be run"
-        );
-        #[allow(clippy::print_stderr, reason = "a skipped test says why, where cargo test shows it")]
-        {
-            eprintln!("skipped: `{name}` is not installed");
-        }
-    }
-    found
-}
-
 /// Writes `files` (name, bytes) into a new temporary directory.
 pub fn files(list: &[(&str, &[u8])]) -> tempfile::TempDir {
     let dir = tempfile::tempdir().expect("temp dir");

@@ -148,6 +148,19 @@ impl Browser {
         );
     }
 
+    /// Moves the mouse to `(x, y)` (page pixels) without pressing, as a pointer resting
+    /// over something (a hover) does.
+    pub fn move_to(&mut self, at: (f64, f64)) {
+        self.mouse("mouseMoved", at, 0);
+    }
+
+    /// Clicks at `(x, y)`, page pixels.
+    pub fn click_at(&mut self, at: (f64, f64)) {
+        self.mouse("mouseMoved", at, 0);
+        self.mouse("mousePressed", at, 1);
+        self.mouse("mouseReleased", at, 0);
+    }
+
     /// A left click at the centre of `selector`.
     pub fn click(&mut self, selector: &str) {
         let at = self.centre(selector);

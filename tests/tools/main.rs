@@ -1,0 +1,126 @@
+//! Tests that drive programs which are not ours: Chromium (the studio's page), Neovim
+//! (the editor set-up), admesh and lib3mf (validators of STL and 3MF exports).
+//!
+//! A test whose program is not installed is reported as `ignored` in cargo's own
+//! summary, with the program it needs as its kind (`test [needs chromium]
+//! studio_in_a_browser ... ignored`), so a skipped test is never counted as passed.
+//! With `SCNC_REQUIRE_TOOLS=1` (set by `.ci/run`, which installs them) a missing program
+//! is a failure instead. This binary has its own harness (libtest-mimic) because the
+//! standard one decides what is ignored when it is compiled, not when it runs.
+
+#![allow(dead_code, reason = "the helpers of tests/scnc are shared by path; these tests use some of them")]
+
+mod browser;
+mod neovim;
+mod page;
+#[path = "../scnc/studio_server.rs"]
+mod studio_server;
+#[path = "../scnc/support.rs"]
+mod support;
+mod validators;
+
+use libtest_mimic::{Arguments, Failed, Trial};
+
+/// A program a test drives, and how to tell whether it can run.
+#[derive(Clone, Copy)]
+enum Tool {
+    /// A program on `PATH` that answers `--version`.
+    Program(&'static str),
+    /// A module Python 3 can import.
+    Python(&'static str),
+}
+
+impl Tool {
+    fn name(self) -> &'static str {
+        match self {
+            Tool::Program(n) | Tool::Python(n) => n,
+        }
+    }
+
+    fn available(self) -> bool {
+        let mut probe = match self {
+            Tool::Program(n) => {
+                let mut c = std::process::Command::new(n);
+                c.arg("--version");
+                c
+            }
+            Tool::Python(m) => {
+                let mut c = std::process::Command::new("python3");
+                c.args(["-c", &format!("import {m}")]);
+                c
+            }
+        };
+        probe
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .status()
+            .is_ok_and(|s| s.success())
+    }
+}
+
+/// Whether `.ci/run` asked for every tool to be there.
+fn required() -> bool {
+    std::env::var_os("SCNC_REQUIRE_TOOLS").is_some_and(|v| v == "1")
+}
+
+/// A test that needs `tool`: ignored (visibly) where it is missing, failed where it is
+/// missing but required, run otherwise. `manual` tests (measurements, the README's
+/// picture) are always ignored unless asked for with `--ignored`.
+fn trial(name: &'static str, tool: Tool, manual: bool, test: fn()) -> Trial {
+    let present = tool.available();
+    let missing_but_required = !present && required();
+    let t = Trial::test(name, move || {
+        if !tool.available() {
+            let why = if required() { " (SCNC_REQUIRE_TOOLS=1)" } else { "" };
+            return Err(Failed::from(format!("`{}` is required{why} but cannot be run", tool.name())));
+        }
+        test();
+        Ok(())
+    })
+    .with_kind(format!("needs {}", tool.name()));
+    t.with_ignored_flag(manual || (!present && !missing_but_required))
+}
+
+fn main() {
+    let args = Arguments::from_args();
+    let chromium = Tool::Program("chromium");
+    let trials = vec![
+        trial("studio_in_a_browser", chromium, false, page::studio_in_a_browser),
+        trial("studio_helps_as_you_work", chromium, false, page::studio_helps_as_you_work),
+        trial("studio_latency_on_the_seed_scenes", chromium, true, page::studio_latency_on_the_seed_scenes),
+        trial("studio_screenshot_for_the_readme", chromium, true, page::studio_screenshot_for_the_readme),
+        trial(
+            "neovim_config_attaches_the_server",
+            Tool::Program("nvim"),
+            false,
+            neovim::neovim_config_attaches_the_server,
+        ),
+        trial(
+            "admesh_finds_stl_exports_closed_and_consistent",
+            Tool::Program("admesh"),
+            false,
+            validators::admesh_finds_stl_exports_closed_and_consistent,
+        ),
+        trial(
+            "lib3mf_reads_3mf_exports_strictly",
+            Tool::Python("lib3mf"),
+            false,
+            validators::lib3mf_reads_3mf_exports_strictly,
+        ),
+    ];
+    let missing: Vec<&str> = [chromium, Tool::Program("nvim"), Tool::Program("admesh"), Tool::Python("lib3mf")]
+        .into_iter()
+        .filter(|t| !t.available())
+        .map(Tool::name)
+        .collect();
+    if !missing.is_empty() && !required() {
+        #[allow(clippy::print_stderr, reason = "said once, before the run, where cargo shows it")]
+        {
+            eprintln!(
+                "note: not installed, so their tests are ignored: {} (`.ci/run` installs them)",
+                missing.join(", ")
+            );
+        }
+    }
+    libtest_mimic::run(&args, trials).exit();
+}
