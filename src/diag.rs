@@ -364,6 +364,8 @@ pub mod codes {
     pub const SHAPE_TOO_LARGE: &str = "E0707";
     /// Too many errors: evaluation stopped.
     pub const TOO_MANY_ERRORS: &str = "E0708";
+    /// The operating system refused what a compile needs (its thread's stack).
+    pub const NO_RESOURCES: &str = "E0709";
     /// A render-time failure traced back to the source (e.g. a mesh file that cannot be read).
     pub const LOWERING: &str = "E0800";
     /// Unused `let` binding.

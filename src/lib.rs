@@ -147,15 +147,52 @@ pub fn compile_source(name: &str, path: &Path, text: String, loader: &dyn Loader
     Compiled { map, scene, diagnostics, root: Some(root), reuse }
 }
 
+/// The stack of the thread compiles run on: deep enough for every nesting the limits in
+/// [`check`] and [`syntax`] allow.
+pub const COMPILER_STACK: usize = check::STACK;
+
+/// The operating system refused the compiler's thread (most often an address space
+/// capped below its stack, `ulimit -v`): a coded error, never a panic.
+#[derive(Debug)]
+pub struct NoThread(pub std::io::Error);
+
+impl std::fmt::Display for NoThread {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "cannot start the compiler's thread with its {} MiB stack: {} (is the address space capped, as by `ulimit -v`?)",
+            COMPILER_STACK >> 20,
+            source::io_reason(&self.0)
+        )
+    }
+}
+
+impl NoThread {
+    /// The error as a diagnostic at the start of the file (E0709).
+    pub fn diagnostic(&self) -> Diagnostic {
+        Diagnostic::error(diag::codes::NO_RESOURCES, span::Span::default(), self.to_string(), "not compiled")
+            .with_note("the compiler runs on a thread of its own so that deep nesting cannot overflow the stack")
+    }
+}
+
 /// Runs `f` on a thread with a large stack, so that pathological nesting in user input
-/// (bounded by the limits in [`check`] and [`syntax`]) cannot overflow the stack.
-pub fn with_big_stack<T: Send>(f: impl FnOnce() -> T + Send) -> T {
+/// (bounded by the limits in [`check`] and [`syntax`]) cannot overflow the stack; an
+/// error when the thread cannot be had.
+pub fn with_big_stack<T: Send>(f: impl FnOnce() -> T + Send) -> Result<T, NoThread> {
     std::thread::scope(|s| {
-        std::thread::Builder::new()
-            .stack_size(256 << 20)
-            .spawn_scoped(s, f)
-            .expect("spawning the compiler thread")
-            .join()
-            .unwrap_or_else(|e| std::panic::resume_unwind(e))
+        let thread = std::thread::Builder::new().stack_size(COMPILER_STACK).spawn_scoped(s, f).map_err(NoThread)?;
+        Ok(thread.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+    })
+}
+
+/// [`compile_source`] on a thread of [`COMPILER_STACK`]; when the thread cannot be had,
+/// the file with that error (E0709) and no scene.
+pub fn compile_file(name: &str, path: &Path, text: String, loader: &(dyn Loader + Sync)) -> Compiled {
+    // Kept for the error's source excerpt: the text moves into the thread that may not start.
+    let fallback = text.clone();
+    with_big_stack(|| compile_source(name, path, text, loader)).unwrap_or_else(|e| {
+        let mut map = SourceMap::new();
+        let _ = map.add(name, path, fallback);
+        Compiled { map, scene: None, diagnostics: vec![e.diagnostic()], root: None, reuse: check::Reuse::default() }
     })
 }

@@ -128,11 +128,7 @@ impl Ctx<'_> {
                 }
             },
             ExprKind::Binary { op: op @ (BinOp::And | BinOp::Or), lhs, rhs } => self.logic(*op, lhs, rhs),
-            ExprKind::Binary { op, lhs, rhs } => {
-                let a = self.expr(lhs);
-                let b = self.expr(rhs);
-                self.binary(*op, a, lhs.span, b, rhs.span, e.span)
-            }
+            ExprKind::Binary { .. } => self.binary_chain(e),
             ExprKind::Not(inner) => {
                 let v = self.expr(inner);
                 if let Value::Sym(s) = v {
@@ -352,6 +348,40 @@ impl Ctx<'_> {
             Value::Vec3(v) => Value::Num(v[i as usize]),
             _ => Value::Error,
         }
+    }
+
+    /// A binary operation and the ones down its left operand (`a + b + c + …`, which
+    /// parses as `((a + b) + c) + …`), evaluated in a loop: a long flat expression is
+    /// not a deep one, and only its operands count towards [`MAX_EXPR_DEPTH`].
+    fn binary_chain(&mut self, e: &ast::Expr) -> Value {
+        // `and` and `or` decide whether their right side is evaluated: they stay nodes
+        // of their own (reached through `expr`), never links of the chain.
+        let arithmetic =
+            |x: &ast::Expr| matches!(&x.kind, ExprKind::Binary { op, .. } if !matches!(op, BinOp::And | BinOp::Or));
+        let mut spine = vec![e];
+        while let ExprKind::Binary { lhs, .. } = &spine[spine.len() - 1].kind {
+            if !arithmetic(lhs) {
+                break;
+            }
+            spine.push(lhs);
+        }
+        let Some(ExprKind::Binary { lhs: first, .. }) = spine.last().map(|x| &x.kind) else { return Value::Error };
+        let mut acc = self.expr(first);
+        let mut acc_span = first.span;
+        for (i, node) in spine.iter().enumerate().rev() {
+            let ExprKind::Binary { op, rhs, .. } = &node.kind else { return Value::Error };
+            // Each link costs fuel and is typed for the editor as `expr` does for `e`.
+            if i > 0 && !self.burn(1, node.span) {
+                return Value::Error;
+            }
+            let b = self.expr(rhs);
+            acc = self.binary(*op, acc, acc_span, b, rhs.span, node.span);
+            acc_span = node.span;
+            if let (Some(ix), true) = (&mut self.index, i > 0) {
+                ix.typed(node.span, (!acc.is_error()).then(|| acc.ty_name()));
+            }
+        }
+        acc
     }
 
     fn binary(&mut self, op: BinOp, a: Value, a_span: Span, b: Value, b_span: Span, span: Span) -> Value {

@@ -115,7 +115,7 @@ enum Command {
 pub(crate) fn compile(path: &Path, format: MessageFormat) -> Option<Compiled> {
     let name = path.display().to_string();
     match FsLoader.read(path) {
-        Ok(text) => Some(scnc::with_big_stack(|| scnc::compile_source(&name, path, text, &FsLoader))),
+        Ok(text) => Some(scnc::compile_file(&name, path, text, &FsLoader)),
         Err(e) => {
             let code = scnc::diag::codes::INCLUDE_READ;
             let message = format!("cannot read `{name}`: {}", scnc::source::io_reason(&e));
@@ -270,7 +270,8 @@ fn run(cli: Cli) -> ExitCode {
                         declared.frames
                     ));
                 }
-                let (scene, diagnostics) = scnc::with_big_stack(|| compiled.frame(frame, &declared, &FsLoader));
+                let (scene, diagnostics) = scnc::with_big_stack(|| compiled.frame(frame, &declared, &FsLoader))
+                    .unwrap_or_else(|e| (None, vec![e.diagnostic()]));
                 if report_in(&compiled.map, &diagnostics, message_format) {
                     return ExitCode::from(1);
                 }

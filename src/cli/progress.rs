@@ -35,7 +35,8 @@ impl Progress {
                 bar.set_style(style);
             }
             let (shown, done) = (bar.clone(), done.clone());
-            std::thread::spawn(move || {
+            // Without a thread for it (resources exhausted) the bar simply never shows.
+            let _ = std::thread::Builder::new().spawn(move || {
                 std::thread::sleep(QUIET);
                 if !done.load(Ordering::Acquire) {
                     SHOWN.add(shown.clone());

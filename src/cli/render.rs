@@ -400,7 +400,8 @@ fn evaluate_frame(
     seen: &mut HashSet<DiagnosticKey>,
     format: MessageFormat,
 ) -> Result<scnc::ir::Scene, ExitCode> {
-    let (scene, diagnostics) = scnc::with_big_stack(|| compiled.frame(number, declared, &FsLoader));
+    let (scene, diagnostics) = scnc::with_big_stack(|| compiled.frame(number, declared, &FsLoader))
+        .unwrap_or_else(|e| (None, vec![e.diagnostic()]));
     let clock = Time::of(number, declared).clock;
     let fresh: Vec<_> = diagnostics
         .into_iter()

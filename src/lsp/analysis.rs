@@ -113,9 +113,11 @@ impl Analysis {
         loader: &(dyn Loader + Sync),
         cancel: &(dyn Fn() -> bool + Sync),
     ) -> Option<Analysis> {
-        crate::with_big_stack(|| {
+        let name = path.display().to_string();
+        // The text is kept for the error's excerpt when the compiler's thread cannot start.
+        let fallback = text.clone();
+        let analysed = crate::with_big_stack(|| {
             let mut map = SourceMap::new();
-            let name = path.display().to_string();
             // Too large a document gets `compile_source`'s error, as the same file on disk
             // would (it used to be analysed as if empty).
             if text.len() > crate::source::MAX_FILE_BYTES {
@@ -136,6 +138,11 @@ impl Analysis {
             };
             let (_, diagnostics, index) = check::check_indexed(&mut map, root, loader, cancel)?;
             Some(Analysis { map, diagnostics, index })
+        });
+        analysed.unwrap_or_else(|e| {
+            let mut map = SourceMap::new();
+            let _ = map.add(&name, path, fallback);
+            Some(Analysis { map, diagnostics: vec![e.diagnostic()], index: Index::default() })
         })
     }
 

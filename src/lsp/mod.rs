@@ -43,7 +43,8 @@ pub fn run_stdio(log: impl Fn(String) + Send + 'static) -> Result<(), String> {
     let (sender, to_client) = crossbeam_channel::bounded::<Message>(0);
     let edits = Arc::new(AtomicU64::new(0));
     let edits_read = edits.clone();
-    let reader = std::thread::spawn(move || -> std::io::Result<()> {
+    let no_thread = |e: std::io::Error| format!("cannot start the server's threads: {e}");
+    let reader = std::thread::Builder::new().name("lsp-reader".into()).spawn(move || -> std::io::Result<()> {
         let mut input = std::io::stdin().lock();
         loop {
             match wire::read_frame(&mut input)? {
@@ -63,13 +64,17 @@ pub fn run_stdio(log: impl Fn(String) + Send + 'static) -> Result<(), String> {
             }
         }
     });
-    let writer = std::thread::spawn(move || -> std::io::Result<()> {
-        let mut out = std::io::stdout().lock();
-        for m in to_client {
-            m.write(&mut out)?;
-        }
-        Ok(())
-    });
+    let reader = reader.map_err(no_thread)?;
+    let writer = std::thread::Builder::new()
+        .name("lsp-writer".into())
+        .spawn(move || -> std::io::Result<()> {
+            let mut out = std::io::stdout().lock();
+            for m in to_client {
+                m.write(&mut out)?;
+            }
+            Ok(())
+        })
+        .map_err(no_thread)?;
     let served = serve(&Connection { sender, receiver }, edits);
     // Dropping the connection ends the writer; the reader ends with its input.
     let wrote = writer.join().map_err(|_| "the writer thread panicked".to_string())?;

@@ -37,7 +37,8 @@ fn clock_and_frame_evaluate_per_frame() {
         let mut actual = String::new();
         for k in frames {
             let time = scnc::check::Time::of(k, &declared);
-            let (scene, diags) = scnc::with_big_stack(|| c.frame(k, &declared, &FsLoader));
+            let (scene, diags) =
+                scnc::with_big_stack(|| c.frame(k, &declared, &FsLoader)).expect("the compiler's thread");
             let scene = scene.unwrap_or_else(|| panic!("{}: frame {k}:\n{diags:?}", path.display()));
             actual.push_str(&format!("== frame {k}, clock {}\n", time.clock));
             actual.push_str(&scnc::ir::dump(&scene, &c.map));

@@ -10,7 +10,7 @@ use scnc::source::FsLoader;
 /// The codes of a compile's errors, in order.
 fn error_codes(path: &Path) -> Vec<&'static str> {
     let text = std::fs::read_to_string(path).expect("reading the case");
-    let c = scnc::with_big_stack(|| scnc::compile_source("t.scn", path, text, &FsLoader));
+    let c = scnc::compile_file("t.scn", path, text, &FsLoader);
     c.diagnostics.iter().filter(|d| d.is_error()).map(|d| d.code).collect()
 }
 

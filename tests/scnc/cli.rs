@@ -486,3 +486,34 @@ fn messages_a_newcomer_meets() {
     let out = scnc(&["sweep", "--help"]);
     assert!(String::from_utf8_lossy(&out.stdout).contains("-o, --output <OUTPUT>"));
 }
+
+/// Under an address space too small for the compiler's 256 MiB stack, `check` and
+/// `render` say so with a code and exit 1; they do not panic (101).
+#[test]
+fn a_thread_the_system_refuses_is_an_error_not_a_panic() {
+    let dir = crate::support::files(&[("s.scn", b"light ambient(1)\nobject sphere(1) at [0, 0, 5]\n")]);
+    for args in [&["check", "s.scn"][..], &["render", "s.scn", "-o", "s.png", "--width", "8", "--height", "8"][..]] {
+        let out = crate::support::scnc_capped(200_000, dir.path(), args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains("E0709") && err.contains("cannot start the compiler's thread"), "{args:?}: {err}");
+        assert!(!dir.path().join("s.png").exists(), "a render that did not compile wrote its image");
+    }
+}
+
+/// A long flat expression is not a deep one: a sum of 300 terms compiles (it was E0700,
+/// "nests too deeply"), and a sum of a million terms (a 4 MB file, a parse tree a
+/// million deep) is checked and formatted without overflowing a stack.
+#[test]
+fn long_flat_sums_compile_and_format() {
+    let sum = |n: usize| format!("light ambient(1)\nlet x = {}\nobject sphere(x / {n})\n", vec!["1"; n].join(" + "));
+    let dir = crate::support::files(&[("a.scn", sum(300).as_bytes()), ("b.scn", sum(1_000_000).as_bytes())]);
+    for file in ["a.scn", "b.scn"] {
+        let path = dir.path().join(file);
+        let path = path.to_str().expect("utf-8");
+        for args in [&["check", path][..], &["fmt", "--check", path][..]] {
+            let out = scnc(args);
+            assert_eq!(out.status.code(), Some(0), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+        }
+    }
+}

@@ -31,7 +31,7 @@ fn tokens(text: &str) -> Vec<Token<'_>> {
 /// What a file means: its IR (without source positions) and effects, or its
 /// diagnostics' codes and messages.
 fn meaning(path: &Path, text: String) -> String {
-    let c = scnc::with_big_stack(|| scnc::compile_source("x.scn", path, text, &FsLoader));
+    let c = scnc::compile_file("x.scn", path, text, &FsLoader);
     let mut out: String = c.diagnostics.iter().map(|d| format!("{} {}\n", d.code, d.message)).collect();
     if let Some(scene) = &c.scene {
         for line in scnc::ir::dump(scene, &c.map).lines() {

@@ -47,7 +47,8 @@ fn every_prefix_compiles_or_reports() {
                 compile(&path, text[..end].to_string());
             }
         }
-    });
+    })
+    .expect("the compiler's thread");
 }
 
 #[test]
@@ -121,7 +122,8 @@ fn random_mutations_compile_or_report() {
             let text = String::from_utf8_lossy(&bytes).into_owned();
             compile(path, text);
         }
-    });
+    })
+    .expect("the compiler's thread");
 }
 
 /// Work amplification (nested unclosed blocks, doubling calls, doubling shapes, long
@@ -182,7 +184,8 @@ fn amplified_examples_end_by_a_budget() {
             assert!(c.diagnostics.len() <= 40, "case {n} ({path}): {} diagnostics", c.diagnostics.len());
             let _ = scnc::diag::render_all(&c.diagnostics, &c.map);
         }
-    });
+    })
+    .expect("the compiler's thread");
 }
 
 /// The language server's questions at every position of every example and diagnostic

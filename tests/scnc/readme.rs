@@ -247,7 +247,7 @@ fn every_scene_snippet_compiles() {
             let path = named.map_or_else(|| page.with_file_name("snippet.scn"), PathBuf::from);
             let source = format!("{preamble}{block}");
             let name = format!("{}:{line}", page.display());
-            let c = scnc::with_big_stack(|| scnc::compile_source(&name, &path, source, &scnc::source::FsLoader));
+            let c = scnc::compile_file(&name, &path, source, &scnc::source::FsLoader);
             if c.diagnostics.iter().any(|d| d.is_error()) || c.scene.is_none() {
                 failures.push(scnc::diag::render_all(&c.diagnostics, &c.map));
             }

@@ -30,6 +30,23 @@ fn studio_refuses_other_hosts_origins_paths_and_methods() {
         assert!(!String::from_utf8_lossy(&body).contains("root:"), "{path}");
     }
     assert_eq!(s.raw("DELETE", "/", &[], b"").0, 405);
+    // HEAD is answered with GET's head; a second `Host` or `Origin` is refused (RFC 9112),
+    // even when the first is this server's.
+    let head = |lines: &str| {
+        let mut c = TcpStream::connect(("127.0.0.1", s.port)).unwrap();
+        c.set_read_timeout(Some(std::time::Duration::from_secs(60))).unwrap();
+        let ours = format!("127.0.0.1:{}", s.port);
+        write!(c, "{}\r\nConnection: close\r\n\r\n", lines.replace("OURS", &ours)).unwrap();
+        let mut reply = String::new();
+        let _ = c.read_to_string(&mut reply);
+        reply
+    };
+    let reply = head("HEAD / HTTP/1.1\r\nHost: OURS");
+    assert!(reply.starts_with("HTTP/1.1 200") && reply.contains("text/html") && !reply.contains("<html"), "{reply}");
+    assert!(head("GET /api/file HTTP/1.1\r\nHost: OURS\r\nHost: evil.example").starts_with("HTTP/1.1 400"));
+    let two_origins = "POST /api/save HTTP/1.1\r\nHost: OURS\r\nOrigin: http://OURS\r\nOrigin: http://evil.example\r\nContent-Length: 0";
+    assert!(head(two_origins).starts_with("HTTP/1.1 400"));
+    assert_eq!(std::fs::read_to_string(&scene).unwrap(), before, "a refused save wrote the file");
     let huge = vec![b' '; 5 << 20];
     assert_eq!(s.raw("POST", "/api/check", &[], &huge).0, 413);
     assert_eq!(s.raw("POST", "/api/check", &[], &[0xff, 0xfe]).0, 400);

@@ -64,7 +64,7 @@ pub fn cases(dir: &str) -> Vec<PathBuf> {
 pub fn compile(path: &Path) -> Compiled {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
     let name = path.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned());
-    scnc::with_big_stack(|| scnc::compile_source(&name, path, text, &FsLoader))
+    scnc::compile_file(&name, path, text, &FsLoader)
 }
 
 /// Scene text compiled as the file `t.scn`, or a panic showing its diagnostics.

@@ -68,7 +68,7 @@ impl Files {
     /// `text` compiled as the file (its includes read through [`Files::loader`]).
     pub(crate) fn compile(&self, text: String) -> scnc::Compiled {
         let name = self.root.file_name().map_or_else(|| "scene".into(), |n| n.to_string_lossy().into_owned());
-        scnc::with_big_stack(|| scnc::compile_source(&name, &self.root, text, &self.loader()))
+        scnc::compile_file(&name, &self.root, text, &self.loader())
     }
 
     /// The loader compiles use: the disk, below the file's directory only.

@@ -101,26 +101,40 @@ impl Req {
         self.query(key).and_then(|v| v.parse::<f64>().ok()).filter(|x| x.is_finite())
     }
 
-    fn header(&self, name: &str) -> Option<String> {
-        let r = self.inner.as_ref()?;
+    /// Every value of the header `name`, in the order sent.
+    fn headers(&self, name: &str) -> Vec<String> {
+        let Some(r) = self.inner.as_ref() else { return Vec::new() };
         r.headers()
             .iter()
-            .find(|h| h.field.as_str().as_str().eq_ignore_ascii_case(name))
+            .filter(|h| h.field.as_str().as_str().eq_ignore_ascii_case(name))
             .map(|h| h.value.as_str().to_string())
+            .collect()
     }
 
     /// `Ok` when the request names this server in `Host` and, if it says where it comes
     /// from, comes from a page of this server: what stops a site in another tab (or one
-    /// rebound to 127.0.0.1) from reading or changing the file.
-    pub(crate) fn same_origin(&self, hosts: &[String]) -> Result<(), String> {
-        let host = self.header("Host").unwrap_or_default();
-        if !hosts.iter().any(|h| h.eq_ignore_ascii_case(&host)) {
-            return Err(format!("refused: `Host: {host}` is not this server ({})", hosts.join(", ")));
+    /// rebound to 127.0.0.1) from reading or changing the file. The refusal: 400 for a
+    /// request that sends `Host` or `Origin` twice (RFC 9112: which one a proxy and this
+    /// server would each believe is not to be guessed), 403 for a foreign one.
+    pub(crate) fn same_origin(&self, hosts: &[String]) -> Result<(), Reply> {
+        let (host, origin) = (self.headers("Host"), self.headers("Origin"));
+        if host.len() > 1 || origin.len() > 1 {
+            return Err(Reply::text(400, "refused: a request with more than one `Host` or `Origin` header"));
         }
-        if let Some(origin) = self.header("Origin") {
+        let host = host.first().map_or("", String::as_str);
+        if !hosts.iter().any(|h| h.eq_ignore_ascii_case(host)) {
+            return Err(Reply::text(
+                403,
+                &format!("refused: `Host: {host}` is not this server ({})", hosts.join(", ")),
+            ));
+        }
+        if let Some(origin) = origin.first() {
             let ours = hosts.iter().any(|h| origin.eq_ignore_ascii_case(&format!("http://{h}")));
             if !ours {
-                return Err(format!("refused: a request from `{origin}`, not from this server's page"));
+                return Err(Reply::text(
+                    403,
+                    &format!("refused: a request from `{origin}`, not from this server's page"),
+                ));
             }
         }
         Ok(())

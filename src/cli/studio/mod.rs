@@ -164,12 +164,14 @@ const FAVICON: &str = include_str!("assets/favicon.svg");
 
 fn handle(studio: &Arc<Studio>, request: tiny_http::Request) {
     let mut req = Req::new(request);
-    if let Err(why) = req.same_origin(&studio.hosts) {
-        return req.reply(Reply::text(403, &why));
+    if let Err(refused) = req.same_origin(&studio.hosts) {
+        return req.reply(refused);
     }
     let method = req.method();
     let path = req.path().to_string();
-    let reply = match (method.as_str(), path.as_str()) {
+    // HEAD is answered as GET is (tiny_http leaves the body out).
+    let get = if method == "HEAD" { "GET" } else { method.as_str() };
+    let reply = match (get, path.as_str()) {
         ("GET", "/") => Reply::asset("text/html; charset=utf-8", INDEX_HTML),
         ("GET", "/assets/studio.js") => Reply::asset("text/javascript; charset=utf-8", STUDIO_JS),
         ("GET", "/assets/studio.css") => Reply::asset("text/css; charset=utf-8", STUDIO_CSS),
@@ -197,7 +199,7 @@ fn handle(studio: &Arc<Studio>, request: tiny_http::Request) {
             },
             Err(reply) => reply,
         },
-        ("GET" | "HEAD", _) => Reply::text(404, "no such page"),
+        ("GET", _) => Reply::text(404, "no such page"),
         _ => Reply::text(405, "method not allowed"),
     };
     req.reply(reply);

@@ -208,7 +208,8 @@ fn run(studio: &Studio, text: &str, ask: &Ask, out: &mut Stream, current: &dyn F
     };
     let declared = first.settings.clone();
     let mut scene = if ask.frame > 0 && ask.frame < declared.frames {
-        let (scene, diagnostics) = scnc::with_big_stack(|| compiled.frame(ask.frame, &declared, &loader));
+        let (scene, diagnostics) = scnc::with_big_stack(|| compiled.frame(ask.frame, &declared, &loader))
+            .unwrap_or_else(|e| (None, vec![e.diagnostic()]));
         match scene {
             Some(s) => s,
             None => return json_message(out, b'E', diagnostics_json(&compiled.map, &diagnostics)),
