@@ -517,3 +517,18 @@ fn long_flat_sums_compile_and_format() {
         }
     }
 }
+
+/// W0010 (radians written where degrees are meant) never fires on a shipped scene: every
+/// example and golden input that uses trigonometry in a body means degrees.
+#[test]
+fn no_radians_warning_on_any_shipped_scene() {
+    let out = std::process::Command::new("git").args(["ls-files", "*.scn"]).output().expect("git ls-files");
+    let files: Vec<String> = String::from_utf8_lossy(&out.stdout).lines().map(str::to_string).collect();
+    assert!(files.len() > 100, "{} scenes", files.len());
+    let flagged: Vec<&String> = files
+        .iter()
+        .filter(|f| !f.ends_with("field-radians.scn"))
+        .filter(|f| crate::support::compile(std::path::Path::new(f)).diagnostics.iter().any(|d| d.code == "W0010"))
+        .collect();
+    assert!(flagged.is_empty(), "W0010 on {flagged:?}");
+}

@@ -50,8 +50,10 @@ fn studio_refuses_other_hosts_origins_paths_and_methods() {
     let huge = vec![b' '; 5 << 20];
     assert_eq!(s.raw("POST", "/api/check", &[], &huge).0, 413);
     assert_eq!(s.raw("POST", "/api/check", &[], &[0xff, 0xfe]).0, 400);
-    // The server is still there after all of that.
+    // The server is still there after all of that, and the tab's icon is served.
     assert_eq!(s.raw("GET", "/assets/studio.js", &[], b"").0, 200);
+    let (status, icon) = s.raw("GET", "/favicon.svg", &[], b"");
+    assert!(status == 200 && String::from_utf8_lossy(&icon).starts_with("<svg"), "{status}");
 }
 
 #[test]
