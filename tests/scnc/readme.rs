@@ -154,9 +154,7 @@ fn links(markdown: &str) -> Vec<String> {
 #[test]
 fn every_link_of_the_readme_and_docs_is_in_a_clone() {
     let files = clone_files();
-    let mut pages: Vec<PathBuf> =
-        files.iter().filter(|p| p.starts_with("docs") && p.extension().is_some_and(|e| e == "md")).cloned().collect();
-    pages.push(PathBuf::from("README.md"));
+    let pages = doc_pages();
     let mut missing = Vec::new();
     for page in &pages {
         let text = std::fs::read_to_string(page).expect("reading a page");
@@ -184,16 +182,22 @@ fn every_link_of_the_readme_and_docs_is_in_a_clone() {
     assert!(missing.is_empty(), "{}", missing.join("\n"));
 }
 
-/// A `scn` block of the README or the docs that names its file on its first line
-/// (`// examples/tour.scn: …`) is that file, word for word, so the tour shown is the
-/// tour that runs.
-#[test]
-fn every_scene_shown_is_the_file_it_names() {
+/// The README and the pages of `docs/` a clone has.
+fn doc_pages() -> Vec<PathBuf> {
     let mut pages: Vec<PathBuf> = clone_files()
         .into_iter()
         .filter(|p| p.starts_with("docs") && p.extension().is_some_and(|e| e == "md"))
         .collect();
     pages.push(PathBuf::from("README.md"));
+    pages
+}
+
+/// A `scn` block of the README or the docs that names its file on its first line
+/// (`// examples/tour.scn: …`) is that file, word for word, so the tour shown is the
+/// tour that runs.
+#[test]
+fn every_scene_shown_is_the_file_it_names() {
+    let pages = doc_pages();
     let mut shown = 0;
     for page in pages {
         let text = std::fs::read_to_string(&page).expect("reading a page");
@@ -220,11 +224,7 @@ fn every_scene_shown_is_the_file_it_names() {
 /// is, as its includes are relative to it.
 #[test]
 fn every_scene_snippet_compiles() {
-    let mut pages: Vec<PathBuf> = clone_files()
-        .into_iter()
-        .filter(|p| p.starts_with("docs") && p.extension().is_some_and(|e| e == "md"))
-        .collect();
-    pages.push(PathBuf::from("README.md"));
+    let pages = doc_pages();
     let (mut checked, mut failures) = (0, Vec::new());
     for page in pages {
         let text = std::fs::read_to_string(&page).expect("reading a page");
