@@ -14,9 +14,7 @@ const INDENT: &str = "    ";
 
 /// Formats `text`; a file with syntax errors is not formatted and its errors are returned.
 pub fn format(text: &str) -> Result<String, Vec<Diagnostic>> {
-    // Parsed (and the tree dropped) on the compiler's stack: a flat sum of a million
-    // terms is a tree a million deep.
-    let diags = crate::with_big_stack(|| syntax::parse(text, 0).1).map_err(|e| vec![e.diagnostic()])?;
+    let (_, diags) = syntax::parse(text, 0);
     if !diags.is_empty() {
         return Err(diags);
     }

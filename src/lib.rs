@@ -149,7 +149,7 @@ pub fn compile_source(name: &str, path: &Path, text: String, loader: &dyn Loader
 
 /// The stack of the thread compiles run on: deep enough for every nesting the limits in
 /// [`check`] and [`syntax`] allow.
-pub const COMPILER_STACK: usize = check::STACK;
+pub const COMPILER_STACK: usize = 256 << 20;
 
 /// The operating system refused the compiler's thread (most often an address space
 /// capped below its stack, `ulimit -v`): a coded error, never a panic.
@@ -173,6 +173,23 @@ impl NoThread {
         Diagnostic::error(diag::codes::NO_RESOURCES, span::Span::default(), self.to_string(), "not compiled")
             .with_note("the compiler runs on a thread of its own so that deep nesting cannot overflow the stack")
     }
+
+    /// The file `text` (named `name`, at `path`) and this error in it, to report.
+    pub fn in_file(&self, name: &str, path: &Path, text: String) -> (SourceMap, Diagnostic) {
+        let mut map = SourceMap::new();
+        let _ = map.add(name, path, text);
+        (map, self.diagnostic())
+    }
+}
+
+/// Runs `f` on `text` on a thread with [`COMPILER_STACK`]; when the thread cannot be
+/// had, the error with the text back (for the error's excerpt), never copied.
+pub fn with_big_stack_on<T: Send>(text: String, f: impl FnOnce(String) -> T + Send) -> Result<T, (NoThread, String)> {
+    // The text waits in a slot the thread takes it from, so a thread that never starts
+    // leaves it there.
+    let slot = std::sync::Mutex::new(Some(text));
+    let take = || slot.lock().ok().and_then(|mut t| t.take()).unwrap_or_default();
+    with_big_stack(|| f(take())).map_err(|e| (e, take()))
 }
 
 /// Runs `f` on a thread with a large stack, so that pathological nesting in user input
@@ -188,11 +205,8 @@ pub fn with_big_stack<T: Send>(f: impl FnOnce() -> T + Send) -> Result<T, NoThre
 /// [`compile_source`] on a thread of [`COMPILER_STACK`]; when the thread cannot be had,
 /// the file with that error (E0709) and no scene.
 pub fn compile_file(name: &str, path: &Path, text: String, loader: &(dyn Loader + Sync)) -> Compiled {
-    // Kept for the error's source excerpt: the text moves into the thread that may not start.
-    let fallback = text.clone();
-    with_big_stack(|| compile_source(name, path, text, loader)).unwrap_or_else(|e| {
-        let mut map = SourceMap::new();
-        let _ = map.add(name, path, fallback);
-        Compiled { map, scene: None, diagnostics: vec![e.diagnostic()], root: None, reuse: check::Reuse::default() }
+    with_big_stack_on(text, |text| compile_source(name, path, text, loader)).unwrap_or_else(|(e, text)| {
+        let (map, d) = e.in_file(name, path, text);
+        Compiled { map, scene: None, diagnostics: vec![d], root: None, reuse: check::Reuse::default() }
     })
 }

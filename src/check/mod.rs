@@ -65,10 +65,6 @@ pub const MAX_LIGHTS: usize = 1_000;
 pub const MAX_LIST: usize = 100_000;
 /// Deepest expression nesting (operators, calls and transforms count).
 pub const MAX_EXPR_DEPTH: usize = 256;
-
-/// The stack compiles run on (`crate::with_big_stack`), and parse trees are dropped on:
-/// deep enough for every nesting the limits here and in `syntax` allow.
-pub const STACK: usize = 256 << 20;
 /// Evaluation steps one compile may take: every expression evaluated, and every list
 /// element copied, is one. Depth limits bound recursion, not total work; this does.
 pub const MAX_FUEL: u64 = 10_000_000;

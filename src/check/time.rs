@@ -50,29 +50,6 @@ pub struct Reuse {
     parsed: HashMap<FileId, Parsed>,
 }
 
-impl Drop for Reuse {
-    /// Parse trees are as deep as the input (a sum of a million terms is a chain a
-    /// million deep) and are dropped by recursion: on a stack as deep as the one they
-    /// were made on. Where that thread cannot be had they are leaked, not dropped into a
-    /// stack overflow.
-    fn drop(&mut self) {
-        if self.parsed.is_empty() {
-            return;
-        }
-        let parsed = std::sync::Mutex::new(std::mem::take(&mut self.parsed));
-        let dropped = std::thread::scope(|s| {
-            std::thread::Builder::new()
-                .stack_size(super::STACK)
-                .spawn_scoped(s, || drop(parsed.lock().map(|mut p| std::mem::take(&mut *p))))
-                .map(|t| t.join().is_ok())
-                .unwrap_or(false)
-        });
-        if !dropped {
-            std::mem::forget(parsed);
-        }
-    }
-}
-
 impl Reuse {
     /// Starts an evaluation: include counts from zero.
     pub(super) fn start(&mut self) {

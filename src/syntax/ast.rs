@@ -113,6 +113,75 @@ pub struct Expr {
     pub span: Span,
 }
 
+impl Drop for Expr {
+    /// Takes the tree apart with a stack of its own: a chain without brackets (a sum of
+    /// a million terms, `- - - 1`, `s at … at …`) is as deep as the input is long, and
+    /// the compiler's recursive drop would overflow any thread's stack on it.
+    fn drop(&mut self) {
+        let mut pending = Vec::new();
+        self.kind.move_children(&mut pending);
+        while let Some(mut e) = pending.pop() {
+            e.kind.move_children(&mut pending);
+        }
+    }
+}
+
+impl ExprKind {
+    /// Moves every child expression out into `out`, leaving [`ExprKind::Error`] in its
+    /// place (what [`Expr`]'s drop walks).
+    fn move_children(&mut self, out: &mut Vec<Expr>) {
+        let mut take = |e: &mut Expr| out.push(std::mem::replace(e, Expr { kind: ExprKind::Error, span: e.span }));
+        match self {
+            ExprKind::Number(_)
+            | ExprKind::Bool(_)
+            | ExprKind::Str(_)
+            | ExprKind::HexColor(_)
+            | ExprKind::Ident(_)
+            | ExprKind::Error => {}
+            ExprKind::List(items) => items.iter_mut().for_each(take),
+            ExprKind::Call { args, .. } | ExprKind::Mesh { args, .. } => {
+                args.iter_mut().for_each(|a| take(&mut a.value))
+            }
+            ExprKind::Index { base, index } => {
+                take(base);
+                take(index);
+            }
+            ExprKind::Component { base: e, .. }
+            | ExprKind::Field { body: e, .. }
+            | ExprKind::Neg(e)
+            | ExprKind::Not(e) => take(e),
+            ExprKind::If { cond, then, otherwise } => {
+                take(cond);
+                take(then);
+                take(otherwise);
+            }
+            ExprKind::Comprehension { generators, filter, body } => {
+                for g in generators {
+                    match &mut g.over {
+                        Iterable::Range { start, end } => {
+                            take(start);
+                            take(end);
+                        }
+                        Iterable::List(e) => take(e),
+                    }
+                }
+                if let Some(f) = filter {
+                    take(f);
+                }
+                take(body);
+            }
+            ExprKind::Binary { lhs, rhs, .. } => {
+                take(lhs);
+                take(rhs);
+            }
+            ExprKind::Transform { target, arg, .. } => {
+                take(target);
+                take(arg);
+            }
+        }
+    }
+}
+
 /// Binary operators.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BinOp {
