@@ -354,31 +354,29 @@ impl Ctx<'_> {
     /// parses as `((a + b) + c) + …`), evaluated in a loop: a long flat expression is
     /// not a deep one, and only its operands count towards [`MAX_EXPR_DEPTH`].
     fn binary_chain(&mut self, e: &ast::Expr) -> Value {
-        // `and` and `or` decide whether their right side is evaluated: they stay nodes
-        // of their own (reached through `expr`), never links of the chain.
-        let arithmetic =
-            |x: &ast::Expr| matches!(&x.kind, ExprKind::Binary { op, .. } if !matches!(op, BinOp::And | BinOp::Or));
-        let mut spine = vec![e];
-        while let ExprKind::Binary { lhs, .. } = &spine[spine.len() - 1].kind {
-            if !arithmetic(lhs) {
+        // The links from the outermost down, and the operand below the last. `and` and
+        // `or` decide whether their right side is evaluated: they stay nodes of their
+        // own (reached through `expr`), never links.
+        let (mut links, mut first) = (Vec::new(), e);
+        while let ExprKind::Binary { op, lhs, rhs } = &first.kind {
+            if matches!(op, BinOp::And | BinOp::Or) {
                 break;
             }
-            spine.push(lhs);
+            links.push((*op, &**rhs, first.span));
+            first = lhs;
         }
-        let Some(ExprKind::Binary { lhs: first, .. }) = spine.last().map(|x| &x.kind) else { return Value::Error };
         let mut acc = self.expr(first);
         let mut acc_span = first.span;
-        for (i, node) in spine.iter().enumerate().rev() {
-            let ExprKind::Binary { op, rhs, .. } = &node.kind else { return Value::Error };
-            // Each link costs fuel and is typed for the editor as `expr` does for `e`.
-            if i > 0 && !self.burn(1, node.span) {
+        for (i, &(op, rhs, span)) in links.iter().enumerate().rev() {
+            // Each inner link costs fuel and is typed for the editor, as `expr` does for `e`.
+            if i > 0 && !self.burn(1, span) {
                 return Value::Error;
             }
             let b = self.expr(rhs);
-            acc = self.binary(*op, acc, acc_span, b, rhs.span, node.span);
-            acc_span = node.span;
+            acc = self.binary(op, acc, acc_span, b, rhs.span, span);
+            acc_span = span;
             if let (Some(ix), true) = (&mut self.index, i > 0) {
-                ix.typed(node.span, (!acc.is_error()).then(|| acc.ty_name()));
+                ix.typed(span, (!acc.is_error()).then(|| acc.ty_name()));
             }
         }
         acc

@@ -73,7 +73,7 @@ pub(crate) fn sweep_cmd(args: SweepArgs) -> ExitCode {
     let started = std::time::Instant::now();
     let progress = |step: Step<'_>| {
         let what = match step {
-            Step::Reference => "the reference render (SDF, epsilon 1e-6)".to_string(),
+            Step::Reference(s) => format!("the reference render ({} {})", s.backend(), s.label()),
             Step::Measured { setting, done, total } => {
                 format!("measured {done}/{total}: {} {}", setting.backend(), setting.label())
             }

@@ -18,7 +18,7 @@ pub struct Guess {
 const PLACE: &str = "scnc places a shape with `at` after it: `box(1) at [x, y, z]`";
 const COLOUR: &str = "a colour belongs to a material: `… with material(color = #ff0000)`";
 
-/// Every word with advice, sorted by word.
+/// Every word with advice.
 pub const GUESSES: &[Guess] = &[
     Guess { word: "colour", replacement: None, hint: COLOUR },
     Guess { word: "color", replacement: None, hint: COLOUR },

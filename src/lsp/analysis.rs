@@ -114,9 +114,7 @@ impl Analysis {
         cancel: &(dyn Fn() -> bool + Sync),
     ) -> Option<Analysis> {
         let name = path.display().to_string();
-        // The text is kept for the error's excerpt when the compiler's thread cannot start.
-        let fallback = text.clone();
-        let analysed = crate::with_big_stack(|| {
+        let analysed = crate::with_big_stack_on(text, |text| {
             let mut map = SourceMap::new();
             // Too large a document gets `compile_source`'s error, as the same file on disk
             // would (it used to be analysed as if empty).
@@ -139,10 +137,9 @@ impl Analysis {
             let (_, diagnostics, index) = check::check_indexed(&mut map, root, loader, cancel)?;
             Some(Analysis { map, diagnostics, index })
         });
-        analysed.unwrap_or_else(|e| {
-            let mut map = SourceMap::new();
-            let _ = map.add(&name, path, fallback);
-            Some(Analysis { map, diagnostics: vec![e.diagnostic()], index: Index::default() })
+        analysed.unwrap_or_else(|(e, text)| {
+            let (map, d) = e.in_file(&name, path, text);
+            Some(Analysis { map, diagnostics: vec![d], index: Index::default() })
         })
     }
 

@@ -296,8 +296,8 @@ pub struct Options<'a> {
 /// A point a sweep reports reaching, for a progress display.
 #[derive(Clone, Copy, Debug)]
 pub enum Step<'a> {
-    /// The many-step reference render is starting.
-    Reference,
+    /// The many-step reference render, at this setting, is starting.
+    Reference(&'a Setting),
     /// Setting `done` of `total` has had its first render (accuracy measured).
     Measured {
         /// The setting.
@@ -319,8 +319,9 @@ pub enum Step<'a> {
 /// Runs the ladder on `scene` (already sized).
 pub fn run(scene: &Scene, settings: &[Setting], opts: &Options<'_>) -> Result<Vec<Row>, Diagnostic> {
     let Options { loader, memory, progress, .. } = *opts;
-    progress(Step::Reference);
-    let (reference_scene, _) = with_setting(scene, Setting::Sdf { epsilon: 1e-6, max_steps: 100_000 });
+    let reference = Setting::Sdf { epsilon: 1e-6, max_steps: 100_000 };
+    progress(Step::Reference(&reference));
+    let (reference_scene, _) = with_setting(scene, reference);
     let (ref_frame, ref_world) =
         world::prepare(&reference_scene, effects::derive(&reference_scene), Mode::Sdf, loader)?;
     let (ref_image, _) = render::render(&ref_world, &ref_frame, &|| {});

@@ -63,56 +63,48 @@ fn required() -> bool {
     std::env::var_os("SCNC_REQUIRE_TOOLS").is_some_and(|v| v == "1")
 }
 
-/// A test that needs `tool`: ignored (visibly) where it is missing, failed where it is
-/// missing but required, run otherwise. `manual` tests (measurements, the README's
-/// picture) are always ignored unless asked for with `--ignored`.
-fn trial(name: &'static str, tool: Tool, manual: bool, test: fn()) -> Trial {
-    let present = tool.available();
-    let missing_but_required = !present && required();
-    let t = Trial::test(name, move || {
-        if !tool.available() {
+/// A test that needs `tool` (`present`: probed once, before the run): ignored (visibly)
+/// where it is missing, failed where it is missing but required, run otherwise.
+/// `manual` tests (measurements, the README's picture) are always ignored unless asked
+/// for with `--ignored`.
+fn trial(name: &'static str, (tool, present): (Tool, bool), manual: bool, test: fn()) -> Trial {
+    Trial::test(name, move || {
+        if !present {
             let why = if required() { " (SCNC_REQUIRE_TOOLS=1)" } else { "" };
             return Err(Failed::from(format!("`{}` is required{why} but cannot be run", tool.name())));
         }
         test();
         Ok(())
     })
-    .with_kind(format!("needs {}", tool.name()));
-    t.with_ignored_flag(manual || (!present && !missing_but_required))
+    .with_kind(format!("needs {}", tool.name()))
+    .with_ignored_flag(manual || (!present && !required()))
 }
 
 fn main() {
     let args = Arguments::from_args();
-    let chromium = Tool::Program("chromium");
+    let probe = |t: Tool| (t, t.available());
+    let (chromium, nvim, admesh, lib3mf) = (
+        probe(Tool::Program("chromium")),
+        probe(Tool::Program("nvim")),
+        probe(Tool::Program("admesh")),
+        probe(Tool::Python("lib3mf")),
+    );
     let trials = vec![
         trial("studio_in_a_browser", chromium, false, page::studio_in_a_browser),
         trial("studio_helps_as_you_work", chromium, false, page::studio_helps_as_you_work),
         trial("studio_latency_on_the_seed_scenes", chromium, true, page::studio_latency_on_the_seed_scenes),
         trial("studio_screenshot_for_the_readme", chromium, true, page::studio_screenshot_for_the_readme),
-        trial(
-            "neovim_config_attaches_the_server",
-            Tool::Program("nvim"),
-            false,
-            neovim::neovim_config_attaches_the_server,
-        ),
+        trial("neovim_config_attaches_the_server", nvim, false, neovim::neovim_config_attaches_the_server),
         trial(
             "admesh_finds_stl_exports_closed_and_consistent",
-            Tool::Program("admesh"),
+            admesh,
             false,
             validators::admesh_finds_stl_exports_closed_and_consistent,
         ),
-        trial(
-            "lib3mf_reads_3mf_exports_strictly",
-            Tool::Python("lib3mf"),
-            false,
-            validators::lib3mf_reads_3mf_exports_strictly,
-        ),
+        trial("lib3mf_reads_3mf_exports_strictly", lib3mf, false, validators::lib3mf_reads_3mf_exports_strictly),
     ];
-    let missing: Vec<&str> = [chromium, Tool::Program("nvim"), Tool::Program("admesh"), Tool::Python("lib3mf")]
-        .into_iter()
-        .filter(|t| !t.available())
-        .map(Tool::name)
-        .collect();
+    let missing: Vec<&str> =
+        [chromium, nvim, admesh, lib3mf].into_iter().filter(|(_, present)| !present).map(|(t, _)| t.name()).collect();
     if !missing.is_empty() && !required() {
         #[allow(clippy::print_stderr, reason = "said once, before the run, where cargo shows it")]
         {

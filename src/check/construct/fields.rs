@@ -14,7 +14,7 @@ use crate::check::{Ctx, Value};
 use crate::diag::{codes, Diagnostic};
 use crate::field::{lipschitz, Estimate, SlopeDistances, Tape};
 use crate::geom::Aabb;
-use crate::ir::field::{Expr, Kind, Ty};
+use crate::ir::field::{Expr, Kind, Ty, Unary, Val};
 use crate::ir::{self, Lipschitz, ShapeKind};
 use crate::sig::Range;
 use crate::span::Span;
@@ -101,32 +101,28 @@ const STEEP: f64 = 2.5;
 const SMALL_TURN: f64 = 45.0;
 
 /// The first `sin`, `cos` or `tan` in `body` whose argument depends on the point but
-/// turns by less than [`SMALL_TURN`] over `domain` (the cube from −1 to 1 without one),
-/// with the turn it makes there, sampled on a 5×5×5 grid. Arguments that read `dist`
-/// are left alone: their turn depends on shapes, not on how the author wrote angles.
-fn radians_for_degrees(body: &Arc<Expr>, domain: Option<Aabb>) -> Option<(Arc<Expr>, f64)> {
-    use crate::ir::field::Unary;
+/// turns by less than [`SMALL_TURN`] over `domain` (the cube from −1 to 1 without one):
+/// the function, its argument and the turn, sampled on a 5×5×5 grid. Arguments that
+/// read `dist` are left alone: their turn depends on shapes, not on how the author wrote
+/// angles.
+fn radians_for_degrees(body: &Arc<Expr>, domain: Option<Aabb>) -> Option<(Unary, Arc<Expr>, f64)> {
     let (lo, hi) = domain.map_or((DVec3::splat(-1.0), DVec3::splat(1.0)), |b| (b.min, b.max));
     let mut stack = vec![body];
     while let Some(e) = stack.pop() {
-        if let Kind::Unary(Unary::Sin | Unary::Cos | Unary::Tan, x) = &e.kind {
+        if let Kind::Unary(f @ (Unary::Sin | Unary::Cos | Unary::Tan), x) = &e.kind {
             if x.uses_point() && x.shapes().is_empty() {
                 let (mut min, mut max) = (f64::INFINITY, f64::NEG_INFINITY);
                 for i in 0..125 {
                     let t = DVec3::new((i % 5) as f64, (i / 5 % 5) as f64, (i / 25) as f64) / 4.0;
-                    let v = x.eval(lo + (hi - lo) * t, &|_, _| 0.0);
-                    let parts = match x.ty {
-                        Ty::Vec3 => v.vec().to_array().to_vec(),
-                        _ => vec![v.num()],
+                    let (a, b) = match x.eval(lo + (hi - lo) * t, &|_, _| 0.0) {
+                        Val::Num(v) => (v, v),
+                        Val::Vec(v) => (v.min_element(), v.max_element()),
                     };
-                    for c in parts {
-                        min = min.min(c);
-                        max = max.max(c);
-                    }
+                    (min, max) = (min.min(a), max.max(b));
                 }
                 let turn = max - min;
                 if turn.is_finite() && turn > 0.0 && turn < SMALL_TURN {
-                    return Some((e.clone(), turn));
+                    return Some((*f, x.clone(), turn));
                 }
             }
         }
@@ -266,18 +262,17 @@ impl Ctx<'_> {
 
     /// Warns (W0010) when the body's trigonometry barely turns over `domain`.
     fn check_angles(&mut self, body: &Arc<Expr>, domain: Option<Aabb>, span: Span) {
-        let Some((call, turn)) = radians_for_degrees(body, domain) else { return };
-        let shown = call.source(60);
+        let Some((f, arg, turn)) = radians_for_degrees(body, domain) else { return };
+        let (name, arg) = (f.name(), arg.source(60));
         let over = if domain.is_some() { "its `bounds`" } else { "the cube from -1 to 1" };
-        let (name, arg) = match &call.kind {
-            Kind::Unary(f, x) => (f.name(), x.source(60)),
-            _ => ("sin", String::new()),
-        };
         self.report(
             Diagnostic::warning(
                 codes::SMALL_TURN,
                 span,
-                format!("`{shown}` turns by only {}° over {over}: `{name}` takes degrees", crate::sig::short(turn)),
+                format!(
+                    "`{name}({arg})` turns by only {}° over {over}: `{name}` takes degrees",
+                    crate::sig::short(turn)
+                ),
                 "in this body",
             )
             .with_note("trigonometry in scnc takes degrees, as in OpenSCAD and POV-Ray; shaders take radians")

@@ -5,7 +5,6 @@
 //! expression of the point `[u, v, 0]`; a sweep substitutes the solid's point into it
 //! and is a `field` with bound 1, exact where the profile is.
 
-use crate::ir::dump_num;
 use std::sync::Arc;
 
 use glam::{DVec2, DVec3};
@@ -19,6 +18,7 @@ use crate::check::{Ctx, Value};
 use crate::diag::{codes, Diagnostic};
 use crate::geom::region::{Combine, Region};
 use crate::geom::Aabb;
+use crate::ir::dump_num;
 use crate::ir::field::{Binary, Expr, Kind, Ty, Unary};
 use crate::ir::{CsgOp, ExactMesh, Lipschitz, ShapeKind, Sweep};
 use crate::sig::Range;

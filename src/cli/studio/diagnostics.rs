@@ -23,28 +23,33 @@ pub(crate) fn to_utf16(text: &str, byte: usize) -> usize {
     text.char_indices().take_while(|(i, _)| *i < byte).map(|(_, c)| c.len_utf16()).sum()
 }
 
+/// Where `span` is in the editor's text, in UTF-16 units; `None` for a span in an
+/// included file.
+pub(crate) fn page_range(map: &SourceMap, span: scnc::span::Span) -> Option<(usize, usize)> {
+    let (id, range) = map.local_range(span);
+    let root = &map.file(FileId(0)).text;
+    (id == FileId(0)).then(|| (to_utf16(root, range.start), to_utf16(root, range.end)))
+}
+
 /// Diagnostics as the page shows them: a span in the editor's text (a diagnostic in an
 /// include points at the start, its place named in the message), and the message with
 /// its notes and help as `scnc check` prints them.
 pub(crate) fn diagnostics_json(map: &SourceMap, diagnostics: &[Diagnostic]) -> serde_json::Value {
-    let root = &map.file(FileId(0)).text;
     let list: Vec<_> = diagnostics
         .iter()
         .map(|d| {
-            let (id, range) = map.local_range(d.span());
             // The primary label says what is wrong at the span, which an editor's squiggle
             // cannot show beside the message.
             let mut message = match d.labels.first().map(|l| l.message.as_str()) {
                 Some(label) if !label.is_empty() => format!("{} ({label})", d.message),
                 _ => d.message.clone(),
             };
-            let (from, to) = if id == FileId(0) {
-                (to_utf16(root, range.start), to_utf16(root, range.end))
-            } else {
+            let (from, to) = page_range(map, d.span()).unwrap_or_else(|| {
+                let (id, range) = map.local_range(d.span());
                 let (line, col) = map.line_col(id, range.start);
                 message = format!("{}:{line}:{col}: {message}", map.file(id).name);
                 (0, 0)
-            };
+            });
             for note in &d.notes {
                 message.push_str(&format!("\nnote: {note}"));
             }

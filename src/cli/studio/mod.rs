@@ -188,7 +188,7 @@ fn handle(studio: &Arc<Studio>, request: tiny_http::Request) {
                 "/api/complete" => edit::complete(studio, text, req.query_u32("pos")),
                 "/api/signature" => edit::signature(studio, text, req.query_u32("pos")),
                 "/api/pick" => {
-                    let at = |k: &str| req.query(k).and_then(|v| v.parse::<f64>().ok()).unwrap_or(-1.0);
+                    let at = |k: &str| req.query_f64(k).unwrap_or(-1.0);
                     preview::pick(studio, text, &preview::View::from_query(&req), at("x"), at("y"))
                 }
                 "/api/format" => edit::format(text),

@@ -20,7 +20,7 @@ use scnc::render::{Frame, Image, Region};
 use scnc::trace::Counters;
 use scnc::world::{Mode, World};
 
-use super::diagnostics::{diagnostics_json, to_utf16};
+use super::diagnostics::{diagnostics_json, page_range};
 use super::files::lock;
 use super::http::{Reply, Req, Stream};
 use super::Studio;
@@ -152,12 +152,8 @@ pub(crate) fn pick(studio: &Studio, text: String, view: &View, x: f64, y: f64) -
     let (px, py) = ((x.clamp(0.0, 1.0) * frame.width as f64) as f32, (y.clamp(0.0, 1.0) * frame.height as f64) as f32);
     let ray = scnc::trace::Ray::new(glam::Vec3A::ZERO, frame.direction(px, py), frame.max_distance);
     let hit = scnc::trace::Geometry::intersect(&world, &ray, &mut Counters::default());
-    let span = hit.and_then(|h| world.span_of(h.object)).filter(|s| compiled.map.file_of(*s).0 == 0);
-    let answer = span.map(|s| {
-        let root = compiled.map.file(scnc::source::FileId(0));
-        let at = |b: u32| to_utf16(&root.text, (b - root.base) as usize);
-        serde_json::json!({ "from": at(s.start), "to": at(s.end) })
-    });
+    let range = hit.and_then(|h| world.span_of(h.object)).and_then(|s| page_range(&compiled.map, s));
+    let answer = range.map(|(from, to)| serde_json::json!({ "from": from, "to": to }));
     Reply::json(&answer.unwrap_or(serde_json::Value::Null))
 }
 

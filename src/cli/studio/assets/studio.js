@@ -8,8 +8,11 @@ const ctx = canvas.getContext("2d");
 /** The coarse pass, kept to fill the canvas until the full frame's bands replace it. */
 const coarse = document.createElement("canvas");
 
+/** The scene's own camera: no orbit, pan or zoom of the page's. */
+const homeView = () => ({ yaw: 0, pitch: 0, zoom: 1, panx: 0, pany: 0 });
+
 const state = {
-  view: { yaw: 0, pitch: 0, zoom: 1, panx: 0, pany: 0 },
+  view: homeView(),
   backend: "sdf",
   rung: null,
   frame: 0,
@@ -41,6 +44,12 @@ async function post(path, body) {
 
 // --- diagnostics ---------------------------------------------------------------------
 
+/** Selects `from`..`to` of the editor's text, scrolled into view, and focuses it. */
+function select(from, to) {
+  editor.dispatch({ selection: { anchor: from, head: to }, scrollIntoView: true });
+  editor.focus();
+}
+
 function showDiagnostics(list) {
   ScnEditor.showDiagnostics(editor, list);
   const ul = $("diagnostics");
@@ -51,7 +60,7 @@ function showDiagnostics(list) {
     code.className = "code";
     code.textContent = `${d.severity}[${d.code}]`;
     li.append(code, d.message);
-    li.onclick = () => { editor.dispatch({ selection: { anchor: d.from, head: d.to }, scrollIntoView: true }); editor.focus(); };
+    li.onclick = () => select(d.from, d.to);
     return li;
   }));
 }
@@ -237,7 +246,7 @@ async function format() {
 async function writeCamera() {
   const r = await (await post(`/api/camera?${query({})}`, ScnEditor.textOf(editor))).json();
   if (r.text === undefined) { showDiagnostics(r.diagnostics); return; }
-  state.view = { yaw: 0, pitch: 0, zoom: 1, panx: 0, pany: 0 };
+  state.view = homeView();
   ScnEditor.replaceText(editor, r.text);
 }
 
@@ -261,9 +270,7 @@ function viewChanged() { render(ScnEditor.textOf(editor)); }
 async function pick(x, y) {
   const r = await (await post(`/api/pick?${query({ x, y })}`, ScnEditor.textOf(editor))).json();
   $("note").textContent = r ? "" : "no object there";
-  if (!r) return;
-  editor.dispatch({ selection: { anchor: r.from, head: r.to }, scrollIntoView: true });
-  editor.focus();
+  if (r) select(r.from, r.to);
 }
 
 let drag = null;
@@ -336,7 +343,7 @@ $("frame").oninput = () => { state.frame = Number($("frame").value); viewChanged
 $("save").onclick = save;
 $("format").onclick = format;
 $("write-camera").onclick = writeCamera;
-$("reset-view").onclick = () => { state.view = { yaw: 0, pitch: 0, zoom: 1, panx: 0, pany: 0 }; viewChanged(); };
+$("reset-view").onclick = () => { state.view = homeView(); viewChanged(); };
 for (const f of ["stl", "3mf", "glb"]) $(`export-${f}`).onclick = () => exportAs(f);
 $("backend").onchange = () => { state.backend = $("backend").value; viewChanged(); };
 function rungChanged() {
@@ -365,7 +372,7 @@ async function loadExamples() {
     const e = list[Number(menu.value)];
     menu.value = "";
     if (!e) return;
-    state.view = { yaw: 0, pitch: 0, zoom: 1, panx: 0, pany: 0 };
+    state.view = homeView();
     ScnEditor.replaceText(editor, e.text);
     $("saved").textContent = `${e.name}: not saved (Ctrl-S writes it to the file)`;
   };
