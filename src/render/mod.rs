@@ -16,7 +16,6 @@ mod transmit;
 
 use glam::Vec3A;
 use rayon::prelude::*;
-use shade::fx;
 pub use shade::{MAX_TREE_RAYS, MIN_WEIGHT};
 
 pub use frame::{Frame, ShadeLight};
@@ -136,25 +135,22 @@ pub fn render_region(
     region: Region,
     progress: &(dyn Fn() + Sync),
 ) -> (Image, Counters) {
-    let e = &frame.effects;
-    let flag = |on: bool, bit: u8| if on { bit } else { 0 };
-    let wanted = flag(e.shadows(), fx::SHADOWS)
-        | flag(e.reflections, fx::REFLECT)
-        | flag(e.specular, fx::SPECULAR)
-        | flag(e.ambient_occlusion.is_some(), fx::AO)
-        | flag(e.refraction, fx::REFRACT);
-    // Pick the tracer built for this effect set, once, before the first ray.
-    macro_rules! pick {
-        ($($n:literal)*) => {
-            match wanted {
-                $($n => rows::<$n>(geometry, frame, region, progress),)*
-                // Every set of the five flags is listed above; the tracer with every
-                // effect would render any scene correctly.
-                _ => rows::<31>(geometry, frame, region, progress),
-            }
-        };
+    effects::specialise(&frame.effects, Rows { geometry, frame, region, progress })
+}
+
+/// The rows of a region, for the tracer built for some effect flags.
+struct Rows<'a> {
+    geometry: &'a dyn Geometry,
+    frame: &'a Frame,
+    region: Region,
+    progress: &'a (dyn Fn() + Sync),
+}
+
+impl effects::Variant for Rows<'_> {
+    type Out = (Image, Counters);
+    fn run<const FX: u8>(self) -> (Image, Counters) {
+        rows::<FX>(self.geometry, self.frame, self.region, self.progress)
     }
-    pick!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31)
 }
 
 fn rows<const FX: u8>(

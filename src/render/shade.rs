@@ -7,10 +7,10 @@
 //! which is the study's model exactly when `t` = 0.
 //!
 //! The tracer is built for the scene's effect set: `block`, `trace` and `shade` are
-//! generic over a const set of flags ([`fx`]: shadow rays, reflection rays, specular
-//! highlights, ambient occlusion, refraction), and [`render`](super::render) picks the
-//! one of thirty-two monomorphised variants that the effect set calls for before the
-//! first ray. Lights arrive pre-split into an ambient sum, casting and non-casting
+//! generic over a const set of flags (the effect table's [`fx`](super::effects::fx):
+//! shadow rays, reflection rays, specular highlights, ambient occlusion, refraction),
+//! and [`render`](super::render) runs the monomorphised variant that the effect set
+//! calls for, chosen before the first ray. Lights arrive pre-split into an ambient sum, casting and non-casting
 //! lists, so no per-ray code tests for an effect or a light kind the scene does not have.
 
 use glam::Vec3A;
@@ -56,20 +56,7 @@ impl Tree<'_> {
     }
 }
 
-/// The effect flags a tracer variant is built with (bits of its `FX` parameter).
-pub(super) mod fx {
-    /// Shadow rays.
-    pub const SHADOWS: u8 = 1;
-    /// Reflection rays for reflective materials.
-    pub const REFLECT: u8 = 2;
-    /// Phong highlights.
-    pub const SPECULAR: u8 = 4;
-    /// Ambient occlusion.
-    pub const AO: u8 = 8;
-    /// Transparent materials: refraction and Fresnel rays, shadows through glass.
-    pub const REFRACT: u8 = 16;
-}
-use fx::{AO, REFLECT, REFRACT, SHADOWS, SPECULAR};
+use super::effects::fx::{AO, REFLECT, REFRACT, SHADOWS, SPECULAR};
 
 /// The colours (linear, clamped to 0–255) of a block of up to 4×4 pixels from `(x, y)`,
 /// `w` wide and `h` high, each averaging `frame.samples` deterministic samples. Each sample's camera rays go

@@ -9,6 +9,8 @@ use scnc::render::Image;
 use scnc::trace::{Counters, Geometry, Ray};
 use scnc::world::Mode;
 
+use crate::support::{cases, check_golden, compile, finish};
+
 fn scene(text: &str) -> scnc::ir::Scene {
     let c = scnc::compile_source("t.scn", Path::new("t.scn"), text.to_string(), &scnc::source::FsLoader);
     c.scene.unwrap_or_else(|| panic!("{}", scnc::diag::render_all(&c.diagnostics, &c.map)))
@@ -197,4 +199,75 @@ object sphere(0.7) at [0, -0.3, 6.5] with material(color = rgb(200, 200, 200))
     // Without ambient light there is nothing to occlude, so the effect is not built.
     let e = effects::derive(&scene(&text.replace("light ambient(1)", "light point(1) at [0, 3, 0]")));
     assert_eq!(e.ambient_occlusion, None);
+}
+
+/// Every scene the repository ships or tests against: the examples, the bench scenes and
+/// the IR cases.
+fn every_scene() -> Vec<std::path::PathBuf> {
+    let dirs = ["examples", "examples/seed", "examples/features", "examples/animation", "examples/povray"];
+    let mut out: Vec<_> = dirs.iter().chain(["benches/scenes", "tests/data/ir"].iter()).flat_map(|d| cases(d)).collect();
+    // A fragment that `include`s are for, not a scene.
+    out.retain(|p| !p.ends_with("lights.scn"));
+    out
+}
+
+/// The effect set derived from every shipped scene and IR case, one line each, against
+/// `tests/data/effects/derived.txt`: the table's rules over every example.
+#[test]
+fn derived_over_every_scene() {
+    let mut actual = String::new();
+    for path in every_scene() {
+        let c = compile(&path);
+        let scene = c.scene.unwrap_or_else(|| panic!("{}: {}", path.display(), scnc::diag::render_all(&c.diagnostics, &c.map)));
+        actual.push_str(&format!("{}: {}\n", path.display(), effects::derive(&scene)));
+    }
+    finish(check_golden(Path::new("tests/data/effects/derived.txt"), &actual).into_iter().collect());
+}
+
+/// Each tracer flag is one bit of its own, and every effect's word is distinct.
+#[test]
+fn the_table_is_well_formed() {
+    let flags: Vec<u8> = effects::TABLE.iter().map(|e| e.flag).filter(|&f| f != 0).collect();
+    assert!(flags.iter().all(|f| f.is_power_of_two()), "{flags:?}");
+    assert_eq!(flags.iter().fold(0, |a, f| a | f).count_ones() as usize, flags.len(), "a bit used twice: {flags:?}");
+    let mut words: Vec<&str> = effects::TABLE.iter().map(|e| e.word).collect();
+    words.sort_unstable();
+    words.dedup();
+    assert_eq!(words.len(), effects::TABLE.len(), "two effects share a word");
+}
+
+/// Over every shipped scene, on both back-ends: a counter that the table ties to effects
+/// stays 0 when all of those effects are off: what an effect the scene does not call for
+/// costs is nothing, counted.
+#[test]
+fn an_effect_that_is_off_casts_nothing() {
+    let mut failures = Vec::new();
+    let scenes: Vec<_> = every_scene().into_iter().filter(|p| !p.starts_with("benches")).collect();
+    for path in scenes {
+        let c = compile(&path);
+        let Some(scene) = c.scene else { continue };
+        let derived = effects::derive(&scene);
+        for mode in [Mode::Sdf, Mode::Mesh(scnc::mesh::Detail::Low)] {
+            let mut small = scene.clone();
+            (small.settings.width, small.settings.height) = (24, 24);
+            // Some scenes cannot be meshed (an unbounded field); their SDF run counts.
+            let Ok((frame, world)) = scnc::world::prepare(&small, derived.clone(), mode, &scnc::source::FsLoader) else {
+                continue;
+            };
+            let (_, counts) = scnc::render::render(&world, &frame, &|| {});
+            for (name, read) in effects::TABLE.iter().flat_map(|e| e.counters) {
+                let raised_by: Vec<_> =
+                    effects::TABLE.iter().filter(|e| e.counters.iter().any(|(n, _)| n == name)).collect();
+                if raised_by.iter().all(|e| !(e.on)(&derived)) && read(&counts) != 0 {
+                    failures.push(format!(
+                        "{} ({mode:?}): {name} = {} with {} off",
+                        path.display(),
+                        read(&counts),
+                        raised_by.iter().map(|e| e.word).collect::<Vec<_>>().join(" and ")
+                    ));
+                }
+            }
+        }
+    }
+    finish(failures);
 }
