@@ -46,6 +46,7 @@ pub mod geom;
 pub mod ir;
 pub mod lsp;
 pub mod mesh;
+pub mod meshfile;
 pub mod primitive;
 pub mod render;
 pub mod sdf;

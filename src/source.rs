@@ -260,3 +260,11 @@ fn floor_char_boundary(s: &str, mut i: usize) -> usize {
 pub fn file_safe(name: &str) -> String {
     name.chars().map(|c| if c.is_ascii_alphanumeric() || "_-.".contains(c) { c } else { '_' }).collect()
 }
+
+/// Whether the system would give `bytes` more now: address space only is taken (no page
+/// is touched) and given back, so an allocation this size that follows at once is not
+/// an abort but for what runs beside it.
+pub fn system_gives(bytes: u64) -> bool {
+    let Ok(bytes) = usize::try_from(bytes) else { return false };
+    Vec::<u8>::new().try_reserve_exact(bytes).is_ok()
+}

@@ -10,29 +10,37 @@ use clap::ValueEnum;
 
 use super::progress::Reading;
 use scnc::diag::codes;
-use scnc::export::formats::{self, Format};
 use scnc::export::report::MeshReport;
 use scnc::export::{Frame, Up};
 use scnc::mesh::Detail;
+use scnc::meshfile::{Format, WriteOptions};
 use scnc::study::tolerance::Tolerance;
 
 use super::files::{cannot_write, check_output_as, overwritten_input, write_atomic};
 use super::render::{parse_bytes, parse_detail};
 use super::{compile, report, usage_error, worker_pool, MessageFormat};
 
-#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
-enum FormatArg {
-    /// STL (binary; ASCII with `--ascii`).
-    Stl,
-    /// Wavefront OBJ with an MTL file beside it.
-    Obj,
-    /// PLY, binary, with vertex colours.
-    Ply,
-    /// 3MF, one object per scene object, with colours.
-    #[value(name = "3mf")]
-    ThreeMf,
-    /// Binary glTF 2.0.
-    Glb,
+/// `--format`: a mesh file format, with the values and help the format list gives.
+#[derive(Clone, Copy, PartialEq, Eq)]
+struct FormatArg(Format);
+
+impl ValueEnum for FormatArg {
+    fn value_variants<'a>() -> &'a [Self] {
+        const ALL: [FormatArg; Format::ALL.len()] = {
+            let mut all = [FormatArg(Format::Stl); Format::ALL.len()];
+            let mut i = 0;
+            while i < all.len() {
+                all[i] = FormatArg(Format::ALL[i]);
+                i += 1;
+            }
+            all
+        };
+        &ALL
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(clap::builder::PossibleValue::new(self.0.name()).help(self.0.about()))
+    }
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -80,7 +88,7 @@ impl Units {
 pub(crate) struct ExportArgs {
     /// The scene file.
     file: PathBuf,
-    /// Output mesh file; its extension (.stl, .obj, .ply, .3mf, .glb) picks the format.
+    /// Output mesh file; its extension picks the format (see `--format`).
     #[arg(short, long)]
     output: PathBuf,
     /// The format, whatever the output's extension.
@@ -145,25 +153,21 @@ impl ExportArgs {
     /// The format: `--format`, else the output's extension.
     fn format(&self) -> Result<Format, String> {
         let format = match self.format {
-            Some(FormatArg::Stl) => Format::Stl,
-            Some(FormatArg::Obj) => Format::Obj,
-            Some(FormatArg::Ply) => Format::Ply,
-            Some(FormatArg::ThreeMf) => Format::ThreeMf,
-            Some(FormatArg::Glb) => Format::Glb,
+            Some(FormatArg(f)) => f,
             None => {
                 self.output.extension().and_then(|e| e.to_str()).and_then(Format::from_extension).ok_or_else(|| {
                     format!(
-                        "cannot tell the format of `{}`: name it .stl, .obj, .ply, .3mf or .glb, or give --format",
-                        self.output.display()
+                        "cannot tell the format of `{}`: name it {}, or give --format",
+                        self.output.display(),
+                        Format::extension_list()
                     )
                 })?
             }
         };
-        match (format, self.ascii) {
-            (Format::Stl, true) => Ok(Format::StlAscii),
-            (_, true) => Err("--ascii is for STL only".into()),
-            (f, false) => Ok(f),
+        if self.ascii && format != Format::Stl {
+            return Err("--ascii is for STL only".into());
         }
+        Ok(format)
     }
 }
 
@@ -282,7 +286,7 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
         );
         return ExitCode::from(1);
     }
-    let units = args.units.map_or(scnc::export::formats::DEFAULT_3MF_UNIT, Units::three_mf);
+    let units = args.units.map_or(scnc::meshfile::DEFAULT_3MF_UNIT, Units::three_mf);
     let mtl_name = mtl.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
     let mut bytes = 0u64;
     let mut write = |path: &Path, what: &dyn Fn(&mut dyn Write) -> std::io::Result<()>| {
@@ -299,10 +303,11 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
     // then fails, a new MTL is removed again, so a failed export leaves nothing behind.
     let mtl_existed = mtl.exists();
     if format == Format::Obj {
-        written = write(&mtl, &|w| formats::mtl(&export, w));
+        written = write(&mtl, &|w| scnc::meshfile::obj::mtl(&export, w));
     }
     if written.is_ok() {
-        written = write(&args.output, &|w| format.write(&export, units, &mtl_name, w));
+        let options = WriteOptions { units, mtl: &mtl_name, ascii: args.ascii };
+        written = write(&args.output, &|w| format.write(&export, &options, w));
         if written.is_err() && format == Format::Obj && !mtl_existed {
             let _ = std::fs::remove_file(&mtl);
         }

@@ -97,7 +97,7 @@ pub fn extract_within(f: &(dyn Fn(Vec3A) -> f32 + Sync), grid: &Grid, max_cells:
     let mut cells = grid.surface_cells(f, max_cells).map_err(too_many)?;
     // Ask for the working memory's address space before using it: a cap (ulimit -v) or a
     // strict overcommit policy refuses here, as a too-fine grid, not by aborting midway.
-    if !super::system_gives((cells.len() as u64).saturating_mul(CELL_BYTES)) {
+    if !crate::source::system_gives((cells.len() as u64).saturating_mul(CELL_BYTES)) {
         return Err(too_many(max_cells as f64 * 2.0));
     }
     let (corners, values, edges, rings) = loop {

@@ -6,11 +6,12 @@
 use glam::{DAffine3, DVec3};
 
 use super::iso_job::{detail_cell, isosurface_object, unbounded, CellFrom, Iso};
-use super::{isosurface, obj, Detail, MeshJob, Normals};
+use super::{isosurface, Detail, MeshJob, Normals};
 use crate::diag::{codes, Diagnostic};
 use crate::geom::tessellate::count;
 use crate::geom::{tessellate, TriMesh};
 use crate::ir::{self, ExactMesh, MeshSource, Shape, ShapeKind};
+use crate::meshfile::{Format, Reader};
 use crate::primitive::{Facets, Tessellation};
 use crate::source::Loader;
 use crate::span::Span;
@@ -292,7 +293,7 @@ impl Budget {
     pub fn confirm(&mut self) -> Result<(), Diagnostic> {
         let planned = std::mem::take(&mut self.unconfirmed);
         let Some((_, span)) = self.largest.take() else { return Ok(()) };
-        if super::system_gives(planned) {
+        if crate::source::system_gives(planned) {
             return Ok(());
         }
         Err(Diagnostic::error(
@@ -416,20 +417,14 @@ pub fn explicit(
                     format!("bad mesh file `{written}`"),
                     format!("{place}: {message}"),
                 )
-                .with_note(
-                    "scnc reads OBJ files (`v x y z` and `f a b c …` records), STL (`.stl`, binary or ASCII, z up, millimetres), PLY (`.ply`), binary glTF (`.glb`) and 3MF (`.3mf`, z up, in its declared unit)",
-                )
+                .with_note(reads_note())
             };
             let limit = crate::source::MAX_MESH_FILE_BYTES;
-            let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-            let whole = || loader.read_bytes(path, limit).map_err(cannot);
-            match ext.as_deref() {
-                Some("stl") => super::stl::parse(&whole()?).map_err(|e| bad(written.clone(), e))?,
-                Some("ply") => super::ply::parse(&whole()?).map_err(|e| bad(written.clone(), e))?,
-                Some("glb") => super::glb::parse(&whole()?).map_err(|e| bad(written.clone(), e))?,
-                Some("3mf") => super::threemf::parse(&whole()?).map_err(|e| bad(written.clone(), e))?,
-                // OBJ, the format of large scans, is read a buffer at a time.
-                _ => obj::read(loader.open_bytes(path, limit).map_err(cannot)?).map_err(|e| {
+            match Format::for_reading(path).reader() {
+                Reader::Whole(read) => {
+                    read(&loader.read_bytes(path, limit).map_err(cannot)?).map_err(|e| bad(written.clone(), e))?
+                }
+                Reader::Lines(read) => read(&mut loader.open_bytes(path, limit).map_err(cannot)?).map_err(|e| {
                     let place = if e.line > 0 { format!("{written}:{}", e.line) } else { written.clone() };
                     bad(place, e.message)
                 })?,
@@ -520,4 +515,13 @@ mod tests {
         assert!(roomy.spend(MAX_SCENE_TRIANGLES, span).is_ok());
         assert!(roomy.spend(1, span).expect_err("over the triangle count").message.contains("triangles"));
     }
+}
+
+/// What `mesh file(…)` reads, for the note on a bad file: every format, OBJ first (any
+/// other name is read as OBJ).
+fn reads_note() -> String {
+    let mut formats: Vec<&str> = Format::ALL.iter().map(|f| f.reads()).collect();
+    formats.sort_by_key(|r| !r.starts_with("OBJ"));
+    let (last, rest) = formats.split_last().expect("formats! lists formats");
+    format!("scnc reads {} and {last}", rest.join(", "))
 }

@@ -10,17 +10,12 @@
 mod detail;
 mod iso_job;
 pub(crate) use iso_job::approx;
-pub mod glb;
 pub mod isosurface;
 pub mod lower;
-pub mod obj;
 pub mod octree;
 pub mod parts;
 pub mod pinch;
-pub mod ply;
 mod qef;
-pub mod stl;
-pub mod threemf;
 pub mod triangle;
 pub mod twist;
 pub mod unfold;
@@ -388,14 +383,6 @@ impl MeshObject {
         c.triangle_tests += tests;
         hit
     }
-}
-
-/// Whether the system would give `bytes` more now: address space only is taken (no page
-/// is touched) and given back, so an allocation this size that follows at once is not
-/// an abort but for what runs beside it.
-pub fn system_gives(bytes: u64) -> bool {
-    let Ok(bytes) = usize::try_from(bytes) else { return false };
-    Vec::<u8>::new().try_reserve_exact(bytes).is_ok()
 }
 
 /// A bounding sphere of a set of points (centre of the box, farthest point).

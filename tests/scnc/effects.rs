@@ -205,7 +205,8 @@ object sphere(0.7) at [0, -0.3, 6.5] with material(color = rgb(200, 200, 200))
 /// the IR cases.
 fn every_scene() -> Vec<std::path::PathBuf> {
     let dirs = ["examples", "examples/seed", "examples/features", "examples/animation", "examples/povray"];
-    let mut out: Vec<_> = dirs.iter().chain(["benches/scenes", "tests/data/ir"].iter()).flat_map(|d| cases(d)).collect();
+    let mut out: Vec<_> =
+        dirs.iter().chain(["benches/scenes", "tests/data/ir"].iter()).flat_map(|d| cases(d)).collect();
     // A fragment that `include`s are for, not a scene.
     out.retain(|p| !p.ends_with("lights.scn"));
     out
@@ -218,7 +219,8 @@ fn derived_over_every_scene() {
     let mut actual = String::new();
     for path in every_scene() {
         let c = compile(&path);
-        let scene = c.scene.unwrap_or_else(|| panic!("{}: {}", path.display(), scnc::diag::render_all(&c.diagnostics, &c.map)));
+        let scene =
+            c.scene.unwrap_or_else(|| panic!("{}: {}", path.display(), scnc::diag::render_all(&c.diagnostics, &c.map)));
         actual.push_str(&format!("{}: {}\n", path.display(), effects::derive(&scene)));
     }
     finish(check_golden(Path::new("tests/data/effects/derived.txt"), &actual).into_iter().collect());
@@ -251,7 +253,8 @@ fn an_effect_that_is_off_casts_nothing() {
             let mut small = scene.clone();
             (small.settings.width, small.settings.height) = (24, 24);
             // Some scenes cannot be meshed (an unbounded field); their SDF run counts.
-            let Ok((frame, world)) = scnc::world::prepare(&small, derived.clone(), mode, &scnc::source::FsLoader) else {
+            let Ok((frame, world)) = scnc::world::prepare(&small, derived.clone(), mode, &scnc::source::FsLoader)
+            else {
                 continue;
             };
             let (_, counts) = scnc::render::render(&world, &frame, &|| {});

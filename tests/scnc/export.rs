@@ -6,6 +6,8 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 
+use scnc::meshfile::{Format, WriteOptions};
+
 use super::support::{check_golden, files, scnc};
 
 /// Exports `scene` to `dir/name` with `extra` flags; the file's bytes.
@@ -79,7 +81,7 @@ fn the_default_detail_loses_the_chord_volume_and_no_more() {
 fn obj_reads_back_through_scncs_reader_with_its_colours() {
     let dir = tempfile::tempdir().expect("temp dir");
     let bytes = export("tests/data/export/unit.scn", dir.path(), "unit.obj", &["--detail", "28"]);
-    let mesh = scnc::mesh::obj::parse(&bytes).expect("scnc reads it");
+    let mesh = scnc::meshfile::Format::Obj.read(&bytes).expect("scnc reads it");
     let text = String::from_utf8(bytes).expect("text");
     let tris: Vec<[DVec3; 3]> = mesh.triangles.iter().map(|t| t.map(|i| mesh.positions[i as usize])).collect();
     let (v, lo, _) = measure(&tris);
@@ -270,12 +272,13 @@ fn every_example_exports_to_every_format_or_names_its_unbounded_object() {
     scenes.sort();
     assert!(scenes.len() >= 15, "{scenes:?}");
     for scene in &scenes {
-        for ext in ["stl", "obj", "ply", "3mf", "glb"] {
+        for format in Format::ALL {
+            let ext = format.extensions()[0];
             let out = dir.path().join(format!("out.{ext}"));
             let args = ["export", scene.to_str().expect("path"), "-o", out.to_str().expect("path"), "--detail", "low"];
             let run = scnc(&args);
             let err = String::from_utf8_lossy(&run.stderr);
-            if matches!(ext, "stl" | "3mf") {
+            if format.for_printing() {
                 assert_eq!(run.status.code(), Some(0), "{}: {err}", scene.display());
             }
             if run.status.code() == Some(0) {
@@ -422,14 +425,10 @@ fn an_exported_mesh_file_reads_back_where_it_was() {
     let meshed = render(&scene, "meshed.png", &["--geometry", "mesh"]);
     // OBJ, PLY and glb are y up, STL z up and in millimetres, 3MF z up in its declared
     // unit (as export writes them); every one reads back unmirrored, at its size.
-    for (name, extra) in [
-        ("l.obj", &[][..]),
-        ("l.stl", &[]),
-        ("l.ply", &[]),
-        ("l.glb", &[]),
-        ("l.3mf", &[]),
-        ("mm.3mf", &["--units", "mm", "--scale", "10"]),
-    ] {
+    let every: Vec<(String, &[&str])> =
+        Format::ALL.iter().map(|f| (format!("l.{}", f.extensions()[0]), &[][..])).collect();
+    for (name, extra) in every.into_iter().chain([("mm.3mf".to_string(), &["--units", "mm", "--scale", "10"][..])]) {
+        let name = name.as_str();
         let file = dir.path().join(name);
         let mut args = vec!["export", scene.to_str().expect("utf-8"), "-o", file.to_str().expect("utf-8")];
         args.extend_from_slice(extra);
@@ -643,4 +642,52 @@ fn twenty_million_triangles_stream_to_3mf_under_an_address_space_cap() {
     assert!(size > 1_000_000_000, "the model's XML is {size} bytes");
     let left: Vec<_> = std::fs::read_dir(dir.path()).expect("dir").map(|e| e.expect("entry").file_name()).collect();
     assert_eq!(left.len(), 2, "only the scene and the package: {left:?}");
+}
+
+/// Every listed format, written and read back in the library: the same triangles (each
+/// reader welds and maps the file's frame back), within f32 of the same places, from
+/// each format's own default frame and scale. And the list itself: names and
+/// extensions are unique, and each extension asks for its format.
+#[test]
+fn every_format_round_trips_through_its_reader() {
+    let scene = super::support::scene(
+        "object box(1, 0.5, 0.25) at [0.5, 0, 0] with material(color = rgb(200, 20, 20))\n\
+         object sphere(0.5) at [-1, 0.5, 2] with material(color = rgb(20, 20, 200))\n",
+    );
+    let mut names = std::collections::BTreeSet::new();
+    for &format in Format::ALL {
+        assert!(names.insert(format.name()), "two formats are named {}", format.name());
+        for ext in format.extensions() {
+            assert_eq!(Format::from_extension(ext), Some(format));
+            assert_eq!(Format::from_extension(&ext.to_uppercase()), Some(format));
+        }
+        let frame = scnc::export::Frame { up: format.default_up(), scale: format.default_scale() };
+        let export = scnc::export::collect(
+            &scene,
+            scnc::mesh::Detail::Low,
+            frame,
+            scnc::mesh::lower::DEFAULT_MEMORY_LIMIT,
+            false,
+            &scnc::source::FsLoader,
+        )
+        .expect("meshes");
+        let mut bytes = Vec::new();
+        format.write(&export, &WriteOptions::default(), &mut bytes).expect("writes");
+        let back = format.read(&bytes).unwrap_or_else(|e| panic!("{}: {e}", format.name()));
+        assert_eq!(back.triangles.len(), export.triangle_count(), "{}", format.name());
+        // In scene space, where the export's own vertices map back to.
+        let bounds = |points: &mut dyn Iterator<Item = DVec3>| {
+            points.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)))
+        };
+        let (lo, hi) = bounds(&mut back.positions.iter().copied());
+        let (want_lo, want_hi) = bounds(
+            &mut export
+                .parts
+                .iter()
+                .flat_map(|p| &p.mesh.positions)
+                .map(|&p| scnc::geom::axes::from_file(p / frame.scale, frame.up)),
+        );
+        assert!(hi.x > 0.9 && hi.z > 2.3, "{}: the box and the sphere are there ({lo} to {hi})", format.name());
+        assert!(close(lo, want_lo, 1e-5) && close(hi, want_hi, 1e-5), "{}: {lo} to {hi}", format.name());
+    }
 }

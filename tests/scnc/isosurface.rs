@@ -207,7 +207,7 @@ fn isosurfaces_at_sharp_corners_have_no_crossing_triangles() {
     let err = String::from_utf8_lossy(&run.stderr);
     assert_eq!(run.status.code(), Some(0), "{err}");
     assert!(err.contains("watertight and manifold"), "{err}");
-    let mesh = scnc::mesh::obj::parse(&std::fs::read(&out).expect("the OBJ")).expect("reads");
+    let mesh = scnc::meshfile::Format::Obj.read(&std::fs::read(&out).expect("the OBJ")).expect("reads");
     assert!(mesh.triangles.len() > 4000, "{}", mesh.triangles.len());
     assert_eq!(scnc::mesh::unfold::crossing_pairs(&mesh, 0.05), []);
 }

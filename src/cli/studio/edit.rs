@@ -5,8 +5,8 @@
 //! Positions cross between the page's UTF-16 units and the compiler's bytes in
 //! [`super::diagnostics`].
 
-use scnc::export::formats::Format;
 use scnc::lsp::analysis::{Analysis, CandidateKind};
+use scnc::meshfile::{Format, WriteOptions};
 use scnc::source::{FileId, SourceMap};
 
 use super::diagnostics::{diagnostics_json, to_byte, to_utf16};
@@ -167,13 +167,11 @@ fn insert_before_first_statement(text: &str, line: &str) -> String {
 /// (detail high; z up for STL and 3MF, which are for printing, y up otherwise).
 pub(crate) fn export(studio: &Studio, text: String, format: &str) -> Reply {
     use scnc::export::Frame;
-    let (format, mime, ext) = match format {
-        "stl" => (Format::Stl, "model/stl", "stl"),
-        "3mf" => (Format::ThreeMf, "model/3mf", "3mf"),
-        "glb" => (Format::Glb, "model/gltf-binary", "glb"),
-        "ply" => (Format::Ply, "application/octet-stream", "ply"),
-        other => return Reply::text(400, &format!("`{other}`: the studio exports stl, 3mf, glb or ply")),
+    let Some(format) = Format::from_name(format).filter(|f| f.one_file()) else {
+        let names: Vec<&str> = downloads().map(Format::name).collect();
+        return Reply::text(400, &format!("`{format}`: the studio exports {}", names.join(", ")));
     };
+    let (mime, ext) = (format.mime(), format.extensions()[0]);
     let compiled = studio.files.compile(text);
     let Some(scene) = &compiled.scene else {
         return Reply::text(422, "the scene has errors: fix them to export");
@@ -195,7 +193,7 @@ pub(crate) fn export(studio: &Studio, text: String, format: &str) -> Reply {
         Err(d) => return Reply::text(422, &format!("error[{}]: {}", d.code, d.message)),
     };
     let mut bytes = Vec::new();
-    if let Err(e) = format.write(&export, scnc::export::formats::DEFAULT_3MF_UNIT, "", &mut bytes) {
+    if let Err(e) = format.write(&export, &WriteOptions::default(), &mut bytes) {
         return Reply::text(500, &format!("cannot write the {ext}: {e}"));
     }
     let stem = studio.files.root.file_stem().map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
@@ -218,4 +216,17 @@ mod tests {
         assert_eq!(short(-0.00001), "0");
         assert_eq!(short(2.5), "2.5");
     }
+}
+
+/// The formats the studio offers as downloads: every one that is a single file.
+pub(crate) fn downloads() -> impl Iterator<Item = Format> {
+    Format::ALL.iter().copied().filter(|f| f.one_file())
+}
+
+/// `GET /api/formats`: the downloads, for the page's buttons.
+pub(crate) fn formats() -> Reply {
+    let list: Vec<serde_json::Value> = downloads()
+        .map(|f| serde_json::json!({ "name": f.name(), "label": f.name().to_uppercase(), "about": f.about() }))
+        .collect();
+    Reply::json(&serde_json::Value::Array(list))
 }

@@ -179,6 +179,7 @@ fn handle(studio: &Arc<Studio>, request: tiny_http::Request) {
         ("GET", "/favicon.svg" | "/favicon.ico") => Reply::asset("image/svg+xml", FAVICON),
         ("GET", "/api/file") => edit::file(studio),
         ("GET", "/api/examples") => Reply::json(&examples::json()),
+        ("GET", "/api/formats") => edit::formats(),
         ("GET", "/api/events") => return studio.files.subscribe(req),
         ("POST", "/api/render") => return preview::render(studio, req),
         ("POST", path) if path.starts_with("/api/") => match req.body() {

@@ -344,7 +344,6 @@ $("save").onclick = save;
 $("format").onclick = format;
 $("write-camera").onclick = writeCamera;
 $("reset-view").onclick = () => { state.view = homeView(); viewChanged(); };
-for (const f of ["stl", "3mf", "glb"]) $(`export-${f}`).onclick = () => exportAs(f);
 $("backend").onchange = () => { state.backend = $("backend").value; viewChanged(); };
 function rungChanged() {
   const on = $("accuracy-on").checked;
@@ -356,6 +355,22 @@ function rungChanged() {
 }
 $("accuracy-on").onchange = rungChanged;
 $("accuracy").oninput = rungChanged;
+
+// --- downloads -----------------------------------------------------------------------
+
+/** One button per format the server can write as one file (its list is the formats'). */
+async function loadFormats() {
+  const list = await (await fetch("/api/formats")).json();
+  for (const f of list) {
+    const b = document.createElement("button");
+    b.id = `export-${f.name}`;
+    b.dataset.testid = `export-${f.name}`;
+    b.textContent = f.label;
+    b.title = f.about;
+    b.onclick = () => exportAs(f.name);
+    $("exports").append(b);
+  }
+}
 
 // --- examples ------------------------------------------------------------------------
 
@@ -398,6 +413,7 @@ async function loadExamples() {
   if (file.starter) $("saved").textContent = "new file: a starter scene, not saved yet";
   edited(opening);
   loadExamples();
+  loadFormats();
   // The file on disk is the truth: an edit made elsewhere replaces the page's text.
   const events = new EventSource("/api/events");
   events.addEventListener("file", (e) => {

@@ -5,8 +5,11 @@
 
 use glam::{DMat4, DVec3};
 
-use super::obj::MAX_ELEMENTS;
+use super::MAX_ELEMENTS;
 use crate::geom::{axes, TriMesh};
+use std::io::{self, Write};
+
+use super::{f32s, material_name, slot, used, Export, MeshFormat, Part, Reader, Up, WriteOptions};
 
 /// Parses a `.glb` file's bytes into scnc's space; an error says what is wrong.
 pub fn parse(bytes: &[u8]) -> Result<TriMesh, String> {
@@ -55,7 +58,7 @@ fn add(mesh: &mut TriMesh, p: &gltf::Primitive, world: DMat4, blob: Option<&[u8]
     let base = mesh.positions.len() as u32;
     for q in positions {
         let q = world.transform_point3(DVec3::from(q.map(f64::from)));
-        if let Some(why) = super::obj::unrenderable(q) {
+        if let Some(why) = super::unrenderable(q) {
             return Err(format!("a vertex {why}"));
         }
         mesh.positions.push(axes::from_file(q, axes::Up::Y));
@@ -163,4 +166,150 @@ mod tests {
         let e = parse(b"glTF\x02\0\0\0").expect_err("truncated");
         assert!(e.contains("not a readable glb"), "{e}");
     }
+}
+
+/// The binary glTF 2.0 format.
+pub struct Glb;
+
+impl MeshFormat for Glb {
+    const NAME: &'static str = "glb";
+    const ABOUT: &'static str = "binary glTF 2.0";
+    const EXTENSIONS: &'static [&'static str] = &["glb"];
+    const MIME: &'static str = "model/gltf-binary";
+    const FOR_PRINTING: bool = false;
+    // Metres to glTF readers: the scene's numbers as they are.
+    const DEFAULT_SCALE: f64 = 1.0;
+    // glTF's specification: +y is up.
+    const FIXED_UP: Option<Up> = Some(Up::Y);
+    const ONE_FILE: bool = true;
+    const READS: &'static str = "binary glTF (`.glb`)";
+    const READER: Reader = Reader::Whole(parse);
+
+    fn working_bytes(part: &Part) -> (u64, u64) {
+        // The binary buffer: positions, normals and indices, each also built apart first.
+        let (v, t) = (part.mesh.positions.len() as u64, part.mesh.triangles.len() as u64);
+        let buffer = 2 * (12 * v + if part.smooth { 12 * v } else { 0 } + 12 * t);
+        (buffer / 2, super::groups_bytes(part) + super::normals_bytes(part) + buffer / 2)
+    }
+
+    fn write(export: &Export, _: &WriteOptions, w: &mut dyn Write) -> io::Result<()> {
+        glb(export, w)
+    }
+}
+
+/// Binary glTF: the JSON document, then one binary buffer holding, per part and
+/// material, positions (with their bounds, which glTF requires), normals for smooth
+/// parts, and `u32` indices.
+fn glb(export: &Export, w: &mut dyn Write) -> io::Result<()> {
+    use serde_json::json;
+    let mut bin: Vec<u8> = Vec::new();
+    let (mut views, mut accessors, mut meshes, mut nodes) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let used = used(export);
+    // Appends a buffer view of `bytes` (aligned to 4) and an accessor over it.
+    let mut push = |bin: &mut Vec<u8>, bytes: Vec<u8>, accessor: serde_json::Value, target: u32| {
+        while !bin.len().is_multiple_of(4) {
+            bin.push(0);
+        }
+        views.push(json!({ "buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len(), "target": target }));
+        bin.extend_from_slice(&bytes);
+        let mut a = accessor;
+        a["bufferView"] = json!(views.len() - 1);
+        accessors.push(a);
+        accessors.len() - 1
+    };
+    for p in &export.parts {
+        let normals = p.smooth.then(|| p.vertex_normals());
+        let mut primitives = Vec::new();
+        for g in p.groups() {
+            let points: Vec<[f32; 3]> = g.vertices.iter().map(|&v| f32s(p.mesh.positions[v as usize])).collect();
+            let (min, max) = points.iter().fold(([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]), |(lo, hi), q| {
+                (std::array::from_fn(|k| lo[k].min(q[k])), std::array::from_fn(|k| hi[k].max(q[k])))
+            });
+            let bytes = points.iter().flatten().flat_map(|c| c.to_le_bytes()).collect();
+            let position = push(
+                &mut bin,
+                bytes,
+                json!({ "componentType": 5126, "count": points.len(), "type": "VEC3", "min": min, "max": max }),
+                34962,
+            );
+            let mut attributes = json!({ "POSITION": position });
+            if let Some(n) = &normals {
+                let bytes =
+                    g.vertices.iter().flat_map(|&v| f32s(n[v as usize])).flat_map(|c| c.to_le_bytes()).collect();
+                let normal = push(
+                    &mut bin,
+                    bytes,
+                    json!({ "componentType": 5126, "count": g.vertices.len(), "type": "VEC3" }),
+                    34962,
+                );
+                attributes["NORMAL"] = json!(normal);
+            }
+            let bytes = g.triangles.iter().flatten().flat_map(|i| i.to_le_bytes()).collect();
+            let indices = push(
+                &mut bin,
+                bytes,
+                json!({ "componentType": 5125, "count": g.triangles.len() * 3, "type": "SCALAR" }),
+                34963,
+            );
+            primitives.push(
+                json!({ "attributes": attributes, "indices": indices, "material": slot(&used, g.material), "mode": 4 }),
+            );
+        }
+        // glTF wants at least one primitive per mesh: a part with no triangles left is
+        // a node without a mesh.
+        if primitives.is_empty() {
+            nodes.push(json!({ "name": p.name }));
+        } else {
+            meshes.push(json!({ "name": p.name, "primitives": primitives }));
+            nodes.push(json!({ "name": p.name, "mesh": meshes.len() - 1 }));
+        }
+    }
+    while !bin.len().is_multiple_of(4) {
+        bin.push(0);
+    }
+    let materials: Vec<serde_json::Value> = used
+        .iter()
+        .map(|&m| {
+            let [r, g, b] = export.colours[m as usize].linear();
+            json!({
+                "name": material_name(export, m),
+                "pbrMetallicRoughness": { "baseColorFactor": [r, g, b, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.8 },
+            })
+        })
+        .collect();
+    let mut doc = json!({
+        "asset": { "version": "2.0", "generator": "scnc export" },
+        "scene": 0,
+        "scenes": [{ "nodes": (0..nodes.len()).collect::<Vec<_>>() }],
+        "nodes": nodes,
+        "meshes": meshes,
+        "materials": materials,
+        "accessors": accessors,
+        "bufferViews": views,
+    });
+    if !bin.is_empty() {
+        doc["buffers"] = json!([{ "byteLength": bin.len() }]);
+    }
+    // glTF's arrays, where present, hold at least one item.
+    if let Some(fields) = doc.as_object_mut() {
+        fields.retain(|_, v| v.as_array().is_none_or(|a| !a.is_empty()));
+    }
+    let mut text = serde_json::to_vec(&doc).map_err(io::Error::other)?;
+    while !text.len().is_multiple_of(4) {
+        text.push(b' ');
+    }
+    let total = 12 + 8 + text.len() + if bin.is_empty() { 0 } else { 8 + bin.len() };
+    let total = u32::try_from(total).map_err(|_| io::Error::other("a .glb file holds at most 4 GiB"))?;
+    w.write_all(b"glTF")?;
+    w.write_all(&2u32.to_le_bytes())?;
+    w.write_all(&total.to_le_bytes())?;
+    w.write_all(&(text.len() as u32).to_le_bytes())?;
+    w.write_all(b"JSON")?;
+    w.write_all(&text)?;
+    if !bin.is_empty() {
+        w.write_all(&(bin.len() as u32).to_le_bytes())?;
+        w.write_all(b"BIN\0")?;
+        w.write_all(&bin)?;
+    }
+    Ok(())
 }
