@@ -9,16 +9,15 @@ use std::time::Instant;
 use clap::ValueEnum;
 
 use super::progress::Reading;
+use super::shared::{Accuracy, Meshing, Messages, Workers};
 use scnc::diag::codes;
 use scnc::export::report::MeshReport;
 use scnc::export::{Frame, Up};
 use scnc::mesh::Detail;
 use scnc::meshfile::{Format, WriteOptions};
-use scnc::study::tolerance::Tolerance;
 
 use super::files::{cannot_write, check_output_as, overwritten_input, write_atomic};
-use super::render::{parse_bytes, parse_detail};
-use super::{compile, report, usage_error, worker_pool, MessageFormat};
+use super::{compile, report, usage_error};
 
 /// `--format`: a mesh file format, with the values and help the format list gives.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -97,13 +96,10 @@ pub(crate) struct ExportArgs {
     /// Write ASCII STL instead of binary.
     #[arg(long)]
     ascii: bool,
-    /// Tessellation detail, as `render --geometry mesh`: `low`, `high` or N rings.
-    #[arg(long, value_parser = parse_detail, default_value = "high")]
-    detail: scnc::mesh::Detail,
-    /// Pick the detail expected to keep the surface within this many scene units (or a
-    /// pixel of the scene's camera with `pixel`), as `render --geometry mesh`.
-    #[arg(long, conflicts_with = "detail")]
-    tolerance: Option<Tolerance>,
+    #[command(flatten)]
+    meshing: Meshing,
+    #[command(flatten)]
+    accuracy: Accuracy,
     /// The file's up axis (default: `z` for STL and 3MF, `y` for OBJ, PLY and glb).
     #[arg(long, value_enum)]
     up: Option<UpArg>,
@@ -114,9 +110,6 @@ pub(crate) struct ExportArgs {
     /// The unit a 3MF file declares (default: cm, one scene unit a centimetre).
     #[arg(long, value_enum)]
     units: Option<Units>,
-    /// Most memory the meshes may take while they are made (as `render`).
-    #[arg(long, value_parser = parse_bytes, default_value = "4G")]
-    memory_limit: u64,
     /// Leave out unbounded objects (a `plane`), with a warning, instead of stopping at
     /// them: always so for STL and 3MF, which are for printing.
     #[arg(long)]
@@ -125,12 +118,10 @@ pub(crate) struct ExportArgs {
     /// enclosed volume and bounds.
     #[arg(long)]
     stats: bool,
-    /// Worker threads (default: one per core).
-    #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024))]
-    threads: Option<u16>,
-    /// How to print diagnostics.
-    #[arg(long, value_enum, default_value = "human")]
-    message_format: MessageFormat,
+    #[command(flatten)]
+    workers: Workers,
+    #[command(flatten)]
+    messages: Messages,
 }
 
 /// Warnings about how a scene renders, which an export leaves out.
@@ -196,15 +187,15 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
     if let Err(e) = super::files::stop_on_interrupt(130) {
         let _ = writeln!(std::io::stderr(), "warning: {e}");
     }
-    let pool = match worker_pool(args.threads) {
+    let pool = match args.workers.pool() {
         Ok(p) => p,
         Err(e) => return usage_error(&e),
     };
-    let Some(mut compiled) = compile(&args.file, args.message_format) else { return ExitCode::from(1) };
+    let Some(mut compiled) = compile(&args.file, args.messages.message_format) else { return ExitCode::from(1) };
     // What only a render sees (lights, the camera's view, a field's marching cost) is
     // not the export's business.
     compiled.diagnostics.retain(|d| d.is_error() || !RENDER_ONLY.contains(&d.code));
-    if report(&compiled, args.message_format) {
+    if report(&compiled, args.messages.message_format) {
         return ExitCode::from(1);
     }
     let Some(scene) = compiled.scene.take() else { return ExitCode::from(1) };
@@ -229,24 +220,25 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
         return ExitCode::from(1);
     }
     let started = Instant::now();
-    let detail: Detail = match args.tolerance {
+    let detail: Detail = match args.accuracy.tolerance {
         Some(tol) => {
             let detail = scnc::study::tolerance::mesh_detail(scene, tol);
             let _ = writeln!(std::io::stderr(), "tolerance {tol}: picked detail {}", detail.rings());
             detail
         }
-        None => args.detail,
+        None => args.meshing.detail,
     };
     let up = args.up.map_or(format.default_up(), Up::from);
     let frame = Frame { up, scale: args.scale.unwrap_or(format.default_scale()) };
     let skip = args.skip_unbounded || format.for_printing();
-    let collect =
-        |detail| pool.install(|| scnc::export::collect(scene, detail, frame, args.memory_limit, skip, &Reading));
+    let collect = |detail| {
+        pool.install(|| scnc::export::collect(scene, detail, frame, args.meshing.memory_limit, skip, &Reading))
+    };
     let mut result = collect(detail);
     // A tolerance promises a mesh good enough to use: where an isosurface is pinched or
     // lost volume (a part thinner than the cell), refine, a few times at most.
     let mut detail = detail;
-    if args.tolerance.is_some() {
+    if args.accuracy.tolerance.is_some() {
         for _ in 0..REFINEMENTS {
             let Ok(e) = &result else { break };
             let thin = [scnc::diag::codes::PINCHED_EDGES, scnc::diag::codes::LOST_VOLUME];
@@ -269,11 +261,11 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
     }
     let export = match result {
         Ok(e) => {
-            super::report_in(&compiled.map, &e.warnings, args.message_format);
+            super::report_in(&compiled.map, &e.warnings, args.messages.message_format);
             e
         }
         Err(d) => {
-            super::report_in(&compiled.map, &[d], args.message_format);
+            super::report_in(&compiled.map, &[d], args.messages.message_format);
             return ExitCode::from(1);
         }
     };

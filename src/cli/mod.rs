@@ -16,6 +16,7 @@ mod frames;
 mod merge;
 mod progress;
 mod render;
+mod shared;
 mod stats;
 mod studio;
 mod sweep;
@@ -56,9 +57,8 @@ enum Command {
         /// The scene files.
         #[arg(required = true)]
         files: Vec<PathBuf>,
-        /// How to print diagnostics.
-        #[arg(long, value_enum, default_value = "human")]
-        message_format: MessageFormat,
+        #[command(flatten)]
+        messages: shared::Messages,
         /// Print nothing on success (no summary line).
         #[arg(long, short)]
         quiet: bool,
@@ -104,9 +104,8 @@ enum Command {
         /// The frame of the scene's animation to evaluate (default 0).
         #[arg(long, default_value = "0")]
         frame: u32,
-        /// How to print diagnostics.
-        #[arg(long, value_enum, default_value = "human")]
-        message_format: MessageFormat,
+        #[command(flatten)]
+        messages: shared::Messages,
     },
 }
 
@@ -223,7 +222,7 @@ fn run(cli: Cli) -> ExitCode {
                 ExitCode::from(1)
             }
         },
-        Command::Check { files, message_format, quiet } => {
+        Command::Check { files, messages: shared::Messages { message_format }, quiet } => {
             let mut failed = false;
             let (mut objects, mut lights, mut warnings) = (0, 0, 0);
             for file in &files {
@@ -255,7 +254,7 @@ fn run(cli: Cli) -> ExitCode {
             }
             ExitCode::SUCCESS
         }
-        Command::Ir { file, frame, message_format } => {
+        Command::Ir { file, frame, messages: shared::Messages { message_format } } => {
             let Some(mut compiled) = compile(&file, message_format) else { return ExitCode::from(1) };
             // Frame 0's diagnostics, unless another frame is asked for and frame 0 has no
             // errors: then that frame's own (its warnings include frame 0's that still hold).

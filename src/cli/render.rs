@@ -11,7 +11,6 @@ use clap::ValueEnum;
 
 use scnc::check::{Time, EPSILON_RANGE, MAX_DEPTH, MAX_FRAMES, MAX_IMAGE_SIDE, MAX_PIXELS, MAX_SAMPLES, MAX_STEPS};
 use scnc::source::FsLoader;
-use scnc::study::tolerance::Tolerance;
 use scnc::Compiled;
 
 use scnc::render::{BitDepth, Region};
@@ -19,7 +18,8 @@ use scnc::render::{BitDepth, Region};
 use super::files::{cannot_write, check_output, stop_on_interrupt, write_part_png, write_png, FPS_KEY};
 use super::frames::{frame_path, is_pattern, parse_frames, FrameChoice};
 use super::progress::{Progress, Reading};
-use super::{compile, report, usage_error, worker_pool, MessageFormat};
+use super::shared::{Accuracy, Meshing, Messages, Workers};
+use super::{compile, report, usage_error, MessageFormat};
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum GeometryKind {
@@ -50,11 +50,10 @@ pub(crate) struct RenderArgs {
     /// Image height in pixels (overrides the scene's `render`).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64))]
     height: Option<u32>,
-    /// Worker threads (default: one per core).
-    #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024))]
-    pub(crate) threads: Option<u16>,
+    #[command(flatten)]
+    workers: Workers,
     /// Sphere-tracing hit threshold, relative to distance from the camera.
-    #[arg(long, value_parser = parse_epsilon)]
+    #[arg(long, value_parser = parse_epsilon, conflicts_with = "tolerance")]
     epsilon: Option<f64>,
     /// Sphere-tracing step budget per ray.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_STEPS as i64))]
@@ -68,21 +67,13 @@ pub(crate) struct RenderArgs {
     /// Samples per pixel (antialiasing).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_SAMPLES as i64))]
     samples: Option<u32>,
-    /// Pick the cheapest setting expected to keep geometric error under this many world
-    /// units, or under a pixel's footprint with `pixel` (sets epsilon, or detail with meshes).
-    #[arg(long, conflicts_with_all = ["epsilon", "detail"])]
-    tolerance: Option<Tolerance>,
+    #[command(flatten)]
+    accuracy: Accuracy,
     /// Geometry back-end for shapes (explicit meshes are always meshes).
     #[arg(long, value_enum, default_value = "sdf")]
     geometry: GeometryKind,
-    /// Tessellation detail with `--geometry mesh`: `low` (7 rings, 10-point circles),
-    /// `high` (14 rings, 50-point circles) or N (N rings, 2N-point circles).
-    #[arg(long, value_parser = parse_detail, default_value = "high")]
-    detail: scnc::mesh::Detail,
-    /// Most memory the scene's meshes may take while they are built, in bytes or with a
-    /// K, M or G suffix (binary); a mesh that would need more is refused before it is made.
-    #[arg(long, value_parser = parse_bytes, default_value = "4G")]
-    memory_limit: u64,
+    #[command(flatten)]
+    meshing: Meshing,
     /// Bits per channel of the PNG: 8, or 16 (finer steps for grading, as shading is
     /// done in f32 before it is quantised).
     #[arg(long, value_parser = parse_bit_depth, value_name = "8|16", default_value = "8")]
@@ -122,9 +113,8 @@ pub(crate) struct RenderArgs {
     #[arg(long, value_name = "K", default_value = "1", requires = "frame_index_from",
           value_parser = clap::value_parser!(u32).range(1..=MAX_FRAMES as i64))]
     chunk: u32,
-    /// How to print diagnostics.
-    #[arg(long, value_enum, default_value = "human")]
-    message_format: MessageFormat,
+    #[command(flatten)]
+    messages: Messages,
 }
 
 /// `8` or `16`.
@@ -236,8 +226,8 @@ impl RenderArgs {
             return Err(usage_error(&format!("{}×{} is too large: at most {} pixels", s.width, s.height, MAX_PIXELS)));
         }
         let part = self.part(s.width, s.height).map_err(|e| usage_error(&e))?;
-        let mut detail = self.detail;
-        if let Some(tol) = self.tolerance {
+        let mut detail = self.meshing.detail;
+        if let Some(tol) = self.accuracy.tolerance {
             let picked = match self.geometry {
                 GeometryKind::Sdf => {
                     scene.settings.epsilon = scnc::study::tolerance::sdf_epsilon(scene, tol);
@@ -290,7 +280,7 @@ impl RenderArgs {
         if let Err(e) = stop_on_interrupt(interrupted) {
             let _ = writeln!(std::io::stderr(), "warning: {e}");
         }
-        worker_pool(self.threads).map_err(|e| usage_error(&e))
+        self.workers.pool().map_err(|e| usage_error(&e))
     }
 }
 
@@ -302,7 +292,7 @@ pub(crate) struct Attempt {
 }
 
 pub(crate) fn render_once(args: &RenderArgs, pool: &rayon::ThreadPool) -> Attempt {
-    let Some(compiled) = compile(&args.file, args.message_format) else {
+    let Some(compiled) = compile(&args.file, args.messages.message_format) else {
         return Attempt { files: vec![args.file.clone()], result: Err(ExitCode::from(1)) };
     };
     let files: Vec<PathBuf> = compiled.map.files().map(|(_, f)| f.path.clone()).collect();
@@ -311,7 +301,7 @@ pub(crate) fn render_once(args: &RenderArgs, pool: &rayon::ThreadPool) -> Attemp
 }
 
 fn render_compiled(args: &RenderArgs, pool: &rayon::ThreadPool, mut compiled: Compiled) -> Result<(), ExitCode> {
-    if report(&compiled, args.message_format) {
+    if report(&compiled, args.messages.message_format) {
         return Err(ExitCode::from(1));
     }
     let Some(first) = compiled.scene.take() else {
@@ -347,7 +337,9 @@ fn render_compiled(args: &RenderArgs, pool: &rayon::ThreadPool, mut compiled: Co
         }
         let scene = match first.take().filter(|_| number == 0) {
             Some(scene) => scene,
-            None => evaluate_frame(&mut compiled, number, &declared, &mut sequence.shown, args.message_format)?,
+            None => {
+                evaluate_frame(&mut compiled, number, &declared, &mut sequence.shown, args.messages.message_format)?
+            }
         };
         if together {
             let target = super::files::link_target(&output);
@@ -433,18 +425,20 @@ fn render_scene(
     let building = Progress::new(scnc::world::lowering_steps(&scene), "steps", "lowering");
     let lowered = pool.install(|| {
         let cache = &mut sequence.cache;
-        scnc::world::prepare_reusing(&scene, effects, mode, &Reading, args.memory_limit, cache, &|| building.step())
+        scnc::world::prepare_reusing(&scene, effects, mode, &Reading, args.meshing.memory_limit, cache, &|| {
+            building.step()
+        })
     });
     building.finish();
     let (mut frame, geometry) = match lowered {
         Ok(g) => {
             let fresh: Vec<_> =
                 g.1.warnings.iter().filter(|d| sequence.shown.insert(diagnostic_key(d))).cloned().collect();
-            super::report_in(map, &fresh, args.message_format);
+            super::report_in(map, &fresh, args.messages.message_format);
             g
         }
         Err(d) => {
-            super::report_in(map, &[d], args.message_format);
+            super::report_in(map, &[d], args.messages.message_format);
             return Err(ExitCode::from(1));
         }
     };

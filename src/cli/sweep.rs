@@ -6,11 +6,11 @@ use std::process::ExitCode;
 
 use scnc::source::FsLoader;
 use scnc::study::sweep::{Options, PeakMemory, Step};
-use scnc::study::tolerance::Tolerance;
 use scnc::study::{chart, report as table, sweep};
 
 use super::files::{cannot_write, write_png, write_text};
-use super::{compile, report, usage_error, MessageFormat};
+use super::shared::{Accuracy, Messages};
+use super::{compile, report, usage_error};
 
 #[derive(clap::Args)]
 pub(crate) struct SweepArgs {
@@ -33,30 +33,27 @@ pub(crate) struct SweepArgs {
     #[arg(long, default_value_t = 3.0, value_parser = parse_cap)]
     time_cap: f64,
     /// Two settings per back-end instead of the full ladder.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "tolerance")]
     quick: bool,
-    /// Sweep only the settings `render --tolerance` would pick (world units or `pixel`),
-    /// to check that they hold.
-    #[arg(long, conflicts_with = "quick")]
-    tolerance: Option<Tolerance>,
-    /// How to print diagnostics.
-    #[arg(long, value_enum, default_value = "human")]
-    message_format: MessageFormat,
+    #[command(flatten)]
+    accuracy: Accuracy,
+    #[command(flatten)]
+    messages: Messages,
 }
 
 pub(crate) fn sweep_cmd(args: SweepArgs) -> ExitCode {
     if let Err(e) = std::fs::create_dir_all(&args.output) {
         return usage_error(&format!("cannot create `{}`: {e}", args.output.display()));
     }
-    let Some(compiled) = compile(&args.file, args.message_format) else { return ExitCode::from(1) };
-    if report(&compiled, args.message_format) {
+    let Some(compiled) = compile(&args.file, args.messages.message_format) else { return ExitCode::from(1) };
+    if report(&compiled, args.messages.message_format) {
         return ExitCode::from(1);
     }
     let Some(mut scene) = compiled.scene else { return ExitCode::from(1) };
     scene.settings.width = args.width.unwrap_or(scene.settings.width);
     scene.settings.height = args.height.unwrap_or(scene.settings.height);
     let (width, height) = (scene.settings.width, scene.settings.height);
-    let ladder = match args.tolerance {
+    let ladder = match args.accuracy.tolerance {
         Some(tol) => sweep::picked(&scene, tol),
         None => sweep::ladder(args.quick),
     };
@@ -102,7 +99,7 @@ pub(crate) fn sweep_cmd(args: SweepArgs) -> ExitCode {
     let rows = match sweep::run(&scene, &ladder, &opts) {
         Ok(rows) => rows,
         Err(d) => {
-            super::report_in(&compiled.map, &[d], args.message_format);
+            super::report_in(&compiled.map, &[d], args.messages.message_format);
             return ExitCode::from(1);
         }
     };

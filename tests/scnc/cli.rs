@@ -1,6 +1,6 @@
 //! The binary: exit codes, streams, and output formats.
 
-use crate::support::{ok, refused, scnc};
+use crate::support::{finish, ok, refused, scnc};
 
 #[test]
 fn check_clean_file_exits_0() {
@@ -531,4 +531,90 @@ fn no_radians_warning_on_any_shipped_scene() {
         .filter(|f| crate::support::compile(std::path::Path::new(f)).diagnostics.iter().any(|d| d.code == "W0010"))
         .collect();
     assert!(flagged.is_empty(), "W0010 on {flagged:?}");
+}
+
+/// The `--flags` a text names.
+fn flags_in(text: &str) -> std::collections::BTreeSet<String> {
+    let mut out = std::collections::BTreeSet::new();
+    for (i, _) in text.match_indices("--") {
+        let name: String = text[i + 2..].chars().take_while(|c| c.is_ascii_lowercase() || *c == '-').collect();
+        let before = text[..i].chars().next_back();
+        if name.len() > 1 && !before.is_some_and(|c| c.is_alphanumeric() || c == '-') {
+            out.insert(name.trim_end_matches('-').to_string());
+        }
+    }
+    out
+}
+
+/// `docs/cli.md` says what `--help` says: each command's row names every flag its
+/// `--help` lists (or the shared-flags table does, for a flag shared by commands), and
+/// names no flag the command does not take.
+#[test]
+fn the_cli_page_names_every_flag_help_lists() {
+    let page = std::fs::read_to_string("docs/cli.md").expect("docs/cli.md");
+    let shared_at = page.find("## Shared flags").expect("docs/cli.md has a Shared flags section");
+    let shared_end = page[shared_at + 3..].find("\n## ").map_or(page.len(), |e| shared_at + 3 + e);
+    let shared = flags_in(&page[shared_at..shared_end]);
+    let help = |args: &[&str]| {
+        let out = scnc(args);
+        assert_eq!(out.status.code(), Some(0), "{args:?}");
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    let top = help(&["--help"]);
+    let commands: Vec<&str> = top
+        .lines()
+        .skip_while(|l| !l.starts_with("Commands:"))
+        .skip(1)
+        .take_while(|l| l.starts_with("  "))
+        .filter_map(|l| l.split_whitespace().next())
+        .filter(|c| *c != "help")
+        .collect();
+    assert!(commands.len() >= 10, "{commands:?}");
+    let mut failures = Vec::new();
+    let mut shared_used = std::collections::BTreeSet::new();
+    for command in commands {
+        let prefix = format!("| `scnc {command}");
+        let Some(row) = page.lines().find(|l| l.starts_with(&prefix)) else {
+            failures.push(format!("docs/cli.md has no row for `scnc {command}`"));
+            continue;
+        };
+        let mut documented = flags_in(row);
+        // `watch` takes `render`'s flags, and its row says so.
+        if row.contains("same flags as `render`") {
+            let render = page.lines().find(|l| l.starts_with("| `scnc render")).unwrap_or("");
+            documented.extend(flags_in(render));
+        }
+        // Options are listed as `  -o, --output <OUTPUT>` or `      --stats`; a row may
+        // give the short form (`-o OUT.png`).
+        let mut listed = std::collections::BTreeSet::new();
+        for line in help(&[command, "--help"]).lines().map(str::trim_start).filter(|l| l.starts_with('-')) {
+            let head = line.split("  ").next().unwrap_or("");
+            let short = head
+                .strip_prefix('-')
+                .and_then(|h| h.chars().next())
+                .filter(|c| c.is_ascii_alphabetic() && head.as_bytes().get(2) == Some(&b','));
+            for f in flags_in(head).into_iter().filter(|f| f != "help" && f != "version") {
+                if let Some(c) = short {
+                    if row.contains(&format!(" -{c} ")) || row.contains(&format!("[-{c}]")) {
+                        documented.insert(f.clone());
+                    }
+                }
+                listed.insert(f);
+            }
+        }
+        for f in &listed {
+            if shared.contains(f) {
+                shared_used.insert(f.clone());
+            } else if !documented.contains(f) {
+                failures.push(format!("`scnc {command} --{f}` is not in its row of docs/cli.md"));
+            }
+        }
+        for f in documented.difference(&listed) {
+            failures.push(format!("docs/cli.md names `--{f}` for `scnc {command}`, which has no such flag"));
+        }
+    }
+    for f in shared.difference(&shared_used) {
+        failures.push(format!("the shared flag `--{f}` is taken by no command"));
+    }
+    finish(failures);
 }

@@ -29,6 +29,7 @@ use std::sync::Arc;
 
 use http::{Reply, Req};
 
+use super::shared::Workers;
 use super::usage_error;
 
 #[derive(clap::Args)]
@@ -43,9 +44,8 @@ pub(crate) struct StudioArgs {
     /// edit and render this file: say so explicitly.
     #[arg(long, default_value = "127.0.0.1")]
     host: IpAddr,
-    /// Worker threads for rendering (default: one per core).
-    #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024))]
-    threads: Option<u16>,
+    #[command(flatten)]
+    workers: Workers,
     /// Write the port listened on to this file (for tests and scripts with `--port 0`).
     #[arg(long, hide = true)]
     port_file: Option<PathBuf>,
@@ -69,7 +69,7 @@ pub(crate) fn studio_cmd(args: StudioArgs) -> ExitCode {
         Ok(f) => f,
         Err(e) => return usage_error(&e),
     };
-    let pool = match super::worker_pool(args.threads) {
+    let pool = match args.workers.pool() {
         Ok(p) => p,
         Err(e) => return usage_error(&e),
     };
