@@ -434,14 +434,7 @@ impl Ctx<'_> {
         let ok = match (ty, v) {
             (_, Value::Error) => return Some(Value::Error),
             (Ty::Num | Ty::Int | Ty::Vec3 | Ty::Size | Ty::Linear | Ty::List, Value::Sym(e)) => {
-                use crate::ir::field::Ty as F;
-                let fits = match ty {
-                    Ty::Num => e.ty == F::Num,
-                    Ty::Vec3 => e.ty == F::Vec3,
-                    Ty::Linear => e.ty != F::Bool,
-                    _ => false,
-                };
-                if self.symbolic_args && fits {
+                if self.symbolic_args && point_value_fits(ty, e) {
                     return Some(v.clone());
                 }
                 self.depends_on_point(span, &what());
@@ -613,7 +606,22 @@ fn deciding_ty(o: &Builtin) -> Ty {
 fn admits_part(o: &Builtin, v: &Value) -> bool {
     match (o.variadic, v) {
         (Some(_), Value::List(items)) => items.first().is_none_or(|x| admits_part(o, x)),
+        // A value that varies with a field's point picks the function of numbers it fits
+        // (`round(p.x)` is the number's `round`, not the shape modifier's).
+        (_, Value::Sym(e)) => Ctx::takes_symbolic(o) && point_value_fits(deciding_ty(o), e),
         _ => admits(deciding_ty(o), v),
+    }
+}
+
+/// Whether a value that varies with a field's point may stand for a parameter of type `ty`
+/// of a function of numbers.
+fn point_value_fits(ty: Ty, e: &crate::ir::field::Expr) -> bool {
+    use crate::ir::field::Ty as F;
+    match ty {
+        Ty::Num => e.ty == F::Num,
+        Ty::Vec3 => e.ty == F::Vec3,
+        Ty::Linear => e.ty != F::Bool,
+        _ => false,
     }
 }
 

@@ -11,7 +11,7 @@
 use std::rc::Rc;
 use std::sync::Arc;
 
-use super::builtins::{Builtin, Ctor, Extreme, MathFn, NumFn, VecFn};
+use super::builtins::{Builtin, Ctor, Extreme, InFields, MathFn, NumFn, VecFn};
 use super::expr::{bad_operands, BoundArgs};
 use super::value::FieldLit;
 use super::{index, Bound, Ctx, Value};
@@ -219,49 +219,22 @@ impl Ctx<'_> {
         }
     }
 
-    /// Whether `b` computes something a field body can hold per point.
+    /// Whether `b` is a function of numbers, which may be given values that vary with
+    /// a field's point (and then has a field form, or refuses them with its reason).
     pub(super) fn takes_symbolic(b: &Builtin) -> bool {
-        matches!(
-            b.ctor,
-            Ctor::Math(_) | Ctor::Numeric(_) | Ctor::Vector(_) | Ctor::Extreme(_) | Ctor::Dist | Ctor::Noise3
-        )
+        !matches!(b.ctor.in_fields(), InFields::NotMaths)
     }
 
     /// A maths builtin with an argument that depends on the point.
     pub(super) fn symbolic_call(&mut self, b: &Builtin, a: &BoundArgs) -> Value {
+        if let InFields::No(why) = b.ctor.in_fields() {
+            return self.not_in_fields(b, a, why);
+        }
         let arg = |i: usize| a.vals.get(i).and_then(|s| s.as_ref()).and_then(|(v, _)| v.as_field());
         let un = |f: Unary| arg(0).and_then(|x| Expr::unary(f, x));
         let bin = |f: Binary, i: usize, j: usize| arg(i).zip(arg(j)).and_then(|(x, y)| Expr::binary(f, x, y));
         let node = match b.ctor {
-            Ctor::Math(f) => match f {
-                MathFn::Sin => un(Unary::Sin),
-                MathFn::Cos => un(Unary::Cos),
-                MathFn::Tan => un(Unary::Tan),
-                MathFn::Sqrt => un(Unary::Sqrt),
-                MathFn::Abs => un(Unary::Abs),
-                MathFn::Floor => un(Unary::Floor),
-                MathFn::Ceil => un(Unary::Ceil),
-                MathFn::Round => un(Unary::Round),
-                MathFn::Sign => un(Unary::Sign),
-                MathFn::Exp => un(Unary::Exp),
-                MathFn::Log => un(Unary::Log),
-                MathFn::Asin => un(Unary::Asin),
-                MathFn::Acos => un(Unary::Acos),
-                MathFn::Atan => un(Unary::Atan),
-                MathFn::Random => {
-                    let span = a.vals[0].as_ref().map_or(a.call, |(_, s)| *s);
-                    self.report(
-                        Diagnostic::error(
-                            codes::DEPENDS_ON_POINT,
-                            span,
-                            "`random`'s seed cannot depend on a field's point",
-                            "this depends on the point",
-                        )
-                        .with_hint("for a field that varies at random, try `noise3(p, size, seed)`"),
-                    );
-                    return Value::Error;
-                }
-            },
+            Ctor::Math(MathFn::Unary(u)) => un(u),
             Ctor::Numeric(NumFn::Pow) => bin(Binary::Pow, 0, 1),
             Ctor::Numeric(NumFn::Atan2) => bin(Binary::Atan2, 0, 1),
             Ctor::Numeric(NumFn::Clamp) => {
@@ -299,7 +272,22 @@ impl Ctx<'_> {
             }
             Ctor::Dist => return self.dist(a),
             Ctor::Noise3 => return self.noise3(a),
-            _ => None,
+            // Declared `InFields::No` (answered above) or `NotMaths` (never called here).
+            Ctor::Math(MathFn::Random)
+            | Ctor::Numeric(NumFn::Hsv | NumFn::Range)
+            | Ctor::Primitive(_)
+            | Ctor::Csg(_)
+            | Ctor::Modifier(_)
+            | Ctor::Field(_)
+            | Ctor::Profile(_)
+            | Ctor::Material
+            | Ctor::Rgb
+            | Ctor::Pattern(_)
+            | Ctor::Light(_)
+            | Ctor::Len
+            | Ctor::Generator(_)
+            | Ctor::Camera
+            | Ctor::Render => None,
         };
         match node {
             Some(e) => Value::Sym(e),
@@ -316,6 +304,20 @@ impl Ctx<'_> {
                 Value::Error
             }
         }
+    }
+}
+
+impl Ctx<'_> {
+    /// The error for a function of numbers given a value that varies with the point,
+    /// which it has no field form for (`why`, as [`Ctor::in_fields`] declares it).
+    fn not_in_fields(&mut self, b: &Builtin, a: &BoundArgs, why: &str) -> Value {
+        let span = a.vals.iter().flatten().chain(&a.rest).find(|(v, _)| has_sym(v)).map_or(a.call, |(_, s)| *s);
+        let mut d = Diagnostic::error(codes::DEPENDS_ON_POINT, span, why.to_string(), "this depends on the point");
+        if matches!(b.ctor, Ctor::Math(MathFn::Random)) {
+            d = d.with_hint("for a field that varies at random, try `noise3(p, size, seed)`");
+        }
+        self.report(d);
+        Value::Error
     }
 }
 

@@ -696,3 +696,51 @@ fn every_hull_said_to_be_the_solid_is() {
     assert!(solids >= 40, "only {solids} primitives whose hull is the solid");
     crate::support::finish(failures);
 }
+
+/// Every function of numbers declares whether it has a form in fields
+/// (`Ctor::in_fields`), and the declaration holds: called inside `p => …` with every
+/// argument it can take varying with the point, one declared `Yes` compiles without an
+/// error, and one declared `No` is refused with its declared reason.
+#[test]
+fn every_function_of_numbers_works_in_fields_or_says_why_not() {
+    use scnc::check::builtins::InFields;
+    let mut failures = Vec::new();
+    let mut rng = Rng(3);
+    let maths = BUILTINS.iter().filter(|b| b.kind() == Kind::Function && b.ctor.in_fields() != InFields::NotMaths);
+    let mut seen = 0;
+    for b in maths {
+        seen += 1;
+        let varying = |ty: Ty| match ty {
+            Ty::Num | Ty::Linear => Some("(p.x * 0.1 + 0.2)".to_string()),
+            Ty::Vec3 | Ty::Size => Some("p".to_string()),
+            Ty::List => Some("[p.x, p.y]".to_string()),
+            _ => None,
+        };
+        let mut args: Vec<String> = b.variadic.map_or(Vec::new(), |t| vec![varying(t).unwrap_or_default(); 2]);
+        for p in b.params.iter().filter(|p| p.default == scnc::sig::Default::Required) {
+            let value = varying(p.ty).or_else(|| literal(p, &mut rng)).expect("an argument");
+            args.push(format!("{} = {value}", p.name));
+        }
+        let call = format!("{}({})", b.name, args.join(", "));
+        let body = if b.result == Ty::Vec3 { format!("length({call})") } else { call.clone() };
+        let text = format!("object field(p => {body} - 0.5, bounds = [[-1, -1, -1], [1, 1, 1]], lipschitz = 100)\n");
+        let c = scnc::compile_source("t.scn", Path::new("t.scn"), text.clone(), &scnc::source::FsLoader);
+        let errors: Vec<&str> = c
+            .diagnostics
+            .iter()
+            .filter(|d| d.severity == scnc::diag::Severity::Error)
+            .map(|d| d.message.as_str())
+            .collect();
+        match b.ctor.in_fields() {
+            InFields::Yes if !errors.is_empty() => {
+                failures.push(format!("`{}` is declared to work in fields, but `{call}` gives {errors:?}", b.name))
+            }
+            InFields::No(why) if !errors.contains(&why) => {
+                failures.push(format!("`{}` is declared not in fields ({why}), but `{call}` gives {errors:?}", b.name))
+            }
+            _ => {}
+        }
+    }
+    assert!(seen >= 25, "only {seen} functions of numbers");
+    crate::support::finish(failures);
+}

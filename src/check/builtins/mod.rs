@@ -78,6 +78,49 @@ pub enum Ctor {
     Render,
 }
 
+/// Whether a builtin takes numbers and vectors that vary with a field's point (inside
+/// `p => …`), declared for every builtin by [`Ctor::in_fields`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum InFields {
+    /// It does: the checker builds its field expression.
+    Yes,
+    /// A function of numbers that does not, for this reason (the error says it).
+    No(&'static str),
+    /// Not a function of numbers (a shape, a light, a setting, a list's length): its
+    /// arguments' types refuse a value that varies with the point, or ignore it.
+    NotMaths,
+}
+
+impl Ctor {
+    /// Whether the builtin has a form in fields. Every kind of builtin is listed: a new
+    /// one must say, or this does not compile.
+    pub fn in_fields(&self) -> InFields {
+        match *self {
+            Ctor::Math(MathFn::Unary(_)) => InFields::Yes,
+            Ctor::Math(MathFn::Random) => InFields::No("`random`'s seed cannot depend on a field's point"),
+            Ctor::Numeric(NumFn::Pow | NumFn::Atan2 | NumFn::Clamp | NumFn::Mix | NumFn::Sum) => InFields::Yes,
+            Ctor::Numeric(NumFn::Hsv) => InFields::No("`hsv` gives a colour, which a field's body does not hold"),
+            Ctor::Numeric(NumFn::Range) => InFields::No("`range` gives a list, whose length cannot vary with the point"),
+            Ctor::Vector(VecFn::Dot | VecFn::Cross | VecFn::Length | VecFn::Normalize) => InFields::Yes,
+            Ctor::Extreme(Extreme::Min | Extreme::Max) => InFields::Yes,
+            Ctor::Dist | Ctor::Noise3 => InFields::Yes,
+            Ctor::Primitive(_)
+            | Ctor::Csg(_)
+            | Ctor::Modifier(_)
+            | Ctor::Field(_)
+            | Ctor::Profile(_)
+            | Ctor::Material
+            | Ctor::Rgb
+            | Ctor::Pattern(_)
+            | Ctor::Light(_)
+            | Ctor::Len
+            | Ctor::Generator(_)
+            | Ctor::Camera
+            | Ctor::Render => InFields::NotMaths,
+        }
+    }
+}
+
 /// The shape modifiers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[allow(missing_docs, reason = "each variant is the builtin of the same name, documented in BUILTINS")]
@@ -138,21 +181,11 @@ pub enum LightFn {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[allow(missing_docs, reason = "each variant is the builtin of the same name, documented in BUILTINS")]
 pub enum MathFn {
-    Sin,
-    Cos,
-    Tan,
-    Sqrt,
-    Abs,
-    Floor,
-    Ceil,
-    Sign,
+    /// A function the IR's field expressions hold too: evaluated, at check time and in
+    /// a field alike, by [`Unary::apply`](crate::ir::field::Unary::apply).
+    Unary(crate::ir::field::Unary),
+    /// `random(seed)`, which is not in fields (its seed cannot vary with the point).
     Random,
-    Exp,
-    Log,
-    Asin,
-    Acos,
-    Atan,
-    Round,
 }
 
 /// Functions of several numbers, or giving a list or a colour.

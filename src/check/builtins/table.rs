@@ -5,6 +5,7 @@
 use std::sync::LazyLock;
 
 use super::{Builtin, Ctor, Extreme, FieldFn, Gen, LightFn, MathFn, Modifier, NumFn, PatternFn, ProfileFn, Ty, VecFn};
+use crate::ir::field::Unary;
 use crate::check::construct::domain::{BendArgs, ElongateArgs, PolarArgs, SymmetricArgs, TwistArgs};
 use crate::check::construct::fields::{DisplaceArgs, DistArgs, FieldArgs, Noise3Args, WarpArgs};
 use crate::check::construct::maths::{
@@ -283,14 +284,14 @@ static REST: &[Builtin] = &[
     ),
     // Maths (angles in degrees). A function of one number checks its argument against
     // its declaration's range: `sqrt`'s, `log`'s and `asin`'s are their domains.
-    f("sin", Ctor::Math(MathFn::Sin), NumberArgs::ANY, Ty::Num, "sine of an angle in degrees"),
-    f("cos", Ctor::Math(MathFn::Cos), NumberArgs::ANY, Ty::Num, "cosine of an angle in degrees"),
-    f("tan", Ctor::Math(MathFn::Tan), NumberArgs::ANY, Ty::Num, "tangent of an angle in degrees"),
-    f("sqrt", Ctor::Math(MathFn::Sqrt), NumberArgs::NONNEG, Ty::Num, "square root of a non-negative number"),
-    f("abs", Ctor::Math(MathFn::Abs), NumberArgs::ANY, Ty::Num, "absolute value"),
-    f("floor", Ctor::Math(MathFn::Floor), NumberArgs::ANY, Ty::Num, "largest whole number not above `x`"),
-    f("ceil", Ctor::Math(MathFn::Ceil), NumberArgs::ANY, Ty::Num, "smallest whole number not below `x`"),
-    f("sign", Ctor::Math(MathFn::Sign), NumberArgs::ANY, Ty::Num, "-1, 0 or 1 as `x` is negative, zero or positive"),
+    f("sin", Ctor::Math(MathFn::Unary(Unary::Sin)), NumberArgs::ANY, Ty::Num, "sine of an angle in degrees"),
+    f("cos", Ctor::Math(MathFn::Unary(Unary::Cos)), NumberArgs::ANY, Ty::Num, "cosine of an angle in degrees"),
+    f("tan", Ctor::Math(MathFn::Unary(Unary::Tan)), NumberArgs::ANY, Ty::Num, "tangent of an angle in degrees"),
+    f("sqrt", Ctor::Math(MathFn::Unary(Unary::Sqrt)), NumberArgs::NONNEG, Ty::Num, "square root of a non-negative number"),
+    f("abs", Ctor::Math(MathFn::Unary(Unary::Abs)), NumberArgs::ANY, Ty::Num, "absolute value"),
+    f("floor", Ctor::Math(MathFn::Unary(Unary::Floor)), NumberArgs::ANY, Ty::Num, "largest whole number not above `x`"),
+    f("ceil", Ctor::Math(MathFn::Unary(Unary::Ceil)), NumberArgs::ANY, Ty::Num, "smallest whole number not below `x`"),
+    f("sign", Ctor::Math(MathFn::Unary(Unary::Sign)), NumberArgs::ANY, Ty::Num, "-1, 0 or 1 as `x` is negative, zero or positive"),
     f(
         "random",
         Ctor::Math(MathFn::Random),
@@ -298,14 +299,14 @@ static REST: &[Builtin] = &[
         Ty::Num,
         "a number in [0, 1) that depends only on `seed` (the same on every machine): `random(i * 7 + 3)`",
     ),
-    f("exp", Ctor::Math(MathFn::Exp), NumberArgs::ANY, Ty::Num, "e raised to `x`"),
-    f("log", Ctor::Math(MathFn::Log), NumberArgs::POSITIVE, Ty::Num, "natural logarithm of a positive number"),
-    f("asin", Ctor::Math(MathFn::Asin), NumberArgs::UNIT, Ty::Num, "arcsine in degrees, of a number in [-1, 1]"),
-    f("acos", Ctor::Math(MathFn::Acos), NumberArgs::UNIT, Ty::Num, "arccosine in degrees, of a number in [-1, 1]"),
-    f("atan", Ctor::Math(MathFn::Atan), NumberArgs::ANY, Ty::Num, "arctangent in degrees"),
+    f("exp", Ctor::Math(MathFn::Unary(Unary::Exp)), NumberArgs::ANY, Ty::Num, "e raised to `x`"),
+    f("log", Ctor::Math(MathFn::Unary(Unary::Log)), NumberArgs::POSITIVE, Ty::Num, "natural logarithm of a positive number"),
+    f("asin", Ctor::Math(MathFn::Unary(Unary::Asin)), NumberArgs::UNIT, Ty::Num, "arcsine in degrees, of a number in [-1, 1]"),
+    f("acos", Ctor::Math(MathFn::Unary(Unary::Acos)), NumberArgs::UNIT, Ty::Num, "arccosine in degrees, of a number in [-1, 1]"),
+    f("atan", Ctor::Math(MathFn::Unary(Unary::Atan)), NumberArgs::ANY, Ty::Num, "arctangent in degrees"),
     // `round(x)` beside the shape modifier `round(shape, r)`: the first argument's type
     // chooses (see `overload`).
-    f("round", Ctor::Math(MathFn::Round), NumberArgs::ANY, Ty::Num, "nearest whole number, halves away from zero"),
+    f("round", Ctor::Math(MathFn::Unary(Unary::Round)), NumberArgs::ANY, Ty::Num, "nearest whole number, halves away from zero"),
     f(
         "pow",
         Ctor::Numeric(NumFn::Pow),

@@ -155,35 +155,17 @@ crate::params! {
 impl Ctx<'_> {
     /// A function of one number, `x` given at `arg` in the call at `call`.
     pub(in crate::check) fn math(&mut self, b: &Builtin, f: MathFn, x: f64, arg: Span, call: Span) -> Value {
-        let r = x.to_radians();
         // The domain is the declared range (the fast path of a call reaches here unbound).
         if let Some(p) = b.params.first() {
             if !self.in_range(p, &Value::Num(x), arg) {
                 return Value::Error;
             }
         }
+        // Within the declared domain `apply` is the function itself (its clamps for
+        // fields never act), so a number means the same here and in a field's body.
         let y = match f {
-            MathFn::Sin => r.sin(),
-            MathFn::Cos => r.cos(),
-            MathFn::Tan => r.tan(),
-            MathFn::Sqrt => x.sqrt(),
-            MathFn::Abs => x.abs(),
-            MathFn::Floor => x.floor(),
-            MathFn::Ceil => x.ceil(),
-            MathFn::Round => x.round(),
-            MathFn::Sign => {
-                if x == 0.0 {
-                    0.0
-                } else {
-                    x.signum()
-                }
-            }
+            MathFn::Unary(u) => u.apply(x),
             MathFn::Random => random(x),
-            MathFn::Exp => x.exp(),
-            MathFn::Log => x.ln(),
-            MathFn::Asin => x.asin().to_degrees(),
-            MathFn::Acos => x.acos().to_degrees(),
-            MathFn::Atan => x.atan().to_degrees(),
         };
         self.finite(Value::Num(y), call, || format!("`{}` overflowed", b.name))
     }
