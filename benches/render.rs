@@ -35,7 +35,7 @@ fn primitives(c: &mut Criterion) {
     let c2 = scnc::compile_source(path, Path::new(path), text.clone(), &scnc::source::FsLoader);
     let list = c2.scene.expect("the primitives list compiles");
     for object in &list.objects {
-        let scnc::ir::Geometry::Shape(_) = &object.geometry else { continue };
+        let scnc::ir::Body::Shape(_) = &object.geometry else { continue };
         let (_, range) = c2.map.local_range(object.span);
         let source = text[range].trim_start_matches("object ").to_string();
         let mut alone = list.clone();

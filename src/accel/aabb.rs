@@ -45,7 +45,7 @@ pub struct Aabb {
 impl Aabb {
     /// `b` (f64, render space) in f32, widened by a few ulps so rounding never clips
     /// the surface it bounds.
-    pub fn padded(b: crate::ir::Aabb) -> Aabb {
+    pub fn padded(b: crate::ir::DAabb) -> Aabb {
         let pad = b.max.abs().max(b.min.abs()).max_element() * 1e-6 + 1e-6;
         Aabb { min: (b.min - pad).as_vec3a(), max: (b.max + pad).as_vec3a() }
     }

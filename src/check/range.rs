@@ -9,7 +9,7 @@
 
 use super::Ctx;
 use crate::diag::{codes, Diagnostic};
-use crate::ir::{self, Camera, Geometry, LightKind, Shape, ShapeKind};
+use crate::ir::{self, Body, Camera, LightKind, Shape, ShapeKind};
 
 /// Farthest any part of the scene may reach from the camera, in world units.
 pub const MAX_REACH: f64 = 1e15;
@@ -47,8 +47,8 @@ impl Ctx<'_> {
         }
         for obj in &self.objects.clone() {
             let parts_ok = match &obj.geometry {
-                Geometry::Shape(s) => self.parts_in_range(s),
-                Geometry::Mesh(m) => {
+                Body::Shape(s) => self.parts_in_range(s),
+                Body::Mesh(m) => {
                     let placed = self.transform_in_range(&m.xf, m.span);
                     let shape = match &m.source {
                         ir::MeshSource::Isosurface { shape, .. } => self.parts_in_range(shape),
@@ -63,8 +63,8 @@ impl Ctx<'_> {
             // The tight sphere: box bounds of a huge blend overflow to NaN, which would
             // look unbounded. Only a half-space (a `plane`) has none.
             let sphere = match &obj.geometry {
-                Geometry::Shape(s) => ir::shape_sphere(s),
-                Geometry::Mesh(_) => ir::bounding_sphere(&obj.geometry),
+                Body::Shape(s) => ir::shape_sphere(s),
+                Body::Mesh(_) => ir::bounding_sphere(&obj.geometry),
             };
             let Some((centre, radius)) = sphere else { continue };
             let reach = (centre - camera.position).length() + radius;

@@ -14,8 +14,8 @@ impl Ctx<'_> {
     pub(super) fn object(&mut self, v: Value, expr: &ast::Expr, stmt_span: Span) {
         let expr_span = expr.span;
         let geometry = match v {
-            Value::Shape(s) => ir::Geometry::Shape(s),
-            Value::Mesh(m) => ir::Geometry::Mesh(m),
+            Value::Shape(s) => ir::Body::Shape(s),
+            Value::Mesh(m) => ir::Body::Mesh(m),
             Value::Error => return,
             other => {
                 let mut d = Diagnostic::error(
@@ -52,8 +52,8 @@ impl Ctx<'_> {
             return;
         }
         let nodes = match &geometry {
-            ir::Geometry::Shape(s) => s.nodes,
-            ir::Geometry::Mesh(m) => match &m.source {
+            ir::Body::Shape(s) => s.nodes,
+            ir::Body::Mesh(m) => match &m.source {
                 ir::MeshSource::Isosurface { shape, .. } => shape.nodes,
                 ir::MeshSource::UvSphere { .. }
                 | ir::MeshSource::IcoSphere { .. }

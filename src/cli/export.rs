@@ -12,7 +12,7 @@ use super::progress::Reading;
 use super::shared::{Accuracy, Meshing, Messages, Workers};
 use scnc::diag::codes;
 use scnc::export::report::MeshReport;
-use scnc::export::{Frame, Up};
+use scnc::export::{Placement, Up};
 use scnc::mesh::Detail;
 use scnc::meshfile::{Format, WriteOptions};
 
@@ -201,11 +201,11 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
     let Some(scene) = compiled.scene.take() else { return ExitCode::from(1) };
     let scene = &scene;
     let meshes = scene.objects.iter().filter_map(|o| match &o.geometry {
-        scnc::ir::Geometry::Mesh(m) => match &m.source {
+        scnc::ir::Body::Mesh(m) => match &m.source {
             scnc::ir::MeshSource::File { path, .. } => Some(path.as_path()),
             _ => None,
         },
-        scnc::ir::Geometry::Shape(_) => None,
+        scnc::ir::Body::Shape(_) => None,
     });
     let sources = compiled.map.files().map(|(_, f)| f.path.as_path());
     if let Some(input) = overwritten_input(&args.output, sources.chain(meshes)) {
@@ -229,7 +229,7 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
         None => args.meshing.detail,
     };
     let up = args.up.map_or(format.default_up(), Up::from);
-    let frame = Frame { up, scale: args.scale.unwrap_or(format.default_scale()) };
+    let frame = Placement { up, scale: args.scale.unwrap_or(format.default_scale()) };
     let skip = args.skip_unbounded || format.for_printing();
     let collect = |detail| {
         pool.install(|| scnc::export::collect(scene, detail, frame, args.meshing.memory_limit, skip, &Reading))

@@ -307,7 +307,7 @@ pub(crate) fn write_part_png(
     path: &Path,
     width: u32,
     height: u32,
-    region: scnc::render::Region,
+    region: scnc::render::PixelRect,
     image: &scnc::render::Image,
 ) -> std::io::Result<()> {
     // One sample is one byte, or two in the machine's order.

@@ -13,7 +13,7 @@ use scnc::check::{Time, EPSILON_RANGE, MAX_DEPTH, MAX_FRAMES, MAX_IMAGE_SIDE, MA
 use scnc::source::FsLoader;
 use scnc::Compiled;
 
-use scnc::render::{BitDepth, Region};
+use scnc::render::{BitDepth, PixelRect};
 
 use super::files::{cannot_write, check_output, stop_on_interrupt, write_part_png, write_png, FPS_KEY};
 use super::frames::{frame_path, is_pattern, parse_frames, FrameChoice};
@@ -213,7 +213,7 @@ impl RenderArgs {
     /// Applies the command line's overrides and `--tolerance` to the scene, and says which
     /// back-end renders its shapes and which part of the image to render (`None`: all);
     /// an image too large or a part outside it is a usage error.
-    fn apply(&self, scene: &mut scnc::ir::Scene) -> Result<(scnc::world::Mode, Option<Region>), ExitCode> {
+    fn apply(&self, scene: &mut scnc::ir::Scene) -> Result<(scnc::world::Mode, Option<PixelRect>), ExitCode> {
         let s = &mut scene.settings;
         s.width = self.width.unwrap_or(s.width);
         s.height = self.height.unwrap_or(s.height);
@@ -249,16 +249,16 @@ impl RenderArgs {
 
     /// The region `--region` or `--tile` asks for in a `width × height` image, if any;
     /// an error when it does not fit.
-    fn part(&self, width: u32, height: u32) -> Result<Option<Region>, String> {
+    fn part(&self, width: u32, height: u32) -> Result<Option<PixelRect>, String> {
         if let Some([x0, y0, x1, y1]) = self.region {
             if x1 > width || y1 > height {
                 return Err(format!("the region {x0}..{x1} × {y0}..{y1} is outside the {width}×{height} image"));
             }
-            return Ok(Some(Region { x0, y0, x1, y1 }));
+            return Ok(Some(PixelRect { x0, y0, x1, y1 }));
         }
         match self.tile {
             Some((_, n)) if n > height => Err(format!("{n} bands of rows in an image {height} rows high")),
-            Some((i, n)) => Ok(Some(Region::band(i, n, width, height))),
+            Some((i, n)) => Ok(Some(PixelRect::band(i, n, width, height))),
             None => Ok(None),
         }
     }
@@ -444,7 +444,7 @@ fn render_scene(
     };
     frame.bit_depth = args.bit_depth;
     let lowered = started.elapsed();
-    let region = part.unwrap_or(Region::full(frame.width, frame.height));
+    let region = part.unwrap_or(PixelRect::full(frame.width, frame.height));
     let progress = Progress::new(region.height() as u64, "rows", "rendering");
     let (image, counters) =
         pool.install(|| scnc::render::render_region(&geometry, &frame, region, &|| progress.step()));

@@ -25,14 +25,14 @@ pub use crate::meshfile::{Colour, Export, Group, Part};
 
 /// How scene coordinates become the file's.
 #[derive(Clone, Copy, Debug)]
-pub struct Frame {
+pub struct Placement {
     /// The up axis of the file.
     pub up: Up,
     /// File units per scene unit.
     pub scale: f64,
 }
 
-impl Frame {
+impl Placement {
     /// A scene point in the file's right-handed frame (a reflection of scnc's
     /// left-handed one, see the module's comment).
     pub fn place(&self, p: DVec3) -> DVec3 {
@@ -47,7 +47,7 @@ impl Frame {
 pub fn collect(
     scene: &Scene,
     detail: Detail,
-    frame: Frame,
+    frame: Placement,
     memory_limit: u64,
     skip_unbounded: bool,
     loader: &dyn Loader,
@@ -60,7 +60,7 @@ pub fn collect(
     let mut skipped = Vec::new();
     for obj in &scene.objects {
         let job = match &obj.geometry {
-            ir::Geometry::Shape(shape) => {
+            ir::Body::Shape(shape) => {
                 if ir::shape_bounds(shape).is_none() {
                     if !skip_unbounded {
                         return Err(unbounded(obj.span));
@@ -79,7 +79,7 @@ pub fn collect(
                 // Only planes use the far limit, and they were refused above.
                 mesh::lower::tessellate(shape, DAffine3::IDENTITY, detail, 0.0, &mut budget, &mut materials)?
             }
-            ir::Geometry::Mesh(m) => mesh::lower::explicit(m, DAffine3::IDENTITY, &mut budget, &mut materials, loader)?,
+            ir::Body::Mesh(m) => mesh::lower::explicit(m, DAffine3::IDENTITY, &mut budget, &mut materials, loader)?,
         };
         jobs.push((job, obj.span, &obj.name));
     }
@@ -142,7 +142,7 @@ fn material_names(scene: &Scene, spans: &[Span]) -> Vec<String> {
 }
 
 /// Object `name`'s mesh in the file's frame, without its zero-area triangles.
-fn part(name: String, job: mesh::MeshJob, span: Span, frame: Frame) -> Part {
+fn part(name: String, job: mesh::MeshJob, span: Span, frame: Placement) -> Part {
     let positions: Vec<DVec3> = job.mesh.positions.iter().map(|&p| frame.place(job.xf.transform_point3(p))).collect();
     // The reflection into the file's frame turns every triangle inside out; a transform
     // that mirrors (negative determinant) turns it back.

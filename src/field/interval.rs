@@ -387,17 +387,17 @@ impl<const N: usize> Default for Jet<N> {
 /// Where a [`Jet`] is evaluated: a box, and the derivatives of the point's coordinates
 /// with respect to the seeds (the identity for a gradient, a ray's direction for `Dir`).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Region<const N: usize> {
+pub struct JetBox<const N: usize> {
     /// The box.
     pub at: [Interval; 3],
     /// `seed[axis][j]`: how coordinate `axis` moves along seed `j`.
     pub seed: [[f64; N]; 3],
 }
 
-impl Region<3> {
+impl JetBox<3> {
     /// A box, for the gradient.
-    pub fn gradient(at: [Interval; 3]) -> Region<3> {
-        Region { at, seed: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]] }
+    pub fn gradient(at: [Interval; 3]) -> JetBox<3> {
+        JetBox { at, seed: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]] }
     }
 }
 
@@ -446,9 +446,9 @@ impl<const N: usize> Jet<N> {
 }
 
 impl<const N: usize> Scalar for Jet<N> {
-    type Point = Region<N>;
+    type Point = JetBox<N>;
 
-    fn input(p: &Region<N>, axis: u8) -> Jet<N> {
+    fn input(p: &JetBox<N>, axis: u8) -> Jet<N> {
         let seed = p.seed[axis as usize];
         let n = seed.iter().map(|x| x * x).sum::<f64>().sqrt();
         Jet { v: p.at[axis as usize], g: seed.map(Interval::point), n }

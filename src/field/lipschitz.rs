@@ -11,9 +11,9 @@ use std::collections::BinaryHeap;
 
 use glam::DVec3;
 
-use super::interval::{Interval, Region, Slope};
+use super::interval::{Interval, JetBox, Slope};
 use super::tape::{Distances, Tape};
-use crate::geom::Aabb;
+use crate::geom::DAabb;
 use crate::ir::field::Ty;
 
 /// How close the bound gets to the largest slope found before refinement stops.
@@ -58,7 +58,7 @@ impl Ord for Cell {
 
 /// The slope bound and value range of `tape` over the box `lo..hi`.
 fn over(tape: &Tape, lo: DVec3, hi: DVec3, dist: &(dyn Distances<Slope> + Sync)) -> (f64, Interval) {
-    let p = Region::gradient([0, 1, 2].map(|i| Interval::new(lo[i], hi[i])));
+    let p = JetBox::gradient([0, 1, 2].map(|i| Interval::new(lo[i], hi[i])));
     if tape.ty() == Ty::Vec3 {
         let v = tape.eval3::<Slope>(&p, dist);
         (Slope::stretch(&v), v[0].v.hull(v[1].v).hull(v[2].v))
@@ -73,7 +73,7 @@ fn over(tape: &Tape, lo: DVec3, hi: DVec3, dist: &(dyn Distances<Slope> + Sync))
 /// as for a sum of sines). Where a few halvings of the box do not bring the bound
 /// within 5 % of a slope found, a grid of `GRID` (32) cells along its longest side bounds
 /// it cell by cell.
-pub fn lipschitz(tape: &Tape, domain: Option<Aabb>, dist: &(dyn Distances<Slope> + Sync)) -> Estimate {
+pub fn lipschitz(tape: &Tape, domain: Option<DAabb>, dist: &(dyn Distances<Slope> + Sync)) -> Estimate {
     let Some(b) = domain else {
         let all = DVec3::splat(f64::INFINITY);
         let (bound, range) = over(tape, -all, all, dist);
@@ -114,7 +114,7 @@ const GRID: u32 = 32;
 const QUICK: usize = 256;
 
 /// The largest slope bound of the cells of a grid over `b`, and the body's value range.
-fn grid(tape: &Tape, b: Aabb, dist: &(dyn Distances<Slope> + Sync)) -> (f64, Interval) {
+fn grid(tape: &Tape, b: DAabb, dist: &(dyn Distances<Slope> + Sync)) -> (f64, Interval) {
     use rayon::prelude::*;
     let size = b.max - b.min;
     let longest = size.max_element();

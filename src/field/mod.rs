@@ -14,7 +14,7 @@ mod support;
 mod tape;
 
 pub use flat::Flat;
-pub use interval::{Dir, Interval, Jet, Region, Slope};
+pub use interval::{Dir, Interval, Jet, JetBox, Slope};
 pub use lipschitz::{lipschitz, Estimate, SlopeDistances};
 pub use support::{support_planes, support_radius};
 pub use tape::{Distances, NoDistances, Op, Reg, Scalar, Tape};

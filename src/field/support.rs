@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use super::interval::Interval;
 use super::lipschitz::Cell;
 use super::tape::{Distances, Tape};
-use crate::geom::Aabb;
+use crate::geom::DAabb;
 
 /// Interval evaluations one direction may spend.
 const BUDGET: usize = 256;
@@ -28,7 +28,7 @@ fn reach(n: DVec3, lo: DVec3, hi: DVec3) -> f64 {
 /// level: the march runs it in f32.
 fn ruled_out<'a>(
     tape: &'a Tape,
-    b: Aabb,
+    b: DAabb,
     level: f64,
     dist: &'a (dyn Distances<Interval> + Sync),
 ) -> impl Fn(DVec3, DVec3) -> bool + Sync + 'a {
@@ -46,7 +46,7 @@ fn ruled_out<'a>(
 /// budget.
 pub fn support_planes(
     tape: &Tape,
-    b: Aabb,
+    b: DAabb,
     level: f64,
     dist: &(dyn Distances<Interval> + Sync),
 ) -> Option<Vec<(DVec3, f64)>> {
@@ -81,7 +81,7 @@ const RADIAL_BUDGET: usize = 1024;
 /// (in parallel). `None` when no point of `b` can be in the solid.
 pub fn support_radius(
     tape: &Tape,
-    b: Aabb,
+    b: DAabb,
     level: f64,
     centre: DVec3,
     dist: &(dyn Distances<Interval> + Sync),
@@ -91,11 +91,11 @@ pub fn support_radius(
     let far = |lo: DVec3, hi: DVec3| (lo - centre).abs().max((hi - centre).abs()).length();
     let near = |lo: DVec3, hi: DVec3| (lo - centre).max(centre - hi).max(DVec3::ZERO).length();
     let mid = centre.clamp(b.min, b.max);
-    let eighths: Vec<Aabb> = (0..8)
+    let eighths: Vec<DAabb> = (0..8)
         .map(|i| {
             let pick = |a: usize, bit: u32| if i >> bit & 1 == 0 { (b.min[a], mid[a]) } else { (mid[a], b.max[a]) };
             let [(x0, x1), (y0, y1), (z0, z1)] = [pick(0, 0), pick(1, 1), pick(2, 2)];
-            Aabb { min: DVec3::new(x0, y0, z0), max: DVec3::new(x1, y1, z1) }
+            DAabb { min: DVec3::new(x0, y0, z0), max: DVec3::new(x1, y1, z1) }
         })
         .filter(|e| e.min.cmplt(e.max).all())
         .collect();
@@ -106,7 +106,7 @@ pub fn support_radius(
 
 /// An upper bound of the largest `n·p` over the boxes within `b` not ruled `empty`, to
 /// within `tol` or the budget; `None` if every box is.
-fn farthest(n: DVec3, b: Aabb, tol: f64, empty: &(dyn Fn(DVec3, DVec3) -> bool + Sync)) -> Option<f64> {
+fn farthest(n: DVec3, b: DAabb, tol: f64, empty: &(dyn Fn(DVec3, DVec3) -> bool + Sync)) -> Option<f64> {
     search(b, tol, BUDGET, &|lo, hi| reach(n, lo, hi), &|lo, hi| -reach(-n, lo, hi), empty)
 }
 
@@ -114,7 +114,7 @@ fn farthest(n: DVec3, b: Aabb, tol: f64, empty: &(dyn Fn(DVec3, DVec3) -> bool +
 /// ruled `empty`, to within `tol` (a box whose `far` and `near` are that close) or
 /// `budget` evaluations; `None` if every box is.
 fn search(
-    b: Aabb,
+    b: DAabb,
     tol: f64,
     budget: usize,
     far: &(dyn Fn(DVec3, DVec3) -> f64 + Sync),

@@ -3,7 +3,7 @@ use std::sync::Arc;
 use glam::{DVec3, Vec3A};
 
 use super::*;
-use crate::geom::Aabb;
+use crate::geom::DAabb;
 use crate::ir::field::{Expr, Kind, Ty, Val};
 
 fn x(i: usize) -> Arc<Expr> {
@@ -242,7 +242,7 @@ fn intervals_hold_every_value() {
 /// bodies a scene writes.
 #[test]
 fn slope_bounds_hold_and_are_tight() {
-    let b = Aabb { min: DVec3::splat(-1.6), max: DVec3::splat(1.6) };
+    let b = DAabb { min: DVec3::splat(-1.6), max: DVec3::splat(1.6) };
     let cases: [(Arc<Expr>, f64); 4] = [
         (sphere(), 1.0),
         (bin(Binary::Mul, n(4.0), sphere()), 4.0),
@@ -317,8 +317,8 @@ fn fast_trig_is_accurate() {
 
 /// The box the support searches are tried in, off centre, and every body of the
 /// language with a gyroid sheet cut by a ball.
-fn support_cases() -> (Aabb, Vec<Arc<Expr>>) {
-    let b = Aabb { min: DVec3::splat(-1.3), max: DVec3::new(1.1, 1.3, 1.2) };
+fn support_cases() -> (DAabb, Vec<Arc<Expr>>) {
+    let b = DAabb { min: DVec3::splat(-1.3), max: DVec3::new(1.1, 1.3, 1.2) };
     let sheet = bin(
         Binary::Max,
         bin(Binary::Sub, un(Unary::Abs, gyroid(450.0)), n(0.3)),
@@ -357,7 +357,7 @@ fn support_planes_hold_the_solid_and_are_tight() {
         }
     }
     assert!(inside > 20_000, "only {inside} points inside");
-    let planes = support_planes(&Tape::new(&sphere()), Aabb::centred(DVec3::splat(1.0)), 0.0, &NoDistances).unwrap();
+    let planes = support_planes(&Tape::new(&sphere()), DAabb::centred(DVec3::splat(1.0)), 0.0, &NoDistances).unwrap();
     assert_eq!(planes.len(), 20, "the box holds the six faces; {planes:?}");
     assert!(planes.iter().all(|(_, o)| (1.0..1.1).contains(o)), "{planes:?}");
 }
@@ -388,7 +388,7 @@ fn support_radius_holds_the_solid_and_is_tight() {
         }
     }
     assert!(inside > 15_000, "only {inside} points inside");
-    let ball = Aabb::centred(DVec3::splat(0.4));
+    let ball = DAabb::centred(DVec3::splat(0.4));
     let r = support_radius(
         &Tape::new(&bin(Binary::Sub, un(Unary::Length, Expr::point()), n(0.4))),
         ball,

@@ -3,7 +3,7 @@
 //! it is marched, so a miss costs no step and a hit starts at (or near) the surface —
 //! exactly on it for a convex polyhedron, a cylinder, a capped cone or an ellipsoid.
 
-use super::Aabb;
+use super::DAabb;
 use glam::{DAffine3, DMat3, DVec3};
 
 /// A convex set holding a solid: where every plane and the round part hold.
@@ -190,7 +190,7 @@ pub const BEND_STRETCH: f64 = 0.01;
 
 impl Hull {
     /// The six planes of the box `b`.
-    pub fn box_planes(b: Aabb) -> Vec<(DVec3, f64)> {
+    pub fn box_planes(b: DAabb) -> Vec<(DVec3, f64)> {
         [DVec3::X, DVec3::Y, DVec3::Z]
             .into_iter()
             .zip(0..3)

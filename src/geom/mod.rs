@@ -13,19 +13,19 @@ pub use noise::noise;
 
 use glam::{DAffine3, DVec3};
 
-/// An axis-aligned box.
+/// An axis-aligned box in f64 (scene space; [`crate::accel::Aabb`] is its f32 render-space kin).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Aabb {
+pub struct DAabb {
     /// Smallest corner.
     pub min: DVec3,
     /// Largest corner.
     pub max: DVec3,
 }
 
-impl Aabb {
+impl DAabb {
     /// A box centred at the origin.
-    pub fn centred(half: DVec3) -> Aabb {
-        Aabb { min: -half, max: half }
+    pub fn centred(half: DVec3) -> DAabb {
+        DAabb { min: -half, max: half }
     }
 
     /// The largest distance from the `y` axis within it.
@@ -36,29 +36,29 @@ impl Aabb {
     }
 
     /// Grown by `d` on every side.
-    pub fn grow(self, d: f64) -> Aabb {
-        Aabb { min: self.min - d, max: self.max + d }
+    pub fn grow(self, d: f64) -> DAabb {
+        DAabb { min: self.min - d, max: self.max + d }
     }
 
     /// The smallest box containing both.
-    pub fn union(self, o: Aabb) -> Aabb {
-        Aabb { min: self.min.min(o.min), max: self.max.max(o.max) }
+    pub fn union(self, o: DAabb) -> DAabb {
+        DAabb { min: self.min.min(o.min), max: self.max.max(o.max) }
     }
 
     /// The overlap of both (may be empty: `min > max` on some axis).
-    pub fn intersect(self, o: Aabb) -> Aabb {
-        Aabb { min: self.min.max(o.min), max: self.max.min(o.max) }
+    pub fn intersect(self, o: DAabb) -> DAabb {
+        DAabb { min: self.min.max(o.min), max: self.max.min(o.max) }
     }
 
     /// The bounds of this box after an affine map.
-    pub fn transform(self, xf: &DAffine3) -> Aabb {
+    pub fn transform(self, xf: &DAffine3) -> DAabb {
         let centre = (self.min + self.max) * 0.5;
         let half = (self.max - self.min) * 0.5;
         let m = xf.matrix3;
         let abs = glam::DMat3::from_cols(m.x_axis.abs(), m.y_axis.abs(), m.z_axis.abs());
         let c = xf.transform_point3(centre);
         let h = abs * half;
-        Aabb { min: c - h, max: c + h }
+        DAabb { min: c - h, max: c + h }
     }
 
     /// Centre point.

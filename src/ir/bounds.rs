@@ -4,13 +4,13 @@ use std::sync::Arc;
 
 use glam::{DAffine3, DMat3, DVec3};
 
-use super::{CsgOp, Geometry, Mesh, MeshSource, Shape, ShapeKind};
+use super::{Body, CsgOp, Mesh, MeshSource, Shape, ShapeKind};
 pub use crate::geom::hull::{max_stretch, transform_half_space};
 use crate::geom::hull::{Hull, Round};
-use crate::geom::Aabb;
+use crate::geom::DAabb;
 
 /// Bounds of a shape tree; `None` when it is unbounded (it contains a half-space).
-pub fn shape_bounds(shape: &Shape) -> Option<Aabb> {
+pub fn shape_bounds(shape: &Shape) -> Option<DAabb> {
     bounds_within(shape, 0.0)
 }
 
@@ -19,7 +19,7 @@ pub fn shape_bounds(shape: &Shape) -> Option<Aabb> {
 /// singular value `σ` of the map (the SDF back-end's bound), so at `g` it reaches
 /// `g / σ` in the child's frame, and the map may stretch that by more than `σ`: a
 /// `round` of a non-uniformly scaled part grows further than its radius.
-fn bounds_within(shape: &Shape, g: f64) -> Option<Aabb> {
+fn bounds_within(shape: &Shape, g: f64) -> Option<DAabb> {
     let children =
         |kids: &[std::sync::Arc<Shape>], g: f64| kids.iter().map(|k| bounds_within(k, g)).collect::<Vec<_>>();
     match &shape.kind {
@@ -29,11 +29,11 @@ fn bounds_within(shape: &Shape, g: f64) -> Option<Aabb> {
         // nearest-first fold stops blending at a gap of `smooth`), so it reaches as far
         // as the parts grown by it.
         ShapeKind::Csg { op: CsgOp::Union, children: kids, smooth } => {
-            let all: Option<Vec<Aabb>> = children(kids, g + smooth).into_iter().collect();
-            all?.into_iter().reduce(Aabb::union)
+            let all: Option<Vec<DAabb>> = children(kids, g + smooth).into_iter().collect();
+            all?.into_iter().reduce(DAabb::union)
         }
         ShapeKind::Csg { op: CsgOp::Intersect, children: kids, smooth } => {
-            children(kids, g + smooth).into_iter().flatten().reduce(Aabb::intersect)
+            children(kids, g + smooth).into_iter().flatten().reduce(DAabb::intersect)
         }
         ShapeKind::Csg { op: CsgOp::Subtract, children: kids, smooth } => bounds_within(kids.first()?, g + smooth),
         ShapeKind::Round { child, radius } => bounds_within(child, g + radius),
@@ -41,7 +41,7 @@ fn bounds_within(shape: &Shape, g: f64) -> Option<Aabb> {
         ShapeKind::Repeat { child, period, count } => {
             let b = bounds_within(child, g)?;
             let reach = *period * (DVec3::new(count[0] as f64, count[1] as f64, count[2] as f64) - 1.0) * 0.5;
-            Some(Aabb { min: b.min - reach, max: b.max + reach })
+            Some(DAabb { min: b.min - reach, max: b.max + reach })
         }
         ShapeKind::Transform { child, xf } => bounds_within(child, within_child(g, xf)).map(|b| b.transform(xf)),
         ShapeKind::Paint { child, .. } => bounds_within(child, g),
@@ -56,15 +56,15 @@ fn bounds_within(shape: &Shape, g: f64) -> Option<Aabb> {
 }
 
 /// Bounds of a mesh in world space; `None` for a file, whose extent is known only once read.
-pub fn mesh_bounds(mesh: &Mesh) -> Option<Aabb> {
+pub fn mesh_bounds(mesh: &Mesh) -> Option<DAabb> {
     let local = match &mesh.source {
         MeshSource::UvSphere { radius, .. } | MeshSource::IcoSphere { radius, .. } => {
-            Aabb::centred(DVec3::splat(*radius))
+            DAabb::centred(DVec3::splat(*radius))
         }
-        MeshSource::Box { half } => Aabb::centred(*half),
-        MeshSource::Cylinder { radius, half_height, .. } => Aabb::centred(DVec3::new(*radius, *half_height, *radius)),
-        MeshSource::Torus { major, minor, .. } => Aabb::centred(DVec3::new(major + minor, *minor, major + minor)),
-        MeshSource::Plane { size } => Aabb::centred(DVec3::new(*size, 0.0, *size)),
+        MeshSource::Box { half } => DAabb::centred(*half),
+        MeshSource::Cylinder { radius, half_height, .. } => DAabb::centred(DVec3::new(*radius, *half_height, *radius)),
+        MeshSource::Torus { major, minor, .. } => DAabb::centred(DVec3::new(major + minor, *minor, major + minor)),
+        MeshSource::Plane { size } => DAabb::centred(DVec3::new(*size, 0.0, *size)),
         MeshSource::Isosurface { shape, .. } => shape_bounds(shape)?,
         MeshSource::File { .. } => return None,
     };
@@ -72,10 +72,10 @@ pub fn mesh_bounds(mesh: &Mesh) -> Option<Aabb> {
 }
 
 /// A bounding sphere (centre, radius) of an object's geometry, if bounded.
-pub fn bounding_sphere(g: &Geometry) -> Option<(DVec3, f64)> {
+pub fn bounding_sphere(g: &Body) -> Option<(DVec3, f64)> {
     let b = match g {
-        Geometry::Shape(s) => shape_bounds(s)?,
-        Geometry::Mesh(m) => mesh_bounds(m)?,
+        Body::Shape(s) => shape_bounds(s)?,
+        Body::Mesh(m) => mesh_bounds(m)?,
     };
     (b.min.cmple(b.max).all()).then(|| (b.centre(), (b.max - b.min).length() * 0.5))
 }
@@ -99,7 +99,7 @@ pub fn shape_sphere(shape: &Shape) -> Option<(DVec3, f64)> {
 /// A sphere holding where a field's body is at most `level` within a box, found by a
 /// search `ir` cannot run (`world` hands it in, as for [`FieldPlanes`]); `None` for none
 /// better than the box's own.
-pub type FieldSphere<'a> = dyn FnMut(&Arc<super::field::Expr>, Aabb, f64) -> Option<(DVec3, f64)> + 'a;
+pub type FieldSphere<'a> = dyn FnMut(&Arc<super::field::Expr>, DAabb, f64) -> Option<(DVec3, f64)> + 'a;
 
 /// [`shape_sphere`] with a field's sphere from `fields` where it is smaller than its
 /// box's.
@@ -109,15 +109,15 @@ pub fn shape_sphere_with(shape: &Shape, fields: &mut FieldSphere<'_>) -> Option<
 
 /// A sphere around where the shape's field is at most `g` (see [`bounds_within`]).
 fn sphere_within(shape: &Shape, g: f64, fields: &mut FieldSphere<'_>) -> Option<(DVec3, f64)> {
-    let from_box = |b: Aabb| (b.centre(), (b.max - b.min).length() * 0.5);
+    let from_box = |b: DAabb| (b.centre(), (b.max - b.min).length() * 0.5);
     match &shape.kind {
         ShapeKind::Primitive(p) => p.sphere_radius().map(|r| (DVec3::ZERO, r + g)),
         ShapeKind::Csg { op: CsgOp::Union, children, smooth } => {
             let spheres: Option<Vec<(DVec3, f64)>> =
                 children.iter().map(|c| sphere_within(c, g + smooth, fields)).collect();
             let spheres = spheres?;
-            let boxes = spheres.iter().map(|(c, r)| Aabb { min: *c - *r, max: *c + *r });
-            let centre = boxes.reduce(Aabb::union)?.centre();
+            let boxes = spheres.iter().map(|(c, r)| DAabb { min: *c - *r, max: *c + *r });
+            let centre = boxes.reduce(DAabb::union)?.centre();
             let radius = spheres.iter().map(|(c, r)| (*c - centre).length() + r).fold(0.0, f64::max);
             Some((centre, radius))
         }
@@ -138,7 +138,7 @@ fn sphere_within(shape: &Shape, g: f64, fields: &mut FieldSphere<'_>) -> Option<
         // As for its hull: where the field is at most `g`, the body is at most `g·L`
         // within the box grown by `g`.
         ShapeKind::Field { body, bounds: Some(b), sweep: None, lipschitz, .. } => {
-            let grown = Aabb { min: b.min - g, max: b.max + g };
+            let grown = DAabb { min: b.min - g, max: b.max + g };
             let boxed = from_box(grown);
             Some(fields(body, grown, g * lipschitz.value).filter(|s| s.1 < boxed.1).unwrap_or(boxed))
         }
@@ -180,7 +180,7 @@ fn half_space_within(shape: &Shape, g: f64) -> Option<(DVec3, f64)> {
 /// Planes `n·p ≤ offset` holding where a field's body is at most `level` within a box,
 /// for the directions where that is nearer than the box's face (`field::support_planes`,
 /// which `ir` cannot call: its caller hands the search in); `None` for none.
-pub type FieldPlanes<'a> = dyn FnMut(&Arc<super::field::Expr>, Aabb, f64) -> Option<Vec<(DVec3, f64)>> + 'a;
+pub type FieldPlanes<'a> = dyn FnMut(&Arc<super::field::Expr>, DAabb, f64) -> Option<Vec<(DVec3, f64)>> + 'a;
 
 /// A convex set holding the shape ([`Solid::hull`](crate::primitive::Solid::hull)):
 /// exactly the solid for a convex polyhedron, a cylinder, a capped cone or an
@@ -244,7 +244,7 @@ fn hull_within(shape: &Shape, g: f64, fields: &mut FieldPlanes<'_>) -> Option<Hu
         // A field is its body over its bound `L`, cut to its box: where it is at most
         // `g`, the body is at most `g·L` within the box grown by `g`.
         ShapeKind::Field { body, bounds: Some(b), sweep: None, lipschitz, .. } => {
-            let grown = Aabb { min: b.min - g, max: b.max + g };
+            let grown = DAabb { min: b.min - g, max: b.max + g };
             let mut planes = fields(body, grown, g * lipschitz.value).filter(|p| !p.is_empty())?;
             // The box's own faces, so the polyhedron is bounded (a twist takes its corners).
             planes.extend(Hull::box_planes(grown));

@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 use glam::{DAffine3, DVec3};
 
 use super::{
-    ColorSpace, Geometry, LightKind, Material, Mesh, MeshSource, Paint, PatternKind, Primitive, Scene, Shape, ShapeKind,
+    Body, ColorSpace, LightKind, Material, Mesh, MeshSource, Paint, PatternKind, Primitive, Scene, Shape, ShapeKind,
 };
 use crate::source::SourceMap;
 use crate::span::Span;
@@ -134,7 +134,7 @@ impl Dumper<'_> {
         }
     }
 
-    fn bounds(b: &Option<super::Aabb>) -> String {
+    fn bounds(b: &Option<super::DAabb>) -> String {
         b.map_or(String::new(), |b| format!(" bounds [{}, {}]", vec(b.min), vec(b.max)))
     }
 
@@ -235,8 +235,8 @@ pub fn dump(scene: &Scene, map: &SourceMap) -> String {
     for (i, obj) in scene.objects.iter().enumerate() {
         d.line(0, &format!("object {i}"), Some(obj.span));
         match &obj.geometry {
-            Geometry::Shape(shape) => d.shape(1, shape),
-            Geometry::Mesh(mesh) => d.mesh(1, mesh),
+            Body::Shape(shape) => d.shape(1, shape),
+            Body::Mesh(mesh) => d.mesh(1, mesh),
         }
     }
     d.out

@@ -19,7 +19,7 @@ use std::sync::Arc;
 
 use glam::{DAffine3, DVec3};
 
-pub use crate::geom::Aabb;
+pub use crate::geom::DAabb;
 pub use crate::primitive::{Facets, Primitive};
 pub use bounds::{
     bounding_sphere, max_stretch, mesh_bounds, min_singular_value, shape_bounds, shape_half_space, shape_hull,
@@ -222,7 +222,7 @@ pub struct Light {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Object {
     /// Its geometry.
-    pub geometry: Geometry,
+    pub geometry: Body,
     /// The statement.
     pub span: Span,
     /// What exported files call it: the name its expression starts from (a `let`, a
@@ -230,9 +230,10 @@ pub struct Object {
     pub name: String,
 }
 
-/// Either an SDF-able shape tree or an explicit mesh.
+/// What an object is made of: an SDF-able shape tree or an explicit mesh (the tracer meets
+/// either through [`crate::trace::Geometry`]).
 #[derive(Clone, Debug, PartialEq)]
-pub enum Geometry {
+pub enum Body {
     /// A shape: sphere traced by the SDF back-end, tessellated by the mesh back-end.
     Shape(Arc<Shape>),
     /// A mesh: traced as triangles by both back-ends.
@@ -409,7 +410,7 @@ pub enum ShapeKind {
         /// The body, a number.
         body: Arc<field::Expr>,
         /// Where it lives; `None`: everywhere, like a plane.
-        bounds: Option<Aabb>,
+        bounds: Option<DAabb>,
         /// The bound of the body's slope it is marched with.
         lipschitz: Lipschitz,
         /// A mesh of its zero set, when the builder knows one (an extruded polygon's
@@ -427,7 +428,7 @@ pub enum ShapeKind {
         /// The map, a vector.
         map: Arc<field::Expr>,
         /// Where the result lives; `None`: everywhere.
-        bounds: Option<Aabb>,
+        bounds: Option<DAabb>,
         /// The bound of how much the map stretches a distance.
         lipschitz: Lipschitz,
         /// The domain operation the warp is, when a builtin made it.
@@ -440,7 +441,7 @@ pub enum ShapeKind {
         /// The displacement, a number.
         by: Arc<field::Expr>,
         /// Where the result lives, when given; otherwise the shape's bounds grown by `reach`.
-        bounds: Option<Aabb>,
+        bounds: Option<DAabb>,
         /// The bound of the displacement's slope.
         lipschitz: Lipschitz,
         /// How far the displacement can push the surface out: the most `-d` gets
@@ -570,12 +571,12 @@ impl Shape {
     }
 }
 
-impl Geometry {
+impl Body {
     /// Whether the object is convex as a solid (see [`Shape::is_convex`], [`Mesh::is_convex`]).
     pub fn is_convex(&self) -> bool {
         match self {
-            Geometry::Shape(s) => s.is_convex(),
-            Geometry::Mesh(m) => m.is_convex(),
+            Body::Shape(s) => s.is_convex(),
+            Body::Mesh(m) => m.is_convex(),
         }
     }
 }

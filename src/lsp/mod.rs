@@ -48,7 +48,7 @@ pub fn run_stdio(log: impl Fn(String) + Send + 'static) -> Result<(), String> {
         let mut input = std::io::stdin().lock();
         loop {
             match wire::read_frame(&mut input)? {
-                wire::Frame::Message(m) => {
+                wire::Received::Message(m) => {
                     // Counted before it waits for the server, so an analysis under way
                     // learns that its document has changed.
                     if matches!(&m, Message::Notification(n) if is_edit(&n.method)) {
@@ -59,8 +59,8 @@ pub fn run_stdio(log: impl Fn(String) + Send + 'static) -> Result<(), String> {
                         return Ok(());
                     }
                 }
-                wire::Frame::Skipped(why) => log(format!("skipped {why}")),
-                wire::Frame::End => return Ok(()),
+                wire::Received::Skipped(why) => log(format!("skipped {why}")),
+                wire::Received::End => return Ok(()),
             }
         }
     });

@@ -14,7 +14,7 @@ const MAX_HEADER_LINE: u64 = 1024;
 
 /// What one read of the stream gave.
 #[derive(Debug)]
-pub enum Frame {
+pub enum Received {
     /// A well-formed message.
     Message(Message),
     /// Something that could not be a message, skipped; why.
@@ -24,14 +24,14 @@ pub enum Frame {
 }
 
 /// Reads one frame: headers up to a blank line, then the body `Content-Length` names.
-pub fn read_frame(r: &mut impl BufRead) -> io::Result<Frame> {
+pub fn read_frame(r: &mut impl BufRead) -> io::Result<Received> {
     let mut length: Option<Result<u64, String>> = None;
     let mut first = true;
     loop {
         let mut line = Vec::new();
         let n = r.by_ref().take(MAX_HEADER_LINE + 1).read_until(b'\n', &mut line)?;
         if n == 0 {
-            return Ok(if first { Frame::End } else { Frame::Skipped("the stream ended inside headers".into()) });
+            return Ok(if first { Received::End } else { Received::Skipped("the stream ended inside headers".into()) });
         }
         first = false;
         if line.last() != Some(&b'\n') {
@@ -54,13 +54,13 @@ pub fn read_frame(r: &mut impl BufRead) -> io::Result<Frame> {
     }
     let length = match length {
         Some(Ok(n)) => n,
-        Some(Err(why)) => return Ok(Frame::Skipped(why)),
-        None => return Ok(Frame::Skipped("a message without Content-Length".into())),
+        Some(Err(why)) => return Ok(Received::Skipped(why)),
+        None => return Ok(Received::Skipped("a message without Content-Length".into())),
     };
     if length > MAX_MESSAGE_BYTES {
         // Read past it without keeping it; the stream stays in step.
         let skipped = io::copy(&mut r.by_ref().take(length), &mut io::sink())?;
-        return Ok(Frame::Skipped(format!(
+        return Ok(Received::Skipped(format!(
             "a message of {length} bytes, over the {} MiB limit ({skipped} bytes read past)",
             MAX_MESSAGE_BYTES >> 20
         )));
@@ -68,14 +68,14 @@ pub fn read_frame(r: &mut impl BufRead) -> io::Result<Frame> {
     let mut body = Vec::with_capacity(length as usize);
     r.by_ref().take(length).read_to_end(&mut body)?;
     if (body.len() as u64) < length {
-        return Ok(Frame::End);
+        return Ok(Received::End);
     }
     let Ok(text) = String::from_utf8(body) else {
-        return Ok(Frame::Skipped("a message that is not UTF-8".into()));
+        return Ok(Received::Skipped("a message that is not UTF-8".into()));
     };
     Ok(match serde_json::from_str::<Message>(&text) {
-        Ok(m) => Frame::Message(m),
-        Err(e) => Frame::Skipped(format!("a message that is not JSON-RPC: {e}")),
+        Ok(m) => Received::Message(m),
+        Err(e) => Received::Skipped(format!("a message that is not JSON-RPC: {e}")),
     })
 }
 
@@ -88,10 +88,10 @@ mod tests {
         let mut out = Vec::new();
         loop {
             match read_frame(&mut r).expect("reading memory") {
-                Frame::Message(Message::Request(q)) => out.push(format!("request {}", q.method)),
-                Frame::Message(m) => out.push(format!("message {m:?}")),
-                Frame::Skipped(why) => out.push(format!("skipped: {why}")),
-                Frame::End => return out,
+                Received::Message(Message::Request(q)) => out.push(format!("request {}", q.method)),
+                Received::Message(m) => out.push(format!("message {m:?}")),
+                Received::Skipped(why) => out.push(format!("skipped: {why}")),
+                Received::End => return out,
             }
         }
     }

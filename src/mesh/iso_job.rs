@@ -238,7 +238,7 @@ const VOLUME_SAMPLES: u32 = 1 << 16;
 fn lost_volume(
     mesh: &TriMesh,
     dist: &(dyn Fn(Vec3A) -> f32 + Sync),
-    bounds: &ir::Aabb,
+    bounds: &ir::DAabb,
     span: Span,
     cell: f64,
     across: f64,

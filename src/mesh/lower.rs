@@ -466,8 +466,8 @@ mod tests {
         let mut out = Vec::new();
         for o in &scene.objects {
             match &o.geometry {
-                ir::Geometry::Shape(s) => walk(s, &mut out),
-                ir::Geometry::Mesh(m) => {
+                ir::Body::Shape(s) => walk(s, &mut out),
+                ir::Body::Mesh(m) => {
                     if let MeshSource::Isosurface { shape, .. } = &m.source {
                         walk(shape, &mut out);
                     }

@@ -5,7 +5,7 @@ use glam::{DVec3, Vec2, Vec3A};
 
 use super::{profile, revolve, Facets, Field, Refusal, Resolution, Solid, Tessellation};
 use crate::geom::hull::Hull;
-use crate::geom::{tessellate, Aabb};
+use crate::geom::{tessellate, DAabb};
 use crate::sig::{Args, Param, Range};
 
 crate::params! {
@@ -41,8 +41,8 @@ impl Solid for CappedCone {
         Ok(c)
     }
 
-    fn bounds(&self) -> Option<Aabb> {
-        Some(Aabb::centred(DVec3::new(self.widest(), self.half_height, self.widest())))
+    fn bounds(&self) -> Option<DAabb> {
+        Some(DAabb::centred(DVec3::new(self.widest(), self.half_height, self.widest())))
     }
 
     fn sphere_radius(&self) -> Option<f64> {

@@ -4,7 +4,7 @@ use glam::{DVec3, Vec3A};
 
 use super::{Facets, Field, Refusal, Resolution, Solid, Tessellation};
 use crate::geom::hull::Hull;
-use crate::geom::{tessellate, Aabb};
+use crate::geom::{tessellate, DAabb};
 use crate::sig::{Args, Param, Range};
 
 crate::params! {
@@ -25,8 +25,8 @@ impl Solid for Cuboid {
         Ok(Cuboid::from_args(args))
     }
 
-    fn bounds(&self) -> Option<Aabb> {
-        Some(Aabb::centred(self.size))
+    fn bounds(&self) -> Option<DAabb> {
+        Some(DAabb::centred(self.size))
     }
 
     fn sphere_radius(&self) -> Option<f64> {
@@ -38,7 +38,7 @@ impl Solid for Cuboid {
     }
 
     fn hull(&self) -> Option<Hull> {
-        Some(Hull::planes(Hull::box_planes(crate::geom::Aabb::centred(self.size))))
+        Some(Hull::planes(Hull::box_planes(crate::geom::DAabb::centred(self.size))))
     }
 
     fn is_convex(&self) -> bool {

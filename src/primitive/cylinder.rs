@@ -4,7 +4,7 @@ use glam::{DVec3, Vec2, Vec3A};
 
 use super::{profile, revolve, Facets, Field, Refusal, Resolution, Solid, Tessellation};
 use crate::geom::hull::Hull;
-use crate::geom::{tessellate, Aabb};
+use crate::geom::{tessellate, DAabb};
 use crate::sig::{Args, Param, Range};
 
 crate::params! {
@@ -27,8 +27,8 @@ impl Solid for Cylinder {
         Ok(Cylinder::from_args(args))
     }
 
-    fn bounds(&self) -> Option<Aabb> {
-        Some(Aabb::centred(DVec3::new(self.r, self.half_height, self.r)))
+    fn bounds(&self) -> Option<DAabb> {
+        Some(DAabb::centred(DVec3::new(self.r, self.half_height, self.r)))
     }
 
     fn sphere_radius(&self) -> Option<f64> {

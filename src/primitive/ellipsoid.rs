@@ -10,7 +10,7 @@ use glam::{DVec3, Vec3A};
 
 use super::{Facets, Field, Refusal, Resolution, Solid, Tessellation};
 use crate::geom::hull::Hull;
-use crate::geom::{tessellate, Aabb};
+use crate::geom::{tessellate, DAabb};
 use crate::sig::{Args, Param, Range};
 
 crate::params! {
@@ -42,8 +42,8 @@ impl Solid for Ellipsoid {
         Ok(Ellipsoid::from_args(args))
     }
 
-    fn bounds(&self) -> Option<Aabb> {
-        Some(Aabb::centred(self.radii()))
+    fn bounds(&self) -> Option<DAabb> {
+        Some(DAabb::centred(self.radii()))
     }
 
     fn sphere_radius(&self) -> Option<f64> {

@@ -6,7 +6,7 @@ use glam::DVec3;
 
 use super::polytope::{polyhedron_facts, Polytope};
 use super::{Refusal, Solid};
-use crate::geom::Aabb;
+use crate::geom::DAabb;
 use crate::sig::{Args, Param, Range};
 
 crate::params! {
@@ -47,8 +47,8 @@ impl Solid for HexPrism {
         Ok(HexPrism::from_args(args))
     }
 
-    fn bounds(&self) -> Option<Aabb> {
-        Some(Aabb::centred(DVec3::new(self.r, self.half_height, self.r * 3f64.sqrt() / 2.0)))
+    fn bounds(&self) -> Option<DAabb> {
+        Some(DAabb::centred(DVec3::new(self.r, self.half_height, self.r * 3f64.sqrt() / 2.0)))
     }
 
     fn sphere_radius(&self) -> Option<f64> {

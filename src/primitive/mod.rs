@@ -43,7 +43,7 @@ pub use sphere::Sphere;
 pub use torus::Torus;
 
 use crate::geom::hull::Hull;
-use crate::geom::{Aabb, TriMesh};
+use crate::geom::{DAabb, TriMesh};
 use crate::sig::{Args, Param};
 
 /// A distance function in render-space f32, or its gradient: what the SDF back-end
@@ -68,7 +68,7 @@ pub trait Solid: Clone + fmt::Debug + PartialEq + Send + Sync + 'static {
     fn new(args: &dyn Args) -> Result<Self, Refusal>;
 
     /// Axis-aligned bounds; `None` for an unbounded solid.
-    fn bounds(&self) -> Option<Aabb>;
+    fn bounds(&self) -> Option<DAabb>;
 
     /// The tightest origin-centred bounding sphere's radius; `None` when unbounded.
     fn sphere_radius(&self) -> Option<f64>;
@@ -270,7 +270,7 @@ macro_rules! ask {
 impl Primitive {
     ask! {
         /// Axis-aligned bounds; `None` for the unbounded half-space.
-        bounds -> Option<Aabb>;
+        bounds -> Option<DAabb>;
         /// The tightest origin-centred bounding sphere's radius; `None` when unbounded.
         sphere_radius -> Option<f64>;
         /// A half-space holding an unbounded solid ([`Solid::half_space`]).

@@ -6,7 +6,7 @@ use glam::DVec3;
 
 use super::polytope::{polyhedron_facts, Polytope};
 use super::{Refusal, Solid};
-use crate::geom::Aabb;
+use crate::geom::DAabb;
 use crate::sig::{Args, Param, Range};
 
 crate::params! {
@@ -44,8 +44,8 @@ impl Solid for Octahedron {
         Ok(Octahedron::from_args(args))
     }
 
-    fn bounds(&self) -> Option<Aabb> {
-        Some(Aabb::centred(DVec3::splat(self.r)))
+    fn bounds(&self) -> Option<DAabb> {
+        Some(DAabb::centred(DVec3::splat(self.r)))
     }
 
     fn sphere_radius(&self) -> Option<f64> {

@@ -4,7 +4,7 @@ use glam::{DVec3, Vec3A};
 
 use super::{Facets, Field, Refusal, Resolution, Solid, Tessellation};
 use crate::geom::hull::Hull;
-use crate::geom::Aabb;
+use crate::geom::DAabb;
 use crate::sig::{Args, Param, Range};
 
 crate::params! {
@@ -30,7 +30,7 @@ impl Solid for Plane {
         Ok(Plane { normal, offset })
     }
 
-    fn bounds(&self) -> Option<Aabb> {
+    fn bounds(&self) -> Option<DAabb> {
         None
     }
 

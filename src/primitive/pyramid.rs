@@ -6,7 +6,7 @@ use glam::DVec3;
 
 use super::polytope::{polyhedron_facts, Polytope};
 use super::{Refusal, Solid};
-use crate::geom::Aabb;
+use crate::geom::DAabb;
 use crate::sig::{Args, Param, Range};
 
 crate::params! {
@@ -46,8 +46,8 @@ impl Solid for Pyramid {
         Ok(Pyramid::from_args(args))
     }
 
-    fn bounds(&self) -> Option<Aabb> {
-        Some(Aabb::centred(DVec3::new(self.half_base, self.height / 2.0, self.half_base)))
+    fn bounds(&self) -> Option<DAabb> {
+        Some(DAabb::centred(DVec3::new(self.half_base, self.height / 2.0, self.half_base)))
     }
 
     fn sphere_radius(&self) -> Option<f64> {

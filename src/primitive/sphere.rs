@@ -4,7 +4,7 @@ use glam::{DVec3, Vec3A};
 
 use super::{Facets, Field, Refusal, Resolution, Solid, Tessellation};
 use crate::geom::hull::Hull;
-use crate::geom::{tessellate, Aabb};
+use crate::geom::{tessellate, DAabb};
 use crate::sig::{Args, Param, Range};
 
 crate::params! {
@@ -25,8 +25,8 @@ impl Solid for Sphere {
         Ok(Sphere::from_args(args))
     }
 
-    fn bounds(&self) -> Option<Aabb> {
-        Some(Aabb::centred(DVec3::splat(self.r)))
+    fn bounds(&self) -> Option<DAabb> {
+        Some(DAabb::centred(DVec3::splat(self.r)))
     }
 
     fn sphere_radius(&self) -> Option<f64> {

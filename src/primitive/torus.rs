@@ -7,7 +7,7 @@ use glam::{DVec3, Vec2, Vec3A};
 
 use super::{profile, revolve, Facets, Field, Refusal, Resolution, Solid, Tessellation};
 use crate::geom::hull::Hull;
-use crate::geom::{tessellate, Aabb};
+use crate::geom::{tessellate, DAabb};
 use crate::sig::{Args, Param, Range};
 
 crate::params! {
@@ -37,9 +37,9 @@ impl Solid for Torus {
         Ok(Torus::from_args(args))
     }
 
-    fn bounds(&self) -> Option<Aabb> {
+    fn bounds(&self) -> Option<DAabb> {
         let outer = self.major + self.minor;
-        Some(Aabb::centred(DVec3::new(outer, self.minor, outer)))
+        Some(DAabb::centred(DVec3::new(outer, self.minor, outer)))
     }
 
     fn sphere_radius(&self) -> Option<f64> {

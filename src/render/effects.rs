@@ -12,7 +12,7 @@
 
 use std::fmt;
 
-use crate::ir::{self, Geometry, LightKind, Scene, ShapeKind};
+use crate::ir::{self, Body, LightKind, Scene, ShapeKind};
 use crate::trace::Counters;
 
 /// One effect as the tests and tools see it.
@@ -300,16 +300,16 @@ fn materials_of_shape(shape: &ir::Shape, out: &mut Vec<ir::Material>) {
 }
 
 /// Every material an object can show, plus the default grey when some part has none.
-fn materials_of(geometry: &Geometry) -> Vec<ir::Material> {
+fn materials_of(geometry: &Body) -> Vec<ir::Material> {
     let mut out = Vec::new();
     match geometry {
-        Geometry::Shape(s) => {
+        Body::Shape(s) => {
             materials_of_shape(s, &mut out);
             if !painted_everywhere(s) {
                 out.push(ir::Material::default_grey());
             }
         }
-        Geometry::Mesh(m) => {
+        Body::Mesh(m) => {
             out.push(m.material.as_deref().cloned().unwrap_or_else(ir::Material::default_grey));
             if let ir::MeshSource::Isosurface { shape, .. } = &m.source {
                 materials_of_shape(shape, &mut out);

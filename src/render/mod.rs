@@ -84,7 +84,7 @@ fn encode(colour: Vec3A, frame: &Frame, out: &mut Vec<u8>) {
 
 /// A rectangle of the image's pixels, `x0..x1` by `y0..y1` (ends exclusive).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Region {
+pub struct PixelRect {
     /// First column.
     pub x0: u32,
     /// First row.
@@ -95,17 +95,17 @@ pub struct Region {
     pub y1: u32,
 }
 
-impl Region {
+impl PixelRect {
     /// The whole `width × height` image.
-    pub fn full(width: u32, height: u32) -> Region {
-        Region { x0: 0, y0: 0, x1: width, y1: height }
+    pub fn full(width: u32, height: u32) -> PixelRect {
+        PixelRect { x0: 0, y0: 0, x1: width, y1: height }
     }
 
     /// Band `i` of `n` bands of rows of a `width × height` image (band heights differ
     /// by at most a row; together the bands cover the image once).
-    pub fn band(i: u32, n: u32, width: u32, height: u32) -> Region {
+    pub fn band(i: u32, n: u32, width: u32, height: u32) -> PixelRect {
         let row = |k: u32| (u64::from(height) * u64::from(k) / u64::from(n.max(1))) as u32;
-        Region { x0: 0, y0: row(i), x1: width, y1: row(i + 1) }
+        PixelRect { x0: 0, y0: row(i), x1: width, y1: row(i + 1) }
     }
 
     /// Columns.
@@ -122,7 +122,7 @@ impl Region {
 /// Renders the frame with any geometry. Rows run in parallel on the current rayon
 /// pool; `progress` is called once per finished row.
 pub fn render(geometry: &dyn Geometry, frame: &Frame, progress: &(dyn Fn() + Sync)) -> (Image, Counters) {
-    render_region(geometry, frame, Region::full(frame.width, frame.height), progress)
+    render_region(geometry, frame, PixelRect::full(frame.width, frame.height), progress)
 }
 
 /// Renders the pixels of `region` (inside the frame, not empty) into an image of the
@@ -132,7 +132,7 @@ pub fn render(geometry: &dyn Geometry, frame: &Frame, progress: &(dyn Fn() + Syn
 pub fn render_region(
     geometry: &dyn Geometry,
     frame: &Frame,
-    region: Region,
+    region: PixelRect,
     progress: &(dyn Fn() + Sync),
 ) -> (Image, Counters) {
     effects::specialise(&frame.effects, Rows { geometry, frame, region, progress })
@@ -142,7 +142,7 @@ pub fn render_region(
 struct Rows<'a> {
     geometry: &'a dyn Geometry,
     frame: &'a Frame,
-    region: Region,
+    region: PixelRect,
     progress: &'a (dyn Fn() + Sync),
 }
 
@@ -156,7 +156,7 @@ impl effects::Variant for Rows<'_> {
 fn rows<const FX: u8>(
     geometry: &dyn Geometry,
     frame: &Frame,
-    region: Region,
+    region: PixelRect,
     progress: &(dyn Fn() + Sync),
 ) -> (Image, Counters) {
     let (w, h) = (frame.width, frame.height);

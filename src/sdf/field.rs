@@ -8,8 +8,8 @@ use std::sync::Arc;
 use glam::Vec3A;
 
 use super::surf::{Sdf, Surf, SurfSdf};
-use crate::field::{Dir, Distances, Dual, Flat, Interval, Region, Tape};
-use crate::geom::Aabb;
+use crate::field::{Dir, Distances, Dual, Flat, Interval, JetBox, Tape};
+use crate::geom::DAabb;
 
 /// The shapes a body's `dist` calls read, as the back-end's closures.
 #[derive(Clone)]
@@ -134,7 +134,7 @@ pub struct BoxCut {
 
 impl BoxCut {
     /// The box `b`.
-    pub fn new(b: &Aabb) -> BoxCut {
+    pub fn new(b: &DAabb) -> BoxCut {
         BoxCut { centre: ((b.min + b.max) * 0.5).as_vec3a(), half: ((b.max - b.min) * 0.5).as_vec3a() }
     }
 
@@ -536,7 +536,7 @@ impl RayField {
     fn along(&self, o: Vec3A, d: Vec3A, a: f32, b: f32) -> f32 {
         let (p, q) = (o + d * a, o + d * b);
         let at = [0, 1, 2].map(|i| Interval::new(p[i].min(q[i]) as f64, p[i].max(q[i]) as f64));
-        let region = Region { at, seed: [[d.x as f64], [d.y as f64], [d.z as f64]] };
+        let region = JetBox { at, seed: [[d.x as f64], [d.y as f64], [d.z as f64]] };
         let j = self.body.tape.eval::<Dir>(&region, &self.body.shapes);
         // A little above, for the f32 rounding of the point's value; never zero.
         ((j.g[0].mag() * (1.0 + 1e-4)) as f32).max(f32::MIN_POSITIVE)

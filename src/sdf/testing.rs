@@ -3,7 +3,7 @@
 
 use std::sync::Arc;
 
-use crate::ir::{Geometry, Shape};
+use crate::ir::{Body, Shape};
 
 /// Numbers uniform in `[lo, hi)` from a xorshift seeded with `seed` (not 0).
 pub fn uniform(seed: u64, lo: f64, hi: f64) -> impl FnMut() -> f64 {
@@ -22,7 +22,7 @@ pub fn only_shape(text: &str) -> Arc<Shape> {
     let c =
         crate::compile_source("t.scn", path, format!("light ambient(1)\nobject {text}\n"), &crate::source::FsLoader);
     match c.scene.expect("compiles").objects[0].geometry.clone() {
-        Geometry::Shape(s) => s,
-        Geometry::Mesh(_) => panic!("{text}: a mesh, not a shape"),
+        Body::Shape(s) => s,
+        Body::Mesh(_) => panic!("{text}: a mesh, not a shape"),
     }
 }

@@ -24,7 +24,7 @@
 //!   through it), at least its own diameter: `tests/data/ladder/sphere.scn`, a glass
 //!   sphere over a floor, is then within 1.5 % of the SDF sphere's pixels at `pixel`.
 
-use crate::ir::{self, DomainOp, ExactMesh, Facets, Geometry, Scene, Shape, ShapeKind};
+use crate::ir::{self, Body, DomainOp, ExactMesh, Facets, Scene, Shape, ShapeKind};
 use crate::mesh::Detail;
 
 /// A geometric error bound.
@@ -66,7 +66,7 @@ pub fn pixel_angle(scene: &Scene) -> f64 {
 }
 
 /// Nearest and farthest distance of an object's bounds from the camera, if bounded.
-fn depth_range(scene: &Scene, g: &Geometry) -> Option<(f64, f64)> {
+fn depth_range(scene: &Scene, g: &Body) -> Option<(f64, f64)> {
     let (c, r) = ir::bounding_sphere(g)?;
     let d = (c - scene.camera.position).length();
     Some(((d - r).max(0.0), d + r))
@@ -169,7 +169,7 @@ pub fn mesh_detail(scene: &Scene, tol: Tolerance) -> Detail {
     let mut rings = 3u32;
     let extent = scene_extent(scene);
     for o in &scene.objects {
-        let Geometry::Shape(shape) = &o.geometry else { continue };
+        let Body::Shape(shape) = &o.geometry else { continue };
         let bound = match tol {
             Tolerance::Absolute(t) => t,
             Tolerance::Pixel => {

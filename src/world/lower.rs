@@ -61,7 +61,7 @@ struct FieldHulls(Vec<KnownPlanes>);
 /// solid.
 struct KnownPlanes {
     body: Arc<ir::field::Expr>,
-    bounds: ir::Aabb,
+    bounds: ir::DAabb,
     level: f64,
     planes: Option<Vec<(DVec3, f64)>>,
     sphere: Option<(DVec3, f64)>,
@@ -101,7 +101,7 @@ impl FieldHulls {
 
     /// [`ir::FieldPlanes`]: the planes holding where `body` is at most `level` within
     /// `b` (`field::support_planes`), for a body of at least [`MIN_OPS`] operations.
-    fn planes(&mut self, body: &Arc<ir::field::Expr>, b: ir::Aabb, level: f64) -> Option<Vec<(DVec3, f64)>> {
+    fn planes(&mut self, body: &Arc<ir::field::Expr>, b: ir::DAabb, level: f64) -> Option<Vec<(DVec3, f64)>> {
         self.known(body, b, level).planes.clone()
     }
 
@@ -109,12 +109,12 @@ impl FieldHulls {
     /// smaller of the ball `field::support_radius` finds and the sphere about the
     /// support planes' polyhedron (within `b`) through its corners. A ray misses it, or
     /// enters it near the surface, for the cost of a native object's sphere test.
-    fn sphere(&mut self, body: &Arc<ir::field::Expr>, b: ir::Aabb, level: f64) -> Option<(DVec3, f64)> {
+    fn sphere(&mut self, body: &Arc<ir::field::Expr>, b: ir::DAabb, level: f64) -> Option<(DVec3, f64)> {
         self.known(body, b, level).sphere
     }
 
     /// What is known of `body` within `b` at `level`, searched once.
-    fn known(&mut self, body: &Arc<ir::field::Expr>, b: ir::Aabb, level: f64) -> &KnownPlanes {
+    fn known(&mut self, body: &Arc<ir::field::Expr>, b: ir::DAabb, level: f64) -> &KnownPlanes {
         let same =
             |k: &KnownPlanes| k.bounds == b && k.level == level && (Arc::ptr_eq(&k.body, body) || k.body == *body);
         let n = self.0.len();
@@ -265,7 +265,7 @@ struct Kept {
 
 /// Whether lowering `obj` reads a file (which may change between frames).
 fn reads_files(obj: &ir::Object) -> bool {
-    matches!(&obj.geometry, ir::Geometry::Mesh(m) if matches!(m.source, ir::MeshSource::File { .. }))
+    matches!(&obj.geometry, ir::Body::Mesh(m) if matches!(m.source, ir::MeshSource::File { .. }))
 }
 
 #[allow(clippy::too_many_arguments, reason = "prepare_reusing's arguments, and the frame it fills")]
@@ -321,11 +321,11 @@ fn lower_reusing(
                 Lowered::Kept(k.object.clone())
             }
             None => match (&obj.geometry, mode) {
-                (ir::Geometry::Shape(shape), Mode::Sdf) => {
+                (ir::Body::Shape(shape), Mode::Sdf) => {
                     let reach = Reach::of(shape, &to_render, &mut field_hulls);
                     Lowered::Sdf(SdfObject::new(shape, to_render, &mut builder), reach)
                 }
-                (ir::Geometry::Shape(shape), Mode::Mesh(detail)) => Lowered::Mesh(mesh::lower::tessellate(
+                (ir::Body::Shape(shape), Mode::Mesh(detail)) => Lowered::Mesh(mesh::lower::tessellate(
                     shape,
                     to_render,
                     detail,
@@ -333,7 +333,7 @@ fn lower_reusing(
                     &mut budget,
                     builder.materials,
                 )?),
-                (ir::Geometry::Mesh(m), _) => {
+                (ir::Body::Mesh(m), _) => {
                     Lowered::Mesh(mesh::lower::explicit(m, to_render, &mut budget, builder.materials, loader)?)
                 }
             },

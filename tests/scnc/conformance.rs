@@ -55,8 +55,8 @@ fn primitive_hits_are_outside_in_and_finite(mode: Mode) {
     for (i, object) in scene.objects.iter().enumerate() {
         // A mesh file's extent is known only once read: aim around where it is placed.
         let (centre, radius) = scnc::ir::bounding_sphere(&object.geometry).unwrap_or_else(|| match &object.geometry {
-            scnc::ir::Geometry::Mesh(m) => (m.xf.translation, 0.5),
-            scnc::ir::Geometry::Shape(_) => panic!("object {i} is unbounded"),
+            scnc::ir::Body::Mesh(m) => (m.xf.translation, 0.5),
+            scnc::ir::Body::Shape(_) => panic!("object {i} is unbounded"),
         });
         let (u, v) = (glam::DVec3::X * radius, glam::DVec3::Y * radius);
         let aims = [0.0, 0.3, 0.6].into_iter().flat_map(|k: f64| {

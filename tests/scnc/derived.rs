@@ -194,7 +194,7 @@ fn case(expr: &str) -> Option<Case> {
     let text = format!("light ambient(1)\nobject {expr} at [{}, {}, {}]\n", AT.x, AT.y, AT.z);
     let c = scnc::compile_source("t.scn", Path::new("t.scn"), text.clone(), &scnc::source::FsLoader);
     let scene = c.scene?;
-    let scnc::ir::Geometry::Shape(shape) = scene.objects[0].geometry.clone() else { return None };
+    let scnc::ir::Body::Shape(shape) = scene.objects[0].geometry.clone() else { return None };
     let (_, world) = lower(&scene, 8, Mode::Sdf);
     Some(Case { text, shape, world })
 }

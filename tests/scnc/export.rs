@@ -661,7 +661,7 @@ fn every_format_round_trips_through_its_reader() {
             assert_eq!(Format::from_extension(ext), Some(format));
             assert_eq!(Format::from_extension(&ext.to_uppercase()), Some(format));
         }
-        let frame = scnc::export::Frame { up: format.default_up(), scale: format.default_scale() };
+        let frame = scnc::export::Placement { up: format.default_up(), scale: format.default_scale() };
         let export = scnc::export::collect(
             &scene,
             scnc::mesh::Detail::Low,

@@ -115,7 +115,7 @@ const CASES: [Case; 4] = [
 /// checker's estimate unless stated), for a displacement one more than the bound of `d`
 /// (the shape's own distance has slope 1).
 fn lipschitz(s: &scnc::ir::Scene) -> f64 {
-    let scnc::ir::Geometry::Shape(shape) = &s.objects[0].geometry else { panic!("not a shape") };
+    let scnc::ir::Body::Shape(shape) = &s.objects[0].geometry else { panic!("not a shape") };
     match &shape.kind {
         scnc::ir::ShapeKind::Field { lipschitz, .. } | scnc::ir::ShapeKind::Warp { lipschitz, .. } => lipschitz.value,
         scnc::ir::ShapeKind::Displace { lipschitz, .. } => 1.0 + lipschitz.value,
@@ -203,7 +203,7 @@ fn fields_miss_no_hit_a_finer_march_finds() {
 fn the_lens_alone_is_known_convex() {
     for case in &CASES {
         let s = scene(&format!("light ambient(1)\nobject {}\n", case.object.replace("{L}", "")));
-        let scnc::ir::Geometry::Shape(shape) = &s.objects[0].geometry else { panic!("not a shape") };
+        let scnc::ir::Body::Shape(shape) = &s.objects[0].geometry else { panic!("not a shape") };
         assert_eq!(shape.is_convex(), case.name == "steep lens", "{}", case.name);
     }
 }
@@ -216,7 +216,7 @@ fn the_gyroid_sheet_meshes_closed_with_its_volume() {
     use scnc::mesh::isosurface::extract;
     use scnc::mesh::octree::Grid;
     let s = scene(&format!("light ambient(1)\nobject {}\n", CASES[0].object.replace("{L}", "")));
-    let scnc::ir::Geometry::Shape(shape) = &s.objects[0].geometry else { panic!("not a shape") };
+    let scnc::ir::Body::Shape(shape) = &s.objects[0].geometry else { panic!("not a shape") };
     let mut materials = scnc::trace::MaterialTable::default();
     let (f, _) = scnc::sdf::Builder::new(&mut materials).build(shape, DAffine3::IDENTITY, 0);
     let b = scnc::ir::shape_bounds(shape).expect("bounded");

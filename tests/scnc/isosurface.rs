@@ -17,7 +17,7 @@ use crate::support::scene;
 /// when the shape has no surface a grid point sees.
 fn meshed(shape: &str, cell: f64) -> (Sdf, Option<TriMesh>) {
     let s = scene(&format!("light ambient(1)\nobject {shape}\n"));
-    let scnc::ir::Geometry::Shape(shape) = &s.objects[0].geometry else { panic!("not a shape: {shape}") };
+    let scnc::ir::Body::Shape(shape) = &s.objects[0].geometry else { panic!("not a shape: {shape}") };
     let mut materials = MaterialTable::default();
     let (f, _) = Builder::new(&mut materials).build(shape, DAffine3::IDENTITY, 0);
     let b = scnc::ir::shape_bounds(shape).expect("bounded");
@@ -140,7 +140,7 @@ fn sheets_crossing_a_face_twice_are_split() {
         [("shell(shell(sphere(0.562), 0.122), 0.029)", 261), ("shell(torus(0.917, 0.182), 0.043)", 69)]
     {
         let s = scene(&format!("light ambient(1)\nobject {shape}\n"));
-        let scnc::ir::Geometry::Shape(ir) = &s.objects[0].geometry else { panic!("not a shape") };
+        let scnc::ir::Body::Shape(ir) = &s.objects[0].geometry else { panic!("not a shape") };
         let b = scnc::ir::shape_bounds(ir).expect("bounded");
         let cell = (b.max - b.min).length() / 60.0;
         let (f, m) = meshed(shape, cell);
@@ -168,7 +168,7 @@ proptest! {
     #[test]
     fn random_csg_trees_mesh_closed_and_near_the_surface(shape in crate::stability::arb_shape()) {
         let s = scene(&format!("light ambient(1)\nobject {shape}\n"));
-        let scnc::ir::Geometry::Shape(ir) = &s.objects[0].geometry else { panic!("not a shape") };
+        let scnc::ir::Body::Shape(ir) = &s.objects[0].geometry else { panic!("not a shape") };
         let b = scnc::ir::shape_bounds(ir).expect("bounded");
         let cell = (b.max - b.min).length() / 60.0;
         let (f, m) = meshed(&shape, cell);

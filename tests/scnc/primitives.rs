@@ -78,7 +78,7 @@ fn statement(b: &Builtin) -> String {
 }
 
 /// A camera that frames an object: on its bounding sphere's axis, or above a half-space.
-fn framing(geometry: &scnc::ir::Geometry) -> String {
+fn framing(geometry: &scnc::ir::Body) -> String {
     match scnc::ir::bounding_sphere(geometry) {
         Some((c, r)) => format!(
             "camera(position = [{}, {}, {}], look_at = [{}, {}, {}])",

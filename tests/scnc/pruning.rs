@@ -61,8 +61,8 @@ fn solid(rng: &mut Rng, depth: u32, budget: &mut usize) -> String {
 /// The shape of the first object of `text`.
 fn shape_of(text: &str) -> std::sync::Arc<scnc::ir::Shape> {
     match &scene(text).objects[0].geometry {
-        scnc::ir::Geometry::Shape(shape) => shape.clone(),
-        scnc::ir::Geometry::Mesh(_) => panic!("not a shape:\n{text}"),
+        scnc::ir::Body::Shape(shape) => shape.clone(),
+        scnc::ir::Body::Mesh(_) => panic!("not a shape:\n{text}"),
     }
 }
 

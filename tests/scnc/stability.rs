@@ -229,7 +229,7 @@ fn normals_at_edges_and_cusps_are_unit_and_finite() {
         Vec3A::new(0.5, -0.5, 5.0),
     ];
     for object in &s.objects {
-        let scnc::ir::Geometry::Shape(shape) = &object.geometry else { continue };
+        let scnc::ir::Body::Shape(shape) = &object.geometry else { continue };
         let mut materials = scnc::trace::MaterialTable::default();
         let sdf =
             scnc::sdf::SdfObject::new(shape, glam::DAffine3::IDENTITY, &mut scnc::sdf::Builder::new(&mut materials));

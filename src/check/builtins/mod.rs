@@ -100,7 +100,9 @@ impl Ctor {
             Ctor::Math(MathFn::Random) => InFields::No("`random`'s seed cannot depend on a field's point"),
             Ctor::Numeric(NumFn::Pow | NumFn::Atan2 | NumFn::Clamp | NumFn::Mix | NumFn::Sum) => InFields::Yes,
             Ctor::Numeric(NumFn::Hsv) => InFields::No("`hsv` gives a colour, which a field's body does not hold"),
-            Ctor::Numeric(NumFn::Range) => InFields::No("`range` gives a list, whose length cannot vary with the point"),
+            Ctor::Numeric(NumFn::Range) => {
+                InFields::No("`range` gives a list, whose length cannot vary with the point")
+            }
             Ctor::Vector(VecFn::Dot | VecFn::Cross | VecFn::Length | VecFn::Normalize) => InFields::Yes,
             Ctor::Extreme(Extreme::Min | Extreme::Max) => InFields::Yes,
             Ctor::Dist | Ctor::Noise3 => InFields::Yes,

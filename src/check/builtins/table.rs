@@ -5,7 +5,6 @@
 use std::sync::LazyLock;
 
 use super::{Builtin, Ctor, Extreme, FieldFn, Gen, LightFn, MathFn, Modifier, NumFn, PatternFn, ProfileFn, Ty, VecFn};
-use crate::ir::field::Unary;
 use crate::check::construct::domain::{BendArgs, ElongateArgs, PolarArgs, SymmetricArgs, TwistArgs};
 use crate::check::construct::fields::{DisplaceArgs, DistArgs, FieldArgs, Noise3Args, WarpArgs};
 use crate::check::construct::maths::{
@@ -21,7 +20,8 @@ use crate::check::construct::shapes::{CsgArgs, RepeatArgs, RoundArgs, ShellArgs}
 use crate::check::construct::values::{
     AmbientArgs, CheckerArgs, DirectionalArgs, GradientArgs, MaterialArgs, NoiseArgs, PointArgs, RgbArgs, StripesArgs,
 };
-use crate::check::construct::{CameraArgs, RenderArgs};
+use crate::check::construct::{CameraArgs, RenderStatementArgs};
+use crate::ir::field::Unary;
 use crate::ir::CsgOp;
 use crate::primitive::PRIMITIVES;
 use crate::sig::Param;
@@ -383,7 +383,7 @@ static REST: &[Builtin] = &[
     Builtin {
         name: "render",
         ctor: Ctor::Render,
-        params: RenderArgs::PARAMS,
+        params: RenderStatementArgs::PARAMS,
         variadic: None,
         result: Ty::Num,
         doc:

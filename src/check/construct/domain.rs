@@ -12,7 +12,7 @@ use crate::check::builtins::FieldFn;
 use crate::check::expr::BoundArgs;
 use crate::check::{Ctx, Value};
 use crate::diag::{codes, Diagnostic};
-use crate::geom::Aabb;
+use crate::geom::DAabb;
 use crate::ir::field::{Binary, Expr, Kind, Ty, Unary};
 use crate::ir::{self, DomainOp, Lipschitz, Shape, ShapeKind};
 use crate::sig::Range;
@@ -109,7 +109,7 @@ impl Ctx<'_> {
                 let (qx, qz) = turn(&x, &z, &theta);
                 let map = Expr::vector([qx, y.clone(), qz]);
                 let r = b.radius_about_y();
-                let bounds = Aabb { min: DVec3::new(-r, b.min.y, -r), max: DVec3::new(r, b.max.y, r) };
+                let bounds = DAabb { min: DVec3::new(-r, b.min.y, -r), max: DVec3::new(r, b.max.y, r) };
                 self.warp(child, map, bounds, span, "this twist", Some(DomainOp::Twist(k)))
             }
             FieldFn::Bend => {
@@ -124,7 +124,7 @@ impl Ctx<'_> {
                 let map = Expr::vector([qx, qy, z.clone()]);
                 // A turn about the origin keeps the distance from it.
                 let r = b.min.abs().max(b.max.abs()).length();
-                let bounds = Aabb { min: DVec3::splat(-r), max: DVec3::splat(r) };
+                let bounds = DAabb { min: DVec3::splat(-r), max: DVec3::splat(r) };
                 self.warp(child, map, bounds, span, "this bend", Some(DomainOp::Bend(k)))
             }
             FieldFn::Elongate => {
@@ -138,7 +138,7 @@ impl Ctx<'_> {
                     let clamped = bin(Binary::Max, &bin(Binary::Min, &c, &Expr::num(h[k])), &Expr::num(-h[k]));
                     bin(Binary::Sub, &c, &clamped)
                 });
-                let bounds = ir::shape_bounds(&child).map(|b| Aabb { min: b.min - h, max: b.max + h });
+                let bounds = ir::shape_bounds(&child).map(|b| DAabb { min: b.min - h, max: b.max + h });
                 let domain_op = Some(DomainOp::Elongate(h));
                 Some(ShapeKind::Warp { child, map: Expr::vector(q), bounds, lipschitz: exact, domain_op })
             }
@@ -161,7 +161,7 @@ impl Ctx<'_> {
                         let m = hi[k].max(0.0);
                         (lo[k], hi[k]) = (-m, m);
                     }
-                    Aabb { min: lo, max: hi }
+                    DAabb { min: lo, max: hi }
                 });
                 let domain_op = Some(DomainOp::Mirror(mirrored));
                 Some(ShapeKind::Warp { child, map: Expr::vector(q), bounds, lipschitz: exact, domain_op })
@@ -173,7 +173,7 @@ impl Ctx<'_> {
                 let b = self.bounded(&child, "polar", span)?;
                 let w = 360.0 / f64::from(count);
                 let r = b.radius_about_y();
-                let bounds = Aabb { min: DVec3::new(-r, b.min.y, -r), max: DVec3::new(r, b.max.y, r) };
+                let bounds = DAabb { min: DVec3::new(-r, b.min.y, -r), max: DVec3::new(r, b.max.y, r) };
                 if self.crosses_sector(&b, w) {
                     if count <= MAX_EXACT_COPIES {
                         // Every copy measured, the nearest taken: exact, `count` times the work.
@@ -226,7 +226,7 @@ impl Ctx<'_> {
         &mut self,
         child: Arc<Shape>,
         map: Arc<Expr>,
-        bounds: Aabb,
+        bounds: DAabb,
         span: Span,
         what: &str,
         domain_op: Option<DomainOp>,
@@ -237,7 +237,7 @@ impl Ctx<'_> {
     }
 
     /// The shape's box, or `None` after reporting that `op` needs one.
-    fn bounded(&mut self, child: &Shape, op: &str, span: Span) -> Option<Aabb> {
+    fn bounded(&mut self, child: &Shape, op: &str, span: Span) -> Option<DAabb> {
         let b = ir::shape_bounds(child);
         if b.is_none() {
             self.report(
@@ -290,7 +290,7 @@ impl Ctx<'_> {
 
     /// Whether a shape with box `b` may reach out of its sector of `w` degrees about
     /// `+x`: a corner of its box in the `xz` plane, or the axis itself, lies outside it.
-    fn crosses_sector(&self, b: &Aabb, w: f64) -> bool {
+    fn crosses_sector(&self, b: &DAabb, w: f64) -> bool {
         if b.min.x <= 0.0 {
             return w < 360.0 || b.min.z < 0.0 && b.max.z > 0.0;
         }

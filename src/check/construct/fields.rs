@@ -13,7 +13,7 @@ use crate::check::expr::BoundArgs;
 use crate::check::{Ctx, Value};
 use crate::diag::{codes, Diagnostic};
 use crate::field::{lipschitz, Estimate, SlopeDistances, Tape};
-use crate::geom::Aabb;
+use crate::geom::DAabb;
 use crate::ir::field::{Expr, Kind, Ty, Unary, Val};
 use crate::ir::{self, Lipschitz, ShapeKind};
 use crate::sig::Range;
@@ -105,7 +105,7 @@ const SMALL_TURN: f64 = 45.0;
 /// the function, its argument and the turn, sampled on a 5×5×5 grid. Arguments that
 /// read `dist` are left alone: their turn depends on shapes, not on how the author wrote
 /// angles.
-fn radians_for_degrees(body: &Arc<Expr>, domain: Option<Aabb>) -> Option<(Unary, Arc<Expr>, f64)> {
+fn radians_for_degrees(body: &Arc<Expr>, domain: Option<DAabb>) -> Option<(Unary, Arc<Expr>, f64)> {
     let (lo, hi) = domain.map_or((DVec3::splat(-1.0), DVec3::splat(1.0)), |b| (b.min, b.max));
     let mut stack = vec![body];
     while let Some(e) = stack.pop() {
@@ -212,7 +212,7 @@ impl Ctx<'_> {
     }
 
     /// A `bounds` argument as a box, `Some(None)` when absent, `None` after reporting.
-    fn bounds(&mut self, v: Option<Value>, span: Span) -> Option<Option<Aabb>> {
+    fn bounds(&mut self, v: Option<Value>, span: Span) -> Option<Option<DAabb>> {
         let Some(v) = v else { return Some(None) };
         let corners: Option<Vec<DVec3>> = match &v {
             Value::List(items) if items.len() == 2 => {
@@ -221,7 +221,7 @@ impl Ctx<'_> {
             _ => None,
         };
         match corners.as_deref() {
-            Some(&[lo, hi]) if lo.cmplt(hi).all() => Some(Some(Aabb { min: lo, max: hi })),
+            Some(&[lo, hi]) if lo.cmplt(hi).all() => Some(Some(DAabb { min: lo, max: hi })),
             Some(&[lo, hi]) => {
                 let shown = format!("from {} to {}", ir::dump_vec(lo), ir::dump_vec(hi));
                 self.range_error(span, "bounds", "a box whose first corner is below its second on every axis", shown);
@@ -261,7 +261,7 @@ impl Ctx<'_> {
     }
 
     /// Warns (W0010) when the body's trigonometry barely turns over `domain`.
-    fn check_angles(&mut self, body: &Arc<Expr>, domain: Option<Aabb>, span: Span) {
+    fn check_angles(&mut self, body: &Arc<Expr>, domain: Option<DAabb>, span: Span) {
         let Some((f, arg, turn)) = radians_for_degrees(body, domain) else { return };
         let (name, arg) = (f.name(), arg.source(60));
         let over = if domain.is_some() { "its `bounds`" } else { "the cube from -1 to 1" };
@@ -287,7 +287,7 @@ impl Ctx<'_> {
     pub(in crate::check) fn field_slope(
         &mut self,
         tape: &Tape,
-        domain: Option<Aabb>,
+        domain: Option<DAabb>,
         given: Option<f64>,
         span: Span,
         what: &str,
@@ -337,7 +337,7 @@ impl Ctx<'_> {
     }
 
     /// The bound of the slope of `tape` over `domain`.
-    fn estimate(&self, tape: &Tape, domain: Option<Aabb>) -> Estimate {
+    fn estimate(&self, tape: &Tape, domain: Option<DAabb>) -> Estimate {
         let spheres = tape.shapes.iter().map(|s| ir::shape_sphere(s)).collect();
         lipschitz(tape, domain, &SlopeDistances { spheres })
     }
@@ -349,9 +349,9 @@ impl Ctx<'_> {
         &mut self,
         tape: &Tape,
         child: &ir::Shape,
-        bounds: Option<Aabb>,
+        bounds: Option<DAabb>,
         span: Span,
-    ) -> Option<(Option<Aabb>, f64)> {
+    ) -> Option<(Option<DAabb>, f64)> {
         if let Some(b) = bounds {
             return Some((Some(b), 0.0));
         }

@@ -313,7 +313,7 @@ impl Ctx<'_> {
 
     pub(super) fn render_stmt(&mut self, args: &[ast::Arg], span: Span) -> Option<Settings> {
         let (_, a) = self.statement_args("render", args, span)?;
-        let r = RenderArgs::from_args(&a);
+        let r = RenderStatementArgs::from_args(&a);
         if r.width as u64 * r.height as u64 > MAX_PIXELS {
             self.report(
                 Diagnostic::error(
@@ -377,7 +377,7 @@ crate::params! {
 
 crate::params! {
     /// The `render` statement's arguments.
-    pub struct RenderArgs {
+    pub struct RenderStatementArgs {
         /// image width in pixels
         width: u32 as Int = 500, Range::closed(1.0, MAX_IMAGE_SIDE as f64);
         /// image height in pixels

@@ -17,7 +17,7 @@ use crate::check::value::Profile;
 use crate::check::{Ctx, Value};
 use crate::diag::{codes, Diagnostic};
 use crate::geom::region::{Combine, Region};
-use crate::geom::Aabb;
+use crate::geom::DAabb;
 use crate::ir::dump_num;
 use crate::ir::field::{Binary, Expr, Kind, Ty, Unary};
 use crate::ir::{CsgOp, ExactMesh, Lipschitz, ShapeKind, Sweep};
@@ -382,7 +382,7 @@ impl Ctx<'_> {
                 };
                 let d2 = profile.body.substitute(&vec2(x, z));
                 let dy = bin(Binary::Sub, &un(Unary::Abs, &y), &num(h));
-                let bounds = Aabb {
+                let bounds = DAabb {
                     min: DVec3::new(profile.min.x, -h, profile.min.y),
                     max: DVec3::new(profile.max.x, h, profile.max.y),
                 };
@@ -423,7 +423,7 @@ impl Ctx<'_> {
                 let radius = un(Unary::Length, &Expr::vector([x, num(0.0), z]));
                 let body = profile.body.substitute(&vec2(radius, y));
                 let r = profile.max.x;
-                let bounds = Aabb { min: DVec3::new(-r, profile.min.y, -r), max: DVec3::new(r, profile.max.y, r) };
+                let bounds = DAabb { min: DVec3::new(-r, profile.min.y, -r), max: DVec3::new(r, profile.max.y, r) };
                 // A polygon wholly at u ≥ 0 is tessellated as a lathe here.
                 let lathe = match profile.region.as_deref() {
                     Some(Region::Polygon(corners)) if crate::geom::polygon::lathe_ok(corners) => {

@@ -176,7 +176,7 @@ fn crowded(children: &[Arc<ir::Shape>], smooth: f64) -> Option<usize> {
     if children.len() < CROWDED_PARTS {
         return None;
     }
-    let boxes: Vec<Option<crate::geom::Aabb>> =
+    let boxes: Vec<Option<crate::geom::DAabb>> =
         children.iter().map(|c| ir::shape_bounds(c).map(|b| b.grow(smooth))).collect();
     let step = (children.len() / 64).max(1);
     let most = (0..children.len())

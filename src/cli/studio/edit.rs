@@ -166,7 +166,7 @@ fn insert_before_first_statement(text: &str, line: &str) -> String {
 /// The scene as a mesh file to download, as `scnc export` writes it with its defaults
 /// (detail high; z up for STL and 3MF, which are for printing, y up otherwise).
 pub(crate) fn export(studio: &Studio, text: String, format: &str) -> Reply {
-    use scnc::export::Frame;
+    use scnc::export::Placement;
     let Some(format) = Format::from_name(format).filter(|f| f.one_file()) else {
         let names: Vec<&str> = downloads().map(Format::name).collect();
         return Reply::text(400, &format!("`{format}`: the studio exports {}", names.join(", ")));
@@ -179,7 +179,7 @@ pub(crate) fn export(studio: &Studio, text: String, format: &str) -> Reply {
     if scene.objects.is_empty() {
         return Reply::text(422, "the scene has no objects to export");
     }
-    let frame = Frame { up: format.default_up(), scale: format.default_scale() };
+    let frame = Placement { up: format.default_up(), scale: format.default_scale() };
     let limit = scnc::mesh::lower::DEFAULT_MEMORY_LIMIT;
     let loader = studio.files.loader();
     let skip_unbounded = format.for_printing();

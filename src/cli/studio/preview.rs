@@ -16,7 +16,7 @@ use glam::DQuat;
 
 use scnc::diag::Diagnostic;
 use scnc::mesh::Detail;
-use scnc::render::{Frame, Image, Region};
+use scnc::render::{Frame, Image, PixelRect};
 use scnc::trace::Counters;
 use scnc::world::{Mode, World};
 
@@ -280,7 +280,7 @@ fn run(studio: &Studio, text: &str, ask: &Ask, out: &mut Stream, current: &dyn F
             return out.message(b'X', b"{}");
         }
         let y1 = (y0 + BAND_ROWS).min(frame.height);
-        let region = Region { x0: 0, y0, x1: frame.width, y1 };
+        let region = PixelRect { x0: 0, y0, x1: frame.width, y1 };
         let (band, c) = studio.preview.pool.install(|| scnc::render::render_region(&world, &frame, region, &|| {}));
         counters.add(&c);
         send_band(out, y0, &band)?;
