@@ -152,39 +152,12 @@ fn parse_tile(s: &str) -> Result<(u32, u32), String> {
     Ok((i, n))
 }
 
-pub(crate) fn parse_detail(s: &str) -> Result<scnc::mesh::Detail, String> {
-    match s {
-        "low" => Ok(scnc::mesh::Detail::Low),
-        "high" => Ok(scnc::mesh::Detail::High),
-        n => match n.parse::<u32>() {
-            Ok(n) if (3..=2048).contains(&n) => Ok(scnc::mesh::Detail::N(n)),
-            _ => Err("expected `low`, `high` or a number of rings from 3 to 2048".into()),
-        },
-    }
-}
-
 fn parse_epsilon(s: &str) -> Result<f64, String> {
     let x: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
     if EPSILON_RANGE.admits(x) {
         Ok(x)
     } else {
         Err(format!("must be {} (f32 cannot resolve less than 1e-6)", EPSILON_RANGE.rule(false)))
-    }
-}
-
-/// A byte count: a whole number, optionally with a K, M or G suffix (powers of 1024).
-pub(crate) fn parse_bytes(s: &str) -> Result<u64, String> {
-    let t = s.trim();
-    let (digits, shift) = match t.char_indices().last() {
-        Some((i, 'K' | 'k')) => (&t[..i], 10),
-        Some((i, 'M' | 'm')) => (&t[..i], 20),
-        Some((i, 'G' | 'g')) => (&t[..i], 30),
-        _ => (t, 0),
-    };
-    let n: u64 = digits.parse().map_err(|_| format!("`{s}` is not a size: try `4G`, `512M` or a number of bytes"))?;
-    match n.checked_mul(1 << shift) {
-        Some(bytes) if bytes > 0 => Ok(bytes),
-        _ => Err(format!("`{s}` must be greater than 0 and at most {} bytes", u64::MAX)),
     }
 }
 

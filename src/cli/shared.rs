@@ -4,7 +4,6 @@
 
 use scnc::study::tolerance::Tolerance;
 
-use super::render::{parse_bytes, parse_detail};
 use super::MessageFormat;
 
 /// `--threads`.
@@ -52,4 +51,32 @@ pub(crate) struct Meshing {
     /// K, M or G suffix (binary); a mesh that would need more is refused before it is made.
     #[arg(long, value_parser = parse_bytes, default_value = "4G")]
     pub(crate) memory_limit: u64,
+}
+
+/// A detail: `low`, `high` or a number of rings.
+fn parse_detail(s: &str) -> Result<scnc::mesh::Detail, String> {
+    match s {
+        "low" => Ok(scnc::mesh::Detail::Low),
+        "high" => Ok(scnc::mesh::Detail::High),
+        n => match n.parse::<u32>() {
+            Ok(n) if (3..=2048).contains(&n) => Ok(scnc::mesh::Detail::N(n)),
+            _ => Err("expected `low`, `high` or a number of rings from 3 to 2048".into()),
+        },
+    }
+}
+
+/// A byte count: a whole number, optionally with a K, M or G suffix (powers of 1024).
+fn parse_bytes(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let (digits, shift) = match t.char_indices().last() {
+        Some((i, 'K' | 'k')) => (&t[..i], 10),
+        Some((i, 'M' | 'm')) => (&t[..i], 20),
+        Some((i, 'G' | 'g')) => (&t[..i], 30),
+        _ => (t, 0),
+    };
+    let n: u64 = digits.parse().map_err(|_| format!("`{s}` is not a size: try `4G`, `512M` or a number of bytes"))?;
+    match n.checked_mul(1 << shift) {
+        Some(bytes) if bytes > 0 => Ok(bytes),
+        _ => Err(format!("`{s}` must be greater than 0 and at most {} bytes", u64::MAX)),
+    }
 }

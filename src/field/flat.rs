@@ -6,14 +6,14 @@
 //! Dispatch, not arithmetic, was much of an evaluation: the gyroid sheet ran 22
 //! instructions, for 3 sines with their cosines and 8 operations. Inputs and copies
 //! become register names, and the pairs bodies are made of become one instruction
-//! each ([`fused`]): 9 instructions, the same bits. `cargo bench --bench render --
-//! 'sdf eval/gyroid'`: 22 → 17 µs per 256 points; the gyroid's primary rays (its scene
-//! without lights, depth 0, `scnc render --stats`): trace 1.81 → 1.31 s.
+//! each ([`fused`]): 9 instructions, the same bits (`cargo bench --bench render --
+//! 'sdf eval/gyroid'`; the measurements are in docs/performance.md, "Measurements
+//! behind the code").
 //!
 //! Every instruction runs over `W` lanes ([`Flat::eval_lanes`]): a block of camera
 //! rays marching a field evaluates its points together, one dispatch for all of them
-//! and the lanes' arithmetic in one loop (gyroid primary rays: trace 1.055 → 0.478 s,
-//! the same image); a single point is one lane.
+//! and the lanes' arithmetic in one loop (`benches/scenes/gyroid-primary.scn`, the
+//! same image); a single point is one lane.
 
 use glam::Vec3A;
 

@@ -71,8 +71,9 @@ pub fn support_planes(
 /// of the box. Over a round solid the bound closes in only as the boxes across the
 /// whole surface shrink: a ball of radius 0.4 in its box is bounded by 0.448, 0.432 and
 /// 0.423 at 512, 1024 and 2048 per eighth, against the box's 0.69 (unit test
-/// `support_radius_holds_the_solid_and_is_tight`). At 1024, about 0.6 ms of lowering
-/// per body; 64 field spheres trace as fast as at 2048.
+/// `support_radius_holds_the_solid_and_is_tight`). 1024 is as fast to trace as 2048
+/// at half the lowering (`benches/scenes/field-spheres-64.scn`; docs/performance.md,
+/// "Measurements behind the code").
 const RADIAL_BUDGET: usize = 1024;
 
 /// The radius of a ball about `centre` holding where the body is at most `level`

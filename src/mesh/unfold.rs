@@ -19,9 +19,7 @@ const ROUNDS: usize = 4;
 /// checked: a fold needs a vertex pulled out towards a sharp feature, and where every
 /// vertex is near its mass point the surface is smooth at the cell's scale. Checking
 /// only those keeps the cost down (`scnc export benches/scenes/gyroid.scn -o g.stl
-/// --tolerance 0.01`: 7.3 s without the pass, 8.2 s with it while each pair's bounds
-/// were worked out again, 6.0 s with them kept per bin, 15.2 s checking every triangle;
-/// a shared machine, so ratios within one run count).
+/// --tolerance 0.01`; docs/performance.md, "Measurements behind the code").
 const PULLED: f64 = 0.25;
 
 /// Unfolds `mesh` (vertex `i`'s mass point is `mass[i]`; triangles span about a `cell`)

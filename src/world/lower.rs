@@ -68,10 +68,9 @@ struct KnownPlanes {
 }
 
 /// The fewest operations a field's body has for its rays to be clipped to its support
-/// planes: below that a step costs less than the clip. 64 spheres written as fields
-/// (three operations) traced in 0.051 s without their planes and 0.079 s with them
-/// (medians of 11 interleaved runs at 1000×1000, `scnc render
-/// benches/scenes/field-spheres-64.scn --width 1000 --height 1000 --stats`). Their
+/// planes: below that a step costs less than the clip (`scnc render
+/// benches/scenes/field-spheres-64.scn --width 1000 --height 1000 --stats`, spheres of
+/// three operations each; docs/performance.md, "Measurements behind the code"). Their
 /// sphere ([`FieldHulls::sphere`]) is clipped to at every size: it costs what a
 /// native object's does.
 const MIN_OPS: usize = 12;
@@ -135,8 +134,8 @@ impl FieldHulls {
             corner_sphere(&crate::geom::hull::Hull::planes(all).corners())
         };
         let corners = planes.as_ref().and_then(hull);
-        // The ball holding the solid, about the middle of its polyhedron or box: about
-        // 0.6 ms of lowering per distinct body (`field::support_radius`). Every body
+        // The ball holding the solid, about the middle of its polyhedron or box (its
+        // search's cost: `field::support_radius`). Every body
         // is searched, so an object's sphere depends on nothing but the object, as an
         // animation's reuse of objects needs (`FrameCache`).
         let centre = corners.map_or(b.centre(), |c| c.0);

@@ -165,8 +165,7 @@ impl Ctx<'_> {
 pub const CROWDED_PARTS: usize = 1_000;
 
 /// The most parts of a combination that may overlap one place: each is evaluated at
-/// every step there (10,000 coincident spheres in a smooth union render at 64×64 in
-/// 0.27 s, 100,000 in 5.7 s: `scnc render`, see docs/limits.md).
+/// every step there (what that costs at 10,000 and 100,000: docs/limits.md).
 pub const MAX_CROWD: usize = 10_000;
 
 /// The most parts whose boxes (grown by the blend `smooth`) hold one point, sampled at up
