@@ -45,23 +45,8 @@ fn everything() -> Vec<Arc<Expr>> {
     let (a, b, c) = (x(0), x(1), x(2));
     let mut out =
         vec![sphere(), gyroid(450.0), sheet(), bin(Binary::Add, bin(Binary::Mul, a.clone(), n(0.7)), b.clone())];
-    for f in [
-        Unary::Neg,
-        Unary::Sin,
-        Unary::Cos,
-        Unary::Tan,
-        Unary::Asin,
-        Unary::Acos,
-        Unary::Atan,
-        Unary::Sqrt,
-        Unary::Abs,
-        Unary::Floor,
-        Unary::Ceil,
-        Unary::Round,
-        Unary::Sign,
-        Unary::Exp,
-        Unary::Log,
-    ] {
+    // Every function of a number (`not`, `length` and `normalize` take other operands).
+    for &f in Unary::ALL.iter().filter(|f| f.ty(Ty::Num) == Some(Ty::Num)) {
         out.push(un(f, bin(Binary::Mul, a.clone(), n(0.7))));
     }
     for f in [

@@ -44,45 +44,69 @@ pub struct Expr {
     pub ty: Ty,
 }
 
-/// Functions of one operand.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Unary {
+/// Lists the functions of one operand once: each variant with its doc and its name (the
+/// builtin's, or the operator), from which the enum, [`Unary::name`] and [`Unary::ALL`]
+/// are made. What a function computes is [`Unary::apply`], matched exhaustively there
+/// and in every evaluator, so a new line here fails to compile until each has it.
+macro_rules! unaries {
+    ($($(#[doc = $doc:literal])* $variant:ident => $name:literal,)*) => {
+        /// Functions of one operand.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        pub enum Unary {
+            $($(#[doc = $doc])* $variant,)*
+        }
+
+        impl Unary {
+            /// Every function, in the list's order (tests walk them all).
+            pub const ALL: &[Unary] = &[$(Unary::$variant),*];
+
+            /// The function's name (`-` and `not` as operators).
+            pub fn name(self) -> &'static str {
+                match self {
+                    $(Unary::$variant => $name,)*
+                }
+            }
+        }
+    };
+}
+
+unaries! {
     /// `-x` of a number or vector.
-    Neg,
+    Neg => "-",
     /// `not b`.
-    Not,
+    Not => "not",
     /// Sine of degrees.
-    Sin,
+    Sin => "sin",
     /// Cosine of degrees.
-    Cos,
+    Cos => "cos",
     /// Tangent of degrees.
-    Tan,
+    Tan => "tan",
     /// Arcsine in degrees; its operand is clamped to [−1, 1].
-    Asin,
+    Asin => "asin",
     /// Arccosine in degrees; its operand is clamped to [−1, 1].
-    Acos,
+    Acos => "acos",
     /// Arctangent in degrees.
-    Atan,
+    Atan => "atan",
     /// Square root; of 0 below 0.
-    Sqrt,
+    Sqrt => "sqrt",
     /// Absolute value.
-    Abs,
+    Abs => "abs",
     /// Largest whole number not above.
-    Floor,
+    Floor => "floor",
     /// Smallest whole number not below.
-    Ceil,
+    Ceil => "ceil",
     /// Nearest whole number, halves away from zero.
-    Round,
+    Round => "round",
     /// −1, 0 or 1.
-    Sign,
+    Sign => "sign",
     /// e to the power.
-    Exp,
+    Exp => "exp",
     /// Natural logarithm; of the smallest positive f32 at or below 0.
-    Log,
+    Log => "log",
     /// Length of a vector.
-    Length,
+    Length => "length",
     /// A vector scaled to length 1 (the zero vector stays zero).
-    Normalize,
+    Normalize => "normalize",
 }
 
 /// Functions of two operands.
@@ -161,30 +185,6 @@ pub enum Kind {
 }
 
 impl Unary {
-    /// The function's name (`-` and `not` as operators).
-    pub fn name(self) -> &'static str {
-        match self {
-            Unary::Neg => "-",
-            Unary::Not => "not",
-            Unary::Sin => "sin",
-            Unary::Cos => "cos",
-            Unary::Tan => "tan",
-            Unary::Asin => "asin",
-            Unary::Acos => "acos",
-            Unary::Atan => "atan",
-            Unary::Sqrt => "sqrt",
-            Unary::Abs => "abs",
-            Unary::Floor => "floor",
-            Unary::Ceil => "ceil",
-            Unary::Round => "round",
-            Unary::Sign => "sign",
-            Unary::Exp => "exp",
-            Unary::Log => "log",
-            Unary::Length => "length",
-            Unary::Normalize => "normalize",
-        }
-    }
-
     /// The result's type for an operand of type `x`; `None` if it takes no such operand.
     pub fn ty(self, x: Ty) -> Option<Ty> {
         match (self, x) {
