@@ -177,6 +177,14 @@ impl Interval {
                 }
             }
             Unary::Floor => x.rising(f64::floor),
+            Unary::Fract => {
+                let whole = x.lo.floor();
+                if x.hi < whole + 1.0 {
+                    Interval::new(x.lo - whole, x.hi - whole)
+                } else {
+                    Interval::new(0.0, 1.0)
+                }
+            }
             Unary::Ceil => x.rising(f64::ceil),
             Unary::Round => x.rising(f64::round),
             Unary::Sign => x.rising(|t| Unary::Sign.apply(t)),
@@ -484,6 +492,8 @@ impl<const N: usize> Scalar for Jet<N> {
             // A step's slope is zero between its jumps; a jump has no bound at all, and
             // is marched as if it were not there (docs/fields.md says so).
             Unary::Not | Unary::Floor | Unary::Ceil | Unary::Round | Unary::Sign => Interval::point(0.0),
+            // Slope 1 between its jumps, which count as `floor`'s do.
+            Unary::Fract => one,
             Unary::Length | Unary::Normalize => Interval::ALL,
         };
         Jet::chain(v, d, x)

@@ -55,6 +55,7 @@ impl Scalar for f32 {
             Unary::Floor => x.floor(),
             Unary::Ceil => x.ceil(),
             Unary::Round => x.round(),
+            Unary::Fract => x - x.floor(),
             Unary::Sign => {
                 if x == 0.0 {
                     0.0
@@ -226,6 +227,8 @@ impl Scalar for Dual {
                     1.0
                 }
             }
+            // Rising at slope 1 between its jumps, which are steps like `floor`'s.
+            Unary::Fract => 1.0,
             Unary::Exp => v,
             Unary::Log if x.v > 0.0 => 1.0 / x.v,
             // Steps are flat between their jumps; below their domain the total forms are constant.

@@ -97,6 +97,8 @@ unaries! {
     Ceil => "ceil",
     /// Nearest whole number, halves away from zero.
     Round => "round",
+    /// What is left above the largest whole number not above, in [0, 1).
+    Fract => "fract",
     /// −1, 0 or 1.
     Sign => "sign",
     /// e to the power.
@@ -214,6 +216,7 @@ impl Unary {
             Unary::Floor => x.floor(),
             Unary::Ceil => x.ceil(),
             Unary::Round => x.round(),
+            Unary::Fract => x - x.floor(),
             Unary::Sign => {
                 if x == 0.0 {
                     0.0

@@ -307,6 +307,7 @@ static REST: &[Builtin] = &[
     // `round(x)` beside the shape modifier `round(shape, r)`: the first argument's type
     // chooses (see `overload`).
     f("round", Ctor::Math(MathFn::Unary(Unary::Round)), NumberArgs::ANY, Ty::Num, "nearest whole number, halves away from zero"),
+    f("fract", Ctor::Math(MathFn::Unary(Unary::Fract)), NumberArgs::ANY, Ty::Num, "`x - floor(x)`, in [0, 1): repeats every 1"),
     f(
         "pow",
         Ctor::Numeric(NumFn::Pow),
