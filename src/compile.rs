@@ -92,7 +92,7 @@ pub fn compile_source(name: &str, path: &Path, text: String, loader: &dyn Loader
 }
 
 /// The stack of the thread compiles run on: deep enough for every nesting the limits in
-/// [`check`] and [`syntax`] allow.
+/// [`check`] and [`syntax`](crate::syntax) allow.
 pub const COMPILER_STACK: usize = 256 << 20;
 
 /// The operating system refused the compiler's thread (most often an address space
@@ -137,7 +137,7 @@ pub fn with_big_stack_on<T: Send>(text: String, f: impl FnOnce(String) -> T + Se
 }
 
 /// Runs `f` on a thread with a large stack, so that pathological nesting in user input
-/// (bounded by the limits in [`check`] and [`syntax`]) cannot overflow the stack; an
+/// (bounded by the limits in [`check`] and [`syntax`](crate::syntax)) cannot overflow the stack; an
 /// error when the thread cannot be had.
 pub fn with_big_stack<T: Send>(f: impl FnOnce() -> T + Send) -> Result<T, NoThread> {
     std::thread::scope(|s| {

@@ -446,6 +446,15 @@ pub fn explicit(
     })
 }
 
+/// What `mesh file(…)` reads, for the note on a bad file: every format, OBJ first (any
+/// other name is read as OBJ).
+fn reads_note() -> String {
+    let mut formats: Vec<&str> = Format::ALL.iter().map(|f| f.reads()).collect();
+    formats.sort_by_key(|r| !r.starts_with("OBJ"));
+    let (last, rest) = formats.split_last().expect("formats! lists formats");
+    format!("scnc reads {} and {last}", rest.join(", "))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -515,13 +524,4 @@ mod tests {
         assert!(roomy.spend(MAX_SCENE_TRIANGLES, span).is_ok());
         assert!(roomy.spend(1, span).expect_err("over the triangle count").message.contains("triangles"));
     }
-}
-
-/// What `mesh file(…)` reads, for the note on a bad file: every format, OBJ first (any
-/// other name is read as OBJ).
-fn reads_note() -> String {
-    let mut formats: Vec<&str> = Format::ALL.iter().map(|f| f.reads()).collect();
-    formats.sort_by_key(|r| !r.starts_with("OBJ"));
-    let (last, rest) = formats.split_last().expect("formats! lists formats");
-    format!("scnc reads {} and {last}", rest.join(", "))
 }

@@ -105,69 +105,6 @@ fn add(mesh: &mut TriMesh, p: &gltf::Primitive, world: DMat4, blob: Option<&[u8]
     Ok(())
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A .glb of one triangle (no indices), placed by `nodes` (the scene is node 0).
-    fn glb(nodes: serde_json::Value, mode: u32) -> Vec<u8> {
-        let bin: Vec<u8> = [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
-            .iter()
-            .flatten()
-            .flat_map(|c| c.to_le_bytes())
-            .collect();
-        let doc = serde_json::json!({
-            "asset": { "version": "2.0" },
-            "scene": 0,
-            "scenes": [{ "nodes": [0] }],
-            "nodes": nodes,
-            "meshes": [{ "primitives": [{ "attributes": { "POSITION": 0 }, "mode": mode }] }],
-            "accessors": [{ "bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
-                            "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 0.0] }],
-            "bufferViews": [{ "buffer": 0, "byteLength": 36 }],
-            "buffers": [{ "byteLength": 36 }],
-        });
-        let mut json = serde_json::to_vec(&doc).expect("json");
-        while !json.len().is_multiple_of(4) {
-            json.push(b' ');
-        }
-        let mut out = b"glTF".to_vec();
-        out.extend(2u32.to_le_bytes());
-        out.extend(((12 + 8 + json.len() + 8 + bin.len()) as u32).to_le_bytes());
-        out.extend((json.len() as u32).to_le_bytes());
-        out.extend(b"JSON");
-        out.extend(json);
-        out.extend((bin.len() as u32).to_le_bytes());
-        out.extend(b"BIN\0");
-        out.extend(bin);
-        out
-    }
-
-    #[test]
-    fn nodes_place_their_meshes_and_a_mirror_keeps_the_winding_outward() {
-        let plain = parse(&glb(serde_json::json!([{ "mesh": 0 }]), 4)).expect("reads");
-        assert_eq!(plain.positions[1], DVec3::new(1.0, 0.0, 0.0));
-        // A parent moves, a child mirrors in x: (1, 0, 0) lands at (−1 + 0, 0, 2) in the
-        // file, (−1, 0, −2) in scnc's space, and the triangle is wound the other way.
-        let nodes = serde_json::json!([{ "translation": [0.0, 0.0, 2.0], "children": [1] }, { "scale": [-1.0, 1.0, 1.0], "mesh": 0 }]);
-        let placed = parse(&glb(nodes, 4)).expect("reads");
-        assert_eq!(placed.positions[1], DVec3::new(-1.0, 0.0, -2.0));
-        let [a, b, c] = plain.triangles[0];
-        assert_eq!(placed.triangles[0], [a, c, b]);
-    }
-
-    #[test]
-    fn strips_and_fans_are_triangles_and_points_have_none() {
-        for mode in [5, 6] {
-            assert_eq!(parse(&glb(serde_json::json!([{ "mesh": 0 }]), mode)).expect("reads").triangles.len(), 1);
-        }
-        let e = parse(&glb(serde_json::json!([{ "mesh": 0 }]), 0)).expect_err("points only");
-        assert!(e.contains("no triangles"), "{e}");
-        let e = parse(b"glTF\x02\0\0\0").expect_err("truncated");
-        assert!(e.contains("not a readable glb"), "{e}");
-    }
-}
-
 /// The binary glTF 2.0 format.
 pub struct Glb;
 
@@ -312,4 +249,67 @@ fn glb(export: &Export, w: &mut dyn Write) -> io::Result<()> {
         w.write_all(&bin)?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A .glb of one triangle (no indices), placed by `nodes` (the scene is node 0).
+    fn glb(nodes: serde_json::Value, mode: u32) -> Vec<u8> {
+        let bin: Vec<u8> = [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+            .iter()
+            .flatten()
+            .flat_map(|c| c.to_le_bytes())
+            .collect();
+        let doc = serde_json::json!({
+            "asset": { "version": "2.0" },
+            "scene": 0,
+            "scenes": [{ "nodes": [0] }],
+            "nodes": nodes,
+            "meshes": [{ "primitives": [{ "attributes": { "POSITION": 0 }, "mode": mode }] }],
+            "accessors": [{ "bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                            "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 0.0] }],
+            "bufferViews": [{ "buffer": 0, "byteLength": 36 }],
+            "buffers": [{ "byteLength": 36 }],
+        });
+        let mut json = serde_json::to_vec(&doc).expect("json");
+        while !json.len().is_multiple_of(4) {
+            json.push(b' ');
+        }
+        let mut out = b"glTF".to_vec();
+        out.extend(2u32.to_le_bytes());
+        out.extend(((12 + 8 + json.len() + 8 + bin.len()) as u32).to_le_bytes());
+        out.extend((json.len() as u32).to_le_bytes());
+        out.extend(b"JSON");
+        out.extend(json);
+        out.extend((bin.len() as u32).to_le_bytes());
+        out.extend(b"BIN\0");
+        out.extend(bin);
+        out
+    }
+
+    #[test]
+    fn nodes_place_their_meshes_and_a_mirror_keeps_the_winding_outward() {
+        let plain = parse(&glb(serde_json::json!([{ "mesh": 0 }]), 4)).expect("reads");
+        assert_eq!(plain.positions[1], DVec3::new(1.0, 0.0, 0.0));
+        // A parent moves, a child mirrors in x: (1, 0, 0) lands at (−1 + 0, 0, 2) in the
+        // file, (−1, 0, −2) in scnc's space, and the triangle is wound the other way.
+        let nodes = serde_json::json!([{ "translation": [0.0, 0.0, 2.0], "children": [1] }, { "scale": [-1.0, 1.0, 1.0], "mesh": 0 }]);
+        let placed = parse(&glb(nodes, 4)).expect("reads");
+        assert_eq!(placed.positions[1], DVec3::new(-1.0, 0.0, -2.0));
+        let [a, b, c] = plain.triangles[0];
+        assert_eq!(placed.triangles[0], [a, c, b]);
+    }
+
+    #[test]
+    fn strips_and_fans_are_triangles_and_points_have_none() {
+        for mode in [5, 6] {
+            assert_eq!(parse(&glb(serde_json::json!([{ "mesh": 0 }]), mode)).expect("reads").triangles.len(), 1);
+        }
+        let e = parse(&glb(serde_json::json!([{ "mesh": 0 }]), 0)).expect_err("points only");
+        assert!(e.contains("no triangles"), "{e}");
+        let e = parse(b"glTF\x02\0\0\0").expect_err("truncated");
+        assert!(e.contains("not a readable glb"), "{e}");
+    }
 }

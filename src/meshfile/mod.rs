@@ -1,7 +1,7 @@
 //! Mesh files, read and written: one file per format, each a [`MeshFormat`] that says
 //! its name, extensions, media type, frame and unit, whether it is for printing, how it
 //! is read (for `mesh file(…)`) and how an [`Export`] is written to it (for `scnc
-//! export` and the studio's downloads). [`formats!`] lists them; the [`Format`] enum and
+//! export` and the studio's downloads). `formats!` lists them; the [`Format`] enum and
 //! its dispatch, the command line's `--format` values and the studio's download buttons
 //! are derived from that list, so a new format is its file and one line there.
 //!

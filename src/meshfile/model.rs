@@ -58,7 +58,7 @@ impl Part {
     /// Unit normal of triangle `t` as the file holds it: of the 32-bit corners every
     /// format writes (far from the origin rounding turns small triangles; admesh
     /// "fixes" a stored normal that disagrees with its corners). Zero for none, which
-    /// [`collect`] never keeps.
+    /// [`crate::export::collect`] never keeps.
     pub fn face_normal(&self, t: usize) -> DVec3 {
         let [a, b, c] = self.mesh.triangles[t].map(|i| self.mesh.positions[i as usize].as_vec3().as_dvec3());
         (b - a).cross(c - a).normalize_or_zero()

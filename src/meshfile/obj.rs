@@ -217,6 +217,84 @@ fn add_face(mesh: &mut TriMesh, idx: &[i64]) {
     }
 }
 
+/// The Wavefront OBJ format.
+pub struct Obj;
+
+impl MeshFormat for Obj {
+    const NAME: &'static str = "obj";
+    const ABOUT: &'static str = "Wavefront OBJ with an MTL file beside it";
+    const EXTENSIONS: &'static [&'static str] = &["obj"];
+    const MIME: &'static str = "model/obj";
+    const FOR_PRINTING: bool = false;
+    const DEFAULT_SCALE: f64 = 1.0;
+    const FIXED_UP: Option<Up> = None;
+    const ONE_FILE: bool = false;
+    const READS: &'static str = "OBJ files (`v x y z` and `f a b c …` records)";
+    const READER: Reader = Reader::Lines(|r| read(r));
+
+    fn working_bytes(part: &Part) -> (u64, u64) {
+        (0, super::normals_bytes(part))
+    }
+
+    /// Its `mtllib` line names `options.mtl`, which [`mtl`] writes.
+    fn write(export: &Export, options: &WriteOptions, w: &mut dyn Write) -> io::Result<()> {
+        obj(export, options.mtl, w)
+    }
+}
+
+fn obj(export: &Export, mtl: &str, w: &mut dyn Write) -> io::Result<()> {
+    writeln!(w, "# scnc export: {} objects, {} triangles", export.parts.len(), export.triangle_count())?;
+    writeln!(w, "mtllib {mtl}")?;
+    // Vertex and normal numbers run on across objects; a smooth part writes one normal
+    // per vertex, so its faces use the same number for both (`f a//a …`).
+    let (mut base, mut normals) = (1u64, 1u64);
+    for p in &export.parts {
+        writeln!(w, "o {}", p.name)?;
+        for v in &p.mesh.positions {
+            let [x, y, z] = f32s(*v);
+            writeln!(w, "v {x} {y} {z}")?;
+        }
+        if p.smooth {
+            for n in p.vertex_normals() {
+                // Rounding leaves components like 3e-18 where 0 is meant; f32 prints them
+                // out in full, so they are written as 0.
+                let [x, y, z] = f32s(n.to_array().map(|c| if c.abs() < 1e-7 { 0.0 } else { c }).into());
+                writeln!(w, "vn {x} {y} {z}")?;
+            }
+        }
+        let mut current = None;
+        for (t, tri) in p.mesh.triangles.iter().enumerate() {
+            if current != Some(p.materials[t]) {
+                current = Some(p.materials[t]);
+                writeln!(w, "usemtl {}", material_name(export, p.materials[t]))?;
+            }
+            let [a, b, c] = tri.map(|i| base + i as u64);
+            if p.smooth {
+                let [na, nb, nc] = tri.map(|i| normals + i as u64);
+                writeln!(w, "f {a}//{na} {b}//{nb} {c}//{nc}")?;
+            } else {
+                writeln!(w, "f {a} {b} {c}")?;
+            }
+        }
+        base += p.mesh.positions.len() as u64;
+        if p.smooth {
+            normals += p.mesh.positions.len() as u64;
+        }
+    }
+    Ok(())
+}
+
+/// The MTL file of an OBJ export: each material used, its diffuse colour.
+pub fn mtl(export: &Export, w: &mut dyn Write) -> io::Result<()> {
+    writeln!(w, "# scnc export: material colours")?;
+    for m in used(export) {
+        let [r, g, b] = export.colours[m as usize].rgb8().map(|c| c as f32 / 255.0);
+        writeln!(w, "newmtl {}", material_name(export, m))?;
+        writeln!(w, "Kd {r} {g} {b}")?;
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -331,82 +409,4 @@ mod tests {
         assert_eq!(parse(b"v 0 0 0\n").unwrap_err().line, 0);
         assert!(parse(b"v 0 0 0\nf a b c\n").is_err());
     }
-}
-
-/// The Wavefront OBJ format.
-pub struct Obj;
-
-impl MeshFormat for Obj {
-    const NAME: &'static str = "obj";
-    const ABOUT: &'static str = "Wavefront OBJ with an MTL file beside it";
-    const EXTENSIONS: &'static [&'static str] = &["obj"];
-    const MIME: &'static str = "model/obj";
-    const FOR_PRINTING: bool = false;
-    const DEFAULT_SCALE: f64 = 1.0;
-    const FIXED_UP: Option<Up> = None;
-    const ONE_FILE: bool = false;
-    const READS: &'static str = "OBJ files (`v x y z` and `f a b c …` records)";
-    const READER: Reader = Reader::Lines(|r| read(r));
-
-    fn working_bytes(part: &Part) -> (u64, u64) {
-        (0, super::normals_bytes(part))
-    }
-
-    /// Its `mtllib` line names `options.mtl`, which [`mtl`] writes.
-    fn write(export: &Export, options: &WriteOptions, w: &mut dyn Write) -> io::Result<()> {
-        obj(export, options.mtl, w)
-    }
-}
-
-fn obj(export: &Export, mtl: &str, w: &mut dyn Write) -> io::Result<()> {
-    writeln!(w, "# scnc export: {} objects, {} triangles", export.parts.len(), export.triangle_count())?;
-    writeln!(w, "mtllib {mtl}")?;
-    // Vertex and normal numbers run on across objects; a smooth part writes one normal
-    // per vertex, so its faces use the same number for both (`f a//a …`).
-    let (mut base, mut normals) = (1u64, 1u64);
-    for p in &export.parts {
-        writeln!(w, "o {}", p.name)?;
-        for v in &p.mesh.positions {
-            let [x, y, z] = f32s(*v);
-            writeln!(w, "v {x} {y} {z}")?;
-        }
-        if p.smooth {
-            for n in p.vertex_normals() {
-                // Rounding leaves components like 3e-18 where 0 is meant; f32 prints them
-                // out in full, so they are written as 0.
-                let [x, y, z] = f32s(n.to_array().map(|c| if c.abs() < 1e-7 { 0.0 } else { c }).into());
-                writeln!(w, "vn {x} {y} {z}")?;
-            }
-        }
-        let mut current = None;
-        for (t, tri) in p.mesh.triangles.iter().enumerate() {
-            if current != Some(p.materials[t]) {
-                current = Some(p.materials[t]);
-                writeln!(w, "usemtl {}", material_name(export, p.materials[t]))?;
-            }
-            let [a, b, c] = tri.map(|i| base + i as u64);
-            if p.smooth {
-                let [na, nb, nc] = tri.map(|i| normals + i as u64);
-                writeln!(w, "f {a}//{na} {b}//{nb} {c}//{nc}")?;
-            } else {
-                writeln!(w, "f {a} {b} {c}")?;
-            }
-        }
-        base += p.mesh.positions.len() as u64;
-        if p.smooth {
-            normals += p.mesh.positions.len() as u64;
-        }
-    }
-    Ok(())
-}
-
-/// The MTL file of an OBJ export: each material used, its diffuse colour.
-pub fn mtl(export: &Export, w: &mut dyn Write) -> io::Result<()> {
-    writeln!(w, "# scnc export: material colours")?;
-    for m in used(export) {
-        let [r, g, b] = export.colours[m as usize].rgb8().map(|c| c as f32 / 255.0);
-        writeln!(w, "newmtl {}", material_name(export, m))?;
-        writeln!(w, "Kd {r} {g} {b}")?;
-    }
-    Ok(())
 }

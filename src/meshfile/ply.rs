@@ -264,6 +264,67 @@ fn read(elements: &[Element], values: &mut dyn Values) -> Result<TriMesh, String
     Ok(mesh)
 }
 
+/// The PLY format.
+pub struct Ply;
+
+impl MeshFormat for Ply {
+    const NAME: &'static str = "ply";
+    const ABOUT: &'static str = "PLY, binary, with vertex colours";
+    const EXTENSIONS: &'static [&'static str] = &["ply"];
+    const MIME: &'static str = "application/octet-stream";
+    const FOR_PRINTING: bool = false;
+    const DEFAULT_SCALE: f64 = 1.0;
+    const FIXED_UP: Option<Up> = None;
+    const ONE_FILE: bool = true;
+    const READS: &'static str = "PLY (`.ply`)";
+    const READER: Reader = Reader::Whole(parse);
+
+    fn working_bytes(part: &Part) -> (u64, u64) {
+        (super::groups_bytes(part), 0)
+    }
+
+    fn write(export: &Export, _: &WriteOptions, w: &mut dyn Write) -> io::Result<()> {
+        ply(export, w)
+    }
+}
+
+fn ply(export: &Export, w: &mut dyn Write) -> io::Result<()> {
+    let groups: Vec<(&Part, Vec<Group>)> = export.parts.iter().map(|p| (p, p.groups())).collect();
+    let vertices: usize = groups.iter().flat_map(|(_, gs)| gs.iter().map(|g| g.vertices.len())).sum();
+    let faces = export.triangle_count();
+    write!(
+        w,
+        "ply\nformat binary_little_endian 1.0\ncomment scnc export\nelement vertex {vertices}\n\
+         property float x\nproperty float y\nproperty float z\n\
+         property uchar red\nproperty uchar green\nproperty uchar blue\n\
+         element face {faces}\nproperty list uchar uint vertex_indices\nend_header\n"
+    )?;
+    for (p, gs) in &groups {
+        for g in gs {
+            let rgb = export.colours[g.material as usize].rgb8();
+            for &v in &g.vertices {
+                for c in f32s(p.mesh.positions[v as usize]) {
+                    w.write_all(&c.to_le_bytes())?;
+                }
+                w.write_all(&rgb)?;
+            }
+        }
+    }
+    let mut base = 0u32;
+    for (_, gs) in &groups {
+        for g in gs {
+            for t in &g.triangles {
+                w.write_all(&[3])?;
+                for i in t {
+                    w.write_all(&(base + i).to_le_bytes())?;
+                }
+            }
+            base += g.vertices.len() as u32;
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -337,65 +398,4 @@ mod tests {
             assert!(e.contains(message), "{text}: {e}");
         }
     }
-}
-
-/// The PLY format.
-pub struct Ply;
-
-impl MeshFormat for Ply {
-    const NAME: &'static str = "ply";
-    const ABOUT: &'static str = "PLY, binary, with vertex colours";
-    const EXTENSIONS: &'static [&'static str] = &["ply"];
-    const MIME: &'static str = "application/octet-stream";
-    const FOR_PRINTING: bool = false;
-    const DEFAULT_SCALE: f64 = 1.0;
-    const FIXED_UP: Option<Up> = None;
-    const ONE_FILE: bool = true;
-    const READS: &'static str = "PLY (`.ply`)";
-    const READER: Reader = Reader::Whole(parse);
-
-    fn working_bytes(part: &Part) -> (u64, u64) {
-        (super::groups_bytes(part), 0)
-    }
-
-    fn write(export: &Export, _: &WriteOptions, w: &mut dyn Write) -> io::Result<()> {
-        ply(export, w)
-    }
-}
-
-fn ply(export: &Export, w: &mut dyn Write) -> io::Result<()> {
-    let groups: Vec<(&Part, Vec<Group>)> = export.parts.iter().map(|p| (p, p.groups())).collect();
-    let vertices: usize = groups.iter().flat_map(|(_, gs)| gs.iter().map(|g| g.vertices.len())).sum();
-    let faces = export.triangle_count();
-    write!(
-        w,
-        "ply\nformat binary_little_endian 1.0\ncomment scnc export\nelement vertex {vertices}\n\
-         property float x\nproperty float y\nproperty float z\n\
-         property uchar red\nproperty uchar green\nproperty uchar blue\n\
-         element face {faces}\nproperty list uchar uint vertex_indices\nend_header\n"
-    )?;
-    for (p, gs) in &groups {
-        for g in gs {
-            let rgb = export.colours[g.material as usize].rgb8();
-            for &v in &g.vertices {
-                for c in f32s(p.mesh.positions[v as usize]) {
-                    w.write_all(&c.to_le_bytes())?;
-                }
-                w.write_all(&rgb)?;
-            }
-        }
-    }
-    let mut base = 0u32;
-    for (_, gs) in &groups {
-        for g in gs {
-            for t in &g.triangles {
-                w.write_all(&[3])?;
-                for i in t {
-                    w.write_all(&(base + i).to_le_bytes())?;
-                }
-            }
-            base += g.vertices.len() as u32;
-        }
-    }
-    Ok(())
 }

@@ -42,68 +42,6 @@ pub fn parse(bytes: &[u8]) -> Result<TriMesh, String> {
     Ok(mesh)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn ascii_and_binary_read_the_same_welded_tetrahedron() {
-        let ascii = b"solid t
-facet normal 0 0 -1
- outer loop
-  vertex 0 0 0
-  vertex 0 1 0
-  vertex 1 0 0
- endloop
-endfacet
-facet normal 0 -1 0
- outer loop
-  vertex 0 0 0
-  vertex 1 0 0
-  vertex 0 0 1
- endloop
-endfacet
-facet normal -1 0 0
- outer loop
-  vertex 0 0 0
-  vertex 0 0 1
-  vertex 0 1 0
- endloop
-endfacet
-facet normal 1 1 1
- outer loop
-  vertex 1 0 0
-  vertex 0 1 0
-  vertex 0 0 1
- endloop
-endfacet
-endsolid t
-";
-        let a = parse(ascii).expect("ASCII STL");
-        assert_eq!((a.positions.len(), a.triangles.len()), (4, 4));
-        assert_eq!(a.open_edges(), (0, 0), "welded and consistently wound");
-        assert!(a.signed_volume() > 0.0, "outward, as the file winds it");
-        let mut binary = vec![0u8; 80];
-        binary.extend_from_slice(&4u32.to_le_bytes());
-        let corners = [[0., 0., 0.], [0., 1., 0.], [1., 0., 0.], [0., 0., 0.], [1., 0., 0.], [0., 0., 1.]];
-        let more = [[0., 0., 0.], [0., 0., 1.], [0., 1., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]];
-        for tri in corners.chunks(3).chain(more.chunks(3)) {
-            binary.extend_from_slice(&[0u8; 12]);
-            for v in tri {
-                for x in v {
-                    binary.extend_from_slice(&(*x as f32).to_le_bytes());
-                }
-            }
-            binary.extend_from_slice(&[0, 0]);
-        }
-        let b = parse(&binary).expect("binary STL");
-        assert_eq!(b.triangles.len(), 4);
-        assert!((b.signed_volume() - a.signed_volume()).abs() < 1e-12);
-        assert!(parse(b"solid nothing\nendsolid\n").is_err());
-        assert!(parse(b"hello").is_err());
-    }
-}
-
 /// The STL format.
 pub struct Stl;
 
@@ -188,4 +126,66 @@ fn stl_ascii(export: &Export, w: &mut dyn Write) -> io::Result<()> {
         writeln!(w, "  endfacet")?;
     }
     writeln!(w, "endsolid scnc")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ascii_and_binary_read_the_same_welded_tetrahedron() {
+        let ascii = b"solid t
+facet normal 0 0 -1
+ outer loop
+  vertex 0 0 0
+  vertex 0 1 0
+  vertex 1 0 0
+ endloop
+endfacet
+facet normal 0 -1 0
+ outer loop
+  vertex 0 0 0
+  vertex 1 0 0
+  vertex 0 0 1
+ endloop
+endfacet
+facet normal -1 0 0
+ outer loop
+  vertex 0 0 0
+  vertex 0 0 1
+  vertex 0 1 0
+ endloop
+endfacet
+facet normal 1 1 1
+ outer loop
+  vertex 1 0 0
+  vertex 0 1 0
+  vertex 0 0 1
+ endloop
+endfacet
+endsolid t
+";
+        let a = parse(ascii).expect("ASCII STL");
+        assert_eq!((a.positions.len(), a.triangles.len()), (4, 4));
+        assert_eq!(a.open_edges(), (0, 0), "welded and consistently wound");
+        assert!(a.signed_volume() > 0.0, "outward, as the file winds it");
+        let mut binary = vec![0u8; 80];
+        binary.extend_from_slice(&4u32.to_le_bytes());
+        let corners = [[0., 0., 0.], [0., 1., 0.], [1., 0., 0.], [0., 0., 0.], [1., 0., 0.], [0., 0., 1.]];
+        let more = [[0., 0., 0.], [0., 0., 1.], [0., 1., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]];
+        for tri in corners.chunks(3).chain(more.chunks(3)) {
+            binary.extend_from_slice(&[0u8; 12]);
+            for v in tri {
+                for x in v {
+                    binary.extend_from_slice(&(*x as f32).to_le_bytes());
+                }
+            }
+            binary.extend_from_slice(&[0, 0]);
+        }
+        let b = parse(&binary).expect("binary STL");
+        assert_eq!(b.triangles.len(), 4);
+        assert!((b.signed_volume() - a.signed_volume()).abs() < 1e-12);
+        assert!(parse(b"solid nothing\nendsolid\n").is_err());
+        assert!(parse(b"hello").is_err());
+    }
 }

@@ -118,85 +118,6 @@ fn add(
     Ok(())
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use threemf::model::{Build, Component, Components, Item, Mesh, Model, Object, Triangle, Triangles, Unit};
-    use threemf::model::{Vertex, Vertices};
-
-    /// A triangle (counter-clockwise about +z in the file, so facing up) in object 1, and
-    /// object 2 holding object 1 through `component`; the build places `item` of `built`
-    /// (7: an object not defined; 3: object 2, holding itself).
-    fn package(unit: Unit, component: Option<[f64; 12]>, built: usize, item: Option<[f64; 12]>) -> Vec<u8> {
-        let vertex = |x, y, z| Vertex { x, y, z };
-        let mesh = Mesh {
-            vertices: Vertices { vertex: vec![vertex(0.0, 0.0, 5.0), vertex(10.0, 0.0, 5.0), vertex(0.0, 10.0, 5.0)] },
-            triangles: Triangles { triangle: vec![Triangle { v1: 0, v2: 1, v3: 2 }] },
-        };
-        let model = Model {
-            resources: threemf::model::Resources {
-                object: vec![
-                    Object { id: 1, mesh: Some(mesh), ..Object::default() },
-                    Object {
-                        id: 2,
-                        components: Some(Components {
-                            component: vec![Component {
-                                objectid: if built == 3 { 2 } else { 1 },
-                                transform: component,
-                            }],
-                        }),
-                        ..Object::default()
-                    },
-                ],
-                basematerials: None,
-            },
-            // 3 stands for object 2 holding itself.
-            build: Build {
-                item: vec![Item { objectid: if built == 3 { 2 } else { built }, transform: item, partnumber: None }],
-            },
-            unit,
-            ..Model::default()
-        };
-        let mut bytes = std::io::Cursor::new(Vec::new());
-        threemf::write(&mut bytes, model).expect("writing a 3MF");
-        bytes.into_inner()
-    }
-
-    /// The triangle's normal in scnc's space, and its first corner.
-    fn read(bytes: &[u8]) -> (DVec3, DVec3) {
-        let m = parse(bytes).expect("readable");
-        let [a, b, c] = m.triangles[0].map(|i| m.positions[i as usize]);
-        ((b - a).cross(c - a).normalize(), a)
-    }
-
-    #[test]
-    fn reads_units_transforms_and_components_into_scncs_space() {
-        // Millimetres to centimetres; the file's +z (up) is scnc's +y, and the triangle
-        // still faces up.
-        let (n, a) = read(&package(Unit::Millimeter, None, 1, None));
-        assert!((n - DVec3::Y).length() < 1e-12 && (a - DVec3::new(0.0, 0.5, 0.0)).length() < 1e-12, "{n} {a}");
-        // Through a component moved up by 10 mm and an item in metres moved along +x.
-        let up = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 10.0];
-        let along = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 2.0, 0.0, 0.0];
-        let (n, a) = read(&package(Unit::Meter, Some(up), 2, Some(along)));
-        assert!((n - DVec3::Y).length() < 1e-12, "{n}");
-        assert!((a - DVec3::new(200.0, 1500.0, 0.0)).length() < 1e-9, "{a}");
-        // A mirroring component turns the triangle over, and it still faces out of the solid
-        // it was (down, after z → −z).
-        let mirror = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0];
-        let (n, _) = read(&package(Unit::Centimeter, Some(mirror), 2, None));
-        assert!((n + DVec3::Y).length() < 1e-12, "{n}");
-    }
-
-    #[test]
-    fn refuses_broken_packages() {
-        assert!(parse(b"not a zip").unwrap_err().contains("not a readable 3MF"));
-        assert!(parse(&package(Unit::Centimeter, None, 7, None)).unwrap_err().contains("does not define"));
-        // Object 2 holding itself.
-        assert!(parse(&package(Unit::Centimeter, None, 3, None)).unwrap_err().contains("nest more than"));
-    }
-}
-
 /// The unit a 3MF file declares unless told: a scene unit is a centimetre for printing.
 pub const DEFAULT_3MF_UNIT: &str = "centimeter";
 
@@ -316,4 +237,83 @@ fn xml_model(export: &Export, units: &str, out: &mut dyn Write) -> io::Result<()
         writeln!(out, "<item objectid=\"{}\"/>", k + 2)?;
     }
     out.write_all(b"</build>\n</model>\n")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use threemf::model::{Build, Component, Components, Item, Mesh, Model, Object, Triangle, Triangles, Unit};
+    use threemf::model::{Vertex, Vertices};
+
+    /// A triangle (counter-clockwise about +z in the file, so facing up) in object 1, and
+    /// object 2 holding object 1 through `component`; the build places `item` of `built`
+    /// (7: an object not defined; 3: object 2, holding itself).
+    fn package(unit: Unit, component: Option<[f64; 12]>, built: usize, item: Option<[f64; 12]>) -> Vec<u8> {
+        let vertex = |x, y, z| Vertex { x, y, z };
+        let mesh = Mesh {
+            vertices: Vertices { vertex: vec![vertex(0.0, 0.0, 5.0), vertex(10.0, 0.0, 5.0), vertex(0.0, 10.0, 5.0)] },
+            triangles: Triangles { triangle: vec![Triangle { v1: 0, v2: 1, v3: 2 }] },
+        };
+        let model = Model {
+            resources: threemf::model::Resources {
+                object: vec![
+                    Object { id: 1, mesh: Some(mesh), ..Object::default() },
+                    Object {
+                        id: 2,
+                        components: Some(Components {
+                            component: vec![Component {
+                                objectid: if built == 3 { 2 } else { 1 },
+                                transform: component,
+                            }],
+                        }),
+                        ..Object::default()
+                    },
+                ],
+                basematerials: None,
+            },
+            // 3 stands for object 2 holding itself.
+            build: Build {
+                item: vec![Item { objectid: if built == 3 { 2 } else { built }, transform: item, partnumber: None }],
+            },
+            unit,
+            ..Model::default()
+        };
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        threemf::write(&mut bytes, model).expect("writing a 3MF");
+        bytes.into_inner()
+    }
+
+    /// The triangle's normal in scnc's space, and its first corner.
+    fn read(bytes: &[u8]) -> (DVec3, DVec3) {
+        let m = parse(bytes).expect("readable");
+        let [a, b, c] = m.triangles[0].map(|i| m.positions[i as usize]);
+        ((b - a).cross(c - a).normalize(), a)
+    }
+
+    #[test]
+    fn reads_units_transforms_and_components_into_scncs_space() {
+        // Millimetres to centimetres; the file's +z (up) is scnc's +y, and the triangle
+        // still faces up.
+        let (n, a) = read(&package(Unit::Millimeter, None, 1, None));
+        assert!((n - DVec3::Y).length() < 1e-12 && (a - DVec3::new(0.0, 0.5, 0.0)).length() < 1e-12, "{n} {a}");
+        // Through a component moved up by 10 mm and an item in metres moved along +x.
+        let up = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 10.0];
+        let along = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 2.0, 0.0, 0.0];
+        let (n, a) = read(&package(Unit::Meter, Some(up), 2, Some(along)));
+        assert!((n - DVec3::Y).length() < 1e-12, "{n}");
+        assert!((a - DVec3::new(200.0, 1500.0, 0.0)).length() < 1e-9, "{a}");
+        // A mirroring component turns the triangle over, and it still faces out of the solid
+        // it was (down, after z → −z).
+        let mirror = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0];
+        let (n, _) = read(&package(Unit::Centimeter, Some(mirror), 2, None));
+        assert!((n + DVec3::Y).length() < 1e-12, "{n}");
+    }
+
+    #[test]
+    fn refuses_broken_packages() {
+        assert!(parse(b"not a zip").unwrap_err().contains("not a readable 3MF"));
+        assert!(parse(&package(Unit::Centimeter, None, 7, None)).unwrap_err().contains("does not define"));
+        // Object 2 holding itself.
+        assert!(parse(&package(Unit::Centimeter, None, 3, None)).unwrap_err().contains("nest more than"));
+    }
 }

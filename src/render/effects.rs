@@ -1,19 +1,22 @@
 //! The effect set: which parts of the shading model a scene calls for, derived from the
 //! IR alone, so the tracer is built with those and no others.
 //!
-//! Every effect is one row of [`effect_table!`]'s invocation below: its field of
-//! [`Effects`], the rule that derives it from a [`Survey`] of the IR, whether it is on,
+//! Every effect is one row of `effect_table!`'s invocation below: its field of
+//! [`Effects`], the rule that derives it from a `Survey` of the IR, whether it is on,
 //! its word in `--stats` and `scnc ir`, the counters only it (or another row naming the
 //! same counter) can raise, and — for an effect the tracer is specialised on — its bit
-//! of the tracer's `FX` parameter. The struct, [`derive`], the `Display` line, the
+//! of the tracer's `FX` parameter. The struct, [`derive()`], the `Display` line, the
 //! [`fx`] flags, the [`TABLE`] the tests walk, and the dispatch to the tracer variant
-//! built for a set of flags ([`specialise`]) are all generated from those rows, so a new
+//! built for a set of flags (`specialise`) are all generated from those rows, so a new
 //! effect is a row here and its code in the tracer.
 
 use std::fmt;
 
 use crate::ir::{self, Body, LightKind, Scene, ShapeKind};
 use crate::trace::Counters;
+
+/// A counter by name, and how to read it.
+pub type Counter = (&'static str, fn(&Counters) -> u64);
 
 /// One effect as the tests and tools see it.
 pub struct Effect {
@@ -28,7 +31,7 @@ pub struct Effect {
     pub show: fn(&Effects) -> String,
     /// The counters it raises, by name: with every effect that names a counter off, a
     /// render's count of it is 0.
-    pub counters: &'static [(&'static str, fn(&Counters) -> u64)],
+    pub counters: &'static [Counter],
 }
 
 /// Generates the effect set's types and functions from one row per effect (see the

@@ -201,6 +201,19 @@ pub(crate) fn export(studio: &Studio, text: String, format: &str) -> Reply {
     Reply::download(mime, format!("{stem}.{ext}"), bytes)
 }
 
+/// The formats the studio offers as downloads: every one that is a single file.
+pub(crate) fn downloads() -> impl Iterator<Item = Format> {
+    Format::ALL.iter().copied().filter(|f| f.one_file())
+}
+
+/// `GET /api/formats`: the downloads, for the page's buttons.
+pub(crate) fn formats() -> Reply {
+    let list: Vec<serde_json::Value> = downloads()
+        .map(|f| serde_json::json!({ "name": f.name(), "label": f.name().to_uppercase(), "about": f.about() }))
+        .collect();
+    Reply::json(&serde_json::Value::Array(list))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -216,17 +229,4 @@ mod tests {
         assert_eq!(short(-0.00001), "0");
         assert_eq!(short(2.5), "2.5");
     }
-}
-
-/// The formats the studio offers as downloads: every one that is a single file.
-pub(crate) fn downloads() -> impl Iterator<Item = Format> {
-    Format::ALL.iter().copied().filter(|f| f.one_file())
-}
-
-/// `GET /api/formats`: the downloads, for the page's buttons.
-pub(crate) fn formats() -> Reply {
-    let list: Vec<serde_json::Value> = downloads()
-        .map(|f| serde_json::json!({ "name": f.name(), "label": f.name().to_uppercase(), "about": f.about() }))
-        .collect();
-    Reply::json(&serde_json::Value::Array(list))
 }
