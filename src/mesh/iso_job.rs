@@ -199,7 +199,7 @@ pub(super) fn isosurface_object(
 /// The warning for parts an isosurface at `cell` lost, of `total` solid parts of a
 /// shape `across` wide; `None` when none was.
 fn lost_parts(
-    lost: &[&parts::Part],
+    lost: &[&parts::SolidPart],
     total: usize,
     span: Span,
     cell: f64,

@@ -18,7 +18,7 @@ const CHECKED_BELOW: f64 = 4.0;
 
 /// A solid part of a shape: its bounds in the grid's frame, and where it was written.
 #[derive(Clone, Copy, Debug)]
-pub struct Part {
+pub struct SolidPart {
     /// Lowest corner of its bounds.
     pub min: DVec3,
     /// Highest corner of its bounds.
@@ -27,7 +27,7 @@ pub struct Part {
     pub span: Span,
 }
 
-impl Part {
+impl SolidPart {
     /// Its smallest extent.
     pub fn across(&self) -> f64 {
         (self.max - self.min).min_element()
@@ -39,11 +39,11 @@ impl Part {
 /// counts as one part (its operands' sizes say little about its own), and a repetition
 /// by its first copy (the others are the same size). Subtracted operands cut, so
 /// losing one only fills a hole, and unbounded parts cannot be small.
-pub fn solid_parts(shape: &Shape, xf: DAffine3, out: &mut Vec<Part>) {
-    let whole = |out: &mut Vec<Part>| {
+pub fn solid_parts(shape: &Shape, xf: DAffine3, out: &mut Vec<SolidPart>) {
+    let whole = |out: &mut Vec<SolidPart>| {
         if let Some(b) = ir::shape_bounds(shape) {
             let b = b.transform(&xf);
-            out.push(Part { min: b.min, max: b.max, span: shape.span });
+            out.push(SolidPart { min: b.min, max: b.max, span: shape.span });
         }
     };
     match &shape.kind {
@@ -75,12 +75,12 @@ pub fn solid_parts(shape: &Shape, xf: DAffine3, out: &mut Vec<Part>) {
 
 /// The parts under four cells across (`CHECKED_BELOW`) that no point of `grid` inside their
 /// bounds finds inside the shape `f`, in the order given.
-pub fn lost<'a>(parts: &'a [Part], grid: &Grid, f: &(dyn Fn(Vec3A) -> f32 + Sync)) -> Vec<&'a Part> {
+pub fn lost<'a>(parts: &'a [SolidPart], grid: &Grid, f: &(dyn Fn(Vec3A) -> f32 + Sync)) -> Vec<&'a SolidPart> {
     parts.par_iter().filter(|p| p.across() < CHECKED_BELOW * grid.cell && !seen(p, grid, f)).collect::<Vec<_>>()
 }
 
 /// Whether some grid point within the part's bounds is inside the shape.
-fn seen(part: &Part, grid: &Grid, f: &(dyn Fn(Vec3A) -> f32 + Sync)) -> bool {
+fn seen(part: &SolidPart, grid: &Grid, f: &(dyn Fn(Vec3A) -> f32 + Sync)) -> bool {
     let first = ((part.min - grid.lo) / grid.cell).ceil().max(DVec3::ZERO);
     let last = ((part.max - grid.lo) / grid.cell).floor();
     if first.cmpgt(last).any() {
@@ -100,7 +100,7 @@ mod tests {
     fn parts_between_grid_points_are_lost() {
         let grid = Grid { lo: DVec3::ZERO, cell: 1.0, levels: 4 };
         let sphere = |c: DVec3, r: f64| move |p: Vec3A| ((p.as_dvec3() - c).length() - r) as f32;
-        let part = |c: DVec3, r: f64| Part { min: c - r, max: c + r, span: Span::default() };
+        let part = |c: DVec3, r: f64| SolidPart { min: c - r, max: c + r, span: Span::default() };
         let between = DVec3::splat(2.5);
         let f = sphere(between, 0.3);
         assert_eq!(lost(&[part(between, 0.3)], &grid, &f).len(), 1);
