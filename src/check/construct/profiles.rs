@@ -357,6 +357,29 @@ impl Ctx<'_> {
             );
             return None;
         }
+        // Boxes that overlap still leave nothing when the rest covers the first profile
+        // (`subtract(rect(1, 1), circle(1.5))`) or the profiles miss each other inside
+        // the shared box: interval arithmetic over the box proves it, or finds a place
+        // that may be inside and lets the profile be.
+        if op != CsgOp::Union && provably_empty(&body, min, max) {
+            let (what, label, note) = match op {
+                CsgOp::Subtract => (
+                    "difference",
+                    "the others cover the first profile",
+                    "`subtract` keeps what is inside the first profile and outside the others",
+                ),
+                _ => (
+                    "intersection",
+                    "no point is inside every profile",
+                    "`intersect` keeps only what is inside every profile",
+                ),
+            };
+            self.report(
+                Diagnostic::error(codes::OUT_OF_RANGE, a.call, format!("this {what} of profiles is empty"), label)
+                    .with_note(note),
+            );
+            return None;
+        }
         // A sharp combination of regions is the region of their combination.
         let regions: Option<Vec<Region>> = parts.iter().map(|p| p.region.as_deref().cloned()).collect();
         let region = regions.filter(|_| k == 0.0).map(|r| {
@@ -563,4 +586,16 @@ impl Ctx<'_> {
         let max = corners.iter().fold(DVec2::NEG_INFINITY, |m, c| m.max(*c));
         Some((body, corners, min, max))
     }
+}
+
+/// Whether no point of the box `min`..`max` can be inside the profile `body`: the
+/// branch-and-bound search that bounds fields' support rules out every box of it.
+fn provably_empty(body: &Arc<Expr>, min: DVec2, max: DVec2) -> bool {
+    // A profile's body reads a point of its plane, z = 0: give it [x, y, 0], and the
+    // box depth for the search's sake.
+    let p = Expr::point();
+    let flat = body.substitute(&vec2(Expr::component(&p, 0), Expr::component(&p, 1)));
+    let tape = crate::field::Tape::new(&flat);
+    let b = DAabb { min: DVec3::new(min.x, min.y, -1.0), max: DVec3::new(max.x, max.y, 1.0) };
+    crate::field::support_radius(&tape, b, 0.0, b.centre(), &crate::field::NoDistances).is_none()
 }
