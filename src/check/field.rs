@@ -11,7 +11,7 @@
 use std::rc::Rc;
 use std::sync::Arc;
 
-use super::builtins::{Builtin, Ctor, Extreme, InFields, MathFn, NumFn, VecFn};
+use super::builtins::{Builtin, Ctor, FieldForm, InFields, MathFn};
 use super::expr::{bad_operands, BoundArgs};
 use super::value::FieldLit;
 use super::{index, Bound, Ctx, Value};
@@ -227,21 +227,23 @@ impl Ctx<'_> {
 
     /// A maths builtin with an argument that depends on the point.
     pub(super) fn symbolic_call(&mut self, b: &Builtin, a: &BoundArgs) -> Value {
-        if let InFields::No(why) = b.ctor.in_fields() {
-            return self.not_in_fields(b, a, why);
-        }
+        let form = match b.ctor.in_fields() {
+            InFields::Yes(form) => form,
+            InFields::No(why) => return self.not_in_fields(b, a, why),
+            // Never called for these: `takes_symbolic` is false.
+            InFields::NotMaths => return Value::Error,
+        };
         let arg = |i: usize| a.vals.get(i).and_then(|s| s.as_ref()).and_then(|(v, _)| v.as_field());
         let un = |f: Unary| arg(0).and_then(|x| Expr::unary(f, x));
         let bin = |f: Binary, i: usize, j: usize| arg(i).zip(arg(j)).and_then(|(x, y)| Expr::binary(f, x, y));
-        let node = match b.ctor {
-            Ctor::Math(MathFn::Unary(u)) => un(u),
-            Ctor::Numeric(NumFn::Pow) => bin(Binary::Pow, 0, 1),
-            Ctor::Numeric(NumFn::Atan2) => bin(Binary::Atan2, 0, 1),
-            Ctor::Numeric(NumFn::Clamp) => {
+        let node = match form {
+            FieldForm::Unary(u) => un(u),
+            FieldForm::Binary(f) => bin(f, 0, 1),
+            FieldForm::Clamp => {
                 let low = bin(Binary::Max, 0, 1);
                 low.zip(arg(2)).and_then(|(l, hi)| Expr::binary(Binary::Min, l, hi))
             }
-            Ctor::Numeric(NumFn::Mix) => {
+            FieldForm::Mix => {
                 // a + (b − a)·t: exactly `a` at 0 and `b` at 1, as `mix` of numbers is.
                 let (x, y, t) = (arg(0), arg(1), arg(2));
                 x.clone().zip(y).zip(t).and_then(|((x, y), t)| {
@@ -249,7 +251,7 @@ impl Ctx<'_> {
                     Expr::binary(Binary::Add, x, Expr::binary(Binary::Mul, d, t)?)
                 })
             }
-            Ctor::Numeric(NumFn::Sum) => {
+            FieldForm::Sum => {
                 let Some((Value::List(items), _)) = a.vals.first().and_then(|s| s.as_ref()) else {
                     return Value::Error;
                 };
@@ -260,34 +262,13 @@ impl Ctx<'_> {
                     ps.try_fold(first, |acc, e| Expr::binary(Binary::Add, acc, e))
                 })
             }
-            Ctor::Vector(VecFn::Dot) => bin(Binary::Dot, 0, 1),
-            Ctor::Vector(VecFn::Cross) => bin(Binary::Cross, 0, 1),
-            Ctor::Vector(VecFn::Length) => un(Unary::Length),
-            Ctor::Vector(VecFn::Normalize) => un(Unary::Normalize),
-            Ctor::Extreme(e) => {
-                let f = if e == Extreme::Min { Binary::Min } else { Binary::Max };
+            FieldForm::Fold(f) => {
                 let mut parts = a.rest.iter().map(|(v, _)| v.as_field());
                 let first = parts.next().flatten();
                 parts.try_fold(first, |acc, x| Some(acc.zip(x).and_then(|(s, x)| Expr::binary(f, s, x)))).flatten()
             }
-            Ctor::Dist => return self.dist(a),
-            Ctor::Noise3 => return self.noise3(a),
-            // Declared `InFields::No` (answered above) or `NotMaths` (never called here).
-            Ctor::Math(MathFn::Random)
-            | Ctor::Numeric(NumFn::Hsv | NumFn::Range)
-            | Ctor::Primitive(_)
-            | Ctor::Csg(_)
-            | Ctor::Modifier(_)
-            | Ctor::Field(_)
-            | Ctor::Profile(_)
-            | Ctor::Material
-            | Ctor::Rgb
-            | Ctor::Pattern(_)
-            | Ctor::Light(_)
-            | Ctor::Len
-            | Ctor::Generator(_)
-            | Ctor::Camera
-            | Ctor::Render => None,
+            FieldForm::Dist => return self.dist(a),
+            FieldForm::Noise3 => return self.noise3(a),
         };
         match node {
             Some(e) => Value::Sym(e),

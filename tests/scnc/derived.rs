@@ -732,7 +732,7 @@ fn every_function_of_numbers_works_in_fields_or_says_why_not() {
             .map(|d| d.message.as_str())
             .collect();
         match b.ctor.in_fields() {
-            InFields::Yes if !errors.is_empty() => {
+            InFields::Yes(_) if !errors.is_empty() => {
                 failures.push(format!("`{}` is declared to work in fields, but `{call}` gives {errors:?}", b.name))
             }
             InFields::No(why) if !errors.contains(&why) => {

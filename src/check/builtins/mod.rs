@@ -82,8 +82,8 @@ pub enum Ctor {
 /// `p => …`), declared for every builtin by [`Ctor::in_fields`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum InFields {
-    /// It does: the checker builds its field expression.
-    Yes,
+    /// It does, in this form.
+    Yes(FieldForm),
     /// A function of numbers that does not, for this reason (the error says it).
     No(&'static str),
     /// Not a function of numbers (a shape, a light, a setting, a list's length): its
@@ -91,21 +91,53 @@ pub enum InFields {
     NotMaths,
 }
 
+/// What a function of numbers becomes in a field's body.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FieldForm {
+    /// A function of one operand.
+    Unary(crate::ir::field::Unary),
+    /// A function of two operands, the first two arguments.
+    Binary(crate::ir::field::Binary),
+    /// `clamp(x, lo, hi)`: `min(max(x, lo), hi)`.
+    Clamp,
+    /// `mix(a, b, t)`: `a + (b − a)·t`.
+    Mix,
+    /// `sum(list)`: the items added.
+    Sum,
+    /// `min` or `max` of any number of operands, folded by this function.
+    Fold(crate::ir::field::Binary),
+    /// `dist(shape, q)`.
+    Dist,
+    /// `noise3(q, size, seed)`.
+    Noise3,
+}
+
 impl Ctor {
     /// Whether the builtin has a form in fields. Every kind of builtin is listed: a new
     /// one must say, or this does not compile.
     pub fn in_fields(&self) -> InFields {
+        use crate::ir::field::{Binary, Unary};
+        let yes = InFields::Yes;
         match *self {
-            Ctor::Math(MathFn::Unary(_)) => InFields::Yes,
+            Ctor::Math(MathFn::Unary(u)) => yes(FieldForm::Unary(u)),
             Ctor::Math(MathFn::Random) => InFields::No("`random`'s seed cannot depend on a field's point"),
-            Ctor::Numeric(NumFn::Pow | NumFn::Atan2 | NumFn::Clamp | NumFn::Mix | NumFn::Sum) => InFields::Yes,
+            Ctor::Numeric(NumFn::Pow) => yes(FieldForm::Binary(Binary::Pow)),
+            Ctor::Numeric(NumFn::Atan2) => yes(FieldForm::Binary(Binary::Atan2)),
+            Ctor::Numeric(NumFn::Clamp) => yes(FieldForm::Clamp),
+            Ctor::Numeric(NumFn::Mix) => yes(FieldForm::Mix),
+            Ctor::Numeric(NumFn::Sum) => yes(FieldForm::Sum),
             Ctor::Numeric(NumFn::Hsv) => InFields::No("`hsv` gives a colour, which a field's body does not hold"),
             Ctor::Numeric(NumFn::Range) => {
                 InFields::No("`range` gives a list, whose length cannot vary with the point")
             }
-            Ctor::Vector(VecFn::Dot | VecFn::Cross | VecFn::Length | VecFn::Normalize) => InFields::Yes,
-            Ctor::Extreme(Extreme::Min | Extreme::Max) => InFields::Yes,
-            Ctor::Dist | Ctor::Noise3 => InFields::Yes,
+            Ctor::Vector(VecFn::Dot) => yes(FieldForm::Binary(Binary::Dot)),
+            Ctor::Vector(VecFn::Cross) => yes(FieldForm::Binary(Binary::Cross)),
+            Ctor::Vector(VecFn::Length) => yes(FieldForm::Unary(Unary::Length)),
+            Ctor::Vector(VecFn::Normalize) => yes(FieldForm::Unary(Unary::Normalize)),
+            Ctor::Extreme(Extreme::Min) => yes(FieldForm::Fold(Binary::Min)),
+            Ctor::Extreme(Extreme::Max) => yes(FieldForm::Fold(Binary::Max)),
+            Ctor::Dist => yes(FieldForm::Dist),
+            Ctor::Noise3 => yes(FieldForm::Noise3),
             Ctor::Primitive(_)
             | Ctor::Csg(_)
             | Ctor::Modifier(_)
