@@ -25,6 +25,29 @@ pub struct Root {
     pub surf: SurfSdf,
     /// How a ray marches it.
     pub walk: Walk,
+    /// Whether the distance bound may understate the distance near the surface by more
+    /// than rounding ([`understates`]): its hits are then confirmed by the gradient
+    /// ([`super::march::refine`]).
+    pub loose: bool,
+}
+
+/// Whether a shape's distance bound is divided by a stated or estimated slope above 1
+/// somewhere (a field, a warp or a displacement): near the surface it is then the
+/// distance over up to that slope, and a hit test on it alone takes a shell up to
+/// `L` thresholds thick for the surface.
+pub fn understates(shape: &Shape) -> bool {
+    match &shape.kind {
+        ShapeKind::Field { body, lipschitz, .. } => {
+            lipschitz.value > 1.0 || body.shapes().iter().any(|s| understates(s))
+        }
+        // A twist or bend divides by its stretch where the point is, not by `L`.
+        ShapeKind::Warp { child, domain_op: Some(op), .. } if super::domain::Map::new(*op).is_some() => {
+            understates(child)
+        }
+        ShapeKind::Warp { child, lipschitz, .. } => lipschitz.value > 1.0 || understates(child),
+        ShapeKind::Displace { .. } => true,
+        _ => shape.children().iter().any(|c| understates(c)),
+    }
 }
 
 /// How an object's rays are marched, by what is at its root (under transforms and paint).
@@ -167,7 +190,7 @@ impl<'a> Builder<'a> {
         } else {
             Walk::Plain
         };
-        Root { dist: d, surf: m, walk }
+        Root { dist: d, surf: m, walk, loose: understates(shape) }
     }
 
     fn sdf<F: Fn(Vec3A) -> f32 + Send + Sync + 'static>(&mut self, f: F) -> Sdf {

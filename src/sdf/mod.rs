@@ -39,6 +39,8 @@ pub struct SdfObject {
     convex: bool,
     /// How its rays are marched.
     walk: Walk,
+    /// Whether its hits are confirmed by [`march::refine`] ([`build::understates`]).
+    loose: bool,
 }
 
 impl SdfObject {
@@ -50,7 +52,7 @@ impl SdfObject {
             Walk::Field(f) => f.convex,
             Walk::Plain | Walk::Parts(_) | Walk::Warp(_) => shape.is_convex(),
         };
-        SdfObject { dist: root.dist, mat: root.surf, walk: root.walk, convex }
+        SdfObject { dist: root.dist, mat: root.surf, walk: root.walk, convex, loose: root.loose }
     }
 
     /// Marches the ray over `[t0, t1]`; on a hit, its distance and the threshold there
@@ -70,12 +72,53 @@ impl SdfObject {
         if inside {
             return march::march_out(&*self.dist, ray, t0, t1, params, c, evals);
         }
+        let hit = self.walk_closest(ray, (t0, t1), params, c, evals);
+        if self.loose {
+            self.confirm(hit, ray, t1, params, c, evals)
+        } else {
+            hit
+        }
+    }
+
+    /// The walk's first hit, unconfirmed.
+    fn walk_closest(
+        &self,
+        ray: &Ray,
+        (t0, t1): (f32, f32),
+        params: MarchParams,
+        c: &mut Counters,
+        evals: &mut u64,
+    ) -> Option<(f32, f32)> {
         match &self.walk {
             Walk::Field(field) => field.march(ray, (t0, t1), params, c, evals),
             Walk::Warp(warp) => warp.march(ray, (t0, t1), params, c, evals),
             Walk::Parts(parts) => parts.march(ray, (t0, t1), params, c, evals),
             Walk::Plain => march::march(&*self.dist, ray, t0, t1, params, c, evals),
         }
+    }
+
+    /// A loose object's hit `hit` confirmed by [`march::refine`], the march going on
+    /// past each place the ray only passes near the surface. The confirmations share one
+    /// step budget.
+    fn confirm(
+        &self,
+        mut hit: Option<(f32, f32)>,
+        ray: &Ray,
+        t1: f32,
+        params: MarchParams,
+        c: &mut Counters,
+        evals: &mut u64,
+    ) -> Option<(f32, f32)> {
+        for _ in 0..params.max_steps {
+            let (t, _) = hit?;
+            match march::refine(&*self.dist, ray, (t, t1), params, c, evals) {
+                march::Refined::Hit(t, threshold) => return Some((t, threshold)),
+                march::Refined::Miss => return None,
+                march::Refined::Resume(t) => hit = self.walk_closest(ray, (t, t1), params, c, evals),
+            }
+        }
+        c.budget_misses += 1;
+        None
     }
 
     /// Whether packets of camera rays are marched together: a sharp union's walk of
@@ -101,11 +144,33 @@ impl SdfObject {
         c: &mut Counters,
         evals: &mut [[u64; 4]; N],
     ) -> [[Option<(f32, f32)>; 4]; N] {
-        match &self.walk {
-            Walk::Field(field) => return field.march_packet(quads, mask, spans, params, c, evals),
-            Walk::Parts(parts) if parts.k == 0.0 => return parts.march_packet(quads, mask, spans, params, c, evals),
-            Walk::Plain | Walk::Parts(_) | Walk::Warp(_) => {}
+        let mut hits = match &self.walk {
+            Walk::Field(field) => field.march_packet(quads, mask, spans, params, c, evals),
+            Walk::Parts(parts) if parts.k == 0.0 => parts.march_packet(quads, mask, spans, params, c, evals),
+            Walk::Plain | Walk::Parts(_) | Walk::Warp(_) => {
+                return self.each_lane(quads, mask, spans, params, c, evals)
+            }
+        };
+        if self.loose {
+            for lane in crate::trace::lanes(mask) {
+                let (g, l) = (lane / 4, lane % 4);
+                let (ray, t1) = (&quads[g].rays[l], spans[g][l].1);
+                hits[g][l] = self.confirm(hits[g][l], ray, t1, params, c, &mut evals[g][l]);
+            }
         }
+        hits
+    }
+
+    /// [`closest_packet`](Self::closest_packet) lane by lane.
+    fn each_lane<const N: usize>(
+        &self,
+        quads: &[Packet; N],
+        mask: u32,
+        spans: &[[(f32, f32); 4]; N],
+        params: MarchParams,
+        c: &mut Counters,
+        evals: &mut [[u64; 4]; N],
+    ) -> [[Option<(f32, f32)>; 4]; N] {
         let mut hits = [[None; 4]; N];
         for lane in crate::trace::lanes(mask) {
             let (g, l) = (lane / 4, lane % 4);
@@ -160,7 +225,19 @@ impl SdfObject {
             let h = (self.dist)(ray.at(t));
             *evals += 1;
             if h < march::threshold(params.epsilon, base, t) {
-                return 0.0;
+                if !self.loose {
+                    return 0.0;
+                }
+                match march::refine(&*self.dist, ray, (t, t1), params, c, evals) {
+                    march::Refined::Hit(..) => return 0.0,
+                    march::Refined::Miss => break,
+                    // Beside the surface, not on it: the penumbra goes on from
+                    // where the confirmation left the ray.
+                    march::Refined::Resume(next) => {
+                        t = next.max(t + 1e-3 * t);
+                        continue;
+                    }
+                }
             }
             res = res.min(h / (cone * t.max(f32::MIN_POSITIVE)));
             // Never step less than a small fraction of the distance, so grazing stays cheap.
