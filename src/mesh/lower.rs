@@ -306,6 +306,11 @@ impl Budget {
         .with_hint("try a lower `--detail`, coarser meshes, or a lower `--memory-limit`"))
     }
 
+    /// Bytes the scene's meshes may still take.
+    pub fn bytes_left(&self) -> u64 {
+        self.bytes
+    }
+
     /// Triangles the scene's meshes may still have.
     pub fn triangles_left(&self) -> u64 {
         self.triangles
@@ -422,7 +427,8 @@ pub fn explicit(
             let limit = crate::source::MAX_MESH_FILE_BYTES;
             match Format::for_reading(path).reader() {
                 Reader::Whole(read) => {
-                    read(&loader.read_bytes(path, limit).map_err(cannot)?).map_err(|e| bad(written.clone(), e))?
+                    let file = loader.read_bytes(path, limit).map_err(cannot)?;
+                    read(&file, budget.bytes_left()).map_err(|e| bad(written.clone(), e))?
                 }
                 Reader::Lines(read) => read(&mut loader.open_bytes(path, limit).map_err(cannot)?).map_err(|e| {
                     let place = if e.line > 0 { format!("{written}:{}", e.line) } else { written.clone() };

@@ -9,19 +9,28 @@ use super::MAX_ELEMENTS;
 use crate::geom::{axes, TriMesh};
 use std::io::{self, Write};
 
-use super::{f32s, material_name, slot, used, Export, MeshFormat, Part, Reader, Up, WriteOptions};
+use super::{f32s, material_name, slot, used, Expansion, Export, MeshFormat, Part, Reader, Up, WriteOptions};
 
-/// Parses a `.glb` file's bytes into scnc's space; an error says what is wrong.
-pub fn parse(bytes: &[u8]) -> Result<TriMesh, String> {
+/// Parses a `.glb` file's bytes into scnc's space, within `allowed` bytes of mesh; an
+/// error says what is wrong.
+pub fn parse(bytes: &[u8], allowed: u64) -> Result<TriMesh, String> {
     let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| format!("not a readable glb file ({e})"))?;
     let blob = gltf.blob.as_deref();
-    let mut mesh = TriMesh::default();
     let scene = gltf.default_scene().or_else(|| gltf.scenes().next()).ok_or("the file has no scene")?;
-    // Nodes with their parents' transforms, depth first; a node may be used once per path.
-    let mut stack: Vec<(gltf::Node, DMat4, usize)> = scene.nodes().map(|n| (n, DMat4::IDENTITY, 0)).collect();
-    while let Some((node, parent, depth)) = stack.pop() {
-        if depth > 64 {
-            return Err("its nodes nest more than 64 deep".into());
+    // The whole expansion first, node by node, so nothing is allocated for a file
+    // that places more than it may.
+    let mut memo = vec![None; gltf.nodes().count()];
+    let mut total = Expansion::default();
+    for node in scene.nodes() {
+        total = total.plus(expansion(&node, &mut memo, 0)?, 1);
+    }
+    let mut mesh = total.reserve(allowed)?;
+    // Nodes with their parents' transforms, depth first, a shared node once per use;
+    // a node that places no triangle is not walked into.
+    let mut stack: Vec<(gltf::Node, DMat4)> = scene.nodes().map(|n| (n, DMat4::IDENTITY)).collect();
+    while let Some((node, parent)) = stack.pop() {
+        if memo[node.index()].is_some_and(|e: Expansion| e.triangles == 0) {
+            continue;
         }
         let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
         let world = parent * local;
@@ -30,12 +39,58 @@ pub fn parse(bytes: &[u8]) -> Result<TriMesh, String> {
                 add(&mut mesh, &p, world, blob)?;
             }
         }
-        stack.extend(node.children().map(|c| (c, world, depth + 1)));
+        stack.extend(node.children().map(|c| (c, world)));
     }
     if mesh.triangles.is_empty() {
         return Err("the file's scene has no triangles".into());
     }
     Ok(mesh)
+}
+
+/// What `node` places with the nodes under it ([`Expansion`]), each node's count kept
+/// in `memo` by its index; refused past 64 levels (a cycle never ends) or past
+/// [`MAX_ELEMENTS`], naming the node.
+fn expansion(node: &gltf::Node, memo: &mut [Option<Expansion>], depth: usize) -> Result<Expansion, String> {
+    if depth > 64 {
+        return Err("its nodes nest more than 64 deep".into());
+    }
+    if let Some(e) = memo[node.index()] {
+        return Ok(e);
+    }
+    let mut e = Expansion::default();
+    for p in node.mesh().iter().flat_map(|m| m.primitives()) {
+        e = e.plus(primitive_counts(&p), 1);
+    }
+    for child in node.children() {
+        e = e.plus(expansion(&child, memo, depth + 1)?, 1);
+    }
+    if e.triangles > 0 {
+        e.uses = e.uses.saturating_add(1);
+    }
+    if e.too_many() {
+        let name = node.name().map_or(String::new(), |n| format!(" `{n}`"));
+        return Err(format!(
+            "node {}{name} places more than {MAX_ELEMENTS} vertices or triangles through the nodes under it, \
+             counting each use of a shared node ({} triangles)",
+            node.index(),
+            e.triangles
+        ));
+    }
+    memo[node.index()] = Some(e);
+    Ok(e)
+}
+
+/// The vertices and triangles one primitive adds ([`add`]), from its accessors' counts.
+fn primitive_counts(p: &gltf::Primitive) -> Expansion {
+    use gltf::mesh::Mode;
+    let vertices = p.get(&gltf::Semantic::Positions).map_or(0, |a| a.count() as u64);
+    let corners = p.indices().map_or(vertices, |a| a.count() as u64);
+    let triangles = match p.mode() {
+        Mode::Triangles => corners / 3,
+        Mode::TriangleStrip | Mode::TriangleFan => corners.saturating_sub(2),
+        Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip => 0,
+    };
+    Expansion { vertices, triangles, uses: 0 }
 }
 
 /// Appends one primitive's triangles, placed by `world`.
@@ -289,14 +344,45 @@ mod tests {
         out
     }
 
+    fn parse_all(bytes: &[u8]) -> Result<TriMesh, String> {
+        parse(bytes, u64::MAX)
+    }
+
+    /// Nodes `0..levels`, each listing the next `fan` times; the last places the mesh.
+    fn fanned(levels: usize, fan: usize) -> serde_json::Value {
+        let mut nodes: Vec<serde_json::Value> =
+            (0..levels - 1).map(|i| serde_json::json!({ "children": vec![i + 1; fan] })).collect();
+        nodes.push(serde_json::json!({ "mesh": 0 }));
+        serde_json::Value::Array(nodes)
+    }
+
+    /// A node listed many times by each of many nested nodes is counted once per node,
+    /// not walked path by path: 41 levels of 16 (16⁴⁰ uses) are refused at once,
+    /// naming the deepest node past the limit (node 34: 16⁶ uses of 3 vertices); 10 levels of 2 place 512 triangles; a budget of fewer bytes
+    /// than the expansion takes is refused before anything is allocated.
+    #[test]
+    fn shared_nodes_are_counted_once_and_refused_past_the_budgets() {
+        let e = parse_all(&glb(fanned(41, 16), 4)).expect_err("16^40 uses");
+        assert!(e.starts_with("node 34 ") && e.contains("each use of a shared node"), "{e}");
+        let m = parse_all(&glb(fanned(10, 2), 4)).expect("512 uses");
+        assert_eq!((m.triangles.len(), m.positions.len()), (512, 1536));
+        // 512 triangles and 1,536 vertices take 43,008 bytes.
+        let e = parse(&glb(fanned(10, 2), 4), 40_000).expect_err("over the memory limit");
+        assert!(e.contains("memory limit"), "{e}");
+        assert!(parse(&glb(fanned(10, 2), 4), 43_008).is_ok());
+        // Nodes that place nothing are neither counted nor walked into.
+        let empty = serde_json::json!([{ "children": vec![1; 16] }, { "children": vec![2; 16] }, {}]);
+        assert!(parse_all(&glb(empty, 4)).expect_err("no triangles").contains("no triangles"));
+    }
+
     #[test]
     fn nodes_place_their_meshes_and_a_mirror_keeps_the_winding_outward() {
-        let plain = parse(&glb(serde_json::json!([{ "mesh": 0 }]), 4)).expect("reads");
+        let plain = parse_all(&glb(serde_json::json!([{ "mesh": 0 }]), 4)).expect("reads");
         assert_eq!(plain.positions[1], DVec3::new(1.0, 0.0, 0.0));
         // A parent moves, a child mirrors in x: (1, 0, 0) lands at (−1 + 0, 0, 2) in the
         // file, (−1, 0, −2) in scnc's space, and the triangle is wound the other way.
         let nodes = serde_json::json!([{ "translation": [0.0, 0.0, 2.0], "children": [1] }, { "scale": [-1.0, 1.0, 1.0], "mesh": 0 }]);
-        let placed = parse(&glb(nodes, 4)).expect("reads");
+        let placed = parse_all(&glb(nodes, 4)).expect("reads");
         assert_eq!(placed.positions[1], DVec3::new(-1.0, 0.0, -2.0));
         let [a, b, c] = plain.triangles[0];
         assert_eq!(placed.triangles[0], [a, c, b]);
@@ -305,11 +391,11 @@ mod tests {
     #[test]
     fn strips_and_fans_are_triangles_and_points_have_none() {
         for mode in [5, 6] {
-            assert_eq!(parse(&glb(serde_json::json!([{ "mesh": 0 }]), mode)).expect("reads").triangles.len(), 1);
+            assert_eq!(parse_all(&glb(serde_json::json!([{ "mesh": 0 }]), mode)).expect("reads").triangles.len(), 1);
         }
-        let e = parse(&glb(serde_json::json!([{ "mesh": 0 }]), 0)).expect_err("points only");
+        let e = parse_all(&glb(serde_json::json!([{ "mesh": 0 }]), 0)).expect_err("points only");
         assert!(e.contains("no triangles"), "{e}");
-        let e = parse(b"glTF\x02\0\0\0").expect_err("truncated");
+        let e = parse_all(b"glTF\x02\0\0\0").expect_err("truncated");
         assert!(e.contains("not a readable glb"), "{e}");
     }
 }

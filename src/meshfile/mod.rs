@@ -23,8 +23,10 @@ pub use three_mf::DEFAULT_3MF_UNIT;
 
 /// How a format's files are read.
 pub enum Reader {
-    /// From the whole file's bytes; an error says what is wrong.
-    Whole(fn(&[u8]) -> Result<TriMesh, String>),
+    /// From the whole file's bytes, within the bytes the mesh may take (a file that
+    /// places one mesh many times expands past its own size); an error says what is
+    /// wrong.
+    Whole(fn(&[u8], u64) -> Result<TriMesh, String>),
     /// A buffer at a time (a large scan need not be held whole); an error names its line.
     Lines(fn(&mut dyn BufRead) -> Result<TriMesh, obj::ObjError>),
 }
@@ -235,7 +237,7 @@ impl Format {
     /// Reads the file `bytes` hold (a test's or a tool's shortcut for [`Format::reader`]).
     pub fn read(self, bytes: &[u8]) -> Result<TriMesh, String> {
         match self.reader() {
-            Reader::Whole(read) => read(bytes),
+            Reader::Whole(read) => read(bytes, u64::MAX),
             Reader::Lines(read) => read(&mut { bytes }).map_err(|e| format!("line {}: {}", e.line, e.message)),
         }
     }
@@ -243,6 +245,74 @@ impl Format {
 
 /// Most vertices or faces accepted from one file.
 pub const MAX_ELEMENTS: usize = 50_000_000;
+
+/// What a node of a file's instance graph (a glb node, a 3MF object) places with
+/// everything under it, each use of a shared node counted: summed over the graph with
+/// each node's sum kept, so a node listed 16 times by each of 40 nested nodes costs 40
+/// sums, not 16⁴⁰ visits, and the whole expansion is known before anything is
+/// allocated. The counts saturate.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Expansion {
+    vertices: u64,
+    triangles: u64,
+    /// Uses of nodes that place triangles: the steps of the walk that places them.
+    uses: u64,
+}
+
+impl Expansion {
+    /// `self` and `other` placed `times` times.
+    fn plus(self, other: Expansion, times: u64) -> Expansion {
+        Expansion {
+            vertices: self.vertices.saturating_add(other.vertices.saturating_mul(times)),
+            triangles: self.triangles.saturating_add(other.triangles.saturating_mul(times)),
+            uses: self.uses.saturating_add(other.uses.saturating_mul(times)),
+        }
+    }
+
+    /// Whether more than [`MAX_ELEMENTS`] of anything.
+    fn too_many(&self) -> bool {
+        self.vertices.max(self.triangles).max(self.uses) > MAX_ELEMENTS as u64
+    }
+
+    /// What the mesh it expands to takes.
+    fn bytes(&self) -> u64 {
+        let (v, t) = (std::mem::size_of::<DVec3>() as u64, std::mem::size_of::<[u32; 3]>() as u64);
+        self.vertices.saturating_mul(v).saturating_add(self.triangles.saturating_mul(t))
+    }
+
+    /// An empty mesh with room for the whole expansion, refused with a reason past
+    /// [`MAX_ELEMENTS`], past the `allowed` bytes or past what the system gives: so the
+    /// walk that fills it allocates nothing more, and no abort is reachable from a
+    /// small file.
+    fn reserve(&self, allowed: u64) -> Result<TriMesh, String> {
+        if self.too_many() {
+            return Err(format!(
+                "it places more than {MAX_ELEMENTS} vertices or triangles, counting each use of a shared mesh \
+                 ({} triangles in all)",
+                self.triangles
+            ));
+        }
+        if self.bytes() > allowed {
+            return Err(format!(
+                "it places {} triangles, counting each use of a shared mesh: {} as a mesh, more than the {} \
+                 the memory limit leaves (`--memory-limit`)",
+                self.triangles,
+                crate::diag::bytes(self.bytes()),
+                crate::diag::bytes(allowed)
+            ));
+        }
+        let mut mesh = TriMesh::default();
+        let (v, t) = (self.vertices as usize, self.triangles as usize);
+        if mesh.positions.try_reserve_exact(v).is_err() || mesh.triangles.try_reserve_exact(t).is_err() {
+            return Err(format!(
+                "the system would not give the {} its {} triangles take (see `ulimit -v`)",
+                crate::diag::bytes(self.bytes()),
+                self.triangles
+            ));
+        }
+        Ok(mesh)
+    }
+}
 
 /// Largest coordinate accepted: the renderable range of positions in a scene
 /// (docs/limits.md), so a mesh file places nothing a scene could not.

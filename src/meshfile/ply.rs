@@ -277,7 +277,8 @@ impl MeshFormat for Ply {
     const FIXED_UP: Option<Up> = None;
     const ONE_FILE: bool = true;
     const READS: &'static str = "PLY (`.ply`)";
-    const READER: Reader = Reader::Whole(parse);
+    // A file's mesh is the size of the file: the mesh budget is spent once it is read.
+    const READER: Reader = Reader::Whole(|bytes, _| parse(bytes));
 
     fn working_bytes(part: &Part) -> (u64, u64) {
         (super::groups_bytes(part), 0)

@@ -56,7 +56,8 @@ impl MeshFormat for Stl {
     const FIXED_UP: Option<Up> = None;
     const ONE_FILE: bool = true;
     const READS: &'static str = "STL (`.stl`, binary or ASCII, z up, millimetres)";
-    const READER: Reader = Reader::Whole(parse);
+    // A file's mesh is the size of the file: the mesh budget is spent once it is read.
+    const READER: Reader = Reader::Whole(|bytes, _| parse(bytes));
 
     fn working_bytes(_: &Part) -> (u64, u64) {
         // Facets are made as they are written.

@@ -4,13 +4,15 @@
 //! as export writes it for printing, and declares its unit, which is read back into
 //! scene units (a scene unit is a centimetre, as export declares it).
 
+use std::collections::HashMap;
+
 use glam::{DAffine3, DMat3, DVec3};
 
 use super::MAX_ELEMENTS;
 use crate::geom::{axes, TriMesh};
 use std::io::{self, Write};
 
-use super::{f32s, material_name, slot, used, Export, MeshFormat, Part, Reader, Up, WriteOptions};
+use super::{f32s, material_name, slot, used, Expansion, Export, MeshFormat, Part, Reader, Up, WriteOptions};
 
 /// Components deeper than this are refused (a cycle of components would never end).
 const MAX_DEPTH: usize = 16;
@@ -19,8 +21,9 @@ const MAX_DEPTH: usize = 16;
 /// three times its size (an 88-byte triangle from a 33-byte element at least).
 const MAX_MODEL_BYTES: u64 = 1 << 30;
 
-/// Parses a `.3mf` file's bytes into scnc's space; an error says what is wrong.
-pub fn parse(bytes: &[u8]) -> Result<TriMesh, String> {
+/// Parses a `.3mf` file's bytes into scnc's space, within `allowed` bytes of mesh; an
+/// error says what is wrong.
+pub fn parse(bytes: &[u8], allowed: u64) -> Result<TriMesh, String> {
     let mut zip =
         zip::ZipArchive::new(std::io::Cursor::new(bytes)).map_err(|e| format!("not a readable 3MF package ({e})"))?;
     for i in 0..zip.len() {
@@ -34,12 +37,26 @@ pub fn parse(bytes: &[u8]) -> Result<TriMesh, String> {
         }
     }
     let models = threemf::read(std::io::Cursor::new(bytes)).map_err(|e| format!("not a readable 3MF package ({e})"))?;
-    let mut mesh = TriMesh::default();
+    // The whole expansion first, object by object, so nothing is allocated for a
+    // package that places more than it may.
+    let mut memos: Vec<HashMap<usize, Expansion>> = Vec::with_capacity(models.len());
+    let mut total = Expansion::default();
     for model in &models {
+        let mut memo = HashMap::new();
+        for item in &model.build.item {
+            total = total.plus(expansion(model, item.objectid, &mut memo, 0)?, 1);
+            if total.too_many() {
+                break;
+            }
+        }
+        memos.push(memo);
+    }
+    let mut mesh = total.reserve(allowed)?;
+    for (model, memo) in models.iter().zip(&memos) {
         let scale = centimetres(&model.unit);
         for item in &model.build.item {
             let place = DAffine3::from_scale(DVec3::splat(scale)) * matrix(item.transform);
-            add(&mut mesh, model, item.objectid, place, 0)?;
+            add(&mut mesh, model, memo, item.objectid, place)?;
         }
     }
     if mesh.triangles.is_empty() {
@@ -71,26 +88,66 @@ fn matrix(t: Option<[f64; 12]>) -> DAffine3 {
     )
 }
 
-/// Appends object `id` of `model` (its mesh, or its components), placed by `place`.
-fn add(
-    mesh: &mut TriMesh,
-    model: &threemf::model::Model,
-    id: usize,
-    place: DAffine3,
-    depth: usize,
-) -> Result<(), String> {
-    if depth > MAX_DEPTH {
-        return Err(format!("its components nest more than {MAX_DEPTH} deep (a cycle?)"));
-    }
-    let object = model
+/// Object `id` of `model`, or why the build cannot name it.
+fn object(model: &threemf::model::Model, id: usize) -> Result<&threemf::model::Object, String> {
+    model
         .resources
         .object
         .iter()
         .find(|o| o.id == id)
-        .ok_or_else(|| format!("the build names object {id}, which the model does not define"))?;
+        .ok_or_else(|| format!("the build names object {id}, which the model does not define"))
+}
+
+/// What object `id` places with its components ([`Expansion`]), each object's count
+/// kept in `memo`; refused past [`MAX_DEPTH`] levels (a cycle never ends) or past
+/// [`MAX_ELEMENTS`], naming the object.
+fn expansion(
+    model: &threemf::model::Model,
+    id: usize,
+    memo: &mut HashMap<usize, Expansion>,
+    depth: usize,
+) -> Result<Expansion, String> {
+    if depth > MAX_DEPTH {
+        return Err(format!("its components nest more than {MAX_DEPTH} deep (a cycle?)"));
+    }
+    if let Some(&e) = memo.get(&id) {
+        return Ok(e);
+    }
+    let object = object(model, id)?;
+    let mut e = Expansion::default();
+    if let Some(m) = &object.mesh {
+        let (vertices, triangles) = (m.vertices.vertex.len() as u64, m.triangles.triangle.len() as u64);
+        e = Expansion { vertices, triangles, uses: u64::from(triangles > 0) };
+    }
+    for c in object.components.iter().flat_map(|c| &c.component) {
+        e = e.plus(expansion(model, c.objectid, memo, depth + 1)?, 1);
+        if e.too_many() {
+            return Err(format!(
+                "object {id} places more than {MAX_ELEMENTS} vertices or triangles through its components, \
+                 counting each use of a shared object"
+            ));
+        }
+    }
+    memo.insert(id, e);
+    Ok(e)
+}
+
+/// Appends object `id` of `model` (its mesh, or its components), placed by `place`;
+/// an object that places no triangle ([`expansion`]'s `memo`) is not walked into.
+fn add(
+    mesh: &mut TriMesh,
+    model: &threemf::model::Model,
+    memo: &HashMap<usize, Expansion>,
+    id: usize,
+    place: DAffine3,
+) -> Result<(), String> {
+    if memo.get(&id).is_some_and(|e| e.triangles == 0) {
+        return Ok(());
+    }
+    let object = object(model, id)?;
     if let Some(components) = &object.components {
         for c in &components.component {
-            add(mesh, model, c.objectid, place * matrix(c.transform), depth + 1)?;
+            add(mesh, model, memo, c.objectid, place * matrix(c.transform))?;
         }
     }
     let Some(m) = &object.mesh else { return Ok(()) };
@@ -285,7 +342,7 @@ mod tests {
 
     /// The triangle's normal in scnc's space, and its first corner.
     fn read(bytes: &[u8]) -> (DVec3, DVec3) {
-        let m = parse(bytes).expect("readable");
+        let m = parse(bytes, u64::MAX).expect("readable");
         let [a, b, c] = m.triangles[0].map(|i| m.positions[i as usize]);
         ((b - a).cross(c - a).normalize(), a)
     }
@@ -311,9 +368,51 @@ mod tests {
 
     #[test]
     fn refuses_broken_packages() {
+        let parse = |bytes: &[u8]| parse(bytes, u64::MAX);
         assert!(parse(b"not a zip").unwrap_err().contains("not a readable 3MF"));
         assert!(parse(&package(Unit::Centimeter, None, 7, None)).unwrap_err().contains("does not define"));
         // Object 2 holding itself.
         assert!(parse(&package(Unit::Centimeter, None, 3, None)).unwrap_err().contains("nest more than"));
+    }
+
+    /// Objects `1..=levels`, each holding the next `fan` times; the last is a triangle.
+    fn fanned(levels: usize, fan: usize) -> Vec<u8> {
+        let vertex = |x, y, z| Vertex { x, y, z };
+        let mesh = Mesh {
+            vertices: Vertices { vertex: vec![vertex(0.0, 0.0, 0.0), vertex(1.0, 0.0, 0.0), vertex(0.0, 1.0, 0.0)] },
+            triangles: Triangles { triangle: vec![Triangle { v1: 0, v2: 1, v3: 2 }] },
+        };
+        let mut object: Vec<Object> = (1..levels)
+            .map(|id| Object {
+                id,
+                components: Some(Components {
+                    component: (0..fan).map(|_| Component { objectid: id + 1, transform: None }).collect(),
+                }),
+                ..Object::default()
+            })
+            .collect();
+        object.push(Object { id: levels, mesh: Some(mesh), ..Object::default() });
+        let model = Model {
+            resources: threemf::model::Resources { object, basematerials: None },
+            build: Build { item: vec![Item { objectid: 1, transform: None, partnumber: None }] },
+            unit: Unit::Millimeter,
+            ..Model::default()
+        };
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        threemf::write(&mut bytes, model).expect("writing a 3MF");
+        bytes.into_inner()
+    }
+
+    /// Components shared level on level are counted once per object: 8 per level over
+    /// 12 levels (8¹¹ ≈ 8.6 G triangles) is refused before anything is allocated,
+    /// naming the object; 4 levels of 8 place 512 triangles, and not within fewer bytes
+    /// than they take.
+    #[test]
+    fn shared_components_are_counted_once_and_refused_past_the_budgets() {
+        let e = parse(&fanned(12, 8), u64::MAX).expect_err("8^11 triangles");
+        assert!(e.contains("object") && e.contains("each use of a shared object"), "{e}");
+        let m = parse(&fanned(4, 8), u64::MAX).expect("512 uses");
+        assert_eq!((m.triangles.len(), m.positions.len()), (512, 1536));
+        assert!(parse(&fanned(4, 8), 43_007).expect_err("over the limit").contains("memory limit"));
     }
 }
