@@ -5,49 +5,86 @@ use glam::{DVec2, DVec3};
 
 use super::TriMesh;
 
-/// A polygon's triangles, wound as the polygon: a triangle as it is, a larger polygon by
-/// ear clipping in the plane of its Newell normal, so a concave outline (an L, a notch)
-/// keeps its shape; a fan where clipping finds no ear (a degenerate or self-crossing
-/// polygon, which has no right answer).
+/// Most corners of a face that is not convex that [`triangulate_within`] is asked to
+/// clip for a mesh file (a convex face of any size is a fan): ear clipping is
+/// quadratic in the worst case, and 10,000 corners take milliseconds, a million hours.
+pub const MAX_CLIPPED_CORNERS: usize = 10_000;
+
+/// A polygon's triangles, wound as the polygon: a triangle as it is, a convex polygon
+/// as a fan, a larger one by ear clipping in the plane of its Newell normal, so a
+/// concave outline (an L, a notch) keeps its shape; a fan where clipping finds no ear (a
+/// degenerate or self-crossing polygon, which has no right answer).
 pub fn triangulate(v: &[u32], positions: &[DVec3]) -> Vec<[u32; 3]> {
-    if v.len() == 3 {
-        return vec![[v[0], v[1], v[2]]];
+    triangulate_within(v, positions, usize::MAX).unwrap_or_default()
+}
+
+/// [`triangulate`], or `None` for a polygon that is not convex and has more than
+/// `max_clipped` corners (before any clipping, in time linear in the corners).
+///
+/// The clipper keeps the corners in a ring and tests a candidate ear only against the
+/// reflex corners (only they can lie inside an ear of a simple polygon), walking on from
+/// each ear it cuts: `O(n·r)` for `r` reflex corners, where the textbook loop that
+/// rescans every corner for every ear is `O(n³)`.
+pub fn triangulate_within(v: &[u32], positions: &[DVec3], max_clipped: usize) -> Option<Vec<[u32; 3]>> {
+    let n = v.len();
+    if n == 3 {
+        return Some(vec![[v[0], v[1], v[2]]]);
     }
-    let fan = || (1..v.len() - 1).map(|k| [v[0], v[k], v[k + 1]]).collect();
+    let fan = || (1..n - 1).map(|k| [v[0], v[k], v[k + 1]]).collect::<Vec<_>>();
     let p: Vec<DVec3> = v.iter().map(|&i| positions[i as usize]).collect();
-    let normal = (0..p.len()).fold(DVec3::ZERO, |n, i| {
-        let (a, b) = (p[i], p[(i + 1) % p.len()]);
-        n + DVec3::new((a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y))
+    let normal = (0..n).fold(DVec3::ZERO, |acc, i| {
+        let (a, b) = (p[i], p[(i + 1) % n]);
+        acc + DVec3::new((a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y))
     });
-    let Some(n) = normal.try_normalize() else { return fan() };
+    let Some(normal) = normal.try_normalize() else { return Some(fan()) };
     // Any two axes across the normal; the polygon's winding is counter-clockwise there.
-    let u = n.any_orthonormal_vector();
-    let w = n.cross(u);
+    let u = normal.any_orthonormal_vector();
+    let w = normal.cross(u);
     let flat: Vec<(f64, f64)> = p.iter().map(|q| (q.dot(u), q.dot(w))).collect();
-    let cross = |a: (f64, f64), b: (f64, f64), c: (f64, f64)| (b.0 - a.0) * (c.1 - a.1) - (b.1 - a.1) * (c.0 - a.0);
-    let mut left: Vec<usize> = (0..v.len()).collect();
-    let mut out = Vec::with_capacity(v.len() - 2);
-    while left.len() > 3 {
-        let m = left.len();
-        let ear = (0..m).find(|&k| {
-            let (a, b, c) = (left[(k + m - 1) % m], left[k], left[(k + 1) % m]);
-            let (fa, fb, fc) = (flat[a], flat[b], flat[c]);
-            cross(fa, fb, fc) > 0.0
-                && left.iter().all(|&o| {
-                    o == a
-                        || o == b
-                        || o == c
-                        || cross(fa, fb, flat[o]) < 0.0
-                        || cross(fb, fc, flat[o]) < 0.0
-                        || cross(fc, fa, flat[o]) < 0.0
-                })
-        });
-        let Some(k) = ear else { return fan() };
-        out.push([v[left[(k + m - 1) % m]], v[left[k]], v[left[(k + 1) % m]]]);
-        left.remove(k);
+    let cross = |a: usize, b: usize, c: usize| {
+        let (a, b, c) = (flat[a], flat[b], flat[c]);
+        (b.0 - a.0) * (c.1 - a.1) - (b.1 - a.1) * (c.0 - a.0)
+    };
+    let (mut prev, mut next): (Vec<usize>, Vec<usize>) =
+        ((0..n).map(|i| (i + n - 1) % n).collect(), (0..n).map(|i| (i + 1) % n).collect());
+    let mut reflex: Vec<bool> = (0..n).map(|i| cross(prev[i], i, next[i]) <= 0.0).collect();
+    if !reflex.contains(&true) {
+        return Some(fan());
     }
-    out.push([v[left[0]], v[left[1]], v[left[2]]]);
-    out
+    if n > max_clipped {
+        return None;
+    }
+    let mut reflexes: Vec<usize> = (0..n).filter(|&i| reflex[i]).collect();
+    let mut out = Vec::with_capacity(n - 2);
+    let (mut left, mut at, mut tried) = (n, 0, 0);
+    while left > 3 {
+        if tried > left {
+            // A full lap without an ear: degenerate or self-crossing.
+            return Some(fan());
+        }
+        let (a, b, c) = (prev[at], at, next[at]);
+        let ear = !reflex[b]
+            && reflexes.iter().all(|&o| {
+                o == a || o == c || !reflex[o] || cross(a, b, o) < 0.0 || cross(b, c, o) < 0.0 || cross(c, a, o) < 0.0
+            });
+        if !ear {
+            (at, tried) = (c, tried + 1);
+            continue;
+        }
+        out.push([v[a], v[b], v[c]]);
+        (next[a], prev[c], left, tried) = (c, a, left - 1, 0);
+        reflex[b] = false;
+        for k in [a, c] {
+            reflex[k] = cross(prev[k], k, next[k]) <= 0.0;
+        }
+        // Corners only ever turn convex: drop those that have, now and then.
+        if reflexes.len() > 32 && out.len().is_multiple_of(32) {
+            reflexes.retain(|&o| reflex[o] && next[prev[o]] == o);
+        }
+        at = c;
+    }
+    out.push([v[prev[at]], v[at], v[next[at]]]);
+    Some(out)
 }
 
 /// The prism of the simple polygon `corners` (`[u, v]`, either winding) as the solid's
@@ -267,6 +304,50 @@ pub fn clip_convex(poly: &[DVec2], n: DVec2, d: f64) -> Vec<DVec2> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A star-shaped polygon of `n` corners in the plane `z = 0.3`, its radii 0.4 to 1
+    /// from a fixed hash (every other corner pulled in: about half are reflex).
+    fn star(n: usize) -> Vec<DVec3> {
+        (0..n)
+            .map(|i| {
+                let h = (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 40;
+                let r = if i % 2 == 0 { 1.0 } else { 0.4 + 0.5 * (h as f64 / (1u64 << 24) as f64) };
+                let a = std::f64::consts::TAU * i as f64 / n as f64;
+                DVec3::new(r * a.cos(), r * a.sin(), 0.3)
+            })
+            .collect()
+    }
+
+    /// Ear clipping cuts a simple polygon into `n − 2` triangles, each wound as the
+    /// polygon, whose areas add up to the polygon's (shoelace), at every size up to the
+    /// corner limit, concave or convex; a concave polygon past the limit is refused at
+    /// once and a convex one of a million corners is a fan.
+    #[test]
+    fn ear_clipping_covers_the_polygon_and_refuses_past_the_limit() {
+        for n in [4, 5, 7, 16, 101, 1000, MAX_CLIPPED_CORNERS] {
+            let p = star(n);
+            let v: Vec<u32> = (0..n as u32).collect();
+            let t = triangulate_within(&v, &p, MAX_CLIPPED_CORNERS).expect("within the limit");
+            assert_eq!(t.len(), n - 2, "{n} corners");
+            let area = |a: DVec3, b: DVec3, c: DVec3| 0.5 * (b - a).cross(c - a).z;
+            let shoelace: f64 = (0..n).map(|i| 0.5 * p[i].truncate().perp_dot(p[(i + 1) % n].truncate())).sum();
+            let cut: f64 = t.iter().map(|&[a, b, c]| area(p[a as usize], p[b as usize], p[c as usize])).sum();
+            assert!(
+                t.iter().all(|&[a, b, c]| area(p[a as usize], p[b as usize], p[c as usize]) > 0.0),
+                "{n}: a triangle wound back"
+            );
+            assert!((cut - shoelace).abs() < 1e-9 * shoelace, "{n} corners: triangles {cut}, polygon {shoelace}");
+        }
+        let v: Vec<u32> = (0..1_000_000).collect();
+        assert_eq!(triangulate_within(&v, &star(1_000_000), MAX_CLIPPED_CORNERS), None);
+        let circle: Vec<DVec3> = (0..1_000_000)
+            .map(|i| {
+                let a = std::f64::consts::TAU * f64::from(i) / 1e6;
+                DVec3::new(a.cos(), a.sin(), 0.0)
+            })
+            .collect();
+        assert_eq!(triangulate_within(&v, &circle, MAX_CLIPPED_CORNERS).map(|t| t.len()), Some(999_998));
+    }
 
     /// Smoothed within a circle's step, an extruded disc's walls take the radial
     /// direction at their corners (a facet's own normal is half a step off) and its

@@ -6,7 +6,7 @@
 
 use glam::DVec3;
 
-use crate::geom::polygon::triangulate;
+use crate::geom::polygon::{triangulate_within, MAX_CLIPPED_CORNERS};
 use super::{MAX_COORDINATE, MAX_ELEMENTS};
 use crate::geom::{axes, TriMesh};
 use std::io::{self, Write};
@@ -181,7 +181,7 @@ pub fn read(r: impl std::io::BufRead) -> Result<TriMesh, ObjError> {
                 }
                 faces += 1;
                 if idx.iter().all(|&i| i >= 1 && i <= mesh.positions.len() as i64) {
-                    add_face(&mut mesh, &idx);
+                    add_face(&mut mesh, &idx).map_err(|e| err(line, e))?;
                 } else {
                     later.push((line, idx.clone()));
                 }
@@ -197,7 +197,7 @@ pub fn read(r: impl std::io::BufRead) -> Result<TriMesh, ObjError> {
         if let Some(i) = idx.iter().find(|&&i| i < 1 || i > count) {
             return Err(err(line, format!("vertex index {i} is out of range: the file has {count} vertices")));
         }
-        add_face(&mut mesh, &idx);
+        add_face(&mut mesh, &idx).map_err(|e| err(line, e))?;
     }
     if mesh.triangles.is_empty() {
         return Err(err(0, "the file has no faces"));
@@ -206,15 +206,26 @@ pub fn read(r: impl std::io::BufRead) -> Result<TriMesh, ObjError> {
 }
 
 /// Adds the triangles of a face whose indices (from 1) are all in range, wound for
-/// scnc's space (the mapping from the file is a reflection).
-fn add_face(mesh: &mut TriMesh, idx: &[i64]) {
+/// scnc's space (the mapping from the file is a reflection); refuses a face that is not
+/// convex and has more than [`MAX_CLIPPED_CORNERS`] corners.
+fn add_face(mesh: &mut TriMesh, idx: &[i64]) -> Result<(), String> {
     if let [a, b, c] = idx[..] {
-        return mesh.triangles.push(axes::wound([a, b, c].map(|i| (i - 1) as u32), false));
+        mesh.triangles.push(axes::wound([a, b, c].map(|i| (i - 1) as u32), false));
+        return Ok(());
     }
     let v: Vec<u32> = idx.iter().map(|&i| (i - 1) as u32).collect();
-    for t in triangulate(&v, &mesh.positions) {
+    for t in triangulate_within(&v, &mesh.positions, MAX_CLIPPED_CORNERS).ok_or_else(|| too_many_corners(v.len()))? {
         mesh.triangles.push(axes::wound(t, false));
     }
+    Ok(())
+}
+
+/// Why a face of `n` corners that is not convex is refused.
+pub fn too_many_corners(n: usize) -> String {
+    format!(
+        "a face of {n} corners that is not convex: scnc triangulates faces that are not convex up to \
+         {MAX_CLIPPED_CORNERS} corners (split it into smaller faces)"
+    )
 }
 
 /// The Wavefront OBJ format.

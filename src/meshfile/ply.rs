@@ -9,7 +9,7 @@
 use glam::DVec3;
 
 use super::MAX_ELEMENTS;
-use crate::geom::polygon::triangulate;
+use crate::geom::polygon::{triangulate_within, MAX_CLIPPED_CORNERS};
 use crate::geom::{axes, TriMesh};
 use std::io::{self, Write};
 
@@ -254,7 +254,9 @@ fn read(elements: &[Element], values: &mut dyn Values) -> Result<TriMesh, String
                 mesh.positions.len()
             ));
         }
-        for [a, b, c] in triangulate(idx, &mesh.positions) {
+        let triangles = triangulate_within(idx, &mesh.positions, MAX_CLIPPED_CORNERS)
+            .ok_or_else(|| format!("face {}: {}", f + 1, super::obj::too_many_corners(idx.len())))?;
+        for [a, b, c] in triangles {
             mesh.triangles.push(axes::wound([a, b, c], false));
         }
     }
