@@ -366,6 +366,8 @@ pub mod codes {
     pub const TOO_MANY_ERRORS: &str = "E0708";
     /// The operating system refused what a compile needs (its thread's stack).
     pub const NO_RESOURCES: &str = "E0709";
+    /// A shape whose one distance evaluation is estimated past the work ceiling.
+    pub const TOO_COSTLY: &str = "E0710";
     /// A render-time failure traced back to the source (e.g. a mesh file that cannot be read).
     pub const LOWERING: &str = "E0800";
     /// Unused `let` binding.
@@ -388,6 +390,8 @@ pub mod codes {
     pub const CROWDED_CSG: &str = "W0009";
     /// Trigonometry in a field body whose argument barely turns: radians written for degrees.
     pub const SMALL_TURN: &str = "W0010";
+    /// A shape whose one distance evaluation is estimated to do a great deal of work.
+    pub const COSTLY: &str = "W0011";
     /// Parts of a shape too small for its isosurface's cell, left out of the mesh.
     pub const LOST_PARTS: &str = "W0801";
     /// Isosurface edges left on four triangles where parts are thinner than the cell.

@@ -80,8 +80,52 @@ impl Ctx<'_> {
             );
             return;
         }
+        if !self.affordable(&geometry, stmt_span) {
+            return;
+        }
         let name = self.unique_name(base_name(expr));
         self.objects.push(ir::Object { geometry, span: stmt_span, name });
+    }
+
+    /// Whether one distance evaluation of the object's shape is within the work
+    /// ceiling ([`crate::field::evaluation_cost`]); past it an error, past the warning
+    /// band a warning, each naming the estimate.
+    fn affordable(&mut self, geometry: &ir::Body, span: Span) -> bool {
+        use crate::field::{evaluation_cost, MAX_WORK, WARN_WORK};
+        let shape = match geometry {
+            ir::Body::Shape(s) => s,
+            ir::Body::Mesh(m) => match &m.source {
+                ir::MeshSource::Isosurface { shape, .. } => shape,
+                _ => return true,
+            },
+        };
+        let cost = evaluation_cost(shape);
+        let work = cost.work();
+        if work <= WARN_WORK {
+            return true;
+        }
+        let label = format!(
+            "one distance evaluation of this shape is estimated at {} primitive evaluations and {} field instructions",
+            cost.leaves, cost.ops
+        );
+        let note = "work multiplies where a body reads `dist` of a shape that itself reads `dist`, where `polar` \
+                    measures every copy of a part crossing its sector, and where `repeat` evaluates neighbouring \
+                    copies: each level multiplies what the levels below it cost";
+        let hint = "nest fewer levels of bodies reading `dist`, or keep `polar` parts within their sectors";
+        if work > MAX_WORK {
+            self.report(
+                Diagnostic::error(codes::TOO_COSTLY, span, "this shape is too costly to evaluate", label)
+                    .with_note(format!("{note}; a shape may cost at most {MAX_WORK} per evaluation (docs/limits.md)"))
+                    .with_hint(hint),
+            );
+            return false;
+        }
+        self.report(
+            Diagnostic::warning(codes::COSTLY, span, "this shape is costly to evaluate", label)
+                .with_note(format!("{note}; every step of every ray does this work (from {WARN_WORK} this warns)"))
+                .with_hint(hint),
+        );
+        true
     }
 
     /// The scene and every diagnostic, with the scene-wide warnings added.

@@ -7,12 +7,14 @@
 //! Every operation's meaning is [`Unary::apply`] / [`Binary::apply`] in f64; each scalar
 //! type follows it (tested against it at random points).
 
+mod cost;
 mod flat;
 mod interval;
 mod lipschitz;
 mod support;
 mod tape;
 
+pub use cost::{evaluation_cost, Cost, MAX_WORK, WARN_WORK};
 pub use flat::Flat;
 pub use interval::{Dir, Interval, Jet, JetBox, Slope};
 pub use lipschitz::{lipschitz, Estimate, SlopeDistances};

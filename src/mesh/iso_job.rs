@@ -152,19 +152,7 @@ pub(super) fn isosurface_object(
     })?;
     let surface = isosurface::extract_within(&*dist, &lattice, max_cells).map_err(|e| match e {
         isosurface::IsoError::TooManyCells { cells, min_cell } => too_fine(cells, min_cell),
-        isosurface::IsoError::NoSurface => {
-            let d = Diagnostic::error(
-                codes::LOWERING,
-                span,
-                "isosurface found no surface",
-                format!("no sign change on a grid of cell {}", ir::dump_num(cell)),
-            )
-            .with_note("the shape is thinner than a cell everywhere, so the mesh would be empty");
-            match from {
-                CellFrom::Scene => d.with_hint("try a smaller `cell`"),
-                CellFrom::Detail => d.with_hint("try a higher `--detail`"),
-            }
-        }
+        isosurface::IsoError::NoSurface => no_surface(shape, &*dist, (&bounds, across), cell, span, from),
     })?;
     let mesh = surface.mesh;
     let per_triangle = mesh
@@ -198,6 +186,71 @@ pub(super) fn isosurface_object(
 
 /// The warning for parts an isosurface at `cell` lost, of `total` solid parts of a
 /// shape `across` wide; `None` when none was.
+/// Why an isosurface found no sign change, and what to do: a distance divided by so
+/// steep a stated or estimated slope that f32 cannot tell its sign apart from zero, a
+/// box grown level by level by nested domain operations (each takes the box of the
+/// turned shape), or a shape thinner than a cell.
+fn no_surface(
+    shape: &Shape,
+    dist: &dyn Fn(Vec3A) -> f32,
+    (bounds, across): (&crate::geom::DAabb, f64),
+    cell: f64,
+    span: Span,
+    from: CellFrom,
+) -> Diagnostic {
+    let (steepest, nesting) = steepness(shape);
+    // The largest value over a coarse grid of the box: a distance divided away reads 0.
+    let largest = (0..16 * 16 * 16)
+        .map(|i| {
+            let f = glam::DVec3::new((i % 16) as f64, (i / 16 % 16) as f64, (i / 256) as f64) / 15.0;
+            dist((bounds.min + (bounds.max - bounds.min) * f).as_vec3a()).abs()
+        })
+        .fold(0.0f32, f32::max);
+    let d = Diagnostic::error(
+        codes::LOWERING,
+        span,
+        "isosurface found no surface",
+        format!("no sign change on a grid of cell {} over a box {} across", short(cell), short(across)),
+    );
+    if largest < 1e-30 || steepest > 1e12 {
+        return d
+            .with_note(format!(
+                "its distance is divided by a slope bound of {} (stated or estimated), which leaves f32 \
+                 nothing to tell inside from outside: the largest value sampled is {largest:e}",
+                short(steepest)
+            ))
+            .with_hint("state a `lipschitz` near the field's true slope (a distance has 1), or leave it out");
+    }
+    let d = if nesting >= 3 {
+        d.with_note(format!(
+            "{nesting} nested `twist`, `bend` and `polar` each take the box of the turned shape, so the box grows \
+             level by level and the shape is much smaller than it; or the shape is thinner than a cell everywhere"
+        ))
+    } else {
+        d.with_note("the shape is thinner than a cell everywhere, or much smaller than its box, so the mesh would be empty")
+    };
+    match from {
+        CellFrom::Scene => d.with_hint("try a smaller `cell`, or mesh the shape before the outer levels turn it"),
+        CellFrom::Detail => d.with_hint("try a higher `--detail`, or `--tolerance` for the size you need"),
+    }
+}
+
+/// The steepest slope bound in `shape`'s tree, and the most domain operations that
+/// turn it (`twist`, `bend`, `polar`) nested on one path.
+fn steepness(shape: &Shape) -> (f64, usize) {
+    use ir::{DomainOp, ShapeKind};
+    let (own, turns) = match &shape.kind {
+        ShapeKind::Field { lipschitz, .. } | ShapeKind::Displace { lipschitz, .. } => (lipschitz.value, 0),
+        ShapeKind::Warp { lipschitz, domain_op, .. } => {
+            let turns = matches!(domain_op, Some(DomainOp::Twist(_) | DomainOp::Bend(_) | DomainOp::Polar(_)));
+            (lipschitz.value, usize::from(turns))
+        }
+        _ => (1.0, 0),
+    };
+    let (below, nested) = shape.children().iter().map(|c| steepness(c)).fold((1.0f64, 0), |a, b| (a.0.max(b.0), a.1.max(b.1)));
+    (own.max(below), turns + nested)
+}
+
 fn lost_parts(
     lost: &[&parts::SolidPart],
     total: usize,

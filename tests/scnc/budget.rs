@@ -125,3 +125,111 @@ fn equality_of_self_sharing_lists_is_counted() {
     std::fs::write(&apart, format!("{text}let same = a40 == b40\n{tail}")).expect("write");
     assert_eq!(error_codes(&apart), vec!["E0706"]);
 }
+
+/// A random shape of `depth` levels mixing what multiplies work: fields reading `dist`
+/// of a shape twice at different points, `polar` of parts that cross their sectors,
+/// `repeat`, warps, displacements, smooth and sharp CSG, over primitives.
+fn random_shape(rng: &mut crate::support::Rng, depth: u32) -> String {
+    const B: &str = "bounds = [[-2, -2, -2], [2, 2, 2]]";
+    if depth == 0 {
+        return ["sphere(0.5)", "box(0.4)", "torus(0.5, 0.1)", "cylinder(0.3, 0.5)"][rng.below(4)].to_string();
+    }
+    let mut sub = || random_shape(rng, depth - 1);
+    let (a, b) = (sub(), sub());
+    match rng.below(8) {
+        0 => format!("field(p => min(dist({a}, p), dist({a}, p * 1.1)), {B})"),
+        1 => format!("polar({a} at [0.3, 0, 0], 5)"),
+        2 => format!("repeat({a}, [1.5, 1.5, 1.5], [3, 2, 1])"),
+        3 => format!("warp({a}, p => p * 0.9, {B})"),
+        4 => format!("displace({a}, p => 0.05 * sin(5 * p.x), lipschitz = 0.3)"),
+        5 => format!("union({a}, {b} at [0.4, 0, 0], smooth = 0.1)"),
+        6 => format!("intersect({a}, {b})"),
+        _ => format!("union({a}, {b} at [1, 0, 0], field(p => dist({a}, p) - 0.1, {B}))"),
+    }
+}
+
+/// The checker's estimate of one distance evaluation's work is an upper bound: over
+/// random trees mixing every operation that multiplies work, the primitives evaluated
+/// at any point (counted by the SDF back-end's leaves, as `--stats` counts them) never
+/// exceed the estimate's, and a chain where each level reads the last twice is
+/// estimated at what it evaluates (2^levels).
+#[test]
+fn the_cost_estimate_bounds_the_leaves_evaluated() {
+    use glam::DAffine3;
+    use scnc::trace::{take_leaf_evals, MaterialTable};
+    let mut rng = crate::support::Rng(0xc057_e571);
+    let leaves_at = |shape: &scnc::ir::Shape, rng: &mut crate::support::Rng| {
+        let mut materials = MaterialTable::default();
+        let (f, _) = scnc::sdf::Builder::new(&mut materials).build(shape, DAffine3::IDENTITY, 0);
+        (0..64)
+            .map(|_| {
+                take_leaf_evals();
+                f(rng.vec(2.5));
+                take_leaf_evals()
+            })
+            .max()
+            .unwrap_or(0)
+    };
+    let mut tight = 0;
+    for case in 0..120 {
+        let text = format!("light ambient(1)\nobject {}\n", random_shape(&mut rng, 1 + case % 4));
+        let c = scnc::compile_source("t.scn", Path::new("t.scn"), text.clone(), &FsLoader);
+        let Some(scene) = c.scene else { continue };
+        let Some(scnc::ir::Body::Shape(shape)) = scene.objects.first().map(|o| o.geometry.clone()) else {
+            continue;
+        };
+        let estimate = scnc::field::evaluation_cost(&shape);
+        let measured = leaves_at(&shape, &mut rng);
+        assert!(measured <= estimate.leaves, "{text}: {measured} leaves evaluated, {} estimated", estimate.leaves);
+        tight += usize::from(measured == estimate.leaves);
+    }
+    assert!(tight > 10, "the estimate is exact on only {tight} trees");
+    let mut text = String::from("let s0 = sphere(1)\n");
+    for i in 1..=10 {
+        let b = "bounds = [[-2, -2, -2], [2, 2, 2]]";
+        text += &format!("let s{i} = field(p => min(dist(s{}, p), dist(s{}, p * 1.01)), {b})\n", i - 1, i - 1);
+    }
+    let shape = match &crate::support::scene(&format!("{text}light ambient(1)\nobject s10\n")).objects[0].geometry {
+        scnc::ir::Body::Shape(s) => s.clone(),
+        scnc::ir::Body::Mesh(_) => unreachable!("a field is a shape"),
+    };
+    let estimate = scnc::field::evaluation_cost(&shape);
+    assert_eq!(estimate.leaves, 2047, "1024 spheres and 1023 fields");
+    assert_eq!(leaves_at(&shape, &mut rng), 2047);
+}
+
+/// Work that multiplies through `dist` and `polar` is refused past the ceiling with
+/// E0710 naming the object, and warned about below it (W0011), at `check`, before
+/// anything runs: 20 levels of a field reading the last twice (2 M primitives per
+/// evaluation; the 23 never finished), and `polar` of `polar` of `polar` of a
+/// part crossing its sectors (64³ copies measured).
+#[test]
+fn work_multiplied_through_dist_and_polar_is_refused_or_warned() {
+    let chain = |levels: usize| {
+        let mut text = String::from("let s0 = sphere(1)\n");
+        for i in 1..=levels {
+            let b = "bounds = [[-2, -2, -2], [2, 2, 2]]";
+            text += &format!("let s{i} = field(p => min(dist(s{}, p), dist(s{}, p * 1.01)), {b})\n", i - 1, i - 1);
+        }
+        text + &format!("light ambient(1)\nobject s{levels}\n")
+    };
+    let polar = |levels: usize| {
+        let mut s = String::from("box(0.3) at [0.5, 0, 0]");
+        for _ in 0..levels {
+            s = format!("polar({s}, 64) at [0.5, 0, 0]");
+        }
+        format!("light ambient(1)\nobject {s}\n")
+    };
+    let codes = |text: String| {
+        let c = scnc::compile_source("t.scn", Path::new("t.scn"), text, &FsLoader);
+        let codes: Vec<&str> =
+            c.diagnostics.iter().map(|d| d.code).filter(|c| c.starts_with("E07") || *c == "W0011").collect();
+        (codes, c.scene.is_some())
+    };
+    use scnc::diag::codes::{COSTLY, TOO_COSTLY};
+    assert_eq!(codes(chain(10)), (vec![], true));
+    assert_eq!(codes(chain(16)), (vec![COSTLY], true));
+    assert_eq!(codes(chain(20)), (vec![TOO_COSTLY], false));
+    assert_eq!(codes(polar(2)), (vec![], true));
+    assert_eq!(codes(polar(3)), (vec![TOO_COSTLY], false));
+}

@@ -225,3 +225,26 @@ fn thin_sheets_mesh_without_pinched_vertices() {
         assert_eq!(mesh.open_edges(), (0, 0), "cell {cell}");
     }
 }
+
+/// An export that finds no surface says why: a distance divided away by a stated slope
+/// names the slope and asks for a true one; a shape inside a box grown by fifty nested
+/// twists names the nesting. Neither blames the detail alone, as the message once did.
+#[test]
+fn an_export_that_finds_no_surface_says_why() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let nested = (0..50).fold("sphere(0.5)".to_string(), |s, _| format!("twist({s}, 10)"));
+    let cases = [
+        ("field(p => length(p) - 1, bounds = [[-2, -2, -2], [2, 2, 2]], lipschitz = 1e100)", "slope bound of 1e100"),
+        (nested.as_str(), "50 nested `twist`"),
+    ];
+    for (object, why) in cases {
+        let scene = dir.path().join("s.scn");
+        std::fs::write(&scene, format!("light ambient(1)\nobject {object}\n")).expect("writing");
+        let out_file = dir.path().join("s.stl");
+        let out = crate::support::scnc(&["export", scene.to_str().unwrap(), "-o", out_file.to_str().unwrap()]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{stderr}");
+        assert!(stderr.contains("E0800") && stderr.contains(why), "{object}: {stderr}");
+        assert!(!out_file.exists(), "nothing is written");
+    }
+}
