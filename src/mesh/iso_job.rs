@@ -227,7 +227,9 @@ fn no_surface(
              level by level and the shape is much smaller than it; or the shape is thinner than a cell everywhere"
         ))
     } else {
-        d.with_note("the shape is thinner than a cell everywhere, or much smaller than its box, so the mesh would be empty")
+        d.with_note(
+            "the shape is thinner than a cell everywhere, or much smaller than its box, so the mesh would be empty",
+        )
     };
     match from {
         CellFrom::Scene => d.with_hint("try a smaller `cell`, or mesh the shape before the outer levels turn it"),
@@ -247,7 +249,8 @@ fn steepness(shape: &Shape) -> (f64, usize) {
         }
         _ => (1.0, 0),
     };
-    let (below, nested) = shape.children().iter().map(|c| steepness(c)).fold((1.0f64, 0), |a, b| (a.0.max(b.0), a.1.max(b.1)));
+    let (below, nested) =
+        shape.children().iter().map(|c| steepness(c)).fold((1.0f64, 0), |a, b| (a.0.max(b.0), a.1.max(b.1)));
     (own.max(below), turns + nested)
 }
 

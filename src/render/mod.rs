@@ -135,7 +135,20 @@ pub fn render_region(
     region: PixelRect,
     progress: &(dyn Fn() + Sync),
 ) -> (Image, Counters) {
-    effects::specialise(&frame.effects, Rows { geometry, frame, region, progress })
+    render_region_until(geometry, frame, region, progress, &|| false).expect("a render never stopped ends")
+}
+
+/// [`render_region`], given up between one 4×4 block of camera rays and the next once
+/// `stop` says so (`None` then): how a newer request preempts an older render in the
+/// studio within a block's time, whatever stage the render is at.
+pub fn render_region_until(
+    geometry: &dyn Geometry,
+    frame: &Frame,
+    region: PixelRect,
+    progress: &(dyn Fn() + Sync),
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Option<(Image, Counters)> {
+    effects::specialise(&frame.effects, Rows { geometry, frame, region, progress, stop })
 }
 
 /// The rows of a region, for the tracer built for some effect flags.
@@ -144,12 +157,13 @@ struct Rows<'a> {
     frame: &'a Frame,
     region: PixelRect,
     progress: &'a (dyn Fn() + Sync),
+    stop: &'a (dyn Fn() -> bool + Sync),
 }
 
 impl effects::Variant for Rows<'_> {
-    type Out = (Image, Counters);
-    fn run<const FX: u8>(self) -> (Image, Counters) {
-        rows::<FX>(self.geometry, self.frame, self.region, self.progress)
+    type Out = Option<(Image, Counters)>;
+    fn run<const FX: u8>(self) -> Option<(Image, Counters)> {
+        rows::<FX>(self.geometry, self.frame, self.region, self.progress, self.stop)
     }
 }
 
@@ -158,7 +172,9 @@ fn rows<const FX: u8>(
     frame: &Frame,
     region: PixelRect,
     progress: &(dyn Fn() + Sync),
-) -> (Image, Counters) {
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Option<(Image, Counters)> {
+    let stopped = std::sync::atomic::AtomicBool::new(false);
     let (w, h) = (frame.width, frame.height);
     // The blocks' first column, and where the region starts in a strip's rows.
     let bx = region.x0 / 4 * 4;
@@ -176,6 +192,10 @@ fn rows<const FX: u8>(
                 (0..rows_here).map(|_| Vec::with_capacity((region.x1 - bx) as usize * bytes)).collect();
             for x in (bx..region.x1).step_by(4) {
                 let cols = (w - x).min(4);
+                if stopped.load(std::sync::atomic::Ordering::Relaxed) || stop() {
+                    stopped.store(true, std::sync::atomic::Ordering::Relaxed);
+                    break;
+                }
                 let px = shade::block::<FX>(geometry, frame, (x, y), (cols, rows_here), &mut c);
                 for (dy, row) in rows.iter_mut().enumerate() {
                     for &colour in &px[4 * dy..4 * dy + cols as usize] {
@@ -203,11 +223,14 @@ fn rows<const FX: u8>(
             kept.into_iter().map(move |row| (row, counters.take().unwrap_or_default()))
         })
         .collect();
+    if stopped.into_inner() {
+        return None;
+    }
     let mut counters = Counters::default();
     let mut pixels = Vec::with_capacity(region.width() as usize * region.height() as usize * bytes);
     for (row, c) in rows {
         pixels.extend_from_slice(&row);
         counters.add(&c);
     }
-    (Image { width: region.width(), height: region.height(), depth: frame.bit_depth, pixels }, counters)
+    Some((Image { width: region.width(), height: region.height(), depth: frame.bit_depth, pixels }, counters))
 }

@@ -167,7 +167,8 @@ pub fn refine(
         // few thresholds, as every bound does; below that the confirmation is worth its
         // risk (a step past a part thinner than the threshold that the bound alone
         // would have taken for a hit).
-        if !(slope > 0.0) || slope > TRUSTED_SLOPE {
+        // (A NaN slope fails the range test too.)
+        if !(f32::MIN_POSITIVE..=TRUSTED_SLOPE).contains(&slope) {
             return Refined::Hit(t, threshold);
         }
         let estimate = d / slope;

@@ -231,3 +231,48 @@ fn studio_measures_the_ladder_and_exports_valid_files() {
     assert_eq!(s.post("/api/export?format=dwg", &text).0, 400);
     assert_eq!(s.post("/api/export?format=stl", "object sphre(1)").0, 422);
 }
+
+/// A page that asks for a heavy render and leaves does not hold the render thread: the
+/// next request preempts it between one 4×4 block and the next, in the coarse pass as
+/// in the full frame, and a light scene's render comes back within a few seconds where
+/// the heavy one would take minutes (a field reading the last level twice, 15 levels:
+/// about 5 ms a pixel).
+#[test]
+fn an_abandoned_heavy_render_does_not_hold_the_next_one() {
+    let (_dir, scene) = seed_scene();
+    let s = Server::start(&scene);
+    let mut heavy = String::from("let s0 = sphere(1)\n");
+    for i in 1..=15 {
+        let b = "bounds = [[-2, -2, -2], [2, 2, 2]]";
+        heavy += &format!("let s{i} = field(p => min(dist(s{}, p), dist(s{}, p * 1.01)), {b})\n", i - 1, i - 1);
+    }
+    heavy += "camera(position = [0, 0, -4], look_at = [0, 0, 0])\nrender(width = 256, height = 256)\n\
+              light ambient(1)\nobject s15\n";
+    let mut c = TcpStream::connect(("127.0.0.1", s.port)).unwrap();
+    c.set_read_timeout(Some(std::time::Duration::from_secs(60))).unwrap();
+    let head = format!(
+        "POST /api/render?coarse=4 HTTP/1.1\r\nHost: 127.0.0.1:{}\r\nContent-Length: {}\r\n\r\n",
+        s.port,
+        heavy.len()
+    );
+    c.write_all(head.as_bytes()).unwrap();
+    c.write_all(heavy.as_bytes()).unwrap();
+    // The reply's head and the coarse image's `M`: the coarse pass is under way.
+    let mut got = Vec::new();
+    let mut some = [0u8; 256];
+    while !got.windows(7).any(|w| w == b"\"level\"") {
+        let n = c.read(&mut some).expect("the heavy render's first message");
+        assert!(n > 0, "the heavy render ended early: {}", String::from_utf8_lossy(&got));
+        got.extend_from_slice(&some[..n]);
+    }
+    drop(c);
+    let light = "camera(position = [0, 0, -4], look_at = [0, 0, 0])\nrender(width = 64, height = 64)\n\
+                 light ambient(1)\nobject sphere(1)\n";
+    let started = std::time::Instant::now();
+    let (status, body) = s.post("/api/render?coarse=4", light);
+    let took = started.elapsed();
+    assert_eq!(status, 200);
+    let kinds: String = messages(&body).iter().map(|(k, _)| *k as char).collect();
+    assert!(kinds.ends_with('S'), "{kinds}");
+    assert!(took < std::time::Duration::from_secs(4), "the light render took {took:?} behind the heavy one");
+}

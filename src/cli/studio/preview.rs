@@ -1,5 +1,6 @@
 //! Renders for the page: a coarse image first, then the full frame in bands of rows as
-//! they finish, streamed; a newer request stops an older one between bands. With an
+//! they finish, streamed; a newer request stops an older one between one 4×4 block of
+//! pixels and the next, in the coarse pass, the full frame or the reference. With an
 //! accuracy rung, the same view rendered at the finest rung is the reference the error
 //! is measured against (`scnc sweep`'s ladder, felt under the hand).
 //!
@@ -196,7 +197,13 @@ fn json_message(out: &mut Stream, kind: u8, value: serde_json::Value) -> std::io
     out.message(kind, value.to_string().as_bytes())
 }
 
-fn run(studio: &Studio, text: &str, ask: &Ask, out: &mut Stream, current: &dyn Fn() -> bool) -> std::io::Result<()> {
+fn run(
+    studio: &Studio,
+    text: &str,
+    ask: &Ask,
+    out: &mut Stream,
+    current: &(dyn Fn() -> bool + Sync),
+) -> std::io::Result<()> {
     let loader = studio.files.loader();
     let mut compiled = studio.files.compile(text.to_string());
     let Some(first) = compiled.scene.take() else {
@@ -249,7 +256,11 @@ fn run(studio: &Studio, text: &str, ask: &Ask, out: &mut Stream, current: &dyn F
         small.height = (frame.height / ask.coarse).max(1);
         json_message(out, b'M', meta("coarse", small.width, small.height))?;
         let t = Instant::now();
-        let (image, _) = studio.preview.pool.install(|| scnc::render::render(&world, &small, &|| {}));
+        let full = PixelRect::full(small.width, small.height);
+        let stop = || !current();
+        let coarse =
+            studio.preview.pool.install(|| scnc::render::render_region_until(&world, &small, full, &|| {}, &stop));
+        let Some((image, _)) = coarse else { return out.message(b'X', b"{}") };
         trace_s = t.elapsed().as_secs_f64();
         send_band(out, 0, &image)?;
         let estimate = trace_s * (ask.coarse * ask.coarse) as f64;
@@ -281,7 +292,10 @@ fn run(studio: &Studio, text: &str, ask: &Ask, out: &mut Stream, current: &dyn F
         }
         let y1 = (y0 + BAND_ROWS).min(frame.height);
         let region = PixelRect { x0: 0, y0, x1: frame.width, y1 };
-        let (band, c) = studio.preview.pool.install(|| scnc::render::render_region(&world, &frame, region, &|| {}));
+        let stop = || !current();
+        let band =
+            studio.preview.pool.install(|| scnc::render::render_region_until(&world, &frame, region, &|| {}, &stop));
+        let Some((band, c)) = band else { return out.message(b'X', b"{}") };
         counters.add(&c);
         send_band(out, y0, &band)?;
         whole.extend_from_slice(&band.pixels);
@@ -334,7 +348,7 @@ fn accuracy(
     image: &Image,
     seconds: f64,
     out: &mut Stream,
-    current: &dyn Fn() -> bool,
+    current: &(dyn Fn() -> bool + Sync),
 ) -> std::io::Result<()> {
     use std::hash::{Hash, Hasher};
     let finest = SDF_RUNGS.len() - 1;
@@ -354,10 +368,14 @@ fn accuracy(
             let mut scene = scene.clone();
             let mode = ask.setting(Some(finest), &mut scene);
             let t = Instant::now();
-            let rendered = lower(studio, &scene, mode)
-                .map(|(frame, world)| studio.preview.pool.install(|| scnc::render::render(&world, &frame, &|| {}).0));
+            let stop = || !current();
+            let rendered = lower(studio, &scene, mode).map(|(frame, world)| {
+                let all = PixelRect::full(frame.width, frame.height);
+                studio.preview.pool.install(|| scnc::render::render_region_until(&world, &frame, all, &|| {}, &stop))
+            });
             match rendered {
-                Ok(i) => (Arc::new(i), t.elapsed().as_secs_f64()),
+                Ok(Some((i, _))) => (Arc::new(i), t.elapsed().as_secs_f64()),
+                Ok(None) => return out.message(b'X', b"{}"),
                 Err(d) => {
                     let note = format!("the finest rung cannot be made: {}", d.message);
                     return json_message(out, b'N', serde_json::json!({ "note": note }));
