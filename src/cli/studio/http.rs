@@ -1,9 +1,23 @@
 //! Requests and replies over tiny_http, and the one stream format the page reads.
 
 use std::io::{Read, Write};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Duration;
 
 /// Largest request body: a scene's source limit and room for the query.
 const MAX_BODY: u64 = scnc::source::MAX_FILE_BYTES as u64 + 4096;
+
+/// How long a request's body may take to arrive: past it the handler gives up on it
+/// (a page sends its few kilobytes at once).
+pub(crate) const BODY_DEADLINE: Duration = Duration::from_secs(10);
+
+/// Bodies read at once, given up on or not: a reader waits on its client until the
+/// body arrives or the connection closes, so a client that never sends one holds a
+/// thread, and past this many new bodies are refused.
+const MAX_READERS: usize = 64;
+
+/// Readers running, over the whole server.
+static READERS: AtomicUsize = AtomicUsize::new(0);
 
 /// A request with its path and query split.
 pub(crate) struct Req {
@@ -72,10 +86,6 @@ impl Req {
         Req { path: path.to_string(), query, inner: Some(inner) }
     }
 
-    fn inner(&mut self) -> &mut tiny_http::Request {
-        self.inner.as_mut().expect("a request is answered once")
-    }
-
     /// `GET`, `POST`, …
     pub(crate) fn method(&self) -> String {
         self.inner.as_ref().map_or_else(String::new, |r| r.method().as_str().to_ascii_uppercase())
@@ -140,13 +150,37 @@ impl Req {
         Ok(())
     }
 
-    /// The body as text, or the reply that refuses it (too large, not UTF-8).
+    /// The body as text, or the reply that refuses it (too large, not UTF-8, not
+    /// arrived within [`BODY_DEADLINE`]: then the handler's slot is free again, and the
+    /// client gets no reply).
+    ///
+    /// The body is read on a thread of its own, as tiny_http's sockets have no read
+    /// timeout; a reader given up on ends when its client sends or closes.
     pub(crate) fn body(&mut self) -> Result<String, Reply> {
-        let mut bytes = Vec::new();
-        let read = self.inner().as_reader().take(MAX_BODY + 1).read_to_end(&mut bytes);
-        if read.is_err() {
-            return Err(Reply::text(400, "the request body could not be read"));
+        let Some(mut inner) = self.inner.take() else { return Err(Reply::text(400, "no request")) };
+        if READERS.fetch_add(1, Ordering::AcqRel) >= MAX_READERS {
+            READERS.fetch_sub(1, Ordering::AcqRel);
+            self.inner = Some(inner);
+            return Err(Reply::text(503, "too many request bodies are arriving at once; try again"));
         }
+        let (tx, rx) = std::sync::mpsc::channel();
+        let reader = std::thread::Builder::new().name("studio-body".into()).spawn(move || {
+            let mut bytes = Vec::new();
+            let read = inner.as_reader().take(MAX_BODY + 1).read_to_end(&mut bytes);
+            READERS.fetch_sub(1, Ordering::AcqRel);
+            let _ = tx.send((inner, read.map(|_| bytes)));
+        });
+        if reader.is_err() {
+            READERS.fetch_sub(1, Ordering::AcqRel);
+            return Err(Reply::text(503, "the system would not start a thread to read the request; try again"));
+        }
+        let (inner, read) = rx.recv_timeout(BODY_DEADLINE).map_err(|_| {
+            Reply::text(408, &format!("the request body did not arrive within {} s", BODY_DEADLINE.as_secs()))
+        })?;
+        self.inner = Some(inner);
+        let Ok(bytes) = read else {
+            return Err(Reply::text(400, "the request body could not be read"));
+        };
         if bytes.len() as u64 > MAX_BODY {
             return Err(Reply::text(413, "the request body is larger than a scene may be (4 MiB)"));
         }

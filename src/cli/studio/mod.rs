@@ -20,13 +20,15 @@ mod files;
 mod http;
 mod preview;
 
+use std::collections::HashMap;
 use std::io::Write;
 use std::net::{IpAddr, SocketAddr};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
+use files::lock;
 use http::{Reply, Req};
 
 use super::shared::Workers;
@@ -51,8 +53,13 @@ pub(crate) struct StudioArgs {
     port_file: Option<PathBuf>,
 }
 
-/// Requests handled at once; more wait for a free slot (a page makes at most a few).
+/// Requests handled at once, of those with a body and of those without each; more are
+/// refused with 503 (a page makes at most a few at a time).
 const MAX_IN_FLIGHT: usize = 16;
+
+/// Requests with a body handled at once for one client address; more are refused with
+/// 429, so one client sending bodies slowly cannot take every slot.
+const MAX_BODIES_PER_CLIENT: usize = 8;
 
 /// What every request handler shares.
 pub(crate) struct Studio {
@@ -131,24 +138,64 @@ fn own_hosts(addr: SocketAddr) -> Vec<String> {
     hosts
 }
 
+/// Answers a refused request on a thread of its own: answering first reads the rest of
+/// its body (tiny_http keeps the connection in step), which a client slow to send holds
+/// up until it sends or closes, and the dispatch loop must never wait. (tiny_http holds
+/// a thread per connection the same way; its sockets have no read timeout, and one set
+/// on the listener would time out `accept` too.)
+fn refuse(request: tiny_http::Request, reply: Reply) {
+    let _ = std::thread::Builder::new().name("studio-refuse".into()).spawn(move || Req::new(request).reply(reply));
+}
+
 fn serve(server: &tiny_http::Server, studio: &Arc<Studio>) {
-    let in_flight = Arc::new(AtomicUsize::new(0));
+    // Requests with a body and those without hold separate slots, so clients slow to
+    // send bodies never keep the page itself from loading.
+    let (bodies, others) = (Arc::new(AtomicUsize::new(0)), Arc::new(AtomicUsize::new(0)));
+    let per_client: Arc<Mutex<HashMap<IpAddr, usize>>> = Arc::default();
     for request in server.incoming_requests() {
-        // A page makes a handful of requests at a time; past the limit new ones wait,
-        // which bounds threads whatever a client sends.
-        while in_flight.load(Ordering::Acquire) >= MAX_IN_FLIGHT {
-            std::thread::sleep(std::time::Duration::from_millis(5));
+        let with_body = !matches!(request.method(), tiny_http::Method::Get | tiny_http::Method::Head);
+        let client = request.remote_addr().map(|a| a.ip());
+        let slots = Arc::clone(if with_body { &bodies } else { &others });
+        // The dispatch loop never waits: past a limit the request is refused at once.
+        if slots.fetch_add(1, Ordering::AcqRel) >= MAX_IN_FLIGHT {
+            slots.fetch_sub(1, Ordering::AcqRel);
+            refuse(request, Reply::text(503, "the studio is busy with other requests; try again"));
+            continue;
         }
-        in_flight.fetch_add(1, Ordering::AcqRel);
+        let counted = with_body.then_some(client).flatten();
+        if let Some(ip) = counted {
+            let mut clients = lock(&per_client);
+            let n = clients.entry(ip).or_insert(0);
+            if *n >= MAX_BODIES_PER_CLIENT {
+                drop(clients);
+                slots.fetch_sub(1, Ordering::AcqRel);
+                refuse(request, Reply::text(429, "too many requests at once from this client"));
+                continue;
+            }
+            *n += 1;
+        }
         let studio = Arc::clone(studio);
-        let count = Arc::clone(&in_flight);
+        let per_client = Arc::clone(&per_client);
+        let release = move || {
+            slots.fetch_sub(1, Ordering::AcqRel);
+            if let Some(ip) = counted {
+                let mut clients = lock(&per_client);
+                if let Some(n) = clients.get_mut(&ip) {
+                    *n -= 1;
+                    if *n == 0 {
+                        clients.remove(&ip);
+                    }
+                }
+            }
+        };
+        let done = release.clone();
         let spawned = std::thread::Builder::new().name("studio-request".into()).spawn(move || {
             // A handler that panics loses its request, never the server.
             let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| handle(&studio, request)));
-            count.fetch_sub(1, Ordering::AcqRel);
+            done();
         });
         if spawned.is_err() {
-            in_flight.fetch_sub(1, Ordering::AcqRel);
+            release();
         }
     }
 }
