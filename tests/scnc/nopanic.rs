@@ -249,3 +249,101 @@ fn numeric_builtins_take_extreme_arguments() {
         }
     }
 }
+
+/// A `.glb` of one triangle placed through nodes `0..levels`, each listing the next
+/// `fan` times (the last places the mesh): instancing that multiplies.
+fn fanned_glb(levels: usize, fan: usize) -> Vec<u8> {
+    let bin: Vec<u8> =
+        [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]].iter().flatten().flat_map(|c| c.to_le_bytes()).collect();
+    let mut nodes: Vec<serde_json::Value> =
+        (0..levels - 1).map(|i| serde_json::json!({ "children": vec![i + 1; fan] })).collect();
+    nodes.push(serde_json::json!({ "mesh": 0 }));
+    let doc = serde_json::json!({
+        "asset": { "version": "2.0" }, "scene": 0, "scenes": [{ "nodes": [0] }], "nodes": nodes,
+        "meshes": [{ "primitives": [{ "attributes": { "POSITION": 0 } }] }],
+        "accessors": [{ "bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                        "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 0.0] }],
+        "bufferViews": [{ "buffer": 0, "byteLength": 36 }], "buffers": [{ "byteLength": 36 }],
+    });
+    let mut json = serde_json::to_vec(&doc).expect("json");
+    while !json.len().is_multiple_of(4) {
+        json.push(b' ');
+    }
+    let mut out = b"glTF".to_vec();
+    out.extend(2u32.to_le_bytes());
+    out.extend(((12 + 8 + json.len() + 8 + bin.len()) as u32).to_le_bytes());
+    out.extend((json.len() as u32).to_le_bytes());
+    out.extend(b"JSON");
+    out.extend(json);
+    out.extend((bin.len() as u32).to_le_bytes());
+    out.extend(b"BIN\0");
+    out.extend(bin);
+    out
+}
+
+/// A random object mixing what multiplies work: fields reading `dist` twice, `polar`
+/// of parts crossing their sectors, twists, bends, warps, displacements, `repeat`,
+/// smooth CSG and instanced mesh files, nested `depth` deep.
+fn random_object(rng: &mut Rng, depth: u32) -> String {
+    const B: &str = "bounds = [[-2, -2, -2], [2, 2, 2]]";
+    if depth == 0 {
+        return ["sphere(0.5)", "box(0.4)", "torus(0.5, 0.1)", "octahedron(0.5)"][rng.below(4)].to_string();
+    }
+    let a = random_object(rng, depth - 1);
+    let n = 2 + rng.below(12);
+    match rng.below(10) {
+        0 => format!("field(p => min(dist({a}, p), dist({a}, p * 1.01)), {B})"),
+        1 => format!("polar({a} at [0.4, 0, 0], {n})"),
+        2 => format!("twist({a}, {})", rng.below(400)),
+        3 => format!("bend({a}, {})", rng.below(200)),
+        4 => format!("warp({a}, p => p * 0.9, {B}, lipschitz = {})", 1 + rng.below(50)),
+        5 => format!("displace({a}, p => 0.05 * sin(400 * p.x))"),
+        6 => format!("repeat({a}, [1.5, 1.5, 1.5], [{n}, 2, 1])"),
+        7 => format!("union({a}, {} at [0.4, 0, 0], smooth = 0.1)", random_object(rng, depth - 1)),
+        _ => format!("subtract({a}, sphere(0.3))"),
+    }
+}
+
+/// 180 random scenes mixing fields, `dist`, `polar`, warps and instanced mesh
+/// files, rendered (SDF and mesh) and exported at small sizes by the binary: none
+/// panics, every exit is 0, 1 or 2, and none runs away (each budget ends it first;
+/// the work estimate bounding what is evaluated is `budget::the_cost_estimate_bounds_the_leaves_evaluated`).
+#[test]
+fn random_scenes_of_multiplied_work_end_cleanly() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    for (name, levels, fan) in [("small.glb", 4, 3), ("bomb.glb", 41, 16), ("wide.glb", 16, 2)] {
+        std::fs::write(dir.path().join(name), fanned_glb(levels, fan)).expect("writing a glb");
+    }
+    let mut rng = Rng(0xf022_5eed);
+    let mut codes = [0usize; 3];
+    for case in 0..180 {
+        let object = match rng.below(6) {
+            0 => ["mesh file(\"small.glb\")", "mesh file(\"bomb.glb\")", "mesh file(\"wide.glb\")"][rng.below(3)]
+                .to_string(),
+            _ => {
+                let depth = 1 + rng.below(4) as u32;
+                random_object(&mut rng, depth)
+            }
+        };
+        let text = format!(
+            "camera(position = [0, 1, -5], look_at = [0, 0, 0])\nrender(width = 16, height = 16)\n\
+             light ambient(0.3)\nlight point(1) at [3, 4, -3]\nobject {object}\n"
+        );
+        let path = dir.path().join("s.scn");
+        std::fs::write(&path, &text).expect("writing the scene");
+        let out = dir.path().join("s.png");
+        let stl = dir.path().join("s.stl");
+        let (p, o, e) = (path.to_str().unwrap(), out.to_str().unwrap(), stl.to_str().unwrap());
+        let run = match case % 3 {
+            0 => crate::support::scnc(&["render", p, "-o", o, "--threads", "1"]),
+            1 => crate::support::scnc(&["render", p, "-o", o, "--threads", "1", "--geometry", "mesh", "--detail", "8"]),
+            _ => crate::support::scnc(&["export", p, "-o", e, "--detail", "8"]),
+        };
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        let code = run.status.code();
+        assert!(matches!(code, Some(0..=2)), "{text}: exit {code:?}\n{stderr}");
+        assert!(!stderr.contains("panicked"), "{text}: {stderr}");
+        codes[code.unwrap_or(0) as usize] += 1;
+    }
+    assert!(codes[0] > 60 && codes[1] > 5, "exits 0/1/2: {codes:?}");
+}
