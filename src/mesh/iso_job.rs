@@ -210,7 +210,7 @@ fn no_surface(
         codes::LOWERING,
         span,
         "isosurface found no surface",
-        format!("no sign change on a grid of cell {} over a box {} across", short(cell), short(across)),
+        format!("no sign change on a grid of cell {} over a box {} across", short(cell), rounded(across)),
     );
     if largest < 1e-30 || steepest > 1e12 {
         return d
@@ -219,7 +219,10 @@ fn no_surface(
                  nothing to tell inside from outside: the largest value sampled is {largest:e}",
                 short(steepest)
             ))
-            .with_hint("state a `lipschitz` near the field's true slope (a distance has 1), or leave it out");
+            .with_hint(
+                "state a `lipschitz` near the field's true slope (a distance has 1); an estimate this large comes \
+                 from a box grown by nesting: nest fewer levels",
+            );
     }
     let d = if nesting >= 3 {
         d.with_note(format!(
@@ -231,9 +234,23 @@ fn no_surface(
             "the shape is thinner than a cell everywhere, or much smaller than its box, so the mesh would be empty",
         )
     };
-    match from {
-        CellFrom::Scene => d.with_hint("try a smaller `cell`, or mesh the shape before the outer levels turn it"),
-        CellFrom::Detail => d.with_hint("try a higher `--detail`, or `--tolerance` for the size you need"),
+    let (scene, detail) = if nesting >= 3 {
+        ("try a smaller `cell`, or nest fewer levels", "try a higher `--detail`, or nest fewer levels")
+    } else {
+        ("try a smaller `cell`", "try a higher `--detail`")
+    };
+    d.with_hint(match from {
+        CellFrom::Scene => scene,
+        CellFrom::Detail => detail,
+    })
+}
+
+/// `x` to four significant digits, in exponent form when large.
+fn rounded(x: f64) -> String {
+    if x.abs() >= 1e4 {
+        format!("{x:.3e}")
+    } else {
+        ir::dump_num((x * 1e3).round() / 1e3)
     }
 }
 

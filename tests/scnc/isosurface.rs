@@ -227,24 +227,34 @@ fn thin_sheets_mesh_without_pinched_vertices() {
 }
 
 /// An export that finds no surface says why: a distance divided away by a stated slope
-/// names the slope and asks for a true one; a shape inside a box grown by fifty nested
-/// twists names the nesting. Neither blames the detail alone, as the message once did.
+/// names the slope and asks for a true one; a sheet thinner than a cell says so. Fifty
+/// nested twists or bends export: a turn keeps the distance from its axis, so the box
+/// of a turned shape is not grown by √2 a level (it was 2²⁵ times the sphere's, and the
+/// export said the shape was thinner than a cell).
 #[test]
 fn an_export_that_finds_no_surface_says_why() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let nested = (0..50).fold("sphere(0.5)".to_string(), |s, _| format!("twist({s}, 10)"));
-    let cases = [
-        ("field(p => length(p) - 1, bounds = [[-2, -2, -2], [2, 2, 2]], lipschitz = 1e100)", "slope bound of 1e100"),
-        (nested.as_str(), "50 nested `twist`"),
-    ];
-    for (object, why) in cases {
+    let export = |object: &str| {
         let scene = dir.path().join("s.scn");
         std::fs::write(&scene, format!("light ambient(1)\nobject {object}\n")).expect("writing");
         let out_file = dir.path().join("s.stl");
+        let _ = std::fs::remove_file(&out_file);
         let out = crate::support::scnc(&["export", scene.to_str().unwrap(), "-o", out_file.to_str().unwrap()]);
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(1), "{stderr}");
+        (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned(), out_file.exists())
+    };
+    let cases = [
+        ("field(p => length(p) - 1, bounds = [[-2, -2, -2], [2, 2, 2]], lipschitz = 1e100)", "slope bound of 1e100"),
+        ("field(p => abs(p.y) - 0.000001, bounds = [[-1, -1, -1], [1, 1, 1]])", "thinner than a cell"),
+    ];
+    for (object, why) in cases {
+        let (code, stderr, written) = export(object);
+        assert_eq!(code, Some(1), "{stderr}");
         assert!(stderr.contains("E0800") && stderr.contains(why), "{object}: {stderr}");
-        assert!(!out_file.exists(), "nothing is written");
+        assert!(!written, "nothing is written");
+    }
+    for op in ["twist", "bend"] {
+        let nested = (0..50).fold("sphere(0.5)".to_string(), |s, _| format!("{op}({s}, 10)"));
+        let (code, stderr, written) = export(&nested);
+        assert!(code == Some(0) && written, "50 nested {op}s: {stderr}");
     }
 }

@@ -108,7 +108,7 @@ impl Ctx<'_> {
                 let theta = bin(Binary::Mul, &Expr::num(k), &y);
                 let (qx, qz) = turn(&x, &z, &theta);
                 let map = Expr::vector([qx, y.clone(), qz]);
-                let r = b.radius_about_y();
+                let r = radius_about_y(&child, &b);
                 let bounds = DAabb { min: DVec3::new(-r, b.min.y, -r), max: DVec3::new(r, b.max.y, r) };
                 self.warp(child, map, bounds, span, "this twist", Some(DomainOp::Twist(k)))
             }
@@ -123,7 +123,7 @@ impl Ctx<'_> {
                 let (qx, qy) = turn(&x, &y, &theta);
                 let map = Expr::vector([qx, qy, z.clone()]);
                 // A turn about the origin keeps the distance from it.
-                let r = b.min.abs().max(b.max.abs()).length();
+                let r = radius_from_origin(&child, &b);
                 let bounds = DAabb { min: DVec3::splat(-r), max: DVec3::splat(r) };
                 self.warp(child, map, bounds, span, "this bend", Some(DomainOp::Bend(k)))
             }
@@ -172,7 +172,7 @@ impl Ctx<'_> {
                 };
                 let b = self.bounded(&child, "polar", span)?;
                 let w = 360.0 / f64::from(count);
-                let r = b.radius_about_y();
+                let r = radius_about_y(&child, &b);
                 let bounds = DAabb { min: DVec3::new(-r, b.min.y, -r), max: DVec3::new(r, b.max.y, r) };
                 if self.crosses_sector(&b, w) {
                     if count <= MAX_EXACT_COPIES {
@@ -297,4 +297,35 @@ impl Ctx<'_> {
         let corners = [(b.min.x, b.min.z), (b.min.x, b.max.z), (b.max.x, b.min.z), (b.max.x, b.max.z)];
         corners.iter().any(|&(x, z)| z.atan2(x).to_degrees().abs() > w / 2.0 + 1e-9)
     }
+}
+
+/// How far `shape` (whose box is `b`) reaches from the `y` axis: through the turns
+/// about `y` below it (a twist, a `polar` of parts within their sectors), which keep
+/// every point's distance from the axis, to the box of what they turn. The box alone
+/// would do, but the box of a turned shape is the square around its circle, √2 wider
+/// each level: fifty nested twists grew a unit sphere's box 2²⁵ times, and its mesh
+/// found no surface.
+fn radius_about_y(shape: &Shape, b: &DAabb) -> f64 {
+    let mut node = shape;
+    while let ShapeKind::Warp { child, domain_op: Some(DomainOp::Twist(_) | DomainOp::Polar(_)), .. } = &node.kind {
+        node = child;
+    }
+    ir::shape_bounds(node).map_or(b.radius_about_y(), |inner| inner.radius_about_y().min(b.radius_about_y()))
+}
+
+/// How far `shape` (whose box is `b`) reaches from the origin: through the turns below
+/// it (twists, bends, `polar`), which keep every point's distance from the origin, to
+/// the box of what they turn (see [`radius_about_y`]).
+fn radius_from_origin(shape: &Shape, b: &DAabb) -> f64 {
+    let corner = |b: &DAabb| b.min.abs().max(b.max.abs()).length();
+    let mut node = shape;
+    while let ShapeKind::Warp {
+        child,
+        domain_op: Some(DomainOp::Twist(_) | DomainOp::Bend(_) | DomainOp::Polar(_)),
+        ..
+    } = &node.kind
+    {
+        node = child;
+    }
+    ir::shape_bounds(node).map_or(corner(b), |inner| corner(&inner).min(corner(b)))
 }
