@@ -26,7 +26,7 @@ pub struct Root {
     /// How a ray marches it.
     pub walk: Walk,
     /// Whether the distance bound may understate the distance near the surface by more
-    /// than rounding ([`understates`]): its hits are then confirmed by the gradient
+    /// than rounding (`understates`): its hits are then confirmed by the gradient
     /// ([`super::march::refine`]).
     pub loose: bool,
 }

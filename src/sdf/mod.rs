@@ -39,7 +39,7 @@ pub struct SdfObject {
     convex: bool,
     /// How its rays are marched.
     walk: Walk,
-    /// Whether its hits are confirmed by [`march::refine`] ([`build::understates`]).
+    /// Whether its hits are confirmed by [`march::refine`] (`build::understates`).
     loose: bool,
 }
 
