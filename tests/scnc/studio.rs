@@ -276,3 +276,58 @@ fn an_abandoned_heavy_render_does_not_hold_the_next_one() {
     assert!(kinds.ends_with('S'), "{kinds}");
     assert!(took < std::time::Duration::from_secs(4), "the light render took {took:?} behind the heavy one");
 }
+
+/// Clients that declare a large body and send one byte of it hold no slot the page
+/// needs: with 32 of them connected at once, `GET /` is answered at once, a request
+/// with a body past the eighth from one address is refused with 429 (its body unread),
+/// and once they leave a body is read again. (Each connection must send its request
+/// within 10 s; a server whose connections wait on their clients without a deadline
+/// was wedged by these.)
+#[test]
+fn slow_request_bodies_do_not_block_the_page() {
+    let (_dir, scene) = seed_scene();
+    let s = Server::start(&scene);
+    let slow: Vec<TcpStream> = (0..32)
+        .map(|_| {
+            let mut c = TcpStream::connect(("127.0.0.1", s.port)).unwrap();
+            let head =
+                format!("POST /api/check HTTP/1.1\r\nHost: 127.0.0.1:{}\r\nContent-Length: 1000000\r\n\r\nx", s.port);
+            c.write_all(head.as_bytes()).unwrap();
+            c
+        })
+        .collect();
+    let started = std::time::Instant::now();
+    let (status, _) = s.raw("GET", "/", &[], b"");
+    assert_eq!(status, 200);
+    assert!(started.elapsed() < std::time::Duration::from_secs(5), "GET / took {:?}", started.elapsed());
+    let (status, _) = s.post("/api/check", "light ambient(1)\n");
+    assert_eq!(status, 429, "a body past the eighth from one client");
+    drop(slow);
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    loop {
+        let (status, _) = s.post("/api/check", "light ambient(1)\n");
+        if status == 200 {
+            break;
+        }
+        assert!(std::time::Instant::now() < deadline, "bodies are still refused ({status}) after the clients left");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+}
+
+/// A request that never finishes arriving is answered 408 once its 10 s are up, and a
+/// malformed one 400, each with the connection closed: none holds a thread for longer.
+#[test]
+fn requests_that_never_arrive_are_timed_out() {
+    let (_dir, scene) = seed_scene();
+    let s = Server::start(&scene);
+    let mut c = TcpStream::connect(("127.0.0.1", s.port)).unwrap();
+    c.set_read_timeout(Some(std::time::Duration::from_secs(60))).unwrap();
+    let head = format!("POST /api/check HTTP/1.1\r\nHost: 127.0.0.1:{}\r\nContent-Length: 100\r\n\r\nx", s.port);
+    c.write_all(head.as_bytes()).unwrap();
+    let mut reply = Vec::new();
+    let _ = c.read_to_end(&mut reply);
+    let reply = String::from_utf8_lossy(&reply);
+    assert!(reply.starts_with("HTTP/1.1 408"), "{reply}");
+    let (status, _) = s.raw("GET", "/", &[("Content-Length", "x")], b"");
+    assert_eq!(status, 400);
+}

@@ -1,29 +1,150 @@
-//! Requests and replies over tiny_http, and the one stream format the page reads.
+//! HTTP/1.1 for the studio, by hand: one request per connection (`Connection: close`),
+//! bodies by `Content-Length`, replies whole or chunked: what a page on localhost needs,
+//! with what a server facing slow or hostile clients needs. A request must arrive, head
+//! and body, within [`DEADLINE`] of its connection; every read waits only for what is
+//! left of it; a refused body is never read. (tiny_http, used before, kept a thread on
+//! each connection whose body never came, and its pool could starve new connections
+//! behind them.)
 
 use std::io::{Read, Write};
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::time::Duration;
+use std::net::{Shutdown, SocketAddr, TcpStream};
+use std::time::{Duration, Instant};
 
 /// Largest request body: a scene's source limit and room for the query.
 const MAX_BODY: u64 = scnc::source::MAX_FILE_BYTES as u64 + 4096;
 
-/// How long a request's body may take to arrive: past it the handler gives up on it
-/// (a page sends its few kilobytes at once).
-pub(crate) const BODY_DEADLINE: Duration = Duration::from_secs(10);
+/// Largest request head (line and headers).
+const MAX_HEAD: usize = 16 * 1024;
 
-/// Bodies read at once, given up on or not: a reader waits on its client until the
-/// body arrives or the connection closes, so a client that never sends one holds a
-/// thread, and past this many new bodies are refused.
-const MAX_READERS: usize = 64;
-
-/// Readers running, over the whole server.
-static READERS: AtomicUsize = AtomicUsize::new(0);
+/// How long a request, head and body, may take to arrive from the moment its connection
+/// is accepted: past it the connection is answered 408 and closed.
+pub(crate) const DEADLINE: Duration = Duration::from_secs(10);
 
 /// A request with its path and query split.
 pub(crate) struct Req {
-    inner: Option<tiny_http::Request>,
+    conn: Option<Conn>,
     path: String,
     query: Vec<(String, String)>,
+}
+
+/// A connection whose request head has been read.
+struct Conn {
+    stream: TcpStream,
+    method: String,
+    headers: Vec<(String, String)>,
+    /// The body's length (`Content-Length`; 0 without one).
+    body_len: u64,
+    /// Body bytes read with the head.
+    pending: Vec<u8>,
+    /// When the connection was accepted.
+    started: Instant,
+}
+
+impl Conn {
+    fn new(stream: TcpStream) -> Conn {
+        Conn {
+            stream,
+            method: String::new(),
+            headers: Vec::new(),
+            body_len: 0,
+            pending: Vec::new(),
+            started: Instant::now(),
+        }
+    }
+
+    /// Reads into `buf` within what is left of the deadline; `None` past it or when the
+    /// client has gone.
+    fn read_some(&mut self, buf: &mut [u8]) -> Option<usize> {
+        let left = DEADLINE.checked_sub(self.started.elapsed()).filter(|d| !d.is_zero())?;
+        self.stream.set_read_timeout(Some(left)).ok()?;
+        match self.stream.read(buf) {
+            Ok(0) | Err(_) => None,
+            Ok(n) => Some(n),
+        }
+    }
+
+    /// Every value of the header `name`, in the order sent.
+    fn header_values(&self, name: &str) -> Vec<&str> {
+        self.headers.iter().filter(|(k, _)| k.eq_ignore_ascii_case(name)).map(|(_, v)| v.as_str()).collect()
+    }
+}
+
+/// Reads the request head of a new connection within [`DEADLINE`]: the request, or
+/// `None` after answering one that is malformed, too large or too slow (or finding the
+/// client gone).
+pub(crate) fn accept(stream: TcpStream) -> Option<Req> {
+    let _ = stream.set_nodelay(true);
+    let mut conn = Conn::new(stream);
+    let mut buf = vec![0u8; MAX_HEAD];
+    let mut have = 0;
+    let end = loop {
+        if let Some(i) = buf[..have].windows(4).position(|w| w == b"\r\n\r\n") {
+            break i;
+        }
+        if have == MAX_HEAD {
+            return refuse(conn, Reply::text(431, "the request head is larger than 16 KiB"));
+        }
+        let Some(n) = conn.read_some(&mut buf[have..]) else {
+            let late = conn.started.elapsed() >= DEADLINE;
+            return if late { refuse(conn, Reply::text(408, "the request did not arrive in time")) } else { None };
+        };
+        have += n;
+    };
+    conn.pending = buf[end + 4..have].to_vec();
+    let Ok(head) = std::str::from_utf8(&buf[..end]) else {
+        return refuse(conn, Reply::text(400, "the request head is not text"));
+    };
+    let mut lines = head.split("\r\n");
+    let first: Vec<&str> = lines.next().unwrap_or("").split(' ').collect();
+    let [method, target, version] = first[..] else {
+        return refuse(conn, Reply::text(400, "a malformed request line"));
+    };
+    if !version.starts_with("HTTP/1.") {
+        return refuse(conn, Reply::text(400, "a malformed request line"));
+    }
+    for line in lines {
+        let Some((k, v)) = line.split_once(':') else {
+            return refuse(conn, Reply::text(400, "a malformed header"));
+        };
+        conn.headers.push((k.trim().to_string(), v.trim().to_string()));
+    }
+    conn.method = method.to_ascii_uppercase();
+    let length = match conn.header_values("Content-Length")[..] {
+        [] => Some(0),
+        [l] => l.parse::<u64>().ok(),
+        _ => None,
+    };
+    let Some(length) = length else {
+        return refuse(conn, Reply::text(400, "a malformed or repeated `Content-Length`"));
+    };
+    if !conn.header_values("Transfer-Encoding").is_empty() {
+        return refuse(conn, Reply::text(411, "request bodies are read by `Content-Length`, not chunked"));
+    }
+    conn.body_len = length;
+    let target = target.to_string();
+    let (path, query) = target.split_once('?').unwrap_or((&target, ""));
+    let query = query
+        .split('&')
+        .filter(|kv| !kv.is_empty())
+        .map(|kv| {
+            let (k, v) = kv.split_once('=').unwrap_or((kv, ""));
+            (percent_decode(k), percent_decode(v))
+        })
+        .collect();
+    Some(Req { path: path.to_string(), query, conn: Some(conn) })
+}
+
+/// Answers `conn` with `reply` and gives no request.
+fn refuse(conn: Conn, reply: Reply) -> Option<Req> {
+    Req { conn: Some(conn), path: String::new(), query: Vec::new() }.reply(reply);
+    None
+}
+
+/// Answers a connection whose request is not even read (the server is full): `reply`,
+/// written with a short timeout, so that a client not reading cannot hold the caller.
+pub(crate) fn turn_away(stream: TcpStream, reply: Reply) {
+    let _ = stream.set_write_timeout(Some(Duration::from_millis(200)));
+    Req { conn: Some(Conn::new(stream)), path: String::new(), query: Vec::new() }.reply(reply);
 }
 
 /// A whole reply.
@@ -72,23 +193,19 @@ impl Reply {
 }
 
 impl Req {
-    pub(crate) fn new(inner: tiny_http::Request) -> Req {
-        let url = inner.url().to_string();
-        let (path, query) = url.split_once('?').unwrap_or((&url, ""));
-        let query = query
-            .split('&')
-            .filter(|kv| !kv.is_empty())
-            .map(|kv| {
-                let (k, v) = kv.split_once('=').unwrap_or((kv, ""));
-                (percent_decode(k), percent_decode(v))
-            })
-            .collect();
-        Req { path: path.to_string(), query, inner: Some(inner) }
-    }
-
     /// `GET`, `POST`, …
     pub(crate) fn method(&self) -> String {
-        self.inner.as_ref().map_or_else(String::new, |r| r.method().as_str().to_ascii_uppercase())
+        self.conn.as_ref().map_or_else(String::new, |c| c.method.clone())
+    }
+
+    /// Whether the request carries a body.
+    pub(crate) fn has_body(&self) -> bool {
+        self.conn.as_ref().is_some_and(|c| c.body_len > 0)
+    }
+
+    /// The client's address.
+    pub(crate) fn client(&self) -> Option<SocketAddr> {
+        self.conn.as_ref().and_then(|c| c.stream.peer_addr().ok())
     }
 
     /// The path, as sent (never decoded, so `/%2e%2e/` is no path of ours either).
@@ -113,12 +230,8 @@ impl Req {
 
     /// Every value of the header `name`, in the order sent.
     fn headers(&self, name: &str) -> Vec<String> {
-        let Some(r) = self.inner.as_ref() else { return Vec::new() };
-        r.headers()
-            .iter()
-            .filter(|h| h.field.as_str().as_str().eq_ignore_ascii_case(name))
-            .map(|h| h.value.as_str().to_string())
-            .collect()
+        let Some(c) = self.conn.as_ref() else { return Vec::new() };
+        c.header_values(name).into_iter().map(str::to_string).collect()
     }
 
     /// `Ok` when the request names this server in `Host` and, if it says where it comes
@@ -150,69 +263,63 @@ impl Req {
         Ok(())
     }
 
-    /// The body as text, or the reply that refuses it (too large, not UTF-8, not
-    /// arrived within [`BODY_DEADLINE`]: then the handler's slot is free again, and the
-    /// client gets no reply).
-    ///
-    /// The body is read on a thread of its own, as tiny_http's sockets have no read
-    /// timeout; a reader given up on ends when its client sends or closes.
+    /// The body as text, or the reply that refuses it: too large (refused before a byte
+    /// of it is read), not arrived within [`DEADLINE`] of the connection, not UTF-8.
     pub(crate) fn body(&mut self) -> Result<String, Reply> {
-        let Some(mut inner) = self.inner.take() else { return Err(Reply::text(400, "no request")) };
-        if READERS.fetch_add(1, Ordering::AcqRel) >= MAX_READERS {
-            READERS.fetch_sub(1, Ordering::AcqRel);
-            self.inner = Some(inner);
-            return Err(Reply::text(503, "too many request bodies are arriving at once; try again"));
-        }
-        let (tx, rx) = std::sync::mpsc::channel();
-        let reader = std::thread::Builder::new().name("studio-body".into()).spawn(move || {
-            let mut bytes = Vec::new();
-            let read = inner.as_reader().take(MAX_BODY + 1).read_to_end(&mut bytes);
-            READERS.fetch_sub(1, Ordering::AcqRel);
-            let _ = tx.send((inner, read.map(|_| bytes)));
-        });
-        if reader.is_err() {
-            READERS.fetch_sub(1, Ordering::AcqRel);
-            return Err(Reply::text(503, "the system would not start a thread to read the request; try again"));
-        }
-        let (inner, read) = rx.recv_timeout(BODY_DEADLINE).map_err(|_| {
-            Reply::text(408, &format!("the request body did not arrive within {} s", BODY_DEADLINE.as_secs()))
-        })?;
-        self.inner = Some(inner);
-        let Ok(bytes) = read else {
-            return Err(Reply::text(400, "the request body could not be read"));
-        };
-        if bytes.len() as u64 > MAX_BODY {
+        let Some(conn) = self.conn.as_mut() else { return Err(Reply::text(400, "no request")) };
+        if conn.body_len > MAX_BODY {
             return Err(Reply::text(413, "the request body is larger than a scene may be (4 MiB)"));
+        }
+        if conn.header_values("Expect").iter().any(|e| e.eq_ignore_ascii_case("100-continue")) {
+            let _ = conn.stream.write_all(b"HTTP/1.1 100 Continue\r\n\r\n");
+        }
+        let len = conn.body_len as usize;
+        let mut bytes = std::mem::take(&mut conn.pending);
+        bytes.truncate(len);
+        let mut buf = vec![0u8; 64 * 1024];
+        while bytes.len() < len {
+            let want = (len - bytes.len()).min(buf.len());
+            let Some(n) = conn.read_some(&mut buf[..want]) else {
+                let message = format!("the request body did not arrive within {} s", DEADLINE.as_secs());
+                return Err(Reply::text(408, &message));
+            };
+            bytes.extend_from_slice(&buf[..n]);
         }
         String::from_utf8(bytes).map_err(|_| Reply::text(400, "the request body is not UTF-8 text"))
     }
 
-    /// Sends `reply`; a client that went away is no error of ours.
+    /// Sends `reply` and closes the connection; a client that went away is no error of
+    /// ours. A `HEAD` request gets the head alone.
     pub(crate) fn reply(mut self, reply: Reply) {
-        let Some(inner) = self.inner.take() else { return };
-        let mut response = tiny_http::Response::from_data(reply.body).with_status_code(reply.status);
-        let mut add = |k: &str, v: &str| {
-            if let Ok(h) = tiny_http::Header::from_bytes(k.as_bytes(), v.as_bytes()) {
-                response.add_header(h);
-            }
-        };
-        add("Content-Type", reply.content_type);
-        add("X-Content-Type-Options", "nosniff");
-        add("Cache-Control", if reply.cache { "max-age=3600" } else { "no-store" });
+        let Some(mut conn) = self.conn.take() else { return };
+        let mut head = format!(
+            "HTTP/1.1 {} {}\r\nContent-Type: {}\r\nContent-Length: {}\r\nX-Content-Type-Options: nosniff\r\n\
+             Cache-Control: {}\r\nConnection: close\r\n",
+            reply.status,
+            reason(reply.status),
+            reply.content_type,
+            reply.body.len(),
+            if reply.cache { "max-age=3600" } else { "no-store" }
+        );
         if let Some(name) = &reply.download {
-            add("Content-Disposition", &format!("attachment; filename=\"{name}\""));
+            head.push_str(&format!("Content-Disposition: attachment; filename=\"{name}\"\r\n"));
         }
-        let _ = inner.respond(response);
+        head.push_str("\r\n");
+        let _ = conn.stream.write_all(head.as_bytes());
+        if conn.method != "HEAD" {
+            let _ = conn.stream.write_all(&reply.body);
+        }
+        close(conn.stream);
     }
 
     /// Starts a streamed reply: chunked, flushed message by message, ended by dropping
     /// the stream. `None` when the client is already gone.
     pub(crate) fn stream(mut self, content_type: &str) -> Option<Stream> {
-        let inner = self.inner.take()?;
-        let mut w = inner.into_writer();
+        let conn = self.conn.take()?;
+        let mut w = conn.stream;
         let head = format!(
             "HTTP/1.1 200 OK\r\nContent-Type: {content_type}\r\nCache-Control: no-store\r\n\
-             X-Content-Type-Options: nosniff\r\nTransfer-Encoding: chunked\r\n\r\n"
+             X-Content-Type-Options: nosniff\r\nTransfer-Encoding: chunked\r\nConnection: close\r\n\r\n"
         );
         w.write_all(head.as_bytes()).ok()?;
         w.flush().ok()?;
@@ -220,18 +327,54 @@ impl Req {
     }
 }
 
+/// Closes a connection after its reply: the write side first, then what the client may
+/// still be sending (a body refused unread) is read off for a moment, so that the close
+/// is not a reset that could discard the reply before the client reads it.
+fn close(mut stream: TcpStream) {
+    let _ = stream.shutdown(Shutdown::Write);
+    let _ = stream.set_read_timeout(Some(Duration::from_millis(100)));
+    let mut sink = [0u8; 4096];
+    let until = Instant::now() + Duration::from_millis(200);
+    while Instant::now() < until {
+        match stream.read(&mut sink) {
+            Ok(0) | Err(_) => break,
+            Ok(_) => {}
+        }
+    }
+}
+
+/// The reason phrase of `status`.
+fn reason(status: u16) -> &'static str {
+    match status {
+        200 => "OK",
+        400 => "Bad Request",
+        403 => "Forbidden",
+        404 => "Not Found",
+        405 => "Method Not Allowed",
+        408 => "Request Timeout",
+        411 => "Length Required",
+        413 => "Content Too Large",
+        429 => "Too Many Requests",
+        431 => "Request Header Fields Too Large",
+        500 => "Internal Server Error",
+        503 => "Service Unavailable",
+        _ => "",
+    }
+}
+
 impl Drop for Req {
     fn drop(&mut self) {
         // A request dropped unanswered (a handler that returned early) is told so.
-        if let Some(inner) = self.inner.take() {
-            let _ = inner.respond(tiny_http::Response::from_string("not answered").with_status_code(500));
+        if self.conn.is_some() {
+            let unanswered = Req { conn: self.conn.take(), path: String::new(), query: Vec::new() };
+            unanswered.reply(Reply::text(500, "not answered"));
         }
     }
 }
 
 /// A chunked reply being written.
 pub(crate) struct Stream {
-    w: Box<dyn Write + Send>,
+    w: TcpStream,
 }
 
 impl Stream {

@@ -53,9 +53,9 @@ pub(crate) struct StudioArgs {
     port_file: Option<PathBuf>,
 }
 
-/// Requests handled at once, of those with a body and of those without each; more are
-/// refused with 503 (a page makes at most a few at a time).
-const MAX_IN_FLIGHT: usize = 16;
+/// Connections open at once (a page keeps a few, and each must send its request within
+/// `http::DEADLINE`); more are turned away with 503.
+const MAX_CONNECTIONS: usize = 64;
 
 /// Requests with a body handled at once for one client address; more are refused with
 /// 429, so one client sending bodies slowly cannot take every slot.
@@ -80,7 +80,7 @@ pub(crate) fn studio_cmd(args: StudioArgs) -> ExitCode {
         Ok(p) => p,
         Err(e) => return usage_error(&e),
     };
-    let server = match tiny_http::Server::http(SocketAddr::new(args.host, args.port)) {
+    let server = match std::net::TcpListener::bind(SocketAddr::new(args.host, args.port)) {
         Ok(s) => s,
         Err(e) => {
             return usage_error(&format!(
@@ -90,7 +90,7 @@ pub(crate) fn studio_cmd(args: StudioArgs) -> ExitCode {
             ))
         }
     };
-    let Some(addr) = server.server_addr().to_ip() else {
+    let Ok(addr) = server.local_addr() else {
         return usage_error("the server has no IP address");
     };
     if !args.host.is_loopback() {
@@ -138,64 +138,55 @@ fn own_hosts(addr: SocketAddr) -> Vec<String> {
     hosts
 }
 
-/// Answers a refused request on a thread of its own: answering first reads the rest of
-/// its body (tiny_http keeps the connection in step), which a client slow to send holds
-/// up until it sends or closes, and the dispatch loop must never wait. (tiny_http holds
-/// a thread per connection the same way; its sockets have no read timeout, and one set
-/// on the listener would time out `accept` too.)
-fn refuse(request: tiny_http::Request, reply: Reply) {
-    let _ = std::thread::Builder::new().name("studio-refuse".into()).spawn(move || Req::new(request).reply(reply));
-}
-
-fn serve(server: &tiny_http::Server, studio: &Arc<Studio>) {
-    // Requests with a body and those without hold separate slots, so clients slow to
-    // send bodies never keep the page itself from loading.
-    let (bodies, others) = (Arc::new(AtomicUsize::new(0)), Arc::new(AtomicUsize::new(0)));
+fn serve(server: &std::net::TcpListener, studio: &Arc<Studio>) {
+    let open = Arc::new(AtomicUsize::new(0));
     let per_client: Arc<Mutex<HashMap<IpAddr, usize>>> = Arc::default();
-    for request in server.incoming_requests() {
-        let with_body = !matches!(request.method(), tiny_http::Method::Get | tiny_http::Method::Head);
-        let client = request.remote_addr().map(|a| a.ip());
-        let slots = Arc::clone(if with_body { &bodies } else { &others });
-        // The dispatch loop never waits: past a limit the request is refused at once.
-        if slots.fetch_add(1, Ordering::AcqRel) >= MAX_IN_FLIGHT {
-            slots.fetch_sub(1, Ordering::AcqRel);
-            refuse(request, Reply::text(503, "the studio is busy with other requests; try again"));
+    for stream in server.incoming() {
+        let Ok(stream) = stream else { continue };
+        // The accept loop never waits on a client: past the limit a connection is
+        // turned away at once, and each is read within its deadline on its own thread.
+        if open.fetch_add(1, Ordering::AcqRel) >= MAX_CONNECTIONS {
+            open.fetch_sub(1, Ordering::AcqRel);
+            http::turn_away(stream, Reply::text(503, "the studio has too many connections open; try again"));
             continue;
         }
-        let counted = with_body.then_some(client).flatten();
-        if let Some(ip) = counted {
-            let mut clients = lock(&per_client);
-            let n = clients.entry(ip).or_insert(0);
-            if *n >= MAX_BODIES_PER_CLIENT {
-                drop(clients);
-                slots.fetch_sub(1, Ordering::AcqRel);
-                refuse(request, Reply::text(429, "too many requests at once from this client"));
-                continue;
+        let (studio, done, per_client) = (Arc::clone(studio), Arc::clone(&open), Arc::clone(&per_client));
+        let run = move || {
+            if let Some(req) = http::accept(stream) {
+                // A handler that panics loses its request, never the server.
+                let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| admit(&studio, req, &per_client)));
             }
-            *n += 1;
-        }
-        let studio = Arc::clone(studio);
-        let per_client = Arc::clone(&per_client);
-        let release = move || {
-            slots.fetch_sub(1, Ordering::AcqRel);
-            if let Some(ip) = counted {
-                let mut clients = lock(&per_client);
-                if let Some(n) = clients.get_mut(&ip) {
-                    *n -= 1;
-                    if *n == 0 {
-                        clients.remove(&ip);
-                    }
-                }
-            }
+            done.fetch_sub(1, Ordering::AcqRel);
         };
-        let done = release.clone();
-        let spawned = std::thread::Builder::new().name("studio-request".into()).spawn(move || {
-            // A handler that panics loses its request, never the server.
-            let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| handle(&studio, request)));
-            done();
-        });
-        if spawned.is_err() {
-            release();
+        if let Err(e) = std::thread::Builder::new().name("studio-request".into()).spawn(run) {
+            // The closure (and its count) went with the failed spawn.
+            let _ = writeln!(std::io::stderr(), "scnc studio: cannot start a thread for a request: {e}");
+            open.fetch_sub(1, Ordering::AcqRel);
+        }
+    }
+}
+
+/// Handles `req` unless its client already has [`MAX_BODIES_PER_CLIENT`] requests
+/// with a body in hand (429, the body unread).
+fn admit(studio: &Arc<Studio>, req: Req, per_client: &Mutex<HashMap<IpAddr, usize>>) {
+    let Some(ip) = req.client().map(|a| a.ip()).filter(|_| req.has_body()) else {
+        return handle(studio, req);
+    };
+    {
+        let mut clients = lock(per_client);
+        let n = clients.entry(ip).or_insert(0);
+        if *n >= MAX_BODIES_PER_CLIENT {
+            drop(clients);
+            return req.reply(Reply::text(429, "too many requests at once from this client"));
+        }
+        *n += 1;
+    }
+    handle(studio, req);
+    let mut clients = lock(per_client);
+    if let Some(n) = clients.get_mut(&ip) {
+        *n -= 1;
+        if *n == 0 {
+            clients.remove(&ip);
         }
     }
 }
@@ -209,14 +200,13 @@ const EDITOR_JS: &str = include_str!("assets/editor.js");
 /// The tab's icon (browsers ask for `/favicon.ico` when a page names none).
 const FAVICON: &str = include_str!("assets/favicon.svg");
 
-fn handle(studio: &Arc<Studio>, request: tiny_http::Request) {
-    let mut req = Req::new(request);
+fn handle(studio: &Arc<Studio>, mut req: Req) {
     if let Err(refused) = req.same_origin(&studio.hosts) {
         return req.reply(refused);
     }
     let method = req.method();
     let path = req.path().to_string();
-    // HEAD is answered as GET is (tiny_http leaves the body out).
+    // HEAD is answered as GET is (`Req::reply` leaves the body out).
     let get = if method == "HEAD" { "GET" } else { method.as_str() };
     let reply = match (get, path.as_str()) {
         ("GET", "/") => Reply::asset("text/html; charset=utf-8", INDEX_HTML),
