@@ -120,8 +120,9 @@ pub enum Refined {
 /// surface): there `f < threshold` holds in a shell up to `L` thresholds thick, and
 /// taking it for the surface draws the shape bigger the larger `L` is stated.
 ///
-/// The first-order distance `f / |∇f|` (gradient by central differences over a
-/// tetrahedron) does not depend on `L`: where it is below the threshold the hit stands;
+/// The first-order distance `f / |∇f|`, from the object's surface closure `surf` (the
+/// value and analytic gradient its hits are shaded with, scaled as `f` is), does not
+/// depend on `L`: where it is below the threshold the hit stands;
 /// where not, the ray steps by it (no surface nearer under the field's linear model,
 /// and a step that still lands inside is bisected back to the crossing) until it is,
 /// or until the bound rises past the threshold again, as beside a silhouette, where the
@@ -130,22 +131,17 @@ pub enum Refined {
 #[inline(never)]
 pub fn refine(
     f: &dyn Fn(Vec3A) -> f32,
+    surf: &dyn Fn(Vec3A) -> super::Surf,
     ray: &Ray,
     (t, t1): (f32, f32),
     params: MarchParams,
     c: &mut Counters,
     evals: &mut u64,
 ) -> Refined {
-    const TETRA: [Vec3A; 4] = [
-        Vec3A::new(1.0, -1.0, -1.0),
-        Vec3A::new(-1.0, -1.0, 1.0),
-        Vec3A::new(-1.0, 1.0, -1.0),
-        Vec3A::new(1.0, 1.0, 1.0),
-    ];
     let (origin, dir) = (ray.origin, ray.dir);
     let base = origin.length();
     let mut t = t;
-    let mut d = f(origin + dir * t);
+    let super::Surf { mut d, mut g, .. } = surf(origin + dir * t);
     *evals += 1;
     for step in 0..params.max_steps {
         let threshold = threshold(params.epsilon, base, t);
@@ -157,11 +153,6 @@ pub fn refine(
         if d <= 0.0 || d.is_nan() {
             return Refined::Hit(t, threshold);
         }
-        let p = origin + dir * t;
-        // Not finer than f32 resolves at `p`, nor coarser than the threshold there.
-        let h = threshold.max(1e-4 * (1.0 + p.length()));
-        let g = TETRA.iter().fold(Vec3A::ZERO, |g, &k| g + k * f(p + k * h)) / (4.0 * h);
-        *evals += 4;
         let slope = g.length();
         // A bound within a few times the field's slope here draws the surface within a
         // few thresholds, as every bound does; below that the confirmation is worth its
@@ -176,7 +167,7 @@ pub fn refine(
             return Refined::Hit(t, threshold);
         }
         let next = (t + estimate.max(d)).min(t1);
-        let dn = f(origin + dir * next);
+        let super::Surf { d: dn, g: gn, .. } = surf(origin + dir * next);
         *evals += 1;
         // The step trusts the field's linear model: where the field is not linear at
         // the step's scale (features the size of the threshold, a gradient the
@@ -206,7 +197,7 @@ pub fn refine(
         if next >= t1 {
             return Refined::Miss;
         }
-        (t, d) = (next, dn);
+        (t, d, g) = (next, dn, gn);
     }
     c.budget_misses += 1;
     Refined::Miss

@@ -111,7 +111,7 @@ impl SdfObject {
     ) -> Option<(f32, f32)> {
         for _ in 0..params.max_steps {
             let (t, _) = hit?;
-            match march::refine(&*self.dist, ray, (t, t1), params, c, evals) {
+            match march::refine(&*self.dist, &*self.mat, ray, (t, t1), params, c, evals) {
                 march::Refined::Hit(t, threshold) => return Some((t, threshold)),
                 march::Refined::Miss => return None,
                 march::Refined::Resume(t) => hit = self.walk_closest(ray, (t, t1), params, c, evals),
@@ -228,7 +228,7 @@ impl SdfObject {
                 if !self.loose {
                     return 0.0;
                 }
-                match march::refine(&*self.dist, ray, (t, t1), params, c, evals) {
+                match march::refine(&*self.dist, &*self.mat, ray, (t, t1), params, c, evals) {
                     march::Refined::Hit(..) => return 0.0,
                     march::Refined::Miss => break,
                     // Beside the surface, not on it: the penumbra goes on from
