@@ -91,6 +91,9 @@ pub(super) struct Iso {
     /// Most cells it may refine: what the memory budget has left, at
     /// [`isosurface::CELL_BYTES`] a cell.
     pub(super) max_cells: usize,
+    /// Asked at every sample: once the lowering is not wanted, every sample reads as far
+    /// outside, so the extraction runs out of cells and ends within one evaluation.
+    pub(super) wanted: Option<super::lower::Wanted>,
 }
 
 /// An isosurface of `shape` sampled and placed as `iso` says, each triangle taking the
@@ -102,7 +105,7 @@ pub(super) fn isosurface_object(
     span: Span,
     materials: &mut MaterialTable,
 ) -> Result<MeshJob, Diagnostic> {
-    let Iso { grid, place, material, cell, smooth, from, max_cells } = iso;
+    let Iso { grid, place, material, cell, smooth, from, max_cells, wanted } = iso;
     let bounds = ir::shape_bounds(shape).ok_or_else(|| unbounded(shape.span))?.transform(&grid);
     // A cell as large as the shape samples a few points around it: the mesh would be a
     // sliver or nothing, so it is refused like a grid that finds no surface.
@@ -121,6 +124,10 @@ pub(super) fn isosurface_object(
         });
     }
     let (dist, mat) = Builder::new(materials).build(shape, grid, material);
+    let dist: crate::sdf::Sdf = match wanted {
+        Some(wanted) => std::sync::Arc::new(move |p| if wanted() { dist(p) } else { f32::MAX }),
+        None => dist,
+    };
     let too_fine = |cells: f64, min_cell: f64| {
         let d = Diagnostic::error(
             codes::LOWERING,

@@ -128,6 +128,7 @@ pub fn tessellate(
                 smooth: false,
                 from: CellFrom::Detail,
                 max_cells: budget.cells_allowed(),
+                wanted: budget.wanted.clone(),
             };
             let job = isosurface_object(node, iso, node.span, materials)?;
             budget.spend(job.mesh.triangles.len() as u64, shape.span)?;
@@ -254,8 +255,12 @@ const CONFIRM_FROM: u64 = 64 << 20;
 /// The default memory limit for meshes: 4 GiB, room on a laptop and on the test machine.
 pub const DEFAULT_MEMORY_LIMIT: u64 = 4 << 30;
 
+/// Whether a lowering is still wanted: in the studio a newer request makes an older
+/// one's not, and its isosurfaces then end at once (what they made is thrown away).
+pub type Wanted = std::sync::Arc<dyn Fn() -> bool + Send + Sync>;
+
 /// What the scene's meshes may still use: triangles, and bytes at the estimate above.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone)]
 pub struct Budget {
     triangles: u64,
     bytes: u64,
@@ -264,6 +269,8 @@ pub struct Budget {
     /// the object that took the most of them, to name if it will not give them.
     unconfirmed: u64,
     largest: Option<(u64, Span)>,
+    /// Asked as isosurfaces are sampled; `None`: always wanted.
+    wanted: Option<Wanted>,
 }
 
 impl Budget {
@@ -275,7 +282,18 @@ impl Budget {
             limit: memory_limit,
             unconfirmed: 0,
             largest: None,
+            wanted: None,
         }
+    }
+
+    /// The same budget for a lowering that ends early once `wanted` says it is not.
+    pub fn while_wanted(self, wanted: Wanted) -> Budget {
+        Budget { wanted: Some(wanted), ..self }
+    }
+
+    /// Whether the lowering is no longer wanted.
+    pub fn abandoned(&self) -> bool {
+        self.wanted.as_ref().is_some_and(|w| !w())
     }
 
     /// Cells an isosurface may refine now: the bytes left at
@@ -400,6 +418,7 @@ pub fn explicit(
                 smooth: m.smooth,
                 from: CellFrom::Scene,
                 max_cells: budget.cells_allowed(),
+                wanted: budget.wanted.clone(),
             };
             let job = isosurface_object(shape, iso, m.span, materials)?;
             budget.spend(job.mesh.triangles.len() as u64, m.span)?;

@@ -9,12 +9,13 @@ use rayon::prelude::*;
 
 use super::{query, Mode, Object, ObjectKind, World};
 use crate::accel::{padded_sphere, Aabb, Bvh};
-use crate::diag::Diagnostic;
+use crate::diag::{codes, Diagnostic};
 use crate::ir;
 use crate::mesh;
 use crate::render::Frame;
 use crate::sdf::{self, MarchParams, SdfObject};
 use crate::source::Loader;
+use crate::span::Span;
 use crate::trace::ShadeMaterial;
 
 /// An object between lowering and building: an SDF object with its bounds, a mesh to
@@ -184,6 +185,29 @@ pub fn prepare_within(
     prepare_reusing(scene, effects, mode, loader, memory_limit, &mut FrameCache::default(), &|| {})
 }
 
+/// [`prepare_within`] for a lowering that may stop being wanted (the studio's, once a
+/// newer request comes): `Ok(None)` as soon as `wanted` says so. It is asked between
+/// objects and at every isosurface sample, so an abandoned lowering lets go of the
+/// workers within one evaluation rather than when its meshes are done.
+pub fn prepare_until(
+    scene: &ir::Scene,
+    effects: crate::render::effects::Effects,
+    mode: Mode,
+    loader: &dyn Loader,
+    memory_limit: u64,
+    wanted: mesh::lower::Wanted,
+) -> Result<Option<(Frame, World)>, Diagnostic> {
+    let mut frame = Frame::with_effects(scene, effects);
+    let params = MarchParams { epsilon: scene.settings.epsilon as f32, max_steps: scene.settings.max_steps };
+    let budget = mesh::lower::Budget::new(memory_limit).while_wanted(wanted.clone());
+    let world = lower_reusing(scene, &mut frame, mode, params, loader, budget, &mut FrameCache::default(), &|| {});
+    // Not wanted any more: whatever the lowering made or refused is moot.
+    if !wanted() {
+        return Ok(None);
+    }
+    world.map(|w| Some((frame, w)))
+}
+
 /// [`prepare_within`] for one frame of an animation: objects equal to the previous
 /// frame's, seen from the same place, are taken from `reuse` instead of lowered again
 /// (their meshes are shared, not rebuilt), and this frame's objects are kept there for
@@ -302,6 +326,9 @@ fn lower_reusing(
     let mut field_hulls = FieldHulls::default();
     let mut kept = Vec::with_capacity(scene.objects.len());
     for (i, obj) in scene.objects.iter().enumerate() {
+        if budget.abandoned() {
+            return Err(abandoned(obj.span));
+        }
         let table = &mut builder.materials.materials;
         while agree < table.len().min(reuse.table.len()) && table[agree] == reuse.table[agree] {
             agree += 1;
@@ -349,6 +376,9 @@ fn lower_reusing(
         step();
     }
     budget.confirm()?;
+    if let (true, Some(last)) = (budget.abandoned(), scene.objects.last()) {
+        return Err(abandoned(last.span));
+    }
     let warnings: Vec<Diagnostic> = lowered.iter().flat_map(|(_, w, _)| w.iter().cloned()).collect();
     // Building the meshes (vertices to render space, BVHs) is most of the lowering time
     // of a scene of many meshes; they are independent, so they are built in parallel.
@@ -385,6 +415,11 @@ fn lower_reusing(
     reuse.table = frame.materials.materials.clone();
     reuse.reused = reused;
     Ok(world_of(objects, params, closure_bytes, warnings))
+}
+
+/// What a lowering that stopped being wanted ends with ([`prepare_until`] drops it).
+fn abandoned(span: Span) -> Diagnostic {
+    Diagnostic::error(codes::LOWERING, span, "lowering abandoned", "a newer request took its place")
 }
 
 /// The world of lowered objects: the top-level BVH over the bounded ones.

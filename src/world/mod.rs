@@ -18,7 +18,8 @@ mod query;
 use glam::Vec3A;
 
 pub use lower::{
-    lower, lowering_steps, prepare, prepare_reusing, prepare_within, shape_hull, shape_sphere, FrameCache,
+    lower, lowering_steps, prepare, prepare_reusing, prepare_until, prepare_within, shape_hull, shape_sphere,
+    FrameCache,
 };
 
 use crate::accel::{Aabb, Bvh};

@@ -88,8 +88,8 @@ fn studio_streams_what_scnc_render_makes() {
     assert_eq!(status, 200);
     let msgs = messages(&body);
     let kinds: String = msgs.iter().map(|(k, _)| *k as char).collect();
-    assert!(kinds.starts_with("MBM") && kinds.ends_with('S'), "{kinds}");
-    let full: Vec<u8> = msgs.iter().skip(3).filter(|(k, _)| *k == b'B').flat_map(|(_, p)| p[12..].to_vec()).collect();
+    assert!(kinds.starts_with("LMBM") && kinds.ends_with('S'), "{kinds}");
+    let full: Vec<u8> = msgs.iter().skip(4).filter(|(k, _)| *k == b'B').flat_map(|(_, p)| p[12..].to_vec()).collect();
     let full = image::RgbImage::from_raw(160, 120, full).expect("a full 160×120 frame");
     if let Some(d) = image_difference("streamed", &full, &rendered(&scene)) {
         panic!("the streamed frame differs from `scnc render`'s: {d}");
@@ -275,6 +275,55 @@ fn an_abandoned_heavy_render_does_not_hold_the_next_one() {
     let kinds: String = messages(&body).iter().map(|(k, _)| *k as char).collect();
     assert!(kinds.ends_with('S'), "{kinds}");
     assert!(took < std::time::Duration::from_secs(4), "the light render took {took:?} behind the heavy one");
+}
+
+/// A newer request stops an older one's lowering too, not only its render: an
+/// isosurface of a heavy field (a field reading the last level twice, 12 levels: 4,096
+/// sphere evaluations a sample, minutes of meshing) asks at every sample whether it is
+/// still wanted, so a light scene sent once the heavy one has begun lowering (its `L`
+/// message) comes back within seconds.
+#[test]
+fn an_abandoned_lowering_does_not_hold_the_next_render() {
+    let (_dir, scene) = seed_scene();
+    let s = Server::start(&scene);
+    let mut heavy = String::from("let s0 = sphere(1)\n");
+    for i in 1..=12 {
+        let b = "bounds = [[-2, -2, -2], [2, 2, 2]]";
+        heavy += &format!("let s{i} = field(p => min(dist(s{}, p), dist(s{}, p * 1.01)), {b})\n", i - 1, i - 1);
+    }
+    heavy += "camera(position = [0, 0, -4], look_at = [0, 0, 0])\nrender(width = 64, height = 64)\n\
+              light ambient(1)\nobject mesh isosurface(s12, cell = 0.005)\n";
+    let mut c = TcpStream::connect(("127.0.0.1", s.port)).unwrap();
+    c.set_read_timeout(Some(std::time::Duration::from_secs(60))).unwrap();
+    let head = format!(
+        "POST /api/render?coarse=4 HTTP/1.1\r\nHost: 127.0.0.1:{}\r\nContent-Length: {}\r\n\r\n",
+        s.port,
+        heavy.len()
+    );
+    c.write_all(head.as_bytes()).unwrap();
+    c.write_all(heavy.as_bytes()).unwrap();
+    // The reply's head and the `L` message: the lowering is under way.
+    let mut got = Vec::new();
+    let mut some = [0u8; 256];
+    while !got.windows(9).any(|w| w == b"\"objects\"") {
+        let n = c.read(&mut some).expect("the heavy render's first message");
+        assert!(n > 0, "the heavy render ended early: {}", String::from_utf8_lossy(&got));
+        got.extend_from_slice(&some[..n]);
+    }
+    let light = "camera(position = [0, 0, -4], look_at = [0, 0, 0])\nrender(width = 64, height = 64)\n\
+                 light ambient(1)\nobject sphere(1)\n";
+    let started = std::time::Instant::now();
+    let (status, body) = s.post("/api/render?coarse=4", light);
+    let took = started.elapsed();
+    assert_eq!(status, 200);
+    let kinds: String = messages(&body).iter().map(|(k, _)| *k as char).collect();
+    assert!(kinds.ends_with('S'), "{kinds}");
+    assert!(took < std::time::Duration::from_secs(4), "the light render took {took:?} behind the heavy lowering");
+    // The heavy request is told it was overtaken.
+    let mut rest = Vec::new();
+    let _ = c.read_to_end(&mut rest);
+    got.extend_from_slice(&rest);
+    assert!(got.windows(7).any(|w| w == b"X\x02\0\0\0{}"), "{}", String::from_utf8_lossy(&got));
 }
 
 /// Clients that declare a large body and send one byte of it hold no slot the page

@@ -7,7 +7,8 @@
 //! The stream is a sequence of messages (see [`super::http::Stream::message`]):
 //! `M` the image about to come (JSON), `B` a band of it (`y0`, `rows`, `width` as u32
 //! and RGB bytes), `S` the render's statistics, `A` the accuracy against the finest rung,
-//! `N` a note, `E` diagnostics that stopped it, `X` overtaken by a newer request.
+//! `N` a note, `E` diagnostics that stopped it, `X` overtaken by a newer request, and
+//! `L` lowering begun (`objects`: how many), sent after the scene compiled.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
@@ -16,6 +17,7 @@ use std::time::Instant;
 use glam::DQuat;
 
 use scnc::diag::Diagnostic;
+use scnc::mesh::lower::Wanted;
 use scnc::mesh::Detail;
 use scnc::render::{Frame, Image, PixelRect};
 use scnc::trace::Counters;
@@ -47,7 +49,7 @@ pub(crate) struct Previews {
     /// Render workers.
     pub(crate) pool: rayon::ThreadPool,
     /// The newest render request: an older one stops at its next band.
-    newest: AtomicU64,
+    newest: Arc<AtomicU64>,
     /// One render at a time.
     running: Mutex<()>,
     /// The last reference render: its key and image.
@@ -56,7 +58,7 @@ pub(crate) struct Previews {
 
 impl Previews {
     pub(crate) fn new(pool: rayon::ThreadPool) -> Previews {
-        Previews { pool, newest: AtomicU64::new(0), running: Mutex::new(()), reference: Mutex::new(None) }
+        Previews { pool, newest: Arc::new(AtomicU64::new(0)), running: Mutex::new(()), reference: Mutex::new(None) }
     }
 }
 
@@ -133,7 +135,8 @@ pub(crate) fn render(studio: &Arc<Studio>, mut req: Req) {
     let id = previews.newest.fetch_add(1, Ordering::AcqRel) + 1;
     let Some(mut out) = req.stream("application/octet-stream") else { return };
     let _one = lock(&previews.running);
-    let current = || previews.newest.load(Ordering::Acquire) == id;
+    let newest = Arc::clone(&previews.newest);
+    let current: Wanted = Arc::new(move || newest.load(Ordering::Acquire) == id);
     if !current() {
         let _ = out.message(b'X', b"{}");
         return;
@@ -149,7 +152,10 @@ pub(crate) fn pick(studio: &Studio, text: String, view: &View, x: f64, y: f64) -
     let mut compiled = studio.files.compile(text);
     let Some(mut scene) = compiled.scene.take() else { return Reply::json(&serde_json::Value::Null) };
     scene.camera = view.apply(&scene.camera);
-    let Ok((frame, world)) = lower(studio, &scene, Mode::Sdf) else { return Reply::json(&serde_json::Value::Null) };
+    let always: Wanted = Arc::new(|| true);
+    let Ok(Some((frame, world))) = lower(studio, &scene, Mode::Sdf, &always) else {
+        return Reply::json(&serde_json::Value::Null);
+    };
     let (px, py) = ((x.clamp(0.0, 1.0) * frame.width as f64) as f32, (y.clamp(0.0, 1.0) * frame.height as f64) as f32);
     let ray = scnc::trace::Ray::new(glam::Vec3A::ZERO, frame.direction(px, py), frame.max_distance);
     let hit = scnc::trace::Geometry::intersect(&world, &ray, &mut Counters::default());
@@ -185,25 +191,27 @@ impl Ask {
     }
 }
 
-/// `scene` lowered for `mode` with the effects it calls for, on the render workers.
-fn lower(studio: &Studio, scene: &scnc::ir::Scene, mode: Mode) -> Result<(Frame, World), Diagnostic> {
+/// `scene` lowered for `mode` with the effects it calls for, on the render workers;
+/// `None` once `current` says a newer request came (an isosurface stops at its next
+/// sample).
+fn lower(
+    studio: &Studio,
+    scene: &scnc::ir::Scene,
+    mode: Mode,
+    current: &Wanted,
+) -> Result<Option<(Frame, World)>, Diagnostic> {
     let effects = scnc::render::effects::derive(scene);
     let limit = scnc::mesh::lower::DEFAULT_MEMORY_LIMIT;
     let loader = studio.files.loader();
-    studio.preview.pool.install(|| scnc::world::prepare_within(scene, effects, mode, &loader, limit))
+    let wanted = Arc::clone(current);
+    studio.preview.pool.install(|| scnc::world::prepare_until(scene, effects, mode, &loader, limit, wanted))
 }
 
 fn json_message(out: &mut Stream, kind: u8, value: serde_json::Value) -> std::io::Result<()> {
     out.message(kind, value.to_string().as_bytes())
 }
 
-fn run(
-    studio: &Studio,
-    text: &str,
-    ask: &Ask,
-    out: &mut Stream,
-    current: &(dyn Fn() -> bool + Sync),
-) -> std::io::Result<()> {
+fn run(studio: &Studio, text: &str, ask: &Ask, out: &mut Stream, current: &Wanted) -> std::io::Result<()> {
     let loader = studio.files.loader();
     let mut compiled = studio.files.compile(text.to_string());
     let Some(first) = compiled.scene.take() else {
@@ -235,9 +243,11 @@ fn run(
         json_message(out, b'N', serde_json::json!({ "note": note }))?;
     }
     let mode = ask.setting(ask.rung, &mut scene);
+    json_message(out, b'L', serde_json::json!({ "objects": scene.objects.len() }))?;
     let started = Instant::now();
-    let (frame, world) = match lower(studio, &scene, mode) {
-        Ok(l) => l,
+    let (frame, world) = match lower(studio, &scene, mode, current) {
+        Ok(Some(l)) => l,
+        Ok(None) => return out.message(b'X', b"{}"),
         Err(d) => return json_message(out, b'E', diagnostics_json(&compiled.map, &[d])),
     };
     let lower_s = started.elapsed().as_secs_f64();
@@ -348,7 +358,7 @@ fn accuracy(
     image: &Image,
     seconds: f64,
     out: &mut Stream,
-    current: &(dyn Fn() -> bool + Sync),
+    current: &Wanted,
 ) -> std::io::Result<()> {
     use std::hash::{Hash, Hasher};
     let finest = SDF_RUNGS.len() - 1;
@@ -369,7 +379,8 @@ fn accuracy(
             let mode = ask.setting(Some(finest), &mut scene);
             let t = Instant::now();
             let stop = || !current();
-            let rendered = lower(studio, &scene, mode).map(|(frame, world)| {
+            let rendered = lower(studio, &scene, mode, current).map(|lowered| {
+                let (frame, world) = lowered?;
                 let all = PixelRect::full(frame.width, frame.height);
                 studio.preview.pool.install(|| scnc::render::render_region_until(&world, &frame, all, &|| {}, &stop))
             });

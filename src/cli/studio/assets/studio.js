@@ -203,6 +203,7 @@ async function render(sourceText, opts = {}) {
           $("status").classList.remove("stale");
           $("status").textContent = "not rendered: the scene has errors (the last image stays)";
           break;
+        case "L": break; // lowering begun: the images follow
         case "X": break;
       }
     });
