@@ -25,28 +25,28 @@ pub struct Root {
     pub surf: SurfSdf,
     /// How a ray marches it.
     pub walk: Walk,
-    /// Whether the distance bound may understate the distance near the surface by more
-    /// than rounding (`understates`): its hits are then confirmed by the gradient
-    /// ([`super::march::refine`]).
-    pub loose: bool,
+    /// How many times over the distance bound may understate the distance near the
+    /// surface ([`looseness`]); above 1 its hits are confirmed by the gradient
+    /// ([`super::march::refine`]) and its marches take that many times the steps.
+    pub loose: f64,
 }
 
-/// Whether a shape's distance bound is divided by a stated or estimated slope above 1
-/// somewhere (a field, a warp or a displacement): near the surface it is then the
-/// distance over up to that slope, and a hit test on it alone takes a shell up to
-/// `L` thresholds thick for the surface.
-pub fn understates(shape: &Shape) -> bool {
+/// How many times over a shape's distance bound may understate its distance near the
+/// surface: the product, down any path of the tree, of the slopes it is divided by (a
+/// field's or a warp's stated or estimated `L`, a displacement's `1 + L`). Above 1 the
+/// bound alone takes a shell up to that many thresholds thick for the surface, and the
+/// march crawls there by the bound: about that many times the steps.
+pub fn looseness(shape: &Shape) -> f64 {
+    let most = |shapes: &[Arc<Shape>]| shapes.iter().map(|s| looseness(s)).fold(1.0, f64::max);
     match &shape.kind {
-        ShapeKind::Field { body, lipschitz, .. } => {
-            lipschitz.value > 1.0 || body.shapes().iter().any(|s| understates(s))
-        }
+        ShapeKind::Field { body, lipschitz, .. } => lipschitz.value.max(1.0) * most(&body.shapes()),
         // A twist or bend divides by its stretch where the point is, not by `L`.
         ShapeKind::Warp { child, domain_op: Some(op), .. } if super::domain::Map::new(*op).is_some() => {
-            understates(child)
+            looseness(child)
         }
-        ShapeKind::Warp { child, lipschitz, .. } => lipschitz.value > 1.0 || understates(child),
-        ShapeKind::Displace { .. } => true,
-        _ => shape.children().iter().any(|c| understates(c)),
+        ShapeKind::Warp { child, lipschitz, .. } => lipschitz.value.max(1.0) * looseness(child),
+        ShapeKind::Displace { child, lipschitz, .. } => (1.0 + lipschitz.value) * looseness(child),
+        _ => most(shape.children()),
     }
 }
 
@@ -190,7 +190,7 @@ impl<'a> Builder<'a> {
         } else {
             Walk::Plain
         };
-        Root { dist: d, surf: m, walk, loose: understates(shape) }
+        Root { dist: d, surf: m, walk, loose: looseness(shape) }
     }
 
     fn sdf<F: Fn(Vec3A) -> f32 + Send + Sync + 'static>(&mut self, f: F) -> Sdf {

@@ -39,9 +39,17 @@ pub struct SdfObject {
     convex: bool,
     /// How its rays are marched.
     walk: Walk,
-    /// Whether its hits are confirmed by [`march::refine`] (`build::understates`).
-    loose: bool,
+    /// Whether its hits are confirmed by [`march::refine`] ([`build::looseness`] above
+    /// 1), and then how many times the scene's step budget its marches get.
+    loose: Option<u32>,
 }
+
+/// Most times the scene's step budget a loose object's marches get: a stated slope of
+/// 64 or more crawls by its bound at up to 64 × 512 steps a ray by default.
+const MAX_WIDENING: f64 = 64.0;
+
+/// The most steps a widened budget reaches, unless the scene's own is larger.
+const MAX_WIDENED_STEPS: u64 = 1 << 16;
 
 impl SdfObject {
     /// Lowers a shape seen through `xf` (render from world) into closures.
@@ -52,7 +60,22 @@ impl SdfObject {
             Walk::Field(f) => f.convex,
             Walk::Plain | Walk::Parts(_) | Walk::Warp(_) => shape.is_convex(),
         };
-        SdfObject { dist: root.dist, mat: root.surf, walk: root.walk, convex, loose: root.loose }
+        // A bound that understates the distance `L` times near the surface crawls there
+        // at about `L` times the steps: the budget grows with it, so a large stated
+        // slope costs steps, not pixels.
+        let loose = (root.loose > 1.0).then(|| root.loose.min(MAX_WIDENING).ceil() as u32);
+        SdfObject { dist: root.dist, mat: root.surf, walk: root.walk, convex, loose }
+    }
+
+    /// `params` with the step budget this object's marches get.
+    fn widened(&self, params: MarchParams) -> MarchParams {
+        match self.loose {
+            Some(k) => {
+                let wide = (u64::from(params.max_steps) * u64::from(k)).min(MAX_WIDENED_STEPS);
+                MarchParams { max_steps: params.max_steps.max(wide as u32), ..params }
+            }
+            None => params,
+        }
     }
 
     /// Marches the ray over `[t0, t1]`; on a hit, its distance and the threshold there
@@ -69,11 +92,12 @@ impl SdfObject {
         c: &mut Counters,
         evals: &mut u64,
     ) -> Option<(f32, f32)> {
+        let params = self.widened(params);
         if inside {
             return march::march_out(&*self.dist, ray, t0, t1, params, c, evals);
         }
         let hit = self.walk_closest(ray, (t0, t1), params, c, evals);
-        if self.loose {
+        if self.loose.is_some() {
             self.confirm(hit, ray, t1, params, c, evals)
         } else {
             hit
@@ -144,18 +168,19 @@ impl SdfObject {
         c: &mut Counters,
         evals: &mut [[u64; 4]; N],
     ) -> [[Option<(f32, f32)>; 4]; N] {
+        let wide = self.widened(params);
         let mut hits = match &self.walk {
-            Walk::Field(field) => field.march_packet(quads, mask, spans, params, c, evals),
-            Walk::Parts(parts) if parts.k == 0.0 => parts.march_packet(quads, mask, spans, params, c, evals),
+            Walk::Field(field) => field.march_packet(quads, mask, spans, wide, c, evals),
+            Walk::Parts(parts) if parts.k == 0.0 => parts.march_packet(quads, mask, spans, wide, c, evals),
             Walk::Plain | Walk::Parts(_) | Walk::Warp(_) => {
                 return self.each_lane(quads, mask, spans, params, c, evals)
             }
         };
-        if self.loose {
+        if self.loose.is_some() {
             for lane in crate::trace::lanes(mask) {
                 let (g, l) = (lane / 4, lane % 4);
                 let (ray, t1) = (&quads[g].rays[l], spans[g][l].1);
-                hits[g][l] = self.confirm(hits[g][l], ray, t1, params, c, &mut evals[g][l]);
+                hits[g][l] = self.confirm(hits[g][l], ray, t1, wide, c, &mut evals[g][l]);
             }
         }
         hits
@@ -218,6 +243,7 @@ impl SdfObject {
         c: &mut Counters,
         evals: &mut u64,
     ) -> f32 {
+        let params = self.widened(params);
         let base = ray.origin.length();
         let mut t = t0;
         let mut res = 1.0f32;
@@ -225,7 +251,7 @@ impl SdfObject {
             let h = (self.dist)(ray.at(t));
             *evals += 1;
             if h < march::threshold(params.epsilon, base, t) {
-                if !self.loose {
+                if self.loose.is_none() {
                     return 0.0;
                 }
                 match march::refine(&*self.dist, &*self.mat, ray, (t, t1), params, c, evals) {
