@@ -37,6 +37,7 @@
 //! Every stage reports problems as [`diag::Diagnostic`] values; only the binary prints.
 
 pub mod accel;
+pub mod builtins;
 pub mod check;
 pub mod compile;
 pub mod diag;

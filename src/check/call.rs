@@ -3,10 +3,11 @@
 
 use glam::DVec3;
 
-use super::builtins::{self, Builtin, Ctor, Kind, Ty};
-use super::expr::{ArgVal, BoundArgs, SYNONYMS};
+use super::expr::{ArgVal, SYNONYMS};
 use super::field::has_sym;
 use super::{Bound, Ctx, Env, Func, Value, MAX_CALL_DEPTH};
+use crate::builtins::BoundArgs;
+use crate::builtins::{self, Builtin, Ctor, Kind, Ty};
 use crate::diag::guesses::guess;
 use crate::diag::{codes, suggest, Diagnostic};
 use crate::ir::dump_num;
@@ -177,7 +178,7 @@ impl Ctx<'_> {
                 let x = self.expr(value);
                 if let Value::Num(x) = x {
                     self.note_builtin(name, b);
-                    return self.math(b, *f, x, value.span, span);
+                    return self.host().math(b, *f, x, value.span, span);
                 }
                 vec![ArgVal { name: None, value: x, span: value.span }]
             }
@@ -196,7 +197,7 @@ impl Ctx<'_> {
             Some(bound) if symbolic && bound.vals.iter().flatten().chain(&bound.rest).any(|(v, _)| has_sym(v)) => {
                 self.symbolic_call(builtin, &bound)
             }
-            Some(bound) => self.construct(builtin, bound),
+            Some(bound) => self.host().construct(builtin, bound),
             None => Value::Error,
         }
     }
@@ -421,7 +422,7 @@ impl Ctx<'_> {
         if ok && !poisoned {
             for (p, slot) in b.params.iter().zip(&vals) {
                 if let Some((v, span)) = slot {
-                    ok &= self.in_range(p, v, *span);
+                    ok &= self.host().in_range(p, v, *span);
                 }
             }
         }
@@ -587,8 +588,8 @@ fn admits(ty: Ty, v: &Value) -> bool {
         Ty::Mesh => matches!(v, Value::Mesh(_)),
         Ty::Light => matches!(v, Value::Light(_)),
         Ty::List => matches!(v, Value::List(_) | Value::Vec3(_)),
-        Ty::FieldNum => matches!(v, Value::Field(f) if f.body.ty == crate::ir::field::Ty::Num),
-        Ty::FieldVec => matches!(v, Value::Field(f) if f.body.ty == crate::ir::field::Ty::Vec3),
+        Ty::FieldNum => matches!(v, Value::Field(f) if f.body.ty == crate::ir::field::FieldTy::Num),
+        Ty::FieldVec => matches!(v, Value::Field(f) if f.body.ty == crate::ir::field::FieldTy::Vec3),
         // Its two corners are checked by the builtin, which can say which is wrong.
         Ty::Bounds => matches!(v, Value::List(_)),
         Ty::Profile => matches!(v, Value::Profile(_)),
@@ -615,8 +616,8 @@ fn admits_part(o: &Builtin, v: &Value) -> bool {
 
 /// Whether a value that varies with a field's point may stand for a parameter of type `ty`
 /// of a function of numbers.
-fn point_value_fits(ty: Ty, e: &crate::ir::field::Expr) -> bool {
-    use crate::ir::field::Ty as F;
+fn point_value_fits(ty: Ty, e: &crate::ir::field::FieldExpr) -> bool {
+    use crate::ir::field::FieldTy as F;
     match ty {
         Ty::Num => e.ty == F::Num,
         Ty::Vec3 => e.ty == F::Vec3,
@@ -664,7 +665,7 @@ fn named_colour(name: &str) -> Option<&'static str> {
 
 #[cfg(test)]
 mod guess_tests {
-    use super::builtins::{self, Kind};
+    use crate::builtins::{self, Kind};
     use crate::diag::guesses::GUESSES;
 
     /// Advice for a word scnc itself defines would hide the real thing; no guess is one,

@@ -74,7 +74,7 @@ impl Ctx<'_> {
         match v {
             Value::Bool(b) => Some(*b),
             Value::Error => None,
-            Value::Sym(e) if e.ty == crate::ir::field::Ty::Bool => {
+            Value::Sym(e) if e.ty == crate::ir::field::FieldTy::Bool => {
                 self.depends_on_point(span, what);
                 None
             }
@@ -121,7 +121,7 @@ impl Ctx<'_> {
     pub(super) fn if_expr(&mut self, cond: &ast::Expr, then: &ast::Expr, otherwise: &ast::Expr) -> Value {
         let c = self.expr(cond);
         if let Value::Sym(s) = &c {
-            if s.ty == crate::ir::field::Ty::Bool {
+            if s.ty == crate::ir::field::FieldTy::Bool {
                 return self.symbolic_if(s.clone(), then, otherwise);
             }
         }
@@ -356,7 +356,7 @@ impl Ctx<'_> {
                 }
             }
             if out.len() >= MAX_LIST {
-                self.list_too_long(span, "this comprehension makes too many elements".into());
+                self.host().list_too_long(span, "this comprehension makes too many elements".into());
                 return false;
             }
             let v = self.expr(body);

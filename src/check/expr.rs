@@ -5,11 +5,11 @@ use std::rc::Rc;
 
 use glam::DVec3;
 
-use super::builtins::{self, Kind};
 use super::{Bound, Ctx, Value, MAX_EXPR_DEPTH, MAX_LIST};
+use crate::builtins::{self, Kind};
 use crate::diag::{codes, suggest, Diagnostic};
 use crate::ir::dump_num;
-use crate::ir::field::Ty as FTy;
+use crate::ir::field::FieldTy as FTy;
 use crate::span::Span;
 use crate::syntax::ast::{self, BinOp, ExprKind};
 
@@ -18,18 +18,6 @@ pub(super) struct ArgVal {
     pub name: Option<ast::Ident>,
     pub value: Value,
     pub span: Span,
-}
-
-/// Arguments bound to a builtin's parameters, after arity, name and type checks.
-pub(super) struct BoundArgs {
-    /// The builtin's parameters, for the defaults of the slots not given.
-    pub params: &'static [crate::sig::Param],
-    /// One slot per parameter: the value and the span to blame for it.
-    pub vals: Vec<Option<(Value, Span)>>,
-    /// Variadic positional arguments.
-    pub rest: Vec<(Value, Span)>,
-    /// The whole call.
-    pub call: Span,
 }
 
 /// Words users reach for that scnc spells differently.
@@ -225,7 +213,7 @@ impl Ctx<'_> {
 
     fn list(&mut self, items: &[ast::Expr], span: Span) -> Value {
         if items.len() > MAX_LIST {
-            self.list_too_long(span, format!("this list has {} elements", items.len()));
+            self.host().list_too_long(span, format!("this list has {} elements", items.len()));
             return Value::Error;
         }
         let values: Vec<(Value, Span)> = items.iter().map(|e| (self.expr(e), e.span)).collect();
@@ -239,8 +227,8 @@ impl Ctx<'_> {
         // Three numbers, some depending on a field's point: a vector that does too.
         let num = |v: &Value| matches!(v, Value::Num(_)) || matches!(v, Value::Sym(e) if e.ty == FTy::Num);
         if values.len() == 3 && values.iter().all(|(v, _)| num(v)) {
-            let c = |i: usize| values[i].0.as_field().unwrap_or_else(|| crate::ir::field::Expr::num(0.0));
-            return Value::Sym(crate::ir::field::Expr::vector([c(0), c(1), c(2)]));
+            let c = |i: usize| values[i].0.as_field().unwrap_or_else(|| crate::ir::field::FieldExpr::num(0.0));
+            return Value::Sym(crate::ir::field::FieldExpr::vector([c(0), c(1), c(2)]));
         }
         self.uniform_list(values).unwrap_or(Value::Error)
     }
@@ -476,25 +464,7 @@ impl Ctx<'_> {
                 return Value::Error;
             }
         };
-        self.finite(result, span, || "arithmetic overflowed".into())
-    }
-
-    /// `v`, or poison after reporting at `span` that a number in it overflowed (E0401);
-    /// `message` is formatted only then.
-    pub(super) fn finite(&mut self, v: Value, span: Span, message: impl FnOnce() -> String) -> Value {
-        if v.is_finite() {
-            return v;
-        }
-        self.report(Diagnostic::error(codes::NOT_FINITE, span, message(), "the result is not a finite number"));
-        Value::Error
-    }
-
-    /// Reports a list over [`MAX_LIST`] elements at `span`, `label` saying how long.
-    pub(super) fn list_too_long(&mut self, span: Span, label: String) {
-        self.report(
-            Diagnostic::error(codes::TOO_LARGE, span, "list is too long", label)
-                .with_note(format!("lists may hold at most {MAX_LIST} elements")),
-        );
+        self.host().finite(result, span, || "arithmetic overflowed".into())
     }
 }
 

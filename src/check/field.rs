@@ -1,7 +1,7 @@
 //! Field literals and the values that depend on their point.
 //!
 //! A literal's body is evaluated once, with the point an unknown: what the point flows
-//! into becomes a [`Value::Sym`], an expression of it (`ir::field::Expr`), and
+//! into becomes a [`Value::Sym`], an expression of it (`ir::field::FieldExpr`), and
 //! everything else is computed as usual, so what does not depend on the point is
 //! folded before rendering. Arithmetic, comparisons, `if`, `and`/`or`/`not`, indexing
 //! and components, the maths builtins and user functions all take such values; what
@@ -11,12 +11,13 @@
 use std::rc::Rc;
 use std::sync::Arc;
 
-use super::builtins::{Builtin, Ctor, FieldForm, InFields, MathFn};
-use super::expr::{bad_operands, BoundArgs};
-use super::value::FieldLit;
+use super::expr::bad_operands;
 use super::{index, Bound, Ctx, Value};
+use crate::builtins::BoundArgs;
+use crate::builtins::FieldLit;
+use crate::builtins::{Builtin, Ctor, FieldForm, InFields, MathFn};
 use crate::diag::{codes, Diagnostic};
-use crate::ir::field::{Binary, Expr, Kind, Ty, Unary};
+use crate::ir::field::{Binary, FieldExpr, FieldKind, FieldTy, Unary};
 use crate::span::Span;
 use crate::syntax::ast::{self, BinOp};
 
@@ -26,14 +27,14 @@ impl Ctx<'_> {
         self.env.push_scope();
         let ty = Some("vec3, the point the field is evaluated at".to_string());
         self.note_def(param, index::DefKind::Point, ty, body.span.start, body.span.end);
-        self.bind(param, Bound::Value(Value::Sym(Expr::point())));
+        self.bind(param, Bound::Value(Value::Sym(FieldExpr::point())));
         self.field_depth += 1;
         let v = self.expr(body);
         self.field_depth -= 1;
         self.env.pop_scope();
         match &v {
             Value::Error => Value::Error,
-            Value::Num(_) | Value::Vec3(_) | Value::Sym(_) if v.ty() != Some(super::builtins::Ty::Bool) => {
+            Value::Num(_) | Value::Vec3(_) | Value::Sym(_) if v.ty() != Some(crate::builtins::Ty::Bool) => {
                 match v.as_field() {
                     Some(body_expr) => Value::Field(Rc::new(FieldLit { body: body_expr, span: body.span })),
                     None => Value::Error,
@@ -92,7 +93,7 @@ impl Ctx<'_> {
         };
         match base {
             Value::Vec3(v) => Value::Num(v[i]),
-            Value::Sym(e) if e.ty == Ty::Vec3 => Value::Sym(component(&e, i)),
+            Value::Sym(e) if e.ty == FieldTy::Vec3 => Value::Sym(component(&e, i)),
             Value::Error => Value::Error,
             other => {
                 self.report(
@@ -110,17 +111,17 @@ impl Ctx<'_> {
     }
 
     /// `-x` of a value that depends on the point.
-    pub(super) fn symbolic_neg(&mut self, e: Arc<Expr>, span: Span) -> Value {
-        self.sym(Expr::unary(Unary::Neg, e), span, "`-`")
+    pub(super) fn symbolic_neg(&mut self, e: Arc<FieldExpr>, span: Span) -> Value {
+        self.sym(FieldExpr::unary(Unary::Neg, e), span, "`-`")
     }
 
     /// `not x` of a value that depends on the point.
-    pub(super) fn symbolic_not(&mut self, e: Arc<Expr>, span: Span) -> Value {
-        self.sym(Expr::unary(Unary::Not, e), span, "`not`")
+    pub(super) fn symbolic_not(&mut self, e: Arc<FieldExpr>, span: Span) -> Value {
+        self.sym(FieldExpr::unary(Unary::Not, e), span, "`not`")
     }
 
     /// The node `e`, or a report at `span` that `what` does not take these operands.
-    fn sym(&mut self, e: Option<Arc<Expr>>, span: Span, what: &str) -> Value {
+    fn sym(&mut self, e: Option<Arc<FieldExpr>>, span: Span, what: &str) -> Value {
         match e {
             Some(e) => Value::Sym(e),
             None => {
@@ -163,7 +164,7 @@ impl Ctx<'_> {
         };
         let (x, y) = (a.as_field(), b.as_field());
         let node = match (&x, &y) {
-            (Some(x), Some(y)) => Expr::binary(f, x.clone(), y.clone()),
+            (Some(x), Some(y)) => FieldExpr::binary(f, x.clone(), y.clone()),
             _ => None,
         };
         Some(match node {
@@ -180,7 +181,7 @@ impl Ctx<'_> {
     }
 
     /// `if c then a else b` where `c` depends on the point: both branches, chosen per point.
-    pub(super) fn symbolic_if(&mut self, c: Arc<Expr>, then: &ast::Expr, otherwise: &ast::Expr) -> Value {
+    pub(super) fn symbolic_if(&mut self, c: Arc<FieldExpr>, then: &ast::Expr, otherwise: &ast::Expr) -> Value {
         self.explored.extend([then.span, otherwise.span]);
         let a = self.expr(then);
         let b = self.expr(otherwise);
@@ -189,7 +190,7 @@ impl Ctx<'_> {
         }
         let (x, y) = (a.as_field(), b.as_field());
         match (x, y) {
-            (Some(x), Some(y)) if x.ty == y.ty => Value::Sym(Expr::new(Kind::Select(c, x.clone(), y), x.ty)),
+            (Some(x), Some(y)) if x.ty == y.ty => Value::Sym(FieldExpr::new(FieldKind::Select(c, x.clone(), y), x.ty)),
             (Some(x), Some(y)) => {
                 self.report(
                     Diagnostic::error(
@@ -234,41 +235,41 @@ impl Ctx<'_> {
             InFields::NotMaths => return Value::Error,
         };
         let arg = |i: usize| a.vals.get(i).and_then(|s| s.as_ref()).and_then(|(v, _)| v.as_field());
-        let un = |f: Unary| arg(0).and_then(|x| Expr::unary(f, x));
-        let bin = |f: Binary, i: usize, j: usize| arg(i).zip(arg(j)).and_then(|(x, y)| Expr::binary(f, x, y));
+        let un = |f: Unary| arg(0).and_then(|x| FieldExpr::unary(f, x));
+        let bin = |f: Binary, i: usize, j: usize| arg(i).zip(arg(j)).and_then(|(x, y)| FieldExpr::binary(f, x, y));
         let node = match form {
             FieldForm::Unary(u) => un(u),
             FieldForm::Binary(f) => bin(f, 0, 1),
             FieldForm::Clamp => {
                 let low = bin(Binary::Max, 0, 1);
-                low.zip(arg(2)).and_then(|(l, hi)| Expr::binary(Binary::Min, l, hi))
+                low.zip(arg(2)).and_then(|(l, hi)| FieldExpr::binary(Binary::Min, l, hi))
             }
             FieldForm::Mix => {
                 // a + (b − a)·t: exactly `a` at 0 and `b` at 1, as `mix` of numbers is.
                 let (x, y, t) = (arg(0), arg(1), arg(2));
                 x.clone().zip(y).zip(t).and_then(|((x, y), t)| {
-                    let d = Expr::binary(Binary::Sub, y, x.clone())?;
-                    Expr::binary(Binary::Add, x, Expr::binary(Binary::Mul, d, t)?)
+                    let d = FieldExpr::binary(Binary::Sub, y, x.clone())?;
+                    FieldExpr::binary(Binary::Add, x, FieldExpr::binary(Binary::Mul, d, t)?)
                 })
             }
             FieldForm::Sum => {
                 let Some((Value::List(items), _)) = a.vals.first().and_then(|s| s.as_ref()) else {
                     return Value::Error;
                 };
-                let parts: Option<Vec<Arc<Expr>>> = items.iter().map(Value::as_field).collect();
+                let parts: Option<Vec<Arc<FieldExpr>>> = items.iter().map(Value::as_field).collect();
                 parts.and_then(|ps| {
                     let mut ps = ps.into_iter();
                     let first = ps.next()?;
-                    ps.try_fold(first, |acc, e| Expr::binary(Binary::Add, acc, e))
+                    ps.try_fold(first, |acc, e| FieldExpr::binary(Binary::Add, acc, e))
                 })
             }
             FieldForm::Fold(f) => {
                 let mut parts = a.rest.iter().map(|(v, _)| v.as_field());
                 let first = parts.next().flatten();
-                parts.try_fold(first, |acc, x| Some(acc.zip(x).and_then(|(s, x)| Expr::binary(f, s, x)))).flatten()
+                parts.try_fold(first, |acc, x| Some(acc.zip(x).and_then(|(s, x)| FieldExpr::binary(f, s, x)))).flatten()
             }
-            FieldForm::Dist => return self.dist(a),
-            FieldForm::Noise3 => return self.noise3(a),
+            FieldForm::Dist => return self.host().dist(a),
+            FieldForm::Noise3 => return self.host().noise3(a),
         };
         match node {
             Some(e) => Value::Sym(e),
@@ -312,10 +313,10 @@ pub(super) fn has_sym(v: &Value) -> bool {
 }
 
 /// Component `i` of a vector expression, folded through vectors built of components.
-fn component(e: &Arc<Expr>, i: usize) -> Arc<Expr> {
+fn component(e: &Arc<FieldExpr>, i: usize) -> Arc<FieldExpr> {
     match &e.kind {
-        Kind::Vector(xs) => xs[i].clone(),
-        Kind::Vec(v) => Expr::num(v[i]),
-        _ => Expr::new(Kind::Component(e.clone(), i), Ty::Num),
+        FieldKind::Vector(xs) => xs[i].clone(),
+        FieldKind::Vec(v) => FieldExpr::num(v[i]),
+        _ => FieldExpr::new(FieldKind::Component(e.clone(), i), FieldTy::Num),
     }
 }

@@ -7,7 +7,7 @@
 
 use std::collections::HashMap;
 
-use super::builtins::{Builtin, Constant, Param};
+use crate::builtins::{Builtin, Constant, Param};
 use crate::span::Span;
 
 /// What kind of name a definition binds.

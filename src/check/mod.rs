@@ -12,9 +12,7 @@
 //! **Invariant:** a `Scene` is returned only when no error was reported, and then it
 //! satisfies the invariants stated in [`ir`].
 
-pub mod builtins;
 mod call;
-mod construct;
 mod control;
 mod env;
 mod expr;
@@ -25,28 +23,25 @@ mod range;
 mod scene;
 mod time;
 mod transform;
-mod value;
 
 use std::cell::Cell;
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
 
-use glam::DVec3;
-
+use crate::builtins::{self, BoundArgs, Host};
+pub use crate::builtins::{
+    Value, EPSILON_RANGE, MAX_DEPTH, MAX_FPS, MAX_FRAMES, MAX_GENERATED_TRIANGLES, MAX_IMAGE_SIDE, MAX_LIST,
+    MAX_MESH_RESOLUTION, MAX_OBJECTS, MAX_PIXELS, MAX_REPEAT, MAX_SAMPLES, MAX_STEPS, MIN_EPSILON,
+};
 use crate::diag::{codes, Diagnostic};
 use crate::ir::{self, Camera, Scene, Settings};
 use crate::source::{FileId, Loader, SourceMap};
 use crate::span::Span;
 use crate::syntax::ast;
-pub use construct::{
-    EPSILON_RANGE, MAX_DEPTH, MAX_FPS, MAX_FRAMES, MAX_GENERATED_TRIANGLES, MAX_IMAGE_SIDE, MAX_MESH_RESOLUTION,
-    MAX_PIXELS, MAX_REPEAT, MAX_SAMPLES, MAX_STEPS, MIN_EPSILON,
-};
 use env::{Binding, Captured, Env, Found};
 pub use range::{MAX_INTENSITY, MAX_REACH, MIN_SIZE};
 pub use time::{Reuse, Time};
-pub use value::Value;
 
 /// Most loop iterations in one compile, over all loops.
 pub const MAX_ITERATIONS: u64 = 1_000_000;
@@ -57,12 +52,8 @@ pub const MAX_INCLUDE_DEPTH: usize = 16;
 /// Most `include` statements one compile may carry out (a file including the next twice,
 /// sixteen deep, would read 65,536 files).
 pub const MAX_INCLUDES: usize = 1_000;
-/// Most objects in a scene.
-pub const MAX_OBJECTS: usize = 100_000;
 /// Most lights in a scene.
 pub const MAX_LIGHTS: usize = 1_000;
-/// Longest list.
-pub const MAX_LIST: usize = 100_000;
 /// Deepest expression nesting (operators, calls and transforms count).
 pub const MAX_EXPR_DEPTH: usize = 256;
 /// Evaluation steps one compile may take: every expression evaluated, and every list
@@ -172,6 +163,47 @@ struct Ctx<'a> {
     /// While evaluating a file included from the root file: the span in the root after
     /// which the included top-level names are in scope, and the scope depth of that level.
     export: Option<(u32, u32, usize)>,
+}
+
+/// The evaluator as the builtins' constructors see it.
+impl Host for Ctx<'_> {
+    fn report(&mut self, d: Diagnostic) {
+        Ctx::report(self, d);
+    }
+
+    fn burn(&mut self, steps: u64, span: Span) -> bool {
+        Ctx::burn(self, steps, span)
+    }
+
+    fn in_field_body(&self) -> bool {
+        self.field_depth > 0
+    }
+
+    fn file_dir(&self) -> &Path {
+        &self.dir
+    }
+}
+
+impl<'a> Ctx<'a> {
+    /// The evaluator as a constructor's host: `self.host().construct(…)`.
+    fn host(&mut self) -> &mut (dyn Host + 'a) {
+        self
+    }
+
+    /// The bound arguments of a `camera` or `render` statement.
+    fn statement_args(&mut self, name: &str, args: &[ast::Arg], span: Span) -> Option<BoundArgs> {
+        let kind = if name == "camera" { builtins::Kind::Camera } else { builtins::Kind::Render };
+        let b = builtins::lookup(name, kind)?;
+        let vals = args
+            .iter()
+            .map(|arg| expr::ArgVal {
+                name: arg.name.clone(),
+                value: self.expr(&arg.value),
+                span: arg.name.as_ref().map_or(arg.value.span, |n| n.span.to(arg.value.span)),
+            })
+            .collect();
+        self.bind_builtin(b, vals, span)
+    }
 }
 
 impl Ctx<'_> {
@@ -383,7 +415,8 @@ impl Ctx<'_> {
                 }
             }
             ast::StmtKind::Camera(args) => {
-                let cam = self.camera_stmt(args, stmt.span);
+                let cam =
+                    self.statement_args("camera", args, stmt.span).and_then(|a| self.host().camera(&a, stmt.span));
                 if self.dry > 0 {
                     return;
                 }
@@ -406,7 +439,8 @@ impl Ctx<'_> {
                 }
             }
             ast::StmtKind::Render(args) => {
-                let settings = self.render_stmt(args, stmt.span);
+                let settings =
+                    self.statement_args("render", args, stmt.span).and_then(|a| self.host().settings(&a, stmt.span));
                 if self.dry > 0 {
                     return;
                 }
@@ -611,25 +645,4 @@ pub fn check_indexed(
     let input = Input { map, root, loader, time: Time::STILL, reuse: &mut Reuse::default() };
     let (scene, diags, index) = run(input, true, cancel)?;
     Some((scene, diags, index.unwrap_or_default()))
-}
-
-/// The unit vector along `v`, or `None` for a zero or non-finite vector. Scaled by its
-/// largest component first, as `hypot` does, so `[1e200, 1e200, 0]` (whose `x·x`
-/// overflows) and `[1e-200, 0, 0]` (whose `x·x` underflows) have directions.
-pub(crate) fn direction(v: DVec3) -> Option<DVec3> {
-    let big = v.abs().max_element();
-    if !big.is_finite() || big == 0.0 {
-        return None;
-    }
-    let n = (v / big).try_normalize()?;
-    n.is_finite().then_some(n)
-}
-
-/// The length of `v` without overflow or underflow in its squares (as `hypot`).
-pub(crate) fn length(v: DVec3) -> f64 {
-    let big = v.abs().max_element();
-    if big == 0.0 || !big.is_finite() {
-        return big;
-    }
-    big * (v / big).length()
 }

@@ -8,11 +8,10 @@
 //! suite renders the same image at every scale it tries (1e-4 to 1e4).
 
 use super::Ctx;
+pub use crate::builtins::MAX_REACH;
 use crate::diag::{codes, Diagnostic};
 use crate::ir::{self, Body, Camera, LightKind, Shape, ShapeKind};
 
-/// Farthest any part of the scene may reach from the camera, in world units.
-pub const MAX_REACH: f64 = 1e15;
 /// Smallest object, across its bounds, in world units.
 pub const MIN_SIZE: f64 = 1e-12;
 /// Largest light intensity.

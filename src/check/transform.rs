@@ -68,7 +68,7 @@ impl Ctx<'_> {
             };
         }
         if let (Value::Profile(profile), false) = (&target, op == TransformOp::With) {
-            return self.transform_profile(op, profile, &arg, arg_span);
+            return self.host().transform_profile(op, profile, &arg, arg_span);
         }
         if !matches!(target, Value::Shape(_) | Value::Mesh(_)) {
             return bad_target(self, "transforms apply to shapes and meshes (and `at`, `rotate`, `scale` to profiles)");
@@ -89,7 +89,7 @@ impl Ctx<'_> {
                 return Value::Error;
             };
             return match target {
-                Value::Shape(s) => self.shape_value(ir::ShapeKind::Paint { child: s, material: m }, span),
+                Value::Shape(s) => self.host().shape_value(ir::ShapeKind::Paint { child: s, material: m }, span),
                 Value::Mesh(mesh) => {
                     let mut mesh = (*mesh).clone();
                     // The innermost material wins, as for shapes.
@@ -153,7 +153,7 @@ impl Ctx<'_> {
             }
         };
         match target {
-            Value::Shape(s) => self.sized(apply_xf(s, xf, span)),
+            Value::Shape(s) => self.host().sized(apply_xf(s, xf, span)),
             Value::Mesh(m) => {
                 let mut m = (*m).clone();
                 m.xf = xf * m.xf;

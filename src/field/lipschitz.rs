@@ -14,7 +14,7 @@ use glam::DVec3;
 use super::interval::{Interval, JetBox, Slope};
 use super::tape::{Distances, Tape};
 use crate::geom::DAabb;
-use crate::ir::field::Ty;
+use crate::ir::field::FieldTy;
 
 /// How close the bound gets to the largest slope found before refinement stops.
 const CLOSE: f64 = 1.05;
@@ -59,7 +59,7 @@ impl Ord for Cell {
 /// The slope bound and value range of `tape` over the box `lo..hi`.
 fn over(tape: &Tape, lo: DVec3, hi: DVec3, dist: &(dyn Distances<Slope> + Sync)) -> (f64, Interval) {
     let p = JetBox::gradient([0, 1, 2].map(|i| Interval::new(lo[i], hi[i])));
-    if tape.ty() == Ty::Vec3 {
+    if tape.ty() == FieldTy::Vec3 {
         let v = tape.eval3::<Slope>(&p, dist);
         (Slope::stretch(&v), v[0].v.hull(v[1].v).hull(v[2].v))
     } else {

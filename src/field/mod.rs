@@ -1,4 +1,4 @@
-//! Evaluating field bodies: a body ([`crate::ir::field::Expr`]) is compiled once to a
+//! Evaluating field bodies: a body ([`crate::ir::field::FieldExpr`]) is compiled once to a
 //! [`Tape`], which every scalar type runs: `f32` to march, [`Dual`] for a hit's value
 //! and gradient, [`Interval`] to rule out a stretch of a ray, and [`Slope`] for the
 //! bound of a body's slope over a box ([`lipschitz()`]), which the checker states and the

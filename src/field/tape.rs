@@ -6,7 +6,7 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use crate::ir::field::{Binary, Expr, Kind, Ty, Unary};
+use crate::ir::field::{Binary, FieldExpr, FieldKind, FieldTy, Unary};
 use crate::ir::Shape;
 
 /// A register index.
@@ -90,7 +90,7 @@ pub struct Tape {
 struct Builder {
     ssa: Vec<Op>,
     seen: HashMap<OpKey, u32>,
-    memo: HashMap<*const Expr, Vec<u32>>,
+    memo: HashMap<*const FieldExpr, Vec<u32>>,
     shapes: Vec<Arc<Shape>>,
 }
 
@@ -164,7 +164,7 @@ impl Builder {
     }
 
     /// The SSA values of `e`: one for a number or truth value, three for a vector.
-    fn expr(&mut self, e: &Arc<Expr>) -> Vec<u32> {
+    fn expr(&mut self, e: &Arc<FieldExpr>) -> Vec<u32> {
         if let Some(v) = self.memo.get(&Arc::as_ptr(e)) {
             return v.clone();
         }
@@ -173,18 +173,18 @@ impl Builder {
         out
     }
 
-    fn expr_inner(&mut self, e: &Arc<Expr>) -> Vec<u32> {
+    fn expr_inner(&mut self, e: &Arc<FieldExpr>) -> Vec<u32> {
         match &e.kind {
-            Kind::Point => (0..3).map(|a| self.push(Op::Input(a))).collect(),
-            Kind::Num(x) => vec![self.push(Op::Const(*x))],
-            Kind::Vec(v) => v.to_array().iter().map(|c| self.push(Op::Const(*c))).collect(),
-            Kind::Component(v, i) => vec![self.expr(v)[*i]],
-            Kind::Vector(xs) => xs.iter().map(|x| self.expr(x)[0]).collect(),
-            Kind::Unary(Unary::Length, v) => {
+            FieldKind::Point => (0..3).map(|a| self.push(Op::Input(a))).collect(),
+            FieldKind::Num(x) => vec![self.push(Op::Const(*x))],
+            FieldKind::Vec(v) => v.to_array().iter().map(|c| self.push(Op::Const(*c))).collect(),
+            FieldKind::Component(v, i) => vec![self.expr(v)[*i]],
+            FieldKind::Vector(xs) => xs.iter().map(|x| self.expr(x)[0]).collect(),
+            FieldKind::Unary(Unary::Length, v) => {
                 let v = self.expr(v);
                 vec![self.push(Op::Length([v[0], v[1], v[2]]))]
             }
-            Kind::Unary(Unary::Normalize, v) => {
+            FieldKind::Unary(Unary::Normalize, v) => {
                 // The zero vector stays zero: divided by a length of at least the tiniest.
                 let v = self.expr(v);
                 let len = self.push(Op::Length([v[0], v[1], v[2]]));
@@ -192,14 +192,14 @@ impl Builder {
                 let len = self.binary(Binary::Max, len, tiny);
                 v.iter().map(|&c| self.binary(Binary::Div, c, len)).collect()
             }
-            Kind::Unary(f, x) => self.expr(x).into_iter().map(|c| self.unary(*f, c)).collect(),
-            Kind::Binary(Binary::Dot, a, b) => {
+            FieldKind::Unary(f, x) => self.expr(x).into_iter().map(|c| self.unary(*f, c)).collect(),
+            FieldKind::Binary(Binary::Dot, a, b) => {
                 let (a, b) = (self.expr(a), self.expr(b));
                 let terms: Vec<u32> = (0..3).map(|i| self.binary(Binary::Mul, a[i], b[i])).collect();
                 let ab = self.binary(Binary::Add, terms[0], terms[1]);
                 vec![self.binary(Binary::Add, ab, terms[2])]
             }
-            Kind::Binary(Binary::Cross, a, b) => {
+            FieldKind::Binary(Binary::Cross, a, b) => {
                 let (a, b) = (self.expr(a), self.expr(b));
                 (0..3)
                     .map(|i| {
@@ -210,13 +210,13 @@ impl Builder {
                     })
                     .collect()
             }
-            Kind::Binary(f, a, b) => {
+            FieldKind::Binary(f, a, b) => {
                 let (a, b) = (self.expr(a), self.expr(b));
                 let n = a.len().max(b.len());
                 // A number against a vector applies to each component.
                 (0..n).map(|i| self.binary(*f, a[i.min(a.len() - 1)], b[i.min(b.len() - 1)])).collect()
             }
-            Kind::Select(c, a, b) => {
+            FieldKind::Select(c, a, b) => {
                 let c = self.expr(c)[0];
                 let (a, b) = (self.expr(a), self.expr(b));
                 match self.constant_of(c) {
@@ -225,7 +225,7 @@ impl Builder {
                     None => a.iter().zip(&b).map(|(&x, &y)| self.push(Op::Select(c, x, y))).collect(),
                 }
             }
-            Kind::Dist(shape, q) => {
+            FieldKind::Dist(shape, q) => {
                 let q = self.expr(q);
                 let i = match self.shapes.iter().position(|s| Arc::ptr_eq(s, shape)) {
                     Some(i) => i,
@@ -236,7 +236,7 @@ impl Builder {
                 } as u32;
                 vec![self.push(Op::Dist(i, [q[0], q[1], q[2]]))]
             }
-            Kind::Noise { at, size, seed } => {
+            FieldKind::Noise { at, size, seed } => {
                 let q = self.expr(at);
                 let inv = self.push(Op::Const(1.0 / size));
                 let q: Vec<u32> = q.iter().map(|&c| self.binary(Binary::Mul, c, inv)).collect();
@@ -276,7 +276,7 @@ impl Op {
 
 impl Tape {
     /// Compiles `e` (a number, vector or truth value).
-    pub fn new(e: &Arc<Expr>) -> Tape {
+    pub fn new(e: &Arc<FieldExpr>) -> Tape {
         let mut b = Builder { ssa: Vec::new(), seen: HashMap::new(), memo: HashMap::new(), shapes: Vec::new() };
         let outs = b.expr(e);
         // Only what the result needs, in order: dead values (an unused branch's parts
@@ -331,11 +331,11 @@ impl Tape {
     }
 
     /// The type of value the tape computes.
-    pub fn ty(&self) -> Ty {
+    pub fn ty(&self) -> FieldTy {
         if self.out.len() == 3 {
-            Ty::Vec3
+            FieldTy::Vec3
         } else {
-            Ty::Num
+            FieldTy::Num
         }
     }
 

@@ -4,26 +4,26 @@ use glam::{DVec3, Vec3A};
 
 use super::*;
 use crate::geom::DAabb;
-use crate::ir::field::{Expr, Kind, Ty, Val};
+use crate::ir::field::{FieldExpr, FieldKind, FieldTy, Val};
 
-fn x(i: usize) -> Arc<Expr> {
-    Expr::new(Kind::Component(Expr::point(), i), Ty::Num)
+fn x(i: usize) -> Arc<FieldExpr> {
+    FieldExpr::new(FieldKind::Component(FieldExpr::point(), i), FieldTy::Num)
 }
 
-fn n(v: f64) -> Arc<Expr> {
-    Expr::num(v)
+fn n(v: f64) -> Arc<FieldExpr> {
+    FieldExpr::num(v)
 }
 
-fn un(f: Unary, a: Arc<Expr>) -> Arc<Expr> {
-    Expr::unary(f, a).unwrap()
+fn un(f: Unary, a: Arc<FieldExpr>) -> Arc<FieldExpr> {
+    FieldExpr::unary(f, a).unwrap()
 }
 
-fn bin(f: Binary, a: Arc<Expr>, b: Arc<Expr>) -> Arc<Expr> {
-    Expr::binary(f, a, b).unwrap()
+fn bin(f: Binary, a: Arc<FieldExpr>, b: Arc<FieldExpr>) -> Arc<FieldExpr> {
+    FieldExpr::binary(f, a, b).unwrap()
 }
 
 /// `sin(k·x)·cos(k·y) + sin(k·y)·cos(k·z) + sin(k·z)·cos(k·x)`, degrees.
-fn gyroid(k: f64) -> Arc<Expr> {
+fn gyroid(k: f64) -> Arc<FieldExpr> {
     let s = |i: usize| un(Unary::Sin, bin(Binary::Mul, n(k), x(i)));
     let c = |i: usize| un(Unary::Cos, bin(Binary::Mul, n(k), x(i)));
     let t = |i: usize, j: usize| bin(Binary::Mul, s(i), c(j));
@@ -31,22 +31,22 @@ fn gyroid(k: f64) -> Arc<Expr> {
 }
 
 /// The gyroid sheet of benches/scenes/gyroid.scn.
-fn sheet() -> Arc<Expr> {
-    let cut = bin(Binary::Sub, un(Unary::Length, Expr::point()), n(1.6));
+fn sheet() -> Arc<FieldExpr> {
+    let cut = bin(Binary::Sub, un(Unary::Length, FieldExpr::point()), n(1.6));
     bin(Binary::Max, bin(Binary::Sub, un(Unary::Abs, gyroid(450.0)), n(0.3)), cut)
 }
 
-fn sphere() -> Arc<Expr> {
-    bin(Binary::Sub, un(Unary::Length, Expr::point()), n(1.0))
+fn sphere() -> Arc<FieldExpr> {
+    bin(Binary::Sub, un(Unary::Length, FieldExpr::point()), n(1.0))
 }
 
 /// Every operation of the language in one body, each somewhere in its domain.
-fn everything() -> Vec<Arc<Expr>> {
+fn everything() -> Vec<Arc<FieldExpr>> {
     let (a, b, c) = (x(0), x(1), x(2));
     let mut out =
         vec![sphere(), gyroid(450.0), sheet(), bin(Binary::Add, bin(Binary::Mul, a.clone(), n(0.7)), b.clone())];
     // Every function of a number (`not`, `length` and `normalize` take other operands).
-    for &f in Unary::ALL.iter().filter(|f| f.ty(Ty::Num) == Some(Ty::Num)) {
+    for &f in Unary::ALL.iter().filter(|f| f.ty(FieldTy::Num) == Some(FieldTy::Num)) {
         out.push(un(f, bin(Binary::Mul, a.clone(), n(0.7))));
     }
     for f in [
@@ -62,14 +62,18 @@ fn everything() -> Vec<Arc<Expr>> {
     ] {
         out.push(bin(f, a.clone(), bin(Binary::Add, b.clone(), n(2.5))));
     }
-    out.push(bin(Binary::Dot, Expr::point(), bin(Binary::Cross, Expr::point(), Expr::vec(DVec3::new(1.0, 2.0, 3.0)))));
-    out.push(Expr::new(
-        Kind::Select(bin(Binary::Lt, a.clone(), b.clone()), c.clone(), bin(Binary::Mul, c.clone(), n(2.0))),
-        Ty::Num,
+    out.push(bin(
+        Binary::Dot,
+        FieldExpr::point(),
+        bin(Binary::Cross, FieldExpr::point(), FieldExpr::vec(DVec3::new(1.0, 2.0, 3.0))),
     ));
-    let norm = un(Unary::Normalize, Expr::point());
-    out.push(Expr::new(Kind::Component(norm, 1), Ty::Num));
-    out.push(Expr::new(Kind::Noise { at: Expr::point(), size: 0.7, seed: 4 }, Ty::Num));
+    out.push(FieldExpr::new(
+        FieldKind::Select(bin(Binary::Lt, a.clone(), b.clone()), c.clone(), bin(Binary::Mul, c.clone(), n(2.0))),
+        FieldTy::Num,
+    ));
+    let norm = un(Unary::Normalize, FieldExpr::point());
+    out.push(FieldExpr::new(FieldKind::Component(norm, 1), FieldTy::Num));
+    out.push(FieldExpr::new(FieldKind::Noise { at: FieldExpr::point(), size: 0.7, seed: 4 }, FieldTy::Num));
     out
 }
 
@@ -144,9 +148,9 @@ fn flat_duals_equal_tape_duals() {
         let (s, c) = (un(Unary::Sin, turn.clone()), un(Unary::Cos, turn));
         let u = bin(Binary::Sub, bin(Binary::Mul, x(0), c.clone()), bin(Binary::Mul, x(2), s.clone()));
         let w = bin(Binary::Add, bin(Binary::Mul, x(0), s), bin(Binary::Mul, x(2), c));
-        Expr::new(Kind::Vector([u, x(1), w]), Ty::Vec3)
+        FieldExpr::new(FieldKind::Vector([u, x(1), w]), FieldTy::Vec3)
     };
-    let vectors = [bin(Binary::Cross, Expr::point(), Expr::vec(DVec3::new(1.0, 2.0, 3.0))), twist];
+    let vectors = [bin(Binary::Cross, FieldExpr::point(), FieldExpr::vec(DVec3::new(1.0, 2.0, 3.0))), twist];
     for e in everything().into_iter().chain(vectors) {
         let tape = Tape::new(&e);
         let flat = Flat::new(&tape).expect("a small tape flattens");
@@ -228,7 +232,7 @@ fn intervals_hold_every_value() {
 #[test]
 fn slope_bounds_hold_and_are_tight() {
     let b = DAabb { min: DVec3::splat(-1.6), max: DVec3::splat(1.6) };
-    let cases: [(Arc<Expr>, f64); 4] = [
+    let cases: [(Arc<FieldExpr>, f64); 4] = [
         (sphere(), 1.0),
         (bin(Binary::Mul, n(4.0), sphere()), 4.0),
         (bin(Binary::Mul, n(0.25), sphere()), 0.25),
@@ -302,12 +306,12 @@ fn fast_trig_is_accurate() {
 
 /// The box the support searches are tried in, off centre, and every body of the
 /// language with a gyroid sheet cut by a ball.
-fn support_cases() -> (DAabb, Vec<Arc<Expr>>) {
+fn support_cases() -> (DAabb, Vec<Arc<FieldExpr>>) {
     let b = DAabb { min: DVec3::splat(-1.3), max: DVec3::new(1.1, 1.3, 1.2) };
     let sheet = bin(
         Binary::Max,
         bin(Binary::Sub, un(Unary::Abs, gyroid(450.0)), n(0.3)),
-        bin(Binary::Sub, un(Unary::Length, Expr::point()), n(1.2)),
+        bin(Binary::Sub, un(Unary::Length, FieldExpr::point()), n(1.2)),
     );
     let mut bodies = everything();
     bodies.push(sheet);
@@ -375,7 +379,7 @@ fn support_radius_holds_the_solid_and_is_tight() {
     assert!(inside > 15_000, "only {inside} points inside");
     let ball = DAabb::centred(DVec3::splat(0.4));
     let r = support_radius(
-        &Tape::new(&bin(Binary::Sub, un(Unary::Length, Expr::point()), n(0.4))),
+        &Tape::new(&bin(Binary::Sub, un(Unary::Length, FieldExpr::point()), n(0.4))),
         ball,
         0.0,
         DVec3::ZERO,

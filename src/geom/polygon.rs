@@ -255,6 +255,21 @@ pub fn smooth_within(m: &TriMesh, crease: f64) -> Vec<[DVec3; 3]> {
         .collect()
 }
 
+/// Whether segments `a0 a1` and `b0 b1` cross or touch.
+pub fn segments_meet(a0: DVec2, a1: DVec2, b0: DVec2, b1: DVec2) -> bool {
+    let side = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
+    let on = |p: DVec2, q: DVec2, r: DVec2| r.cmpge(p.min(q)).all() && r.cmple(p.max(q)).all();
+    let (d1, d2) = (side(b0, b1, a0), side(b0, b1, a1));
+    let (d3, d4) = (side(a0, a1, b0), side(a0, a1, b1));
+    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0)) && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0)) {
+        return true;
+    }
+    (d1 == 0.0 && on(b0, b1, a0))
+        || (d2 == 0.0 && on(b0, b1, a1))
+        || (d3 == 0.0 && on(a0, a1, b0))
+        || (d4 == 0.0 && on(a0, a1, b1))
+}
+
 /// The corners of the convex hull of `pts`, counter-clockwise, by Andrew's monotone
 /// chain; fewer than three when the points span no area.
 pub fn convex_hull(mut pts: Vec<DVec2>) -> Vec<DVec2> {

@@ -99,7 +99,7 @@ pub fn shape_sphere(shape: &Shape) -> Option<(DVec3, f64)> {
 /// A sphere holding where a field's body is at most `level` within a box, found by a
 /// search `ir` cannot run (`world` hands it in, as for [`FieldPlanes`]); `None` for none
 /// better than the box's own.
-pub type FieldSphere<'a> = dyn FnMut(&Arc<super::field::Expr>, DAabb, f64) -> Option<(DVec3, f64)> + 'a;
+pub type FieldSphere<'a> = dyn FnMut(&Arc<super::field::FieldExpr>, DAabb, f64) -> Option<(DVec3, f64)> + 'a;
 
 /// [`shape_sphere`] with a field's sphere from `fields` where it is smaller than its
 /// box's.
@@ -180,7 +180,7 @@ fn half_space_within(shape: &Shape, g: f64) -> Option<(DVec3, f64)> {
 /// Planes `n·p ≤ offset` holding where a field's body is at most `level` within a box,
 /// for the directions where that is nearer than the box's face (`field::support_planes`,
 /// which `ir` cannot call: its caller hands the search in); `None` for none.
-pub type FieldPlanes<'a> = dyn FnMut(&Arc<super::field::Expr>, DAabb, f64) -> Option<Vec<(DVec3, f64)>> + 'a;
+pub type FieldPlanes<'a> = dyn FnMut(&Arc<super::field::FieldExpr>, DAabb, f64) -> Option<Vec<(DVec3, f64)>> + 'a;
 
 /// A convex set holding the shape ([`Solid::hull`](crate::primitive::Solid::hull)):
 /// exactly the solid for a convex polyhedron, a cylinder, a capped cone or an

@@ -14,7 +14,7 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use super::field::{Binary, Expr, Kind, Ty, Unary};
+use super::field::{Binary, FieldExpr, FieldKind, FieldTy, Unary};
 
 /// How a value bends as the point moves along any line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -146,27 +146,27 @@ impl Fact {
 }
 
 /// Whether the number `body` is a convex function of the point by the rules above.
-pub fn is_convex(body: &Arc<Expr>) -> bool {
-    body.ty == Ty::Num && facts(body, &mut HashMap::new())[0].convexish()
+pub fn is_convex(body: &Arc<FieldExpr>) -> bool {
+    body.ty == FieldTy::Num && facts(body, &mut HashMap::new())[0].convexish()
 }
 
 /// What is known of each of the value's components (a number's in the first; nothing
 /// reads the other two).
-fn facts(e: &Arc<Expr>, memo: &mut HashMap<*const Expr, [Fact; 3]>) -> [Fact; 3] {
+fn facts(e: &Arc<FieldExpr>, memo: &mut HashMap<*const FieldExpr, [Fact; 3]>) -> [Fact; 3] {
     if let Some(f) = memo.get(&Arc::as_ptr(e)) {
         return *f;
     }
-    let mut f = |x: &Arc<Expr>| facts(x, memo);
+    let mut f = |x: &Arc<FieldExpr>| facts(x, memo);
     let num = |x: Fact| [x, OTHER, OTHER];
     let per = |a: [Fact; 3], g: &dyn Fn(Fact) -> Fact| a.map(g);
     let both = |a: [Fact; 3], b: [Fact; 3], g: &dyn Fn(Fact, Fact) -> Fact| [0, 1, 2].map(|i| g(a[i], b[i]));
     let out = match &e.kind {
-        Kind::Point => [Fact { curv: Curv::Affine, sign: Sign::Any }; 3],
-        Kind::Num(c) => num(Fact::constant(*c)),
-        Kind::Vec(c) => c.to_array().map(Fact::constant),
-        Kind::Component(x, i) => num(f(x)[*i]),
-        Kind::Vector(xs) => [f(&xs[0])[0], f(&xs[1])[0], f(&xs[2])[0]],
-        Kind::Unary(op, x) => {
+        FieldKind::Point => [Fact { curv: Curv::Affine, sign: Sign::Any }; 3],
+        FieldKind::Num(c) => num(Fact::constant(*c)),
+        FieldKind::Vec(c) => c.to_array().map(Fact::constant),
+        FieldKind::Component(x, i) => num(f(x)[*i]),
+        FieldKind::Vector(xs) => [f(&xs[0])[0], f(&xs[1])[0], f(&xs[2])[0]],
+        FieldKind::Unary(op, x) => {
             let a = f(x);
             match op {
                 Unary::Neg => per(a, &Fact::neg),
@@ -181,13 +181,13 @@ fn facts(e: &Arc<Expr>, memo: &mut HashMap<*const Expr, [Fact; 3]>) -> [Fact; 3]
                 _ => [OTHER; 3],
             }
         }
-        Kind::Binary(op, x, y) => {
+        FieldKind::Binary(op, x, y) => {
             let (a, b) = (f(x), f(y));
             // A finite constant operand (a product with an infinite one is no function).
-            let constant = |e: &Arc<Expr>| {
+            let constant = |e: &Arc<FieldExpr>| {
                 let c = match &e.kind {
-                    Kind::Num(c) => [*c; 3],
-                    Kind::Vec(c) => c.to_array(),
+                    FieldKind::Num(c) => [*c; 3],
+                    FieldKind::Vec(c) => c.to_array(),
                     _ => return None,
                 };
                 c.iter().all(|x| x.is_finite()).then_some(c)
@@ -225,7 +225,7 @@ fn facts(e: &Arc<Expr>, memo: &mut HashMap<*const Expr, [Fact; 3]>) -> [Fact; 3]
                 _ => [OTHER; 3],
             }
         }
-        Kind::Select(..) | Kind::Dist(..) | Kind::Noise { .. } => [OTHER; 3],
+        FieldKind::Select(..) | FieldKind::Dist(..) | FieldKind::Noise { .. } => [OTHER; 3],
     };
     memo.insert(Arc::as_ptr(e), out);
     out
@@ -237,31 +237,31 @@ mod tests {
 
     use super::*;
 
-    fn p() -> Arc<Expr> {
-        Expr::point()
+    fn p() -> Arc<FieldExpr> {
+        FieldExpr::point()
     }
-    fn c(x: f64) -> Arc<Expr> {
-        Expr::num(x)
-    }
-    #[track_caller]
-    fn un(f: Unary, x: Arc<Expr>) -> Arc<Expr> {
-        Expr::unary(f, x).unwrap()
+    fn c(x: f64) -> Arc<FieldExpr> {
+        FieldExpr::num(x)
     }
     #[track_caller]
-    fn bin(f: Binary, a: Arc<Expr>, b: Arc<Expr>) -> Arc<Expr> {
-        Expr::binary(f, a, b).unwrap()
+    fn un(f: Unary, x: Arc<FieldExpr>) -> Arc<FieldExpr> {
+        FieldExpr::unary(f, x).unwrap()
     }
-    fn x(i: usize) -> Arc<Expr> {
-        Expr::component(&p(), i)
+    #[track_caller]
+    fn bin(f: Binary, a: Arc<FieldExpr>, b: Arc<FieldExpr>) -> Arc<FieldExpr> {
+        FieldExpr::binary(f, a, b).unwrap()
+    }
+    fn x(i: usize) -> Arc<FieldExpr> {
+        FieldExpr::component(&p(), i)
     }
 
     /// Bodies, whether the rules must call them convex, and whether they are.
-    fn cases() -> Vec<(&'static str, Arc<Expr>, bool, bool)> {
+    fn cases() -> Vec<(&'static str, Arc<FieldExpr>, bool, bool)> {
         let sphere = bin(Binary::Sub, un(Unary::Length, p()), c(1.0));
         // The box's exact distance, written as the catalogue writes it.
         let half = [1.0, 0.5, 0.25];
         let q: Vec<_> = (0..3).map(|i| bin(Binary::Sub, un(Unary::Abs, x(i)), c(half[i]))).collect();
-        let outside = un(Unary::Length, Expr::vector([0, 1, 2].map(|i| bin(Binary::Max, q[i].clone(), c(0.0)))));
+        let outside = un(Unary::Length, FieldExpr::vector([0, 1, 2].map(|i| bin(Binary::Max, q[i].clone(), c(0.0)))));
         let inside =
             bin(Binary::Min, bin(Binary::Max, q[0].clone(), bin(Binary::Max, q[1].clone(), q[2].clone())), c(0.0));
         let cube = bin(Binary::Add, outside, inside.clone());
@@ -272,16 +272,16 @@ mod tests {
             bin(Binary::Add, bin(Binary::Pow, x(0), c(4.0)), bin(Binary::Pow, un(Unary::Abs, x(2)), c(2.5))),
             c(1.0),
         );
-        let plane = bin(Binary::Dot, p(), Expr::vec(DVec3::new(0.0, 1.0, 0.0)));
+        let plane = bin(Binary::Dot, p(), FieldExpr::vec(DVec3::new(0.0, 1.0, 0.0)));
         let steep = bin(Binary::Mul, c(4.0), sphere.clone());
-        let scaled = un(Unary::Length, bin(Binary::Mul, p(), Expr::vec(DVec3::new(1.0, 2.0, -3.0))));
+        let scaled = un(Unary::Length, bin(Binary::Mul, p(), FieldExpr::vec(DVec3::new(1.0, 2.0, -3.0))));
         let hole = bin(Binary::Sub, c(1.0), un(Unary::Length, p()));
         let torus = bin(
             Binary::Sub,
             un(
                 Unary::Length,
-                Expr::vector([
-                    bin(Binary::Sub, un(Unary::Length, Expr::vector([x(0), c(0.0), x(2)])), c(1.0)),
+                FieldExpr::vector([
+                    bin(Binary::Sub, un(Unary::Length, FieldExpr::vector([x(0), c(0.0), x(2)])), c(1.0)),
                     x(1),
                     c(0.0),
                 ]),

@@ -143,7 +143,7 @@ impl Dumper<'_> {
     }
 
     /// A field body as source, then each shape its `dist` calls read.
-    fn body(&mut self, indent: usize, body: &std::sync::Arc<super::field::Expr>) {
+    fn body(&mut self, indent: usize, body: &std::sync::Arc<super::field::FieldExpr>) {
         self.line(indent, &format!("p => {}", body.source(2000)), None);
         for (i, s) in body.shapes().iter().enumerate() {
             self.line(indent, &format!("shape#{i}"), None);

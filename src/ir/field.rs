@@ -2,7 +2,7 @@
 //! everything that does not depend on it already folded to a number.
 //!
 //! An expression is a tree of `Arc`-shared nodes (a name used twice in a body is one
-//! node reached twice); its meaning is fixed here, in f64, by [`Expr::eval`], which the
+//! node reached twice); its meaning is fixed here, in f64, by [`FieldExpr::eval`], which the
 //! back-ends' f32 evaluators (`crate::field`) are tested against.
 
 use std::fmt::Write as _;
@@ -15,7 +15,7 @@ use crate::sig::num;
 
 /// What a field expression evaluates to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Ty {
+pub enum FieldTy {
     /// A number.
     Num,
     /// A vector.
@@ -24,24 +24,24 @@ pub enum Ty {
     Bool,
 }
 
-impl Ty {
+impl FieldTy {
     /// The language's name for it.
     pub fn name(self) -> &'static str {
         match self {
-            Ty::Num => "num",
-            Ty::Vec3 => "vec3",
-            Ty::Bool => "bool",
+            FieldTy::Num => "num",
+            FieldTy::Vec3 => "vec3",
+            FieldTy::Bool => "bool",
         }
     }
 }
 
 /// One node of a field expression.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Expr {
+pub struct FieldExpr {
     /// What it computes.
-    pub kind: Kind,
+    pub kind: FieldKind,
     /// Its type, fixed by its operands'.
-    pub ty: Ty,
+    pub ty: FieldTy,
 }
 
 /// Lists the functions of one operand once: each variant with its doc and its name (the
@@ -156,7 +156,7 @@ pub enum Binary {
 
 /// What a node computes.
 #[derive(Clone, Debug, PartialEq)]
-pub enum Kind {
+pub enum FieldKind {
     /// The point `p`.
     Point,
     /// A number known before rendering.
@@ -164,21 +164,21 @@ pub enum Kind {
     /// A vector known before rendering.
     Vec(DVec3),
     /// One component (0, 1, 2 for x, y, z) of a vector.
-    Component(Arc<Expr>, usize),
+    Component(Arc<FieldExpr>, usize),
     /// A vector of three numbers.
-    Vector([Arc<Expr>; 3]),
+    Vector([Arc<FieldExpr>; 3]),
     /// A function of one operand.
-    Unary(Unary, Arc<Expr>),
+    Unary(Unary, Arc<FieldExpr>),
     /// A function of two operands.
-    Binary(Binary, Arc<Expr>, Arc<Expr>),
+    Binary(Binary, Arc<FieldExpr>, Arc<FieldExpr>),
     /// `if c then a else b`, both of one type.
-    Select(Arc<Expr>, Arc<Expr>, Arc<Expr>),
+    Select(Arc<FieldExpr>, Arc<FieldExpr>, Arc<FieldExpr>),
     /// `dist(shape, q)`: the shape's signed distance bound at the point `q`.
-    Dist(Arc<Shape>, Arc<Expr>),
+    Dist(Arc<Shape>, Arc<FieldExpr>),
     /// `noise3(q, size, seed)`: the `noise` pattern's gradient noise at `q / size`.
     Noise {
         /// Where.
-        at: Arc<Expr>,
+        at: Arc<FieldExpr>,
         /// The feature size, > 0.
         size: f64,
         /// The seed.
@@ -188,14 +188,14 @@ pub enum Kind {
 
 impl Unary {
     /// The result's type for an operand of type `x`; `None` if it takes no such operand.
-    pub fn ty(self, x: Ty) -> Option<Ty> {
+    pub fn ty(self, x: FieldTy) -> Option<FieldTy> {
         match (self, x) {
-            (Unary::Neg, Ty::Num | Ty::Vec3) => Some(x),
-            (Unary::Not, Ty::Bool) => Some(Ty::Bool),
-            (Unary::Length, Ty::Vec3) => Some(Ty::Num),
-            (Unary::Normalize, Ty::Vec3) => Some(Ty::Vec3),
+            (Unary::Neg, FieldTy::Num | FieldTy::Vec3) => Some(x),
+            (Unary::Not, FieldTy::Bool) => Some(FieldTy::Bool),
+            (Unary::Length, FieldTy::Vec3) => Some(FieldTy::Num),
+            (Unary::Normalize, FieldTy::Vec3) => Some(FieldTy::Vec3),
             (Unary::Neg | Unary::Not | Unary::Length | Unary::Normalize, _) => None,
-            (_, Ty::Num) => Some(Ty::Num),
+            (_, FieldTy::Num) => Some(FieldTy::Num),
             _ => None,
         }
     }
@@ -226,7 +226,7 @@ impl Unary {
             }
             Unary::Exp => x.exp(),
             Unary::Log => x.max(f64::from(f32::MIN_POSITIVE)).ln(),
-            // Vector functions are applied by `Expr::eval`.
+            // Vector functions are applied by `FieldExpr::eval`.
             Unary::Length | Unary::Normalize => f64::NAN,
         }
     }
@@ -264,8 +264,8 @@ impl Binary {
     }
 
     /// The result's type for operands of types `a` and `b`; `None` if it takes no such pair.
-    pub fn ty(self, a: Ty, b: Ty) -> Option<Ty> {
-        use Ty::{Bool, Num, Vec3};
+    pub fn ty(self, a: FieldTy, b: FieldTy) -> Option<FieldTy> {
+        use FieldTy::{Bool, Num, Vec3};
         match (self, a, b) {
             (Binary::Add | Binary::Sub, Num, Num) => Some(Num),
             (Binary::Add | Binary::Sub, Vec3, Vec3) => Some(Vec3),
@@ -309,7 +309,7 @@ impl Binary {
             }
             // `atan2(y, x)`: the first operand is y.
             Binary::Atan2 => (x + 0.0).atan2(y).to_degrees(),
-            // Vector functions are applied by `Expr::eval`.
+            // Vector functions are applied by `FieldExpr::eval`.
             Binary::Dot | Binary::Cross => f64::NAN,
         }
     }
@@ -343,71 +343,74 @@ impl Val {
     }
 }
 
-impl Expr {
+impl FieldExpr {
     /// A node of `kind` whose type is `ty`.
-    pub fn new(kind: Kind, ty: Ty) -> Arc<Expr> {
-        Arc::new(Expr { kind, ty })
+    pub fn new(kind: FieldKind, ty: FieldTy) -> Arc<FieldExpr> {
+        Arc::new(FieldExpr { kind, ty })
     }
 
     /// The point `p`.
-    pub fn point() -> Arc<Expr> {
-        Expr::new(Kind::Point, Ty::Vec3)
+    pub fn point() -> Arc<FieldExpr> {
+        FieldExpr::new(FieldKind::Point, FieldTy::Vec3)
     }
 
     /// A number.
-    pub fn num(x: f64) -> Arc<Expr> {
-        Expr::new(Kind::Num(x), Ty::Num)
+    pub fn num(x: f64) -> Arc<FieldExpr> {
+        FieldExpr::new(FieldKind::Num(x), FieldTy::Num)
     }
 
     /// A vector.
-    pub fn vec(v: DVec3) -> Arc<Expr> {
-        Expr::new(Kind::Vec(v), Ty::Vec3)
+    pub fn vec(v: DVec3) -> Arc<FieldExpr> {
+        FieldExpr::new(FieldKind::Vec(v), FieldTy::Vec3)
     }
 
     /// The vector `[x, y, z]` of three number expressions.
-    pub fn vector(xs: [Arc<Expr>; 3]) -> Arc<Expr> {
-        Expr::new(Kind::Vector(xs), Ty::Vec3)
+    pub fn vector(xs: [Arc<FieldExpr>; 3]) -> Arc<FieldExpr> {
+        FieldExpr::new(FieldKind::Vector(xs), FieldTy::Vec3)
     }
 
     /// Component `k` (0, 1, 2 for x, y, z) of a vector expression.
-    pub fn component(v: &Arc<Expr>, k: usize) -> Arc<Expr> {
-        Expr::new(Kind::Component(v.clone(), k), Ty::Num)
+    pub fn component(v: &Arc<FieldExpr>, k: usize) -> Arc<FieldExpr> {
+        FieldExpr::new(FieldKind::Component(v.clone(), k), FieldTy::Num)
     }
 
     /// `f(x)`; `None` if `f` takes no operand of `x`'s type.
-    pub fn unary(f: Unary, x: Arc<Expr>) -> Option<Arc<Expr>> {
+    pub fn unary(f: Unary, x: Arc<FieldExpr>) -> Option<Arc<FieldExpr>> {
         let ty = f.ty(x.ty)?;
-        Some(Expr::new(Kind::Unary(f, x), ty))
+        Some(FieldExpr::new(FieldKind::Unary(f, x), ty))
     }
 
     /// `f(a, b)`; `None` if `f` takes no operands of these types.
-    pub fn binary(f: Binary, a: Arc<Expr>, b: Arc<Expr>) -> Option<Arc<Expr>> {
+    pub fn binary(f: Binary, a: Arc<FieldExpr>, b: Arc<FieldExpr>) -> Option<Arc<FieldExpr>> {
         let ty = f.ty(a.ty, b.ty)?;
-        Some(Expr::new(Kind::Binary(f, a, b), ty))
+        Some(FieldExpr::new(FieldKind::Binary(f, a, b), ty))
     }
 
     /// The operands, in order.
-    pub fn operands(&self) -> Vec<&Arc<Expr>> {
+    pub fn operands(&self) -> Vec<&Arc<FieldExpr>> {
         match &self.kind {
-            Kind::Point | Kind::Num(_) | Kind::Vec(_) => vec![],
-            Kind::Component(x, _) | Kind::Unary(_, x) | Kind::Dist(_, x) | Kind::Noise { at: x, .. } => vec![x],
-            Kind::Vector(xs) => xs.iter().collect(),
-            Kind::Binary(_, a, b) => vec![a, b],
-            Kind::Select(c, a, b) => vec![c, a, b],
+            FieldKind::Point | FieldKind::Num(_) | FieldKind::Vec(_) => vec![],
+            FieldKind::Component(x, _)
+            | FieldKind::Unary(_, x)
+            | FieldKind::Dist(_, x)
+            | FieldKind::Noise { at: x, .. } => vec![x],
+            FieldKind::Vector(xs) => xs.iter().collect(),
+            FieldKind::Binary(_, a, b) => vec![a, b],
+            FieldKind::Select(c, a, b) => vec![c, a, b],
         }
     }
 
     /// Whether the value depends on the point (else it is a constant the checker folded).
     pub fn uses_point(&self) -> bool {
         match &self.kind {
-            Kind::Point => true,
-            Kind::Num(_) | Kind::Vec(_) => false,
+            FieldKind::Point => true,
+            FieldKind::Num(_) | FieldKind::Vec(_) => false,
             _ => self.operands().iter().any(|x| x.uses_point()),
         }
     }
 
     /// Distinct nodes (shared ones once): the work of one evaluation.
-    pub fn size(self: &Arc<Expr>) -> usize {
+    pub fn size(self: &Arc<FieldExpr>) -> usize {
         let mut seen = std::collections::HashSet::new();
         let mut stack = vec![self];
         while let Some(e) = stack.pop() {
@@ -420,31 +423,31 @@ impl Expr {
 
     /// This expression with the point replaced by `q` (an expression of the new point):
     /// `f(p)` becomes `f(q(p))`. Shared nodes stay shared.
-    pub fn substitute(self: &Arc<Expr>, q: &Arc<Expr>) -> Arc<Expr> {
+    pub fn substitute(self: &Arc<FieldExpr>, q: &Arc<FieldExpr>) -> Arc<FieldExpr> {
         fn walk(
-            e: &Arc<Expr>,
-            q: &Arc<Expr>,
-            memo: &mut std::collections::HashMap<*const Expr, Arc<Expr>>,
-        ) -> Arc<Expr> {
+            e: &Arc<FieldExpr>,
+            q: &Arc<FieldExpr>,
+            memo: &mut std::collections::HashMap<*const FieldExpr, Arc<FieldExpr>>,
+        ) -> Arc<FieldExpr> {
             if !e.uses_point() {
                 return e.clone();
             }
             if let Some(done) = memo.get(&Arc::as_ptr(e)) {
                 return done.clone();
             }
-            let mut w = |x: &Arc<Expr>| walk(x, q, memo);
+            let mut w = |x: &Arc<FieldExpr>| walk(x, q, memo);
             let kind = match &e.kind {
-                Kind::Point => return q.clone(),
-                Kind::Num(_) | Kind::Vec(_) => return e.clone(),
-                Kind::Component(x, k) => Kind::Component(w(x), *k),
-                Kind::Vector([a, b, c]) => Kind::Vector([w(a), w(b), w(c)]),
-                Kind::Unary(f, x) => Kind::Unary(*f, w(x)),
-                Kind::Binary(f, a, b) => Kind::Binary(*f, w(a), w(b)),
-                Kind::Select(c, a, b) => Kind::Select(w(c), w(a), w(b)),
-                Kind::Dist(s, at) => Kind::Dist(s.clone(), w(at)),
-                Kind::Noise { at, size, seed } => Kind::Noise { at: w(at), size: *size, seed: *seed },
+                FieldKind::Point => return q.clone(),
+                FieldKind::Num(_) | FieldKind::Vec(_) => return e.clone(),
+                FieldKind::Component(x, k) => FieldKind::Component(w(x), *k),
+                FieldKind::Vector([a, b, c]) => FieldKind::Vector([w(a), w(b), w(c)]),
+                FieldKind::Unary(f, x) => FieldKind::Unary(*f, w(x)),
+                FieldKind::Binary(f, a, b) => FieldKind::Binary(*f, w(a), w(b)),
+                FieldKind::Select(c, a, b) => FieldKind::Select(w(c), w(a), w(b)),
+                FieldKind::Dist(s, at) => FieldKind::Dist(s.clone(), w(at)),
+                FieldKind::Noise { at, size, seed } => FieldKind::Noise { at: w(at), size: *size, seed: *seed },
             };
-            let out = Expr::new(kind, e.ty);
+            let out = FieldExpr::new(kind, e.ty);
             memo.insert(Arc::as_ptr(e), out.clone());
             out
         }
@@ -452,7 +455,7 @@ impl Expr {
     }
 
     /// The shapes `dist` reads, in first-use order, each once.
-    pub fn shapes(self: &Arc<Expr>) -> Vec<Arc<Shape>> {
+    pub fn shapes(self: &Arc<FieldExpr>) -> Vec<Arc<Shape>> {
         let mut out: Vec<Arc<Shape>> = Vec::new();
         let mut seen = std::collections::HashSet::new();
         let mut stack = vec![self];
@@ -460,7 +463,7 @@ impl Expr {
             if !seen.insert(Arc::as_ptr(e)) {
                 continue;
             }
-            if let Kind::Dist(s, _) = &e.kind {
+            if let FieldKind::Dist(s, _) = &e.kind {
                 if !out.iter().any(|o| Arc::ptr_eq(o, s)) {
                     out.push(s.clone());
                 }
@@ -474,40 +477,40 @@ impl Expr {
     /// The value at `p`, in f64, with `dist(shape, q)` given by `dist` (by the shape's
     /// index in [`shapes`](Self::shapes)).
     pub fn eval(&self, p: DVec3, dist: &dyn Fn(&Arc<Shape>, DVec3) -> f64) -> Val {
-        let n = |e: &Arc<Expr>| e.eval(p, dist).num();
-        let v = |e: &Arc<Expr>| e.eval(p, dist).vec();
+        let n = |e: &Arc<FieldExpr>| e.eval(p, dist).num();
+        let v = |e: &Arc<FieldExpr>| e.eval(p, dist).vec();
         match &self.kind {
-            Kind::Point => Val::Vec(p),
-            Kind::Num(x) => Val::Num(*x),
-            Kind::Vec(x) => Val::Vec(*x),
-            Kind::Component(x, i) => Val::Num(v(x)[*i]),
-            Kind::Vector(xs) => Val::Vec(DVec3::new(n(&xs[0]), n(&xs[1]), n(&xs[2]))),
-            Kind::Unary(Unary::Length, x) => Val::Num(v(x).length()),
-            Kind::Unary(Unary::Normalize, x) => Val::Vec(v(x).normalize_or_zero()),
-            Kind::Unary(f, x) if x.ty == Ty::Vec3 => Val::Vec(v(x).to_array().map(|c| f.apply(c)).into()),
-            Kind::Unary(f, x) => Val::Num(f.apply(n(x))),
-            Kind::Binary(Binary::Dot, a, b) => Val::Num(v(a).dot(v(b))),
-            Kind::Binary(Binary::Cross, a, b) => Val::Vec(v(a).cross(v(b))),
-            Kind::Binary(f, a, b) if self.ty == Ty::Vec3 => {
+            FieldKind::Point => Val::Vec(p),
+            FieldKind::Num(x) => Val::Num(*x),
+            FieldKind::Vec(x) => Val::Vec(*x),
+            FieldKind::Component(x, i) => Val::Num(v(x)[*i]),
+            FieldKind::Vector(xs) => Val::Vec(DVec3::new(n(&xs[0]), n(&xs[1]), n(&xs[2]))),
+            FieldKind::Unary(Unary::Length, x) => Val::Num(v(x).length()),
+            FieldKind::Unary(Unary::Normalize, x) => Val::Vec(v(x).normalize_or_zero()),
+            FieldKind::Unary(f, x) if x.ty == FieldTy::Vec3 => Val::Vec(v(x).to_array().map(|c| f.apply(c)).into()),
+            FieldKind::Unary(f, x) => Val::Num(f.apply(n(x))),
+            FieldKind::Binary(Binary::Dot, a, b) => Val::Num(v(a).dot(v(b))),
+            FieldKind::Binary(Binary::Cross, a, b) => Val::Vec(v(a).cross(v(b))),
+            FieldKind::Binary(f, a, b) if self.ty == FieldTy::Vec3 => {
                 let (a, b) = (v(a), v(b));
                 Val::Vec(DVec3::new(f.apply(a.x, b.x), f.apply(a.y, b.y), f.apply(a.z, b.z)))
             }
-            Kind::Binary(f, a, b) => Val::Num(f.apply(n(a), n(b))),
-            Kind::Select(c, a, b) => {
+            FieldKind::Binary(f, a, b) => Val::Num(f.apply(n(a), n(b))),
+            FieldKind::Select(c, a, b) => {
                 if n(c) != 0.0 {
                     a.eval(p, dist)
                 } else {
                     b.eval(p, dist)
                 }
             }
-            Kind::Dist(s, q) => Val::Num(dist(s, v(q))),
-            Kind::Noise { at, size, seed } => Val::Num(crate::geom::noise(v(at) / *size, *seed)),
+            FieldKind::Dist(s, q) => Val::Num(dist(s, v(q))),
+            FieldKind::Noise { at, size, seed } => Val::Num(crate::geom::noise(v(at) / *size, *seed)),
         }
     }
 
     /// The expression as scn source, with `p` for the point and `shape#i` for the
     /// `i`-th shape `dist` reads ([`shapes`](Self::shapes)); cut short past `limit` bytes.
-    pub fn source(self: &Arc<Expr>, limit: usize) -> String {
+    pub fn source(self: &Arc<FieldExpr>, limit: usize) -> String {
         let shapes = self.shapes();
         let mut out = String::new();
         write_expr(&mut out, self, 0, &shapes, limit);
@@ -524,22 +527,22 @@ impl Expr {
 }
 
 /// Binding strength of a node as written: higher binds tighter.
-fn precedence(e: &Expr) -> u8 {
+fn precedence(e: &FieldExpr) -> u8 {
     match &e.kind {
-        Kind::Select(..) => 1,
-        Kind::Binary(Binary::Or, ..) => 2,
-        Kind::Binary(Binary::And, ..) => 3,
-        Kind::Unary(Unary::Not, _) => 4,
-        Kind::Binary(Binary::Lt | Binary::Le | Binary::Gt | Binary::Ge | Binary::Eq | Binary::Ne, ..) => 5,
-        Kind::Binary(Binary::Add | Binary::Sub, ..) => 6,
-        Kind::Binary(Binary::Mul | Binary::Div | Binary::Rem, ..) => 7,
-        Kind::Unary(Unary::Neg, _) => 8,
-        Kind::Num(x) if *x < 0.0 => 8,
+        FieldKind::Select(..) => 1,
+        FieldKind::Binary(Binary::Or, ..) => 2,
+        FieldKind::Binary(Binary::And, ..) => 3,
+        FieldKind::Unary(Unary::Not, _) => 4,
+        FieldKind::Binary(Binary::Lt | Binary::Le | Binary::Gt | Binary::Ge | Binary::Eq | Binary::Ne, ..) => 5,
+        FieldKind::Binary(Binary::Add | Binary::Sub, ..) => 6,
+        FieldKind::Binary(Binary::Mul | Binary::Div | Binary::Rem, ..) => 7,
+        FieldKind::Unary(Unary::Neg, _) => 8,
+        FieldKind::Num(x) if *x < 0.0 => 8,
         _ => 10,
     }
 }
 
-fn write_expr(out: &mut String, e: &Arc<Expr>, outer: u8, shapes: &[Arc<Shape>], limit: usize) {
+fn write_expr(out: &mut String, e: &Arc<FieldExpr>, outer: u8, shapes: &[Arc<Shape>], limit: usize) {
     if out.len() > limit {
         return;
     }
@@ -548,7 +551,7 @@ fn write_expr(out: &mut String, e: &Arc<Expr>, outer: u8, shapes: &[Arc<Shape>],
     if paren {
         out.push('(');
     }
-    let args = |out: &mut String, xs: &[&Arc<Expr>]| {
+    let args = |out: &mut String, xs: &[&Arc<FieldExpr>]| {
         for (i, x) in xs.iter().enumerate() {
             if i > 0 {
                 out.push_str(", ");
@@ -557,44 +560,44 @@ fn write_expr(out: &mut String, e: &Arc<Expr>, outer: u8, shapes: &[Arc<Shape>],
         }
     };
     match &e.kind {
-        Kind::Point => out.push('p'),
-        Kind::Num(x) => out.push_str(&num(*x)),
-        Kind::Vec(v) => out.push_str(&crate::sig::vec(*v)),
-        Kind::Component(x, i) => {
+        FieldKind::Point => out.push('p'),
+        FieldKind::Num(x) => out.push_str(&num(*x)),
+        FieldKind::Vec(v) => out.push_str(&crate::sig::vec(*v)),
+        FieldKind::Component(x, i) => {
             write_expr(out, x, 10, shapes, limit);
             out.push_str([".x", ".y", ".z"][*i]);
             // (A negative number's component needs its parentheses: `(-1).x`.)
         }
-        Kind::Vector(xs) => {
+        FieldKind::Vector(xs) => {
             out.push('[');
             args(out, &[&xs[0], &xs[1], &xs[2]]);
             out.push(']');
         }
-        Kind::Unary(Unary::Neg, x) => {
+        FieldKind::Unary(Unary::Neg, x) => {
             out.push('-');
             write_expr(out, x, 8, shapes, limit);
         }
-        Kind::Unary(Unary::Not, x) => {
+        FieldKind::Unary(Unary::Not, x) => {
             out.push_str("not ");
             write_expr(out, x, 5, shapes, limit);
         }
-        Kind::Unary(f, x) => {
+        FieldKind::Unary(f, x) => {
             let _ = write!(out, "{}(", f.name());
             args(out, &[x]);
             out.push(')');
         }
-        Kind::Binary(f, a, b) if f.is_call() => {
+        FieldKind::Binary(f, a, b) if f.is_call() => {
             let _ = write!(out, "{}(", f.name());
             args(out, &[a, b]);
             out.push(')');
         }
-        Kind::Binary(f, a, b) => {
+        FieldKind::Binary(f, a, b) => {
             // Left-associative: the right operand of an equal-precedence operator needs parentheses.
             write_expr(out, a, prec, shapes, limit);
             let _ = write!(out, " {} ", f.name());
             write_expr(out, b, prec + 1, shapes, limit);
         }
-        Kind::Select(c, a, b) => {
+        FieldKind::Select(c, a, b) => {
             out.push_str("if ");
             write_expr(out, c, 0, shapes, limit);
             out.push_str(" then ");
@@ -602,13 +605,13 @@ fn write_expr(out: &mut String, e: &Arc<Expr>, outer: u8, shapes: &[Arc<Shape>],
             out.push_str(" else ");
             write_expr(out, b, 1, shapes, limit);
         }
-        Kind::Dist(s, q) => {
+        FieldKind::Dist(s, q) => {
             let i = shapes.iter().position(|o| Arc::ptr_eq(o, s)).unwrap_or(0);
             let _ = write!(out, "dist(shape#{i}, ");
             write_expr(out, q, 0, shapes, limit);
             out.push(')');
         }
-        Kind::Noise { at, size, seed } => {
+        FieldKind::Noise { at, size, seed } => {
             out.push_str("noise3(");
             write_expr(out, at, 0, shapes, limit);
             let _ = write!(out, ", {}, {seed})", num(*size));
@@ -623,18 +626,20 @@ fn write_expr(out: &mut String, e: &Arc<Expr>, outer: u8, shapes: &[Arc<Shape>],
 mod tests {
     use super::*;
 
-    fn x() -> Arc<Expr> {
-        Expr::new(Kind::Component(Expr::point(), 0), Ty::Num)
+    fn x() -> Arc<FieldExpr> {
+        FieldExpr::new(FieldKind::Component(FieldExpr::point(), 0), FieldTy::Num)
     }
 
     #[test]
     fn source_is_readable_and_parenthesised_where_needed() {
-        let sum = Expr::binary(Binary::Add, x(), Expr::num(1.0)).unwrap();
-        let prod = Expr::binary(Binary::Mul, sum.clone(), Expr::num(2.0)).unwrap();
+        let sum = FieldExpr::binary(Binary::Add, x(), FieldExpr::num(1.0)).unwrap();
+        let prod = FieldExpr::binary(Binary::Mul, sum.clone(), FieldExpr::num(2.0)).unwrap();
         assert_eq!(prod.source(100), "(p.x + 1) * 2");
-        let diff = Expr::binary(Binary::Sub, x(), Expr::binary(Binary::Sub, x(), Expr::num(1.0)).unwrap()).unwrap();
+        let diff =
+            FieldExpr::binary(Binary::Sub, x(), FieldExpr::binary(Binary::Sub, x(), FieldExpr::num(1.0)).unwrap())
+                .unwrap();
         assert_eq!(diff.source(100), "p.x - (p.x - 1)");
-        let s = Expr::unary(Unary::Sin, prod).unwrap();
+        let s = FieldExpr::unary(Unary::Sin, prod).unwrap();
         assert_eq!(s.source(100), "sin((p.x + 1) * 2)");
         assert_eq!(s.source(5), "sin((…");
     }
@@ -642,14 +647,14 @@ mod tests {
     #[test]
     fn eval_follows_the_language() {
         let p = DVec3::new(3.0, 4.0, 0.0);
-        let len = Expr::unary(Unary::Length, Expr::point()).unwrap();
+        let len = FieldExpr::unary(Unary::Length, FieldExpr::point()).unwrap();
         let none = |_: &Arc<Shape>, _: DVec3| 0.0;
         assert_eq!(len.eval(p, &none), Val::Num(5.0));
-        let s = Expr::unary(Unary::Sin, Expr::num(90.0)).unwrap();
+        let s = FieldExpr::unary(Unary::Sin, FieldExpr::num(90.0)).unwrap();
         assert_eq!(s.eval(p, &none), Val::Num(1.0), "degrees");
-        let root = Expr::unary(Unary::Sqrt, Expr::num(-4.0)).unwrap();
+        let root = FieldExpr::unary(Unary::Sqrt, FieldExpr::num(-4.0)).unwrap();
         assert_eq!(root.eval(p, &none), Val::Num(0.0), "total: sqrt of a negative is 0");
-        let shared = Expr::binary(Binary::Mul, len.clone(), len.clone()).unwrap();
+        let shared = FieldExpr::binary(Binary::Mul, len.clone(), len.clone()).unwrap();
         assert_eq!(shared.size(), 3, "a shared node counts once");
     }
 }

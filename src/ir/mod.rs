@@ -408,7 +408,7 @@ pub enum ShapeKind {
     /// `field(p => f)`: inside where `f(p) < 0`, cut to `bounds` when given.
     Field {
         /// The body, a number.
-        body: Arc<field::Expr>,
+        body: Arc<field::FieldExpr>,
         /// Where it lives; `None`: everywhere, like a plane.
         bounds: Option<DAabb>,
         /// The bound of the body's slope it is marched with.
@@ -426,7 +426,7 @@ pub enum ShapeKind {
         /// The shape.
         child: Arc<Shape>,
         /// The map, a vector.
-        map: Arc<field::Expr>,
+        map: Arc<field::FieldExpr>,
         /// Where the result lives; `None`: everywhere.
         bounds: Option<DAabb>,
         /// The bound of how much the map stretches a distance.
@@ -439,7 +439,7 @@ pub enum ShapeKind {
         /// The shape.
         child: Arc<Shape>,
         /// The displacement, a number.
-        by: Arc<field::Expr>,
+        by: Arc<field::FieldExpr>,
         /// Where the result lives, when given; otherwise the shape's bounds grown by `reach`.
         bounds: Option<DAabb>,
         /// The bound of the displacement's slope.
@@ -557,7 +557,7 @@ impl Shape {
     /// The node's children, in order (none for a primitive).
     pub fn children(&self) -> &[Arc<Shape>] {
         match &self.kind {
-            // A field's shapes are inside its body ([`field::Expr::shapes`]).
+            // A field's shapes are inside its body ([`field::FieldExpr::shapes`]).
             ShapeKind::Primitive(_) | ShapeKind::Field { .. } => &[],
             ShapeKind::Csg { children, .. } => children,
             ShapeKind::Round { child, .. }

@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
+use crate::builtins::{self, Builtin, Kind};
 use crate::check;
-use crate::check::builtins::{self, Builtin, Kind};
 use crate::check::index::{Def, DefKind, Index};
 use crate::diag::Diagnostic;
 use crate::source::Loader;

@@ -78,7 +78,7 @@ pub struct Builder<'a> {
     last_union: Option<LastUnion>,
     /// The field built last (its node's address and body), for
     /// [`build_root`](Self::build_root).
-    last_field: Option<(usize, field::Body)>,
+    last_field: Option<(usize, field::CompiledBody)>,
     /// The twist or bend built last of a child with a convex distance (its node's
     /// address, the map, the child's closure, the cut and the closure's `1/L`), for
     /// [`build_root`](Self::build_root).
@@ -465,11 +465,11 @@ impl<'a> Builder<'a> {
 
     /// A field body compiled, the shapes its `dist` calls read lowered in its frame
     /// (their materials are not the field's: a field's surface is its own).
-    fn body(&mut self, e: &Arc<crate::ir::field::Expr>, mat: u32) -> field::Body {
+    fn body(&mut self, e: &Arc<crate::ir::field::FieldExpr>, mat: u32) -> field::CompiledBody {
         let tape = crate::field::Tape::new(e);
         let built: Vec<(Sdf, SurfSdf)> = tape.shapes.iter().map(|s| self.build(s, DAffine3::IDENTITY, mat)).collect();
         let (dist, surf): (Vec<Sdf>, Vec<SurfSdf>) = built.into_iter().unzip();
-        let body = field::Body::new(tape, field::Shapes { dist: dist.into(), surf: surf.into() });
+        let body = field::CompiledBody::new(tape, field::Shapes { dist: dist.into(), surf: surf.into() });
         self.bytes += body.bytes() + ARC_HEADER;
         body
     }

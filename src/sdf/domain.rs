@@ -1,6 +1,6 @@
 //! Domain operations' maps evaluated natively: `twist`, `bend`, `elongate` and `symmetric` move
 //! the point by a few operations each, which the field interpreter paid a dispatch for
-//! one by one. Each is the map its `warp` body states (`check::construct::domain`), and
+//! one by one. Each is the map its `warp` body states (`builtins::domain`), and
 //! the chain rule carries the shape's gradient back through it.
 
 use glam::Vec3A;

@@ -37,7 +37,7 @@ impl Distances<Dual> for Shapes {
 
 /// A compiled body with what its `dist` calls read.
 #[derive(Clone)]
-pub struct Body {
+pub struct CompiledBody {
     /// The compiled body.
     pub tape: Arc<Tape>,
     /// The same, flattened for f32, when it fits.
@@ -56,10 +56,10 @@ fn far_if_undefined(v: f32) -> f32 {
     }
 }
 
-impl Body {
+impl CompiledBody {
     /// The body of `tape`, its shapes lowered to `shapes`.
-    pub fn new(tape: Tape, shapes: Shapes) -> Body {
-        Body { flat: Flat::new(&tape).map(Arc::new), tape: Arc::new(tape), shapes }
+    pub fn new(tape: Tape, shapes: Shapes) -> CompiledBody {
+        CompiledBody { flat: Flat::new(&tape).map(Arc::new), tape: Arc::new(tape), shapes }
     }
 
     /// Bytes it holds: its instructions and the closures' pointers.
@@ -208,7 +208,7 @@ pub struct RayField {
     /// as the closure judges it).
     pub scale: f32,
     /// The body.
-    pub body: Body,
+    pub body: CompiledBody,
     /// The box it is cut to, in its frame.
     pub bounds: Option<(Vec3A, Vec3A)>,
     /// Whether the body is a convex function of the point ([`crate::ir::Shape::is_convex`]):
@@ -412,7 +412,7 @@ impl RayField {
 
     /// [`march`](Self::march) for the lanes `mask` of `N` packets of camera rays, lane
     /// `l` of packet `g` over `spans[g][l]`: the plain steps of all lanes still
-    /// marching evaluate the body together ([`Body::num_lanes`]), the same steps to the
+    /// marching evaluate the body together ([`CompiledBody::num_lanes`]), the same steps to the
     /// bit as one by one.
     pub fn march_packet<const N: usize>(
         &self,

@@ -60,7 +60,7 @@ fn pick(a: (f32, Vec2), b: (f32, Vec2), keep: impl Fn(f32, f32) -> bool) -> (f32
     }
 }
 
-/// Quilez's exact polygon distance, as `check::construct::profiles` writes it: the
+/// Quilez's exact polygon distance, as `builtins::profiles` writes it: the
 /// nearest edge, the sign flipped by each edge the horizontal ray from `p` crosses.
 fn polygon(c: &[Vec2], p: Vec2) -> (f32, Vec2) {
     let n = c.len();
@@ -161,7 +161,7 @@ mod tests {
     use crate::ir::ShapeKind;
 
     /// The sweep of the scene's only object, with its field body.
-    fn sweep_of(text: &str) -> (Swept, Arc<crate::ir::field::Expr>) {
+    fn sweep_of(text: &str) -> (Swept, Arc<crate::ir::field::FieldExpr>) {
         let mut s = only_shape(text);
         loop {
             match &s.kind {

@@ -85,7 +85,7 @@ pub fn sdf_epsilon(scene: &Scene, tol: Tolerance) -> f64 {
             t / far.max(f64::MIN_POSITIVE)
         }
     };
-    eps.clamp(crate::check::MIN_EPSILON, 0.5)
+    eps.clamp(crate::builtins::MIN_EPSILON, 0.5)
 }
 
 /// Largest radius of curvature among the curved parts of a shape, in world units, and

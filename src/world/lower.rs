@@ -61,7 +61,7 @@ struct FieldHulls(Vec<KnownPlanes>);
 /// A body, box and level with the planes found for them and the sphere holding its
 /// solid.
 struct KnownPlanes {
-    body: Arc<ir::field::Expr>,
+    body: Arc<ir::field::FieldExpr>,
     bounds: ir::DAabb,
     level: f64,
     planes: Option<Vec<(DVec3, f64)>>,
@@ -101,7 +101,7 @@ impl FieldHulls {
 
     /// [`ir::FieldPlanes`]: the planes holding where `body` is at most `level` within
     /// `b` (`field::support_planes`), for a body of at least [`MIN_OPS`] operations.
-    fn planes(&mut self, body: &Arc<ir::field::Expr>, b: ir::DAabb, level: f64) -> Option<Vec<(DVec3, f64)>> {
+    fn planes(&mut self, body: &Arc<ir::field::FieldExpr>, b: ir::DAabb, level: f64) -> Option<Vec<(DVec3, f64)>> {
         self.known(body, b, level).planes.clone()
     }
 
@@ -109,12 +109,12 @@ impl FieldHulls {
     /// smaller of the ball `field::support_radius` finds and the sphere about the
     /// support planes' polyhedron (within `b`) through its corners. A ray misses it, or
     /// enters it near the surface, for the cost of a native object's sphere test.
-    fn sphere(&mut self, body: &Arc<ir::field::Expr>, b: ir::DAabb, level: f64) -> Option<(DVec3, f64)> {
+    fn sphere(&mut self, body: &Arc<ir::field::FieldExpr>, b: ir::DAabb, level: f64) -> Option<(DVec3, f64)> {
         self.known(body, b, level).sphere
     }
 
     /// What is known of `body` within `b` at `level`, searched once.
-    fn known(&mut self, body: &Arc<ir::field::Expr>, b: ir::DAabb, level: f64) -> &KnownPlanes {
+    fn known(&mut self, body: &Arc<ir::field::FieldExpr>, b: ir::DAabb, level: f64) -> &KnownPlanes {
         let same =
             |k: &KnownPlanes| k.bounds == b && k.level == level && (Arc::ptr_eq(&k.body, body) || k.body == *body);
         let n = self.0.len();

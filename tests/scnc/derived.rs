@@ -18,7 +18,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use glam::{DVec3, Vec3A};
-use scnc::check::builtins::{Builtin, Ctor, Kind, BUILTINS};
+use scnc::builtins::{Builtin, Ctor, Kind, BUILTINS};
 use scnc::ir::{Shape, ShapeKind};
 use scnc::primitive::{Facets, Primitive, Resolution, Solid, Tessellation, Visit, PRIMITIVES};
 use scnc::sig::{Limit, Param, Range, Ty};
@@ -703,7 +703,7 @@ fn every_hull_said_to_be_the_solid_is() {
 /// error, and one declared `No` is refused with its declared reason.
 #[test]
 fn every_function_of_numbers_works_in_fields_or_says_why_not() {
-    use scnc::check::builtins::InFields;
+    use scnc::builtins::InFields;
     let mut failures = Vec::new();
     let mut rng = Rng(3);
     let maths = BUILTINS.iter().filter(|b| b.kind() == Kind::Function && b.ctor.in_fields() != InFields::NotMaths);

@@ -137,6 +137,6 @@ fn lowering_diagnostics() {
 /// `docs/builtins.md` is the reference the table writes (`UPDATE_EXPECT=1` rewrites it).
 #[test]
 fn reference_is_written_from_the_table() {
-    let failures = check_golden(std::path::Path::new("docs/builtins.md"), &scnc::check::builtins::reference());
+    let failures = check_golden(std::path::Path::new("docs/builtins.md"), &scnc::builtins::reference());
     finish(failures.into_iter().collect());
 }

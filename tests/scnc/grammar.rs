@@ -3,7 +3,7 @@
 
 use std::collections::BTreeSet;
 
-use scnc::check::builtins::{self, Kind};
+use scnc::builtins::{self, Kind};
 use scnc::syntax::Token;
 use serde_json::Value;
 

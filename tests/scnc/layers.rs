@@ -167,3 +167,30 @@ fn the_crate_root_is_a_module_list() {
     let roots = root_names(&[]);
     assert_eq!(roots.get("compile_source").map(String::as_str), Some("compile"), "{roots:?}");
 }
+
+/// No two public types share a name anywhere in `src/`: a reader (and a search) meeting
+/// `Expr` or `Body` must know which one it is without looking at the imports. (The IR's
+/// field expression was `Expr` beside the syntax tree's, `Kind` beside the builtins'.)
+#[test]
+fn public_type_names_are_unique() {
+    let mut files = Vec::new();
+    sources(Path::new("src"), &mut files);
+    let mut by_name: BTreeMap<String, Vec<String>> = BTreeMap::new();
+    for file in &files {
+        let text = std::fs::read_to_string(file).expect("reading a source file");
+        let code = text.split("#[cfg(test)]").next().unwrap_or("");
+        for line in code.lines() {
+            let line = line.trim_start();
+            for kind in ["pub struct ", "pub enum ", "pub type ", "pub trait "] {
+                if let Some(rest) = line.strip_prefix(kind) {
+                    let name: String = rest.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
+                    by_name.entry(name).or_default().push(file.display().to_string());
+                }
+            }
+        }
+    }
+    let shared: Vec<String> =
+        by_name.iter().filter(|(_, at)| at.len() > 1).map(|(n, at)| format!("{n}: {}", at.join(", "))).collect();
+    assert!(by_name.len() > 100, "only {} public types found: is the scan reading src/?", by_name.len());
+    assert!(shared.is_empty(), "public types of one name:\n{}", shared.join("\n"));
+}

@@ -222,7 +222,7 @@ fn editor_queries_never_panic() {
 /// or reports an error: no panic.
 #[test]
 fn numeric_builtins_take_extreme_arguments() {
-    use scnc::check::builtins::{Kind, Ty, BUILTINS};
+    use scnc::builtins::{Kind, Ty, BUILTINS};
     const EXTREMES: &[&str] = &["0", "-0", "1", "-1", "0.5", "1e308", "-1e308", "1e-308", "360", "-2"];
     let numeric = |t: Ty| matches!(t, Ty::Num | Ty::Int | Ty::Size | Ty::Vec3 | Ty::Linear);
     for b in BUILTINS.iter().filter(|b| b.kind() == Kind::Function) {

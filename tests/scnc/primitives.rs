@@ -2,7 +2,7 @@
 //! builtin in the table that the checker, the SDF back-end or the mesh back-end does not
 //! handle fails here (the matches over kinds are exhaustive, so most fail to compile).
 
-use scnc::check::builtins::{Builtin, Kind, Ty, BUILTINS};
+use scnc::builtins::{Builtin, Kind, Ty, BUILTINS};
 
 use crate::support::{coverage, scene};
 
@@ -49,7 +49,7 @@ fn call(b: &Builtin) -> String {
     args.extend(
         b.params
             .iter()
-            .filter(|p| p.default == scnc::check::builtins::Default::Required)
+            .filter(|p| p.default == scnc::builtins::Default::Required)
             // `symmetric`'s axes are a string that is not a path.
             .map(|p| match p.name {
                 "axes" => "\"xz\"".to_string(),

@@ -3,10 +3,10 @@
 
 use glam::DVec3;
 
+use super::BoundArgs;
 use super::MAX_REPEAT;
-use crate::check::builtins::{Builtin, Modifier};
-use crate::check::expr::BoundArgs;
-use crate::check::{Ctx, Value, MAX_OBJECTS};
+use super::{Builtin, Modifier};
+use super::{Host, Value, MAX_OBJECTS};
 use crate::diag::{codes, Diagnostic};
 use std::sync::Arc;
 
@@ -54,7 +54,7 @@ crate::params! {
     }
 }
 
-impl Ctx<'_> {
+impl dyn Host + '_ {
     /// A primitive from its definition, or `None` after reporting a rule between its
     /// parameters that the arguments break.
     pub(super) fn primitive(&mut self, e: &Entry, a: &BoundArgs) -> Option<Primitive> {

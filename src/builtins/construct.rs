@@ -3,27 +3,22 @@
 //! plain values (materials, colours, lights, numbers). Each family declares its
 //! builtins' parameters with [`params!`](crate::params) and reads them as typed fields.
 
-pub(super) mod domain;
-pub(super) mod fields;
-pub(super) mod maths;
-pub(super) mod meshes;
-pub(crate) mod profiles;
-pub(super) mod shapes;
-pub(super) mod values;
-
 use std::sync::Arc;
 
 use glam::DVec3;
 
-use super::builtins::{self, Builtin, Ctor, Kind, Ty};
-use super::expr::BoundArgs;
-use super::{direction, Ctx, Value, MAX_REACH};
+use super::{direction, maths, BoundArgs, Builtin, Ctor, FieldFn, Host, Ty, Value};
 use crate::diag::{codes, Diagnostic};
 use crate::ir::{self, dump_num, dump_vec, Camera, Settings, ShapeKind};
 use crate::sig::{self, Args, FromArg, Param, Range};
 use crate::span::Span;
-use crate::syntax::ast;
 
+/// Most objects in a scene.
+pub const MAX_OBJECTS: usize = 100_000;
+/// Longest list.
+pub const MAX_LIST: usize = 100_000;
+/// Farthest any part of the scene may reach from the camera, in world units.
+pub const MAX_REACH: f64 = 1e15;
 /// Largest rings/segments/sides of a mesh generator.
 pub const MAX_MESH_RESOLUTION: u32 = 16_384;
 /// Most triangles one mesh generator may make.
@@ -55,7 +50,7 @@ pub const MAX_SHAPE_NODES: u64 = 1_000_000;
 impl BoundArgs {
     /// The value of slot `i`: the argument given, or the parameter's default (poison for
     /// one that has none: a required argument's absence was reported when binding).
-    pub(super) fn value(&self, i: usize) -> Value {
+    pub(crate) fn value(&self, i: usize) -> Value {
         match &self.vals[i] {
             Some((v, _)) => v.clone(),
             None => match self.params[i].default {
@@ -72,19 +67,19 @@ impl BoundArgs {
     }
 
     /// The slot of the parameter `name` (a name of the builtin's own declaration).
-    pub(super) fn slot(&self, name: &str) -> Option<usize> {
+    pub(crate) fn slot(&self, name: &str) -> Option<usize> {
         let slot = self.params.iter().position(|p| p.name == name);
         debug_assert!(slot.is_some(), "no parameter `{name}`");
         slot
     }
 
     /// The span to blame for parameter `name`: its argument, or the whole call for a default.
-    pub(super) fn span_of(&self, name: &str) -> Span {
+    pub(crate) fn span_of(&self, name: &str) -> Span {
         self.slot(name).and_then(|i| self.vals[i].as_ref()).map_or(self.call, |(_, s)| *s)
     }
 
     /// Whether parameter `name` was given.
-    pub(super) fn was_given(&self, name: &str) -> bool {
+    pub(crate) fn was_given(&self, name: &str) -> bool {
         self.slot(name).is_some_and(|i| self.vals[i].is_some())
     }
 }
@@ -129,9 +124,27 @@ impl FromArg<BoundArgs> for Value {
     }
 }
 
-impl Ctx<'_> {
+impl dyn Host + '_ {
+    /// `v`, or poison after reporting at `span` that a number in it overflowed (E0401);
+    /// `message` is formatted only then.
+    pub(crate) fn finite(&mut self, v: Value, span: Span, message: impl FnOnce() -> String) -> Value {
+        if v.is_finite() {
+            return v;
+        }
+        self.report(Diagnostic::error(codes::NOT_FINITE, span, message(), "the result is not a finite number"));
+        Value::Error
+    }
+
+    /// Reports a list over [`MAX_LIST`] elements at `span`, `label` saying how long.
+    pub(crate) fn list_too_long(&mut self, span: Span, label: String) {
+        self.report(
+            Diagnostic::error(codes::TOO_LARGE, span, "list is too long", label)
+                .with_note(format!("lists may hold at most {MAX_LIST} elements")),
+        );
+    }
+
     /// Reports that parameter `name`, at `span`, breaks `rule`; `shown` is its value.
-    fn range_error(&mut self, span: Span, name: &str, rule: &str, shown: String) {
+    pub(super) fn range_error(&mut self, span: Span, name: &str, rule: &str, shown: String) {
         self.report(Diagnostic::error(
             codes::OUT_OF_RANGE,
             span,
@@ -142,7 +155,7 @@ impl Ctx<'_> {
 
     /// Whether the value given for `p` at `span` is in its declared range; reports it
     /// when not.
-    pub(super) fn in_range(&mut self, p: &Param, v: &Value, span: Span) -> bool {
+    pub(crate) fn in_range(&mut self, p: &Param, v: &Value, span: Span) -> bool {
         let (ok, shown) = match v {
             Value::Num(x) => (p.range.admits(*x), dump_num(*x)),
             Value::Vec3(v) | Value::Color(v) => (p.range.admits_vec(*v), dump_vec(*v)),
@@ -155,12 +168,12 @@ impl Ctx<'_> {
     }
 
     /// The shape value of a node made by a constructor, or `Value::Error` if it reported.
-    fn shape(&mut self, kind: Option<ShapeKind>, span: Span) -> Value {
+    pub(super) fn shape(&mut self, kind: Option<ShapeKind>, span: Span) -> Value {
         kind.map_or(Value::Error, |kind| self.shape_value(kind, span))
     }
 
     /// The shape value of a new node, if its tree is not too large.
-    pub(in crate::check) fn shape_value(&mut self, kind: ShapeKind, span: Span) -> Value {
+    pub(crate) fn shape_value(&mut self, kind: ShapeKind, span: Span) -> Value {
         self.sized(Arc::new(ir::Shape::new(kind, span)))
     }
 
@@ -168,7 +181,7 @@ impl Ctx<'_> {
     /// counted each time they are used, has more than [`MAX_SHAPE_NODES`] nodes: every
     /// later stage walks the expanded tree, so a doubling `let` chain would otherwise
     /// build a small value that takes hours to lower.
-    pub(in crate::check) fn sized(&mut self, shape: Arc<ir::Shape>) -> Value {
+    pub(crate) fn sized(&mut self, shape: Arc<ir::Shape>) -> Value {
         if shape.nodes <= MAX_SHAPE_NODES {
             return Value::Shape(shape);
         }
@@ -187,7 +200,7 @@ impl Ctx<'_> {
     }
 
     /// Builds the value of a builtin call whose arguments are bound and well typed.
-    pub(super) fn construct(&mut self, b: &Builtin, a: BoundArgs) -> Value {
+    pub(crate) fn construct(&mut self, b: &Builtin, a: BoundArgs) -> Value {
         match b.ctor {
             Ctor::Primitive(p) => {
                 let kind = self.primitive(p, &a).map(ShapeKind::Primitive);
@@ -201,7 +214,7 @@ impl Ctx<'_> {
                 let kind = self.modifier(m, &a);
                 self.shape(kind, a.call)
             }
-            Ctor::Field(f @ (builtins::FieldFn::Field | builtins::FieldFn::Warp | builtins::FieldFn::Displace)) => {
+            Ctor::Field(f @ (FieldFn::Field | FieldFn::Warp | FieldFn::Displace)) => {
                 let kind = self.field_shape(f, &a);
                 self.shape(kind, a.call)
             }
@@ -244,7 +257,7 @@ impl Ctx<'_> {
         }
     }
 
-    fn triangle_budget(&mut self, triangles: u64, span: Span) -> bool {
+    pub(super) fn triangle_budget(&mut self, triangles: u64, span: Span) -> bool {
         if triangles <= MAX_GENERATED_TRIANGLES {
             return true;
         }
@@ -260,24 +273,9 @@ impl Ctx<'_> {
         false
     }
 
-    fn statement_args(&mut self, name: &str, args: &[ast::Arg], span: Span) -> Option<(&'static Builtin, BoundArgs)> {
-        let kind = if name == "camera" { Kind::Camera } else { Kind::Render };
-        let b = builtins::lookup(name, kind)?;
-        let vals = args
-            .iter()
-            .map(|arg| super::expr::ArgVal {
-                name: arg.name.clone(),
-                value: self.expr(&arg.value),
-                span: arg.name.as_ref().map_or(arg.value.span, |n| n.span.to(arg.value.span)),
-            })
-            .collect();
-        let bound = self.bind_builtin(b, vals, span)?;
-        Some((b, bound))
-    }
-
-    pub(super) fn camera_stmt(&mut self, args: &[ast::Arg], span: Span) -> Option<Camera> {
-        let (_, a) = self.statement_args("camera", args, span)?;
-        let CameraArgs { position, look_at, up, fov } = CameraArgs::from_args(&a);
+    /// The camera of a `camera` statement whose arguments are bound.
+    pub(crate) fn camera(&mut self, a: &BoundArgs, span: Span) -> Option<Camera> {
+        let CameraArgs { position, look_at, up, fov } = CameraArgs::from_args(a);
         let mut ok = true;
         let view = direction(look_at - position);
         if view.is_none() {
@@ -311,9 +309,9 @@ impl Ctx<'_> {
         ok.then_some(Camera { position, look_at, up, fov, span: Some(span) })
     }
 
-    pub(super) fn render_stmt(&mut self, args: &[ast::Arg], span: Span) -> Option<Settings> {
-        let (_, a) = self.statement_args("render", args, span)?;
-        let r = RenderStatementArgs::from_args(&a);
+    /// The settings of a `render` statement whose arguments are bound.
+    pub(crate) fn settings(&mut self, a: &BoundArgs, span: Span) -> Option<Settings> {
+        let r = RenderStatementArgs::from_args(a);
         if r.width as u64 * r.height as u64 > MAX_PIXELS {
             self.report(
                 Diagnostic::error(

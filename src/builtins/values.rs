@@ -4,9 +4,9 @@ use std::sync::Arc;
 
 use glam::DVec3;
 
-use crate::check::builtins::{LightFn, PatternFn};
-use crate::check::expr::BoundArgs;
-use crate::check::{Ctx, Value};
+use super::BoundArgs;
+use super::{Host, Value};
+use super::{LightFn, PatternFn};
 use crate::diag::{codes, Diagnostic};
 use crate::ir::{self, dump_vec, Material, Paint, Pattern, PatternKind};
 use crate::sig::Range;
@@ -151,7 +151,7 @@ fn pattern_nodes(p: &Pattern) -> usize {
     1 + inner(&p.a) + inner(&p.b)
 }
 
-impl Ctx<'_> {
+impl dyn Host + '_ {
     /// `material(color, specular, reflective, transparency, ior, absorption)`.
     pub(super) fn material(&mut self, a: &BoundArgs) -> Value {
         let m = MaterialArgs::from_args(a);
@@ -208,7 +208,7 @@ impl Ctx<'_> {
                 let kind = if !(to - from).is_finite() {
                     self.range_error(a.span_of("to"), "to", "a point within 1e308 of `from`", dump_vec(to));
                     None
-                } else if crate::check::direction(to - from).is_none() {
+                } else if super::direction(to - from).is_none() {
                     self.range_error(a.span_of("to"), "to", "a point other than `from`", dump_vec(to));
                     None
                 } else {

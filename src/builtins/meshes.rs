@@ -4,10 +4,10 @@ use std::sync::Arc;
 
 use glam::{DAffine3, DVec3};
 
+use super::BoundArgs;
+use super::Gen;
 use super::MAX_MESH_RESOLUTION;
-use crate::check::builtins::Gen;
-use crate::check::expr::BoundArgs;
-use crate::check::{Ctx, Value};
+use super::{Host, Value};
 use crate::ir::{self, MeshSource};
 use crate::sig::Range;
 
@@ -112,7 +112,7 @@ crate::params! {
     }
 }
 
-impl Ctx<'_> {
+impl dyn Host + '_ {
     /// A mesh from a generator, or `Value::Error` after reporting.
     pub(super) fn mesh(&mut self, g: Gen, a: BoundArgs) -> Value {
         let (source, smooth) = match g {
@@ -155,7 +155,7 @@ impl Ctx<'_> {
             }
             Gen::File => {
                 let FileArgs { path, smooth } = FileArgs::from_args(&a);
-                (MeshSource::File { path: self.dir.join(&path), written: path }, smooth)
+                (MeshSource::File { path: self.file_dir().join(&path), written: path }, smooth)
             }
         };
         Value::Mesh(Arc::new(ir::Mesh { source, xf: DAffine3::IDENTITY, material: None, smooth, span: a.call }))

@@ -4,23 +4,23 @@
 
 use std::sync::LazyLock;
 
-use super::{Builtin, Ctor, Extreme, FieldFn, Gen, LightFn, MathFn, Modifier, NumFn, PatternFn, ProfileFn, Ty, VecFn};
-use crate::check::construct::domain::{BendArgs, ElongateArgs, PolarArgs, SymmetricArgs, TwistArgs};
-use crate::check::construct::fields::{DisplaceArgs, DistArgs, FieldArgs, Noise3Args, WarpArgs};
-use crate::check::construct::maths::{
+use super::construct::{CameraArgs, RenderStatementArgs};
+use super::domain::{BendArgs, ElongateArgs, PolarArgs, SymmetricArgs, TwistArgs};
+use super::fields::{DisplaceArgs, DistArgs, FieldArgs, Noise3Args, WarpArgs};
+use super::maths::{
     Atan2Args, ClampArgs, HsvArgs, ListArgs, MixArgs, NumberArgs, PairArgs, PowArgs, RangeArgs, VectorArgs,
 };
-use crate::check::construct::meshes::{
+use super::meshes::{
     BoxMeshArgs, CylinderMeshArgs, FileArgs, IcoSphereArgs, IsosurfaceArgs, PlaneMeshArgs, TorusMeshArgs, UvSphereArgs,
 };
-use crate::check::construct::profiles::{
+use super::profiles::{
     CircleArgs, ExtrudeArgs, PolygonArgs, RectArgs, RevolveArgs, RoundProfileArgs, ShellProfileArgs,
 };
-use crate::check::construct::shapes::{CsgArgs, RepeatArgs, RoundArgs, ShellArgs};
-use crate::check::construct::values::{
+use super::shapes::{CsgArgs, RepeatArgs, RoundArgs, ShellArgs};
+use super::values::{
     AmbientArgs, CheckerArgs, DirectionalArgs, GradientArgs, MaterialArgs, NoiseArgs, PointArgs, RgbArgs, StripesArgs,
 };
-use crate::check::construct::{CameraArgs, RenderStatementArgs};
+use super::{Builtin, Ctor, Extreme, FieldFn, Gen, LightFn, MathFn, Modifier, NumFn, PatternFn, ProfileFn, Ty, VecFn};
 use crate::ir::field::Unary;
 use crate::ir::CsgOp;
 use crate::primitive::PRIMITIVES;
@@ -412,7 +412,7 @@ pub struct Constant {
 pub enum ConstValue {
     /// Always this number.
     Num(f64),
-    /// The frame's `clock` (see [`Time`](crate::check::Time)).
+    /// The frame's `clock` (see the checker's `Time`).
     Clock,
     /// The frame's number.
     Frame,

@@ -5,9 +5,9 @@ use std::rc::Rc;
 
 use glam::DVec3;
 
-use crate::check::builtins::{Builtin, Extreme, MathFn, NumFn, VecFn};
-use crate::check::expr::BoundArgs;
-use crate::check::{direction, Ctx, Value, MAX_LIST};
+use super::BoundArgs;
+use super::{direction, Host, Value, MAX_LIST};
+use super::{Builtin, Extreme, MathFn, NumFn, VecFn};
 use crate::diag::{codes, Diagnostic};
 use crate::ir::dump_num;
 use crate::sig::{Default, Param, Range, Ty};
@@ -152,9 +152,9 @@ crate::params! {
     }
 }
 
-impl Ctx<'_> {
+impl dyn Host + '_ {
     /// A function of one number, `x` given at `arg` in the call at `call`.
-    pub(in crate::check) fn math(&mut self, b: &Builtin, f: MathFn, x: f64, arg: Span, call: Span) -> Value {
+    pub(crate) fn math(&mut self, b: &Builtin, f: MathFn, x: f64, arg: Span, call: Span) -> Value {
         // The domain is the declared range (the fast path of a call reaches here unbound).
         if let Some(p) = b.params.first() {
             if !self.in_range(p, &Value::Num(x), arg) {
@@ -310,7 +310,7 @@ impl Ctx<'_> {
                     Value::Vec3(u.cross(w))
                 }
             }
-            VecFn::Length => Value::Num(crate::check::length(OneVector::from_args(a).v)),
+            VecFn::Length => Value::Num(super::length(OneVector::from_args(a).v)),
             // The range refused zero; one too small to scale is refused the same way.
             VecFn::Normalize => match direction(OneVector::from_args(a).v) {
                 Some(n) => Value::Vec3(n),

@@ -1,20 +1,89 @@
 //! The builtins: every function, shape, mesh generator, light and statement argument
 //! list, with parameter names, types, defaults and a one-line doc, in one table
-//! (`table`, with the named constants); here are its types and the lookups into it. The
-//! checker, the docs and the editor tooling read this one table.
+//! (`table`, with the named constants), and beside each family's declarations the
+//! constructors that build its values (one file per family: maths, shapes, fields,
+//! domain, profiles, meshes, values). Here are the table's types and lookups, the
+//! [`Host`] a constructor asks of the evaluator, and the bound arguments it reads.
+//! The checker, the docs and the editor tooling read this one table.
 
 use std::collections::HashMap;
+use std::path::Path;
 use std::sync::OnceLock;
 
 use foldhash::fast::FixedState;
 
+use crate::diag::Diagnostic;
 use crate::ir::CsgOp;
 pub use crate::sig::{Default, Param, Range, Ty};
+use crate::span::Span;
 
+mod construct;
+pub(crate) mod domain;
+pub(crate) mod fields;
+pub(crate) mod maths;
+pub(crate) mod meshes;
+pub(crate) mod profiles;
 mod reference;
+pub(crate) mod shapes;
 mod table;
+mod value;
+pub(crate) mod values;
+pub use construct::{
+    CameraArgs, RenderStatementArgs, EPSILON_RANGE, MAX_DEPTH, MAX_FPS, MAX_FRAMES, MAX_GENERATED_TRIANGLES,
+    MAX_IMAGE_SIDE, MAX_LIST, MAX_MESH_RESOLUTION, MAX_OBJECTS, MAX_PIXELS, MAX_REACH, MAX_REPEAT, MAX_SAMPLES,
+    MAX_SHAPE_NODES, MAX_STEPS, MIN_EPSILON,
+};
 pub use reference::reference;
 pub use table::{constant, ConstValue, Constant, BUILTINS, CONSTANTS};
+pub use value::{FieldLit, Profile, Value};
+
+/// What a constructor asks of the evaluator calling it: to report, to spend fuel, and
+/// two facts about where the call is. The constructors are methods of `dyn Host`, so
+/// this room does not depend on the checker that implements it.
+pub trait Host {
+    /// Reports a diagnostic.
+    fn report(&mut self, d: Diagnostic);
+    /// Spends `steps` of the compile's fuel for work at `span`; `false` once it is out
+    /// (reported) or the compile is no longer wanted.
+    fn burn(&mut self, steps: u64, span: Span) -> bool;
+    /// Whether the call is inside a field's body (`p => …`), where there is a point.
+    fn in_field_body(&self) -> bool;
+    /// The directory of the file being evaluated: a mesh file's path is relative to it.
+    fn file_dir(&self) -> &Path;
+}
+
+/// Arguments bound to a builtin's parameters, after arity, name and type checks.
+pub struct BoundArgs {
+    /// The builtin's parameters, for the defaults of the slots not given.
+    pub params: &'static [crate::sig::Param],
+    /// One slot per parameter: the value and the span to blame for it.
+    pub vals: Vec<Option<(Value, Span)>>,
+    /// Variadic positional arguments.
+    pub rest: Vec<(Value, Span)>,
+    /// The whole call.
+    pub call: Span,
+}
+
+/// The unit vector along `v`, or `None` for a zero or non-finite vector. Scaled by its
+/// largest component first, as `hypot` does, so `[1e200, 1e200, 0]` (whose `x·x`
+/// overflows) and `[1e-200, 0, 0]` (whose `x·x` underflows) have directions.
+pub(crate) fn direction(v: glam::DVec3) -> Option<glam::DVec3> {
+    let big = v.abs().max_element();
+    if !big.is_finite() || big == 0.0 {
+        return None;
+    }
+    let n = (v / big).try_normalize()?;
+    n.is_finite().then_some(n)
+}
+
+/// The length of `v` without overflow or underflow in its squares (as `hypot`).
+pub(crate) fn length(v: glam::DVec3) -> f64 {
+    let big = v.abs().max_element();
+    if big == 0.0 || !big.is_finite() {
+        return big;
+    }
+    big * (v / big).length()
+}
 
 /// Where a builtin may be used (follows from its [`Ctor`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

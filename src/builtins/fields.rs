@@ -8,13 +8,13 @@ use std::sync::Arc;
 
 use glam::DVec3;
 
-use crate::check::builtins::FieldFn;
-use crate::check::expr::BoundArgs;
-use crate::check::{Ctx, Value};
+use super::BoundArgs;
+use super::FieldFn;
+use super::{Host, Value};
 use crate::diag::{codes, Diagnostic};
 use crate::field::{lipschitz, Estimate, SlopeDistances, Tape};
 use crate::geom::DAabb;
-use crate::ir::field::{Expr, Kind, Ty, Unary, Val};
+use crate::ir::field::{FieldExpr, FieldKind, FieldTy, Unary, Val};
 use crate::ir::{self, Lipschitz, ShapeKind};
 use crate::sig::Range;
 use crate::span::Span;
@@ -105,11 +105,11 @@ const SMALL_TURN: f64 = 45.0;
 /// the function, its argument and the turn, sampled on a 5×5×5 grid. Arguments that
 /// read `dist` are left alone: their turn depends on shapes, not on how the author wrote
 /// angles.
-fn radians_for_degrees(body: &Arc<Expr>, domain: Option<DAabb>) -> Option<(Unary, Arc<Expr>, f64)> {
+fn radians_for_degrees(body: &Arc<FieldExpr>, domain: Option<DAabb>) -> Option<(Unary, Arc<FieldExpr>, f64)> {
     let (lo, hi) = domain.map_or((DVec3::splat(-1.0), DVec3::splat(1.0)), |b| (b.min, b.max));
     let mut stack = vec![body];
     while let Some(e) = stack.pop() {
-        if let Kind::Unary(f @ (Unary::Sin | Unary::Cos | Unary::Tan), x) = &e.kind {
+        if let FieldKind::Unary(f @ (Unary::Sin | Unary::Cos | Unary::Tan), x) = &e.kind {
             if x.uses_point() && x.shapes().is_empty() {
                 let (mut min, mut max) = (f64::INFINITY, f64::NEG_INFINITY);
                 for i in 0..125 {
@@ -134,9 +134,9 @@ fn radians_for_degrees(body: &Arc<Expr>, domain: Option<DAabb>) -> Option<(Unary
 /// Most operations one field body may have after folding (shared ones once).
 pub const MAX_FIELD_OPS: usize = 100_000;
 
-impl Ctx<'_> {
+impl dyn Host + '_ {
     /// `field`, `warp` or `displace`, or `None` after reporting.
-    pub(in crate::check) fn field_shape(&mut self, f: FieldFn, a: &BoundArgs) -> Option<ShapeKind> {
+    pub(crate) fn field_shape(&mut self, f: FieldFn, a: &BoundArgs) -> Option<ShapeKind> {
         match f {
             FieldFn::Field => {
                 let FieldArgs { f: Value::Field(lit), bounds, lipschitz: given } = FieldArgs::from_args(a) else {
@@ -179,11 +179,11 @@ impl Ctx<'_> {
     }
 
     /// `dist(shape, q)`: only inside a field's body, where there is a point to measure at.
-    pub(in crate::check) fn dist(&mut self, a: &BoundArgs) -> Value {
+    pub(crate) fn dist(&mut self, a: &BoundArgs) -> Value {
         let DistArgs { shape: Value::Shape(shape), q } = DistArgs::from_args(a) else {
             return Value::Error;
         };
-        if self.field_depth == 0 {
+        if !self.in_field_body() {
             self.report(
                 Diagnostic::error(
                     codes::DEPENDS_ON_POINT,
@@ -196,17 +196,17 @@ impl Ctx<'_> {
             return Value::Error;
         }
         match q.as_field() {
-            Some(q) => Value::Sym(Expr::new(Kind::Dist(shape, q), Ty::Num)),
+            Some(q) => Value::Sym(FieldExpr::new(FieldKind::Dist(shape, q), FieldTy::Num)),
             None => Value::Error,
         }
     }
 
     /// `noise3(q, size, seed)`: folded when `q` is known.
-    pub(in crate::check) fn noise3(&mut self, a: &BoundArgs) -> Value {
+    pub(crate) fn noise3(&mut self, a: &BoundArgs) -> Value {
         let Noise3Args { q, size, seed } = Noise3Args::from_args(a);
         match q {
             Value::Vec3(v) => Value::Num(crate::geom::noise(v / size, seed)),
-            Value::Sym(q) => Value::Sym(Expr::new(Kind::Noise { at: q, size, seed }, Ty::Num)),
+            Value::Sym(q) => Value::Sym(FieldExpr::new(FieldKind::Noise { at: q, size, seed }, FieldTy::Num)),
             _ => Value::Error,
         }
     }
@@ -243,7 +243,7 @@ impl Ctx<'_> {
     }
 
     /// The body compiled, or `None` after reporting one too large.
-    pub(in crate::check) fn field_tape(&mut self, body: &Arc<Expr>, span: Span) -> Option<Tape> {
+    pub(crate) fn field_tape(&mut self, body: &Arc<FieldExpr>, span: Span) -> Option<Tape> {
         let tape = Tape::new(body);
         if tape.ops.len() > MAX_FIELD_OPS {
             self.report(
@@ -261,7 +261,7 @@ impl Ctx<'_> {
     }
 
     /// Warns (W0010) when the body's trigonometry barely turns over `domain`.
-    fn check_angles(&mut self, body: &Arc<Expr>, domain: Option<DAabb>, span: Span) {
+    fn check_angles(&mut self, body: &Arc<FieldExpr>, domain: Option<DAabb>, span: Span) {
         let Some((f, arg, turn)) = radians_for_degrees(body, domain) else { return };
         let (name, arg) = (f.name(), arg.source(60));
         let over = if domain.is_some() { "its `bounds`" } else { "the cube from -1 to 1" };
@@ -284,7 +284,7 @@ impl Ctx<'_> {
 
     /// What the body's slope is bounded by: `given`, or estimated over `domain`;
     /// `None` after reporting that no bound was found. `what` names the field.
-    pub(in crate::check) fn field_slope(
+    pub(crate) fn field_slope(
         &mut self,
         tape: &Tape,
         domain: Option<DAabb>,

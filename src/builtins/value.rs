@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use glam::DVec3;
 
-use super::builtins::Ty;
+use super::Ty;
 use crate::ir;
 use crate::span::Span;
 
@@ -13,7 +13,7 @@ use crate::span::Span;
 #[derive(Debug)]
 pub struct FieldLit {
     /// The body.
-    pub body: Arc<ir::field::Expr>,
+    pub body: Arc<ir::field::FieldExpr>,
     /// The body's span, to blame for what it computes.
     pub span: Span,
 }
@@ -46,7 +46,7 @@ pub enum Value {
     List(Rc<Vec<Value>>),
     /// A number, vector or truth value that depends on a field's point: inside a field
     /// literal's body, what the point flows into.
-    Sym(Arc<ir::field::Expr>),
+    Sym(Arc<ir::field::FieldExpr>),
     /// A field literal `p => …`, its body evaluated.
     Field(Rc<FieldLit>),
     /// A 2D profile.
@@ -72,11 +72,11 @@ impl Value {
             Value::Light(_) => Ty::Light,
             Value::List(_) => Ty::List,
             Value::Sym(e) => match e.ty {
-                ir::field::Ty::Num => Ty::Num,
-                ir::field::Ty::Vec3 => Ty::Vec3,
-                ir::field::Ty::Bool => Ty::Bool,
+                ir::field::FieldTy::Num => Ty::Num,
+                ir::field::FieldTy::Vec3 => Ty::Vec3,
+                ir::field::FieldTy::Bool => Ty::Bool,
             },
-            Value::Field(f) if f.body.ty == ir::field::Ty::Vec3 => Ty::FieldVec,
+            Value::Field(f) if f.body.ty == ir::field::FieldTy::Vec3 => Ty::FieldVec,
             Value::Field(_) => Ty::FieldNum,
             Value::Profile(_) => Ty::Profile,
             Value::Error => return None,
@@ -135,12 +135,12 @@ impl Value {
 
     /// The value as a field expression, if it is a number, vector or truth value
     /// (known, or depending on the point).
-    pub fn as_field(&self) -> Option<Arc<ir::field::Expr>> {
-        use ir::field::{Expr, Kind, Ty};
+    pub fn as_field(&self) -> Option<Arc<ir::field::FieldExpr>> {
+        use ir::field::{FieldExpr, FieldKind, FieldTy};
         Some(match self {
-            Value::Num(x) => Expr::num(*x),
-            Value::Vec3(v) => Expr::vec(*v),
-            Value::Bool(b) => Expr::new(Kind::Num(f64::from(*b)), Ty::Bool),
+            Value::Num(x) => FieldExpr::num(*x),
+            Value::Vec3(v) => FieldExpr::vec(*v),
+            Value::Bool(b) => FieldExpr::new(FieldKind::Num(f64::from(*b)), FieldTy::Bool),
             Value::Sym(e) => e.clone(),
             _ => return None,
         })
@@ -157,7 +157,7 @@ impl Value {
 pub struct Profile {
     /// The signed distance: exact for a circle, rectangle or polygon, moved or not; a
     /// bound after `union`, `intersect`, `subtract`, `round` or `shell`.
-    pub body: Arc<ir::field::Expr>,
+    pub body: Arc<ir::field::FieldExpr>,
     /// The region it covers when that is made of polygons and circles by sharp CSG
     /// (moved or not): what an extrusion's mesh is made from, and a lathe's when it is one
     /// polygon. `None` after `round` or `shell` of anything but a circle, or a smooth CSG.

@@ -10,16 +10,16 @@ use std::sync::Arc;
 use glam::{DVec2, DVec3};
 
 use super::domain::{bin, un};
-use crate::check::builtins::ProfileFn;
-use crate::check::construct::shapes::CsgArgs;
-use crate::check::expr::BoundArgs;
-use crate::check::value::Profile;
-use crate::check::{Ctx, Value};
+use super::shapes::CsgArgs;
+use super::BoundArgs;
+use super::Profile;
+use super::ProfileFn;
+use super::{Host, Value};
 use crate::diag::{codes, Diagnostic};
 use crate::geom::region::{Combine, Region};
 use crate::geom::DAabb;
 use crate::ir::dump_num;
-use crate::ir::field::{Binary, Expr, Kind, Ty, Unary};
+use crate::ir::field::{Binary, FieldExpr, FieldKind, FieldTy, Unary};
 use crate::ir::{CsgOp, ExactMesh, Lipschitz, ShapeKind, Sweep};
 use crate::sig::Range;
 use crate::span::Span;
@@ -92,36 +92,21 @@ crate::params! {
 /// Most corners of one polygon (its distance takes a few operations per edge).
 pub const MAX_POLYGON_POINTS: usize = 1000;
 
-fn vec2(a: Arc<Expr>, b: Arc<Expr>) -> Arc<Expr> {
-    Expr::vector([a, b, Expr::num(0.0)])
+fn vec2(a: Arc<FieldExpr>, b: Arc<FieldExpr>) -> Arc<FieldExpr> {
+    FieldExpr::vector([a, b, FieldExpr::num(0.0)])
 }
 
-fn num(x: f64) -> Arc<Expr> {
-    Expr::num(x)
+fn num(x: f64) -> Arc<FieldExpr> {
+    FieldExpr::num(x)
 }
 
 /// `min(max(a, b), 0) + |[max(a, 0), max(b, 0)]|`: the exact distance of the
 /// intersection of two slabs' distances `a` and `b` taken along orthogonal directions.
-fn corner(a: &Arc<Expr>, b: &Arc<Expr>) -> Arc<Expr> {
+fn corner(a: &Arc<FieldExpr>, b: &Arc<FieldExpr>) -> Arc<FieldExpr> {
     let zero = num(0.0);
     let inside = bin(Binary::Min, &bin(Binary::Max, a, b), &zero);
     let outside = un(Unary::Length, &vec2(bin(Binary::Max, a, &zero), bin(Binary::Max, b, &zero)));
     bin(Binary::Add, &inside, &outside)
-}
-
-/// Whether segments `a0 a1` and `b0 b1` cross or touch.
-fn segments_meet(a0: DVec2, a1: DVec2, b0: DVec2, b1: DVec2) -> bool {
-    let side = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
-    let on = |p: DVec2, q: DVec2, r: DVec2| r.cmpge(p.min(q)).all() && r.cmple(p.max(q)).all();
-    let (d1, d2) = (side(b0, b1, a0), side(b0, b1, a1));
-    let (d3, d4) = (side(a0, a1, b0), side(a0, a1, b1));
-    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0)) && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0)) {
-        return true;
-    }
-    (d1 == 0.0 && on(b0, b1, a0))
-        || (d2 == 0.0 && on(b0, b1, a1))
-        || (d3 == 0.0 && on(a0, a1, b0))
-        || (d4 == 0.0 && on(a0, a1, b1))
 }
 
 /// The region of `profile`, if it has one, moved by `f` (scaling by `k`).
@@ -134,11 +119,11 @@ fn disc(r: f64) -> Option<Arc<Region>> {
     Some(Arc::new(Region::Circle { centre: DVec2::ZERO, r }))
 }
 
-impl Ctx<'_> {
+impl dyn Host + '_ {
     /// A profile builtin's value (a profile, or a sweep's shape), or poison after reporting.
-    pub(in crate::check) fn profile(&mut self, f: ProfileFn, a: &BoundArgs) -> Value {
-        let p = Expr::point();
-        let (u, v) = (Expr::component(&p, 0), Expr::component(&p, 1));
+    pub(crate) fn profile(&mut self, f: ProfileFn, a: &BoundArgs) -> Value {
+        let p = FieldExpr::point();
+        let (u, v) = (FieldExpr::component(&p, 0), FieldExpr::component(&p, 1));
         let made = match f {
             ProfileFn::Csg(op) => self.profile_csg(op, a),
             ProfileFn::Circle => {
@@ -207,15 +192,15 @@ impl Ctx<'_> {
 
     /// A profile moved in its plane: `at [u, v]`, `rotate degrees` (counter-clockwise,
     /// from `u` towards `v`) or `scale k` (uniform, so the distance stays exact).
-    pub(in crate::check) fn transform_profile(
+    pub(crate) fn transform_profile(
         &mut self,
         op: TransformOp,
         profile: &Profile,
         arg: &Value,
         arg_span: Span,
     ) -> Value {
-        let p = Expr::point();
-        let (u, v) = (Expr::component(&p, 0), Expr::component(&p, 1));
+        let p = FieldExpr::point();
+        let (u, v) = (FieldExpr::component(&p, 0), FieldExpr::component(&p, 1));
         let two = match arg {
             Value::List(items) if items.len() == 2 => match (&items[0], &items[1]) {
                 (Value::Num(a), Value::Num(b)) if a.is_finite() && b.is_finite() => Some(DVec2::new(*a, *b)),
@@ -315,12 +300,12 @@ impl Ctx<'_> {
         }
         let CsgArgs { smooth: k } = CsgArgs::from_args(a);
         // max(k − |a − b|, 0)² / 4k: how far the blend moves the seam (at most k/4).
-        let blend = |x: &Arc<Expr>, y: &Arc<Expr>| {
+        let blend = |x: &Arc<FieldExpr>, y: &Arc<FieldExpr>| {
             let gap = bin(Binary::Sub, &num(k), &un(Unary::Abs, &bin(Binary::Sub, x, y)));
             let h = bin(Binary::Max, &gap, &num(0.0));
             bin(Binary::Div, &bin(Binary::Mul, &h, &h), &num(4.0 * k))
         };
-        let combine = |x: &Arc<Expr>, y: &Arc<Expr>, outer: Binary| {
+        let combine = |x: &Arc<FieldExpr>, y: &Arc<FieldExpr>, outer: Binary| {
             let sharp = bin(outer, x, y);
             match (k > 0.0, outer) {
                 (false, _) => sharp,
@@ -395,8 +380,8 @@ impl Ctx<'_> {
 
     /// `extrude` or `revolve` as a field of the solid's point, or `None` after reporting.
     fn sweep(&mut self, f: ProfileFn, a: &BoundArgs) -> Option<ShapeKind> {
-        let p = Expr::point();
-        let (x, y, z) = (Expr::component(&p, 0), Expr::component(&p, 1), Expr::component(&p, 2));
+        let p = FieldExpr::point();
+        let (x, y, z) = (FieldExpr::component(&p, 0), FieldExpr::component(&p, 1), FieldExpr::component(&p, 2));
         let exact = Lipschitz { value: 1.0, given: false };
         match f {
             ProfileFn::Extrude => {
@@ -443,7 +428,7 @@ impl Ctx<'_> {
                 }
                 // The radius is never negative: a part of the profile at u < 0 is never
                 // reached (it is clipped), and the distance stays a bound.
-                let radius = un(Unary::Length, &Expr::vector([x, num(0.0), z]));
+                let radius = un(Unary::Length, &FieldExpr::vector([x, num(0.0), z]));
                 let body = profile.body.substitute(&vec2(radius, y));
                 let r = profile.max.x;
                 let bounds = DAabb { min: DVec3::new(-r, profile.min.y, -r), max: DVec3::new(r, profile.max.y, r) };
@@ -471,7 +456,7 @@ impl Ctx<'_> {
 
     /// A simple polygon's exact signed distance (Quilez's: the nearest edge, the sign by
     /// the crossing count), corners and box, or `None` after reporting a bad polygon.
-    fn polygon(&mut self, points: &Value, span: Span) -> Option<(Arc<Expr>, Vec<DVec2>, DVec2, DVec2)> {
+    fn polygon(&mut self, points: &Value, span: Span) -> Option<(Arc<FieldExpr>, Vec<DVec2>, DVec2, DVec2)> {
         let bad = |this: &mut Self, what: String, label: &str| {
             this.report(
                 Diagnostic::error(codes::OUT_OF_RANGE, span, what, label)
@@ -520,7 +505,7 @@ impl Ctx<'_> {
                     (other_a - shared).perp_dot(other_b - shared) == 0.0
                         && (other_a - shared).dot(other_b - shared) > 0.0
                 } else {
-                    segments_meet(a0, a1, b0, b1)
+                    crate::geom::polygon::segments_meet(a0, a1, b0, b1)
                 };
                 if meet {
                     // Name each edge by its corners, index and place, so the crossing can be
@@ -545,10 +530,10 @@ impl Ctx<'_> {
         if area == 0.0 {
             return bad(self, "the polygon has no area".into(), "its corners lie on a line");
         }
-        let p = Expr::point();
-        let (u, v) = (Expr::component(&p, 0), Expr::component(&p, 1));
+        let p = FieldExpr::point();
+        let (u, v) = (FieldExpr::component(&p, 0), FieldExpr::component(&p, 1));
         let zero = num(0.0);
-        let (mut d2, mut sign): (Option<Arc<Expr>>, Arc<Expr>) = (None, num(1.0));
+        let (mut d2, mut sign): (Option<Arc<FieldExpr>>, Arc<FieldExpr>) = (None, num(1.0));
         for i in 0..n {
             let (vi, vj) = (corners[i], corners[(i + n - 1) % n]);
             let e = vj - vi;
@@ -577,7 +562,7 @@ impl Ctx<'_> {
             let none =
                 bin(Binary::And, &bin(Binary::And, &un(Unary::Not, &c1), &un(Unary::Not, &c2)), &un(Unary::Not, &c3));
             let flip = bin(Binary::Or, &all, &none);
-            let factor = Expr::new(Kind::Select(flip, num(-1.0), num(1.0)), Ty::Num);
+            let factor = FieldExpr::new(FieldKind::Select(flip, num(-1.0), num(1.0)), FieldTy::Num);
             sign = bin(Binary::Mul, &sign, &factor);
         }
         let d = un(Unary::Sqrt, &d2.unwrap_or_else(|| num(0.0)));
@@ -590,11 +575,11 @@ impl Ctx<'_> {
 
 /// Whether no point of the box `min`..`max` can be inside the profile `body`: the
 /// branch-and-bound search that bounds fields' support rules out every box of it.
-fn provably_empty(body: &Arc<Expr>, min: DVec2, max: DVec2) -> bool {
+fn provably_empty(body: &Arc<FieldExpr>, min: DVec2, max: DVec2) -> bool {
     // A profile's body reads a point of its plane, z = 0: give it [x, y, 0], and the
     // box depth for the search's sake.
-    let p = Expr::point();
-    let flat = body.substitute(&vec2(Expr::component(&p, 0), Expr::component(&p, 1)));
+    let p = FieldExpr::point();
+    let flat = body.substitute(&vec2(FieldExpr::component(&p, 0), FieldExpr::component(&p, 1)));
     let tape = crate::field::Tape::new(&flat);
     let b = DAabb { min: DVec3::new(min.x, min.y, -1.0), max: DVec3::new(max.x, max.y, 1.0) };
     crate::field::support_radius(&tape, b, 0.0, b.centre(), &crate::field::NoDistances).is_none()

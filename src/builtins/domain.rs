@@ -8,12 +8,12 @@ use std::sync::Arc;
 
 use glam::DVec3;
 
-use crate::check::builtins::FieldFn;
-use crate::check::expr::BoundArgs;
-use crate::check::{Ctx, Value};
+use super::BoundArgs;
+use super::FieldFn;
+use super::{Host, Value};
 use crate::diag::{codes, Diagnostic};
 use crate::geom::DAabb;
-use crate::ir::field::{Binary, Expr, Kind, Ty, Unary};
+use crate::ir::field::{Binary, FieldExpr, FieldKind, FieldTy, Unary};
 use crate::ir::{self, DomainOp, Lipschitz, Shape, ShapeKind};
 use crate::sig::Range;
 use crate::span::Span;
@@ -73,28 +73,28 @@ const MAX_EXACT_COPIES: u32 = 64;
 
 /// Expression builders for maps and bodies written here (also by `profiles`); every use
 /// is well typed, so a refusal would be a bug, shown as NaN rather than a panic.
-pub(super) fn un(f: Unary, x: &Arc<Expr>) -> Arc<Expr> {
-    Expr::unary(f, x.clone()).unwrap_or_else(|| Expr::num(f64::NAN))
+pub(super) fn un(f: Unary, x: &Arc<FieldExpr>) -> Arc<FieldExpr> {
+    FieldExpr::unary(f, x.clone()).unwrap_or_else(|| FieldExpr::num(f64::NAN))
 }
 
 /// `f(a, b)`, see [`un`].
-pub(super) fn bin(f: Binary, a: &Arc<Expr>, b: &Arc<Expr>) -> Arc<Expr> {
-    Expr::binary(f, a.clone(), b.clone()).unwrap_or_else(|| Expr::num(f64::NAN))
+pub(super) fn bin(f: Binary, a: &Arc<FieldExpr>, b: &Arc<FieldExpr>) -> Arc<FieldExpr> {
+    FieldExpr::binary(f, a.clone(), b.clone()).unwrap_or_else(|| FieldExpr::num(f64::NAN))
 }
 
 /// `[a·cos θ − b·sin θ, a·sin θ + b·cos θ]`: `(a, b)` turned by `θ` degrees.
-fn turn(a: &Arc<Expr>, b: &Arc<Expr>, theta: &Arc<Expr>) -> (Arc<Expr>, Arc<Expr>) {
+fn turn(a: &Arc<FieldExpr>, b: &Arc<FieldExpr>, theta: &Arc<FieldExpr>) -> (Arc<FieldExpr>, Arc<FieldExpr>) {
     let (c, s) = (un(Unary::Cos, theta), un(Unary::Sin, theta));
     let first = bin(Binary::Sub, &bin(Binary::Mul, a, &c), &bin(Binary::Mul, b, &s));
     let second = bin(Binary::Add, &bin(Binary::Mul, a, &s), &bin(Binary::Mul, b, &c));
     (first, second)
 }
 
-impl Ctx<'_> {
+impl dyn Host + '_ {
     /// A domain operation, or `None` after reporting.
-    pub(in crate::check) fn domain_shape(&mut self, f: FieldFn, a: &BoundArgs, span: Span) -> Option<ShapeKind> {
-        let p = Expr::point();
-        let (x, y, z) = (Expr::component(&p, 0), Expr::component(&p, 1), Expr::component(&p, 2));
+    pub(crate) fn domain_shape(&mut self, f: FieldFn, a: &BoundArgs, span: Span) -> Option<ShapeKind> {
+        let p = FieldExpr::point();
+        let (x, y, z) = (FieldExpr::component(&p, 0), FieldExpr::component(&p, 1), FieldExpr::component(&p, 2));
         let exact = Lipschitz { value: 1.0, given: false };
         match f {
             FieldFn::Twist => {
@@ -105,9 +105,9 @@ impl Ctx<'_> {
                 // The slice at height y is the shape's turned by k·y: it is seen at p
                 // turned back (rotate [0, a, 0] takes (x, z) to (x cos a + z sin a,
                 // −x sin a + z cos a), so back is the other way).
-                let theta = bin(Binary::Mul, &Expr::num(k), &y);
+                let theta = bin(Binary::Mul, &FieldExpr::num(k), &y);
                 let (qx, qz) = turn(&x, &z, &theta);
-                let map = Expr::vector([qx, y.clone(), qz]);
+                let map = FieldExpr::vector([qx, y.clone(), qz]);
                 let r = radius_about_y(&child, &b);
                 let bounds = DAabb { min: DVec3::new(-r, b.min.y, -r), max: DVec3::new(r, b.max.y, r) };
                 self.warp(child, map, bounds, span, "this twist", Some(DomainOp::Twist(k)))
@@ -119,9 +119,9 @@ impl Ctx<'_> {
                 let b = self.bounded(&child, "bend", span)?;
                 // The point at height y is turned about z by k·y degrees, so the shape's
                 // y axis, seen where q.x = 0, lies at x = y·tan(k·y): towards +x.
-                let theta = bin(Binary::Mul, &Expr::num(k), &y);
+                let theta = bin(Binary::Mul, &FieldExpr::num(k), &y);
                 let (qx, qy) = turn(&x, &y, &theta);
-                let map = Expr::vector([qx, qy, z.clone()]);
+                let map = FieldExpr::vector([qx, qy, z.clone()]);
                 // A turn about the origin keeps the distance from it.
                 let r = radius_from_origin(&child, &b);
                 let bounds = DAabb { min: DVec3::splat(-r), max: DVec3::splat(r) };
@@ -134,13 +134,14 @@ impl Ctx<'_> {
                 // q = p − clamp(p, −h, h): the shape's halves moved apart by the slab,
                 // exact outside (Quilez's elongation) and 1-Lipschitz everywhere.
                 let q = [0, 1, 2].map(|k| {
-                    let c = Expr::component(&p, k);
-                    let clamped = bin(Binary::Max, &bin(Binary::Min, &c, &Expr::num(h[k])), &Expr::num(-h[k]));
+                    let c = FieldExpr::component(&p, k);
+                    let clamped =
+                        bin(Binary::Max, &bin(Binary::Min, &c, &FieldExpr::num(h[k])), &FieldExpr::num(-h[k]));
                     bin(Binary::Sub, &c, &clamped)
                 });
                 let bounds = ir::shape_bounds(&child).map(|b| DAabb { min: b.min - h, max: b.max + h });
                 let domain_op = Some(DomainOp::Elongate(h));
-                Some(ShapeKind::Warp { child, map: Expr::vector(q), bounds, lipschitz: exact, domain_op })
+                Some(ShapeKind::Warp { child, map: FieldExpr::vector(q), bounds, lipschitz: exact, domain_op })
             }
             FieldFn::Symmetric => {
                 let SymmetricArgs { shape: Value::Shape(child), axes } = SymmetricArgs::from_args(a) else {
@@ -148,7 +149,7 @@ impl Ctx<'_> {
                 };
                 let mirrored = self.axes(&axes, a.span_of("axes"))?;
                 let q = [0, 1, 2].map(|k| {
-                    let c = Expr::component(&p, k);
+                    let c = FieldExpr::component(&p, k);
                     if mirrored[k] {
                         un(Unary::Abs, &c)
                     } else {
@@ -164,7 +165,7 @@ impl Ctx<'_> {
                     DAabb { min: lo, max: hi }
                 });
                 let domain_op = Some(DomainOp::Mirror(mirrored));
-                Some(ShapeKind::Warp { child, map: Expr::vector(q), bounds, lipschitz: exact, domain_op })
+                Some(ShapeKind::Warp { child, map: FieldExpr::vector(q), bounds, lipschitz: exact, domain_op })
             }
             FieldFn::Polar => {
                 let PolarArgs { shape: Value::Shape(child), count } = PolarArgs::from_args(a) else {
@@ -178,10 +179,14 @@ impl Ctx<'_> {
                     if count <= MAX_EXACT_COPIES {
                         // Every copy measured, the nearest taken: exact, `count` times the work.
                         let copies = (0..count).map(|j| {
-                            let (qx, qz) = turn(&x, &z, &Expr::num(-w * f64::from(j)));
-                            Expr::new(Kind::Dist(child.clone(), Expr::vector([qx, y.clone(), qz])), Ty::Num)
+                            let (qx, qz) = turn(&x, &z, &FieldExpr::num(-w * f64::from(j)));
+                            FieldExpr::new(
+                                FieldKind::Dist(child.clone(), FieldExpr::vector([qx, y.clone(), qz])),
+                                FieldTy::Num,
+                            )
                         });
-                        let body = copies.reduce(|a, b| bin(Binary::Min, &a, &b)).unwrap_or_else(|| Expr::num(1.0));
+                        let body =
+                            copies.reduce(|a, b| bin(Binary::Min, &a, &b)).unwrap_or_else(|| FieldExpr::num(1.0));
                         return Some(ShapeKind::Field {
                             body,
                             bounds: Some(bounds),
@@ -209,10 +214,10 @@ impl Ctx<'_> {
                 // and p turned back by that many steps into the first sector: within a
                 // sector a rotation, so a part within its sector keeps an exact distance.
                 let angle = bin(Binary::Atan2, &z, &x);
-                let step = un(Unary::Round, &bin(Binary::Div, &angle, &Expr::num(w)));
-                let back = bin(Binary::Mul, &step, &Expr::num(-w));
+                let step = un(Unary::Round, &bin(Binary::Div, &angle, &FieldExpr::num(w)));
+                let back = bin(Binary::Mul, &step, &FieldExpr::num(-w));
                 let (qx, qz) = turn(&x, &z, &back);
-                let map = Expr::vector([qx, y.clone(), qz]);
+                let map = FieldExpr::vector([qx, y.clone(), qz]);
                 // Within its sector, a part's copies are apart: their mesh is the part's, copied.
                 let domain_op = (!self.crosses_sector(&b, w)).then_some(DomainOp::Polar(count));
                 Some(ShapeKind::Warp { child, map, bounds: Some(bounds), lipschitz: exact, domain_op })
@@ -225,7 +230,7 @@ impl Ctx<'_> {
     fn warp(
         &mut self,
         child: Arc<Shape>,
-        map: Arc<Expr>,
+        map: Arc<FieldExpr>,
         bounds: DAabb,
         span: Span,
         what: &str,
