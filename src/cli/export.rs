@@ -11,8 +11,9 @@ use clap::ValueEnum;
 use super::progress::Reading;
 use super::shared::{Accuracy, Meshing, Messages, Workers};
 use scnc::diag::codes;
+use scnc::diag::Diagnostic;
 use scnc::export::report::MeshReport;
-use scnc::export::{Placement, Up};
+use scnc::export::{Export, Placement, Up};
 use scnc::mesh::Detail;
 use scnc::meshfile::{Format, WriteOptions};
 
@@ -128,8 +129,6 @@ pub(crate) struct ExportArgs {
 const RENDER_ONLY: [&str; 5] =
     [codes::NO_LIGHTS, codes::USELESS_LIGHT, codes::BEHIND_CAMERA, codes::NO_EFFECT, codes::STEEP_FIELD];
 
-/// How many times a `--tolerance` export refines a pinched isosurface (×1.3 each).
-const REFINEMENTS: usize = 3;
 /// A scale from 1e-12 to 1e12, which keeps a renderable scene finite in f32.
 fn parse_scale(s: &str) -> Result<f64, String> {
     let x: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
@@ -162,28 +161,13 @@ impl ExportArgs {
     }
 }
 
+/// `scnc export`: the flags checked, the scene compiled and meshed (refined where a
+/// tolerance promises a usable mesh), the files written whole or not at all.
 pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
-    let format = match args.format() {
+    let (format, mtl) = match args.checked() {
         Ok(f) => f,
         Err(e) => return usage_error(&e),
     };
-    if let (Some(fixed), Some(asked)) = (format.fixed_up(), args.up) {
-        if Up::from(asked) != fixed {
-            return usage_error(
-                "--up: glTF fixes +y as up (glTF 2.0, \"Coordinate System and Units\"); turn the scene instead",
-            );
-        }
-    }
-    if args.units.is_some() && format != Format::ThreeMf {
-        return usage_error("--units is for 3MF, the one format that records units; use --scale to convert");
-    }
-    if let Err(e) = check_output_as(&args.output, "a mesh file") {
-        return usage_error(&e);
-    }
-    let mtl = mtl_path(&args.output);
-    if format == Format::Obj && mtl == args.output {
-        return usage_error("an OBJ export writes its materials beside it in a .mtl file; name the output .obj");
-    }
     if let Err(e) = super::files::stop_on_interrupt(130) {
         let _ = writeln!(std::io::stderr(), "warning: {e}");
     }
@@ -199,66 +183,15 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
         return ExitCode::from(1);
     }
     let Some(scene) = compiled.scene.take() else { return ExitCode::from(1) };
-    let scene = &scene;
-    let meshes = scene.objects.iter().filter_map(|o| match &o.geometry {
-        scnc::ir::Body::Mesh(m) => match &m.source {
-            scnc::ir::MeshSource::File { path, .. } => Some(path.as_path()),
-            _ => None,
-        },
-        scnc::ir::Body::Shape(_) => None,
-    });
-    let sources = compiled.map.files().map(|(_, f)| f.path.as_path());
-    if let Some(input) = overwritten_input(&args.output, sources.chain(meshes)) {
-        return usage_error(&format!(
-            "`{}` is an input of the scene ({}); name another output",
-            args.output.display(),
-            input.display()
-        ));
+    if let Err(e) = args.inputs_kept(&scene, &compiled) {
+        return usage_error(&e);
     }
     if scene.objects.is_empty() {
         let _ = writeln!(std::io::stderr(), "error: `{}` has no objects to export", args.file.display());
         return ExitCode::from(1);
     }
     let started = Instant::now();
-    let detail: Detail = match args.accuracy.tolerance {
-        Some(tol) => {
-            let detail = scnc::study::tolerance::mesh_detail(scene, tol);
-            let _ = writeln!(std::io::stderr(), "tolerance {tol}: picked detail {}", detail.rings());
-            detail
-        }
-        None => args.meshing.detail,
-    };
-    let up = args.up.map_or(format.default_up(), Up::from);
-    let frame = Placement { up, scale: args.scale.unwrap_or(format.default_scale()) };
-    let skip = args.skip_unbounded || format.for_printing();
-    let collect = |detail| {
-        pool.install(|| scnc::export::collect(scene, detail, frame, args.meshing.memory_limit, skip, &Reading))
-    };
-    let mut result = collect(detail);
-    // A tolerance promises a mesh good enough to use: where an isosurface is pinched or
-    // lost volume (a part thinner than the cell), refine, a few times at most.
-    let mut detail = detail;
-    if args.accuracy.tolerance.is_some() {
-        for _ in 0..REFINEMENTS {
-            let Ok(e) = &result else { break };
-            let thin = [scnc::diag::codes::PINCHED_EDGES, scnc::diag::codes::LOST_VOLUME];
-            if !e.warnings.iter().any(|w| thin.contains(&w.code)) {
-                break;
-            }
-            let finer = Detail::N((detail.rings() as f64 * 1.3).ceil() as u32);
-            let _ = writeln!(
-                std::io::stderr(),
-                "detail {} is coarser than parts of an isosurface: refining to detail {}",
-                detail.rings(),
-                finer.rings()
-            );
-            match collect(finer) {
-                // A finer grid over the cell limit keeps the pinched mesh and its warning.
-                Err(_) => break,
-                ok => (result, detail) = (ok, finer),
-            }
-        }
-    }
+    let (result, detail, up) = pool.install(|| args.mesh(&scene, format));
     let export = match result {
         Ok(e) => {
             super::report_in(&compiled.map, &e.warnings, args.messages.message_format);
@@ -278,36 +211,13 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
         );
         return ExitCode::from(1);
     }
-    let units = args.units.map_or(scnc::meshfile::DEFAULT_3MF_UNIT, Units::three_mf);
-    let mtl_name = mtl.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-    let mut bytes = 0u64;
-    let mut write = |path: &Path, what: &dyn Fn(&mut dyn Write) -> std::io::Result<()>| {
-        write_atomic(path, ".tmp", |w| {
-            let mut counted = Counted { inner: w, bytes: 0 };
-            what(&mut counted)?;
-            bytes += counted.bytes;
-            Ok(())
-        })
-        .map_err(|e| cannot_write(path, &e))
-    };
-    let mut written = Ok(());
-    // The MTL goes first (an OBJ must not name a file that is not there); if the OBJ
-    // then fails, a new MTL is removed again, so a failed export leaves nothing behind.
-    let mtl_existed = mtl.exists();
-    if format == Format::Obj {
-        written = write(&mtl, &|w| scnc::meshfile::obj::mtl(&export, w));
-    }
-    if written.is_ok() {
-        let options = WriteOptions { units, mtl: &mtl_name, ascii: args.ascii };
-        written = write(&args.output, &|w| format.write(&export, &options, w));
-        if written.is_err() && format == Format::Obj && !mtl_existed {
-            let _ = std::fs::remove_file(&mtl);
+    let bytes = match args.write(&export, format, &mtl) {
+        Ok(b) => b,
+        Err(e) => {
+            let _ = writeln!(std::io::stderr(), "error: {e}");
+            return ExitCode::from(1);
         }
-    }
-    if let Err(e) = written {
-        let _ = writeln!(std::io::stderr(), "error: {e}");
-        return ExitCode::from(1);
-    }
+    };
     let mut err = std::io::stderr().lock();
     let _ = writeln!(
         err,
@@ -321,33 +231,140 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
     );
     if args.stats {
         for part in &export.parts {
-            let r = MeshReport::of(part);
-            let (id, range) = compiled.map.local_range(part.span);
-            let (line, _) = compiled.map.line_col(id, range.start);
-            let (lo, hi) = r.bounds;
-            let _ = writeln!(
-                err,
-                "  {} ({}:{line}): {} triangles, {}, {} degenerate dropped, volume {:.6}, bounds [{:.4}, {:.4}, {:.4}] to [{:.4}, {:.4}, {:.4}]",
-                part.name,
-                compiled.map.file(id).name,
-                r.triangles,
-                if r.is_closed_manifold() {
-                    "watertight and manifold".to_string()
-                } else {
-                    format!("not closed: {} open edges, {} wound twice one way", r.open_edges, r.misoriented_edges)
-                },
-                r.degenerate,
-                r.volume,
-                lo.x,
-                lo.y,
-                lo.z,
-                hi.x,
-                hi.y,
-                hi.z,
-            );
+            let _ = writeln!(err, "  {}", part_stats(part, &compiled.map));
         }
     }
     ExitCode::SUCCESS
+}
+
+impl ExportArgs {
+    /// The format, and where an OBJ's materials go, once every flag agrees with it.
+    fn checked(&self) -> Result<(Format, PathBuf), String> {
+        let format = self.format()?;
+        if let (Some(fixed), Some(asked)) = (format.fixed_up(), self.up) {
+            if Up::from(asked) != fixed {
+                return Err(
+                    "--up: glTF fixes +y as up (glTF 2.0, \"Coordinate System and Units\"); turn the scene instead"
+                        .into(),
+                );
+            }
+        }
+        if self.units.is_some() && format != Format::ThreeMf {
+            return Err("--units is for 3MF, the one format that records units; use --scale to convert".into());
+        }
+        check_output_as(&self.output, "a mesh file")?;
+        let mtl = mtl_path(&self.output);
+        if format == Format::Obj && mtl == self.output {
+            return Err("an OBJ export writes its materials beside it in a .mtl file; name the output .obj".into());
+        }
+        Ok((format, mtl))
+    }
+
+    /// Refuses an output that is one of the scene's inputs (a source or a mesh file).
+    fn inputs_kept(&self, scene: &scnc::ir::Scene, compiled: &scnc::Compiled) -> Result<(), String> {
+        let meshes = scene.objects.iter().filter_map(|o| match &o.geometry {
+            scnc::ir::Body::Mesh(m) => match &m.source {
+                scnc::ir::MeshSource::File { path, .. } => Some(path.as_path()),
+                _ => None,
+            },
+            scnc::ir::Body::Shape(_) => None,
+        });
+        let sources = compiled.map.files().map(|(_, f)| f.path.as_path());
+        match overwritten_input(&self.output, sources.chain(meshes)) {
+            Some(input) => Err(format!(
+                "`{}` is an input of the scene ({}); name another output",
+                self.output.display(),
+                input.display()
+            )),
+            None => Ok(()),
+        }
+    }
+
+    /// The scene meshed at the detail the flags ask for. A tolerance promises a mesh
+    /// good enough to use, so it is refined where an isosurface is pinched or lost
+    /// volume ([`scnc::export::collect_refined`]).
+    fn mesh(&self, scene: &scnc::ir::Scene, format: Format) -> (Result<Export, Diagnostic>, Detail, Up) {
+        let detail: Detail = match self.accuracy.tolerance {
+            Some(tol) => {
+                let detail = scnc::study::tolerance::mesh_detail(scene, tol);
+                let _ = writeln!(std::io::stderr(), "tolerance {tol}: picked detail {}", detail.rings());
+                detail
+            }
+            None => self.meshing.detail,
+        };
+        let up = self.up.map_or(format.default_up(), Up::from);
+        let frame = Placement { up, scale: self.scale.unwrap_or(format.default_scale()) };
+        let skip = self.skip_unbounded || format.for_printing();
+        let limit = self.meshing.memory_limit;
+        if self.accuracy.tolerance.is_none() {
+            return (scnc::export::collect(scene, detail, frame, limit, skip, &Reading), detail, up);
+        }
+        let mut said = |from: Detail, to: Detail| {
+            let _ = writeln!(
+                std::io::stderr(),
+                "detail {} is coarser than parts of an isosurface: refining to detail {}",
+                from.rings(),
+                to.rings()
+            );
+        };
+        let (result, detail) = scnc::export::collect_refined(scene, detail, frame, limit, skip, &Reading, &mut said);
+        (result, detail, up)
+    }
+
+    /// Writes the export (and an OBJ's MTL first, so the OBJ never names a missing
+    /// file; a new MTL is removed again if the OBJ fails): the bytes written.
+    fn write(&self, export: &Export, format: Format, mtl: &Path) -> Result<u64, String> {
+        let units = self.units.map_or(scnc::meshfile::DEFAULT_3MF_UNIT, Units::three_mf);
+        let mtl_name = mtl.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+        let mut bytes = 0u64;
+        let mut write = |path: &Path, what: &dyn Fn(&mut dyn Write) -> std::io::Result<()>| {
+            write_atomic(path, ".tmp", |w| {
+                let mut counted = Counted { inner: w, bytes: 0 };
+                what(&mut counted)?;
+                bytes += counted.bytes;
+                Ok(())
+            })
+            .map_err(|e| cannot_write(path, &e))
+        };
+        let mtl_existed = mtl.exists();
+        if format == Format::Obj {
+            write(mtl, &|w| scnc::meshfile::obj::mtl(export, w))?;
+        }
+        let options = WriteOptions { units, mtl: &mtl_name, ascii: self.ascii };
+        let written = write(&self.output, &|w| format.write(export, &options, w));
+        if written.is_err() && format == Format::Obj && !mtl_existed {
+            let _ = std::fs::remove_file(mtl);
+        }
+        written.map(|()| bytes)
+    }
+}
+
+/// One line of `--stats` for an exported part: where it came from, its triangles,
+/// whether it is closed, its volume and bounds.
+fn part_stats(part: &scnc::meshfile::Part, map: &scnc::source::SourceMap) -> String {
+    let r = MeshReport::of(part);
+    let (id, range) = map.local_range(part.span);
+    let (line, _) = map.line_col(id, range.start);
+    let (lo, hi) = r.bounds;
+    format!(
+        "{} ({}:{line}): {} triangles, {}, {} degenerate dropped, volume {:.6}, bounds [{:.4}, {:.4}, {:.4}] to [{:.4}, {:.4}, {:.4}]",
+        part.name,
+        map.file(id).name,
+        r.triangles,
+        if r.is_closed_manifold() {
+            "watertight and manifold".to_string()
+        } else {
+            format!("not closed: {} open edges, {} wound twice one way", r.open_edges, r.misoriented_edges)
+        },
+        r.degenerate,
+        r.volume,
+        lo.x,
+        lo.y,
+        lo.z,
+        hi.x,
+        hi.y,
+        hi.z,
+    )
 }
 
 /// Where an OBJ export's MTL file goes: beside it, same stem.

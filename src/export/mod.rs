@@ -40,6 +40,41 @@ impl Placement {
     }
 }
 
+/// How many times [`collect_refined`] refines a pinched isosurface (×1.3 each).
+pub const REFINEMENTS: usize = 3;
+
+/// [`collect`], refined where the mesh is not good enough to use: while an isosurface
+/// is pinched or lost volume (a part thinner than its cell), the detail grows 1.3× and
+/// the scene is meshed again, [`REFINEMENTS`] times at most. A finer grid over the
+/// cell limit keeps the coarser mesh and its warning. `refining(from, to)` is told each
+/// step; the detail the result was made at comes back with it.
+pub fn collect_refined(
+    scene: &Scene,
+    detail: Detail,
+    frame: Placement,
+    memory_limit: u64,
+    skip_unbounded: bool,
+    loader: &dyn Loader,
+    refining: &mut dyn FnMut(Detail, Detail),
+) -> (Result<Export, Diagnostic>, Detail) {
+    let collect = |detail| collect(scene, detail, frame, memory_limit, skip_unbounded, loader);
+    let (mut result, mut detail) = (collect(detail), detail);
+    for _ in 0..REFINEMENTS {
+        let Ok(e) = &result else { break };
+        let thin = [codes::PINCHED_EDGES, codes::LOST_VOLUME];
+        if !e.warnings.iter().any(|w| thin.contains(&w.code)) {
+            break;
+        }
+        let finer = Detail::N((detail.rings() as f64 * 1.3).ceil() as u32);
+        refining(detail, finer);
+        match collect(finer) {
+            Err(_) => break,
+            ok => (result, detail) = (ok, finer),
+        }
+    }
+    (result, detail)
+}
+
 /// Meshes every object of `scene` at `detail` into `frame`, within `memory_limit`
 /// bytes of meshes (as `render` counts them). An unbounded shape (a `plane`) cannot be
 /// a mesh file's solid: with `skip_unbounded` it is left out with a warning, otherwise

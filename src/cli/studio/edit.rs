@@ -183,10 +183,12 @@ pub(crate) fn export(studio: &Studio, text: String, format: &str) -> Reply {
     let limit = scnc::mesh::lower::DEFAULT_MEMORY_LIMIT;
     let loader = studio.files.loader();
     let skip_unbounded = format.for_printing();
-    let collected = studio
-        .preview
-        .pool
-        .install(|| scnc::export::collect(scene, scnc::mesh::Detail::High, frame, limit, skip_unbounded, &loader));
+    // Refined where an isosurface is pinched or lost volume, as `scnc export
+    // --tolerance` does: a download is meant to be used.
+    let (collected, _) = studio.preview.pool.install(|| {
+        let high = scnc::mesh::Detail::High;
+        scnc::export::collect_refined(scene, high, frame, limit, skip_unbounded, &loader, &mut |_, _| {})
+    });
     let export = match collected {
         Ok(e) if !e.parts.is_empty() => e,
         Ok(_) => return Reply::text(422, "no object of the scene has a surface to write"),
