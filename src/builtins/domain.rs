@@ -92,6 +92,9 @@ fn turn(a: &Arc<FieldExpr>, b: &Arc<FieldExpr>, theta: &Arc<FieldExpr>) -> (Arc<
 
 impl dyn Host + '_ {
     /// A domain operation, or `None` after reporting.
+    ///
+    /// Long because it is one match over the domain operations, each arm its checks and its
+    /// map written as a field expression.
     pub(crate) fn domain_shape(&mut self, f: FieldFn, a: &BoundArgs, span: Span) -> Option<ShapeKind> {
         let p = FieldExpr::point();
         let (x, y, z) = (FieldExpr::component(&p, 0), FieldExpr::component(&p, 1), FieldExpr::component(&p, 2));

@@ -192,6 +192,9 @@ impl dyn Host + '_ {
 
     /// A profile moved in its plane: `at [u, v]`, `rotate degrees` (counter-clockwise,
     /// from `u` towards `v`) or `scale k` (uniform, so the distance stays exact).
+    ///
+    /// Long because it is one match over the three moves, each with its checks, its
+    /// distance and its region.
     pub(crate) fn transform_profile(
         &mut self,
         op: TransformOp,
@@ -277,6 +280,9 @@ impl dyn Host + '_ {
     /// `union`, `intersect` or `subtract` of profiles: the min or max of their distances
     /// (Quilez's quadratic blend with `smooth`), a bound that is exact outside a union
     /// and inside an intersection; `None` after reporting.
+    ///
+    /// Long because it is one match over the three operations, sharp and smooth, each with
+    /// its checks and its distance and region.
     fn profile_csg(&mut self, op: CsgOp, a: &BoundArgs) -> Option<Profile> {
         let name = op.name();
         let parts: Vec<Arc<Profile>> =
@@ -456,6 +462,10 @@ impl dyn Host + '_ {
 
     /// A simple polygon's exact signed distance (Quilez's: the nearest edge, the sign by
     /// the crossing count), corners and box, or `None` after reporting a bad polygon.
+    ///
+    /// Long because it is the polygon's checks in the order they are reported (count,
+    /// finiteness, repeated corners, crossings, each naming the corners) before its
+    /// distance expression.
     fn polygon(&mut self, points: &Value, span: Span) -> Option<(Arc<FieldExpr>, Vec<DVec2>, DVec2, DVec2)> {
         let bad = |this: &mut Self, what: String, label: &str| {
             this.report(

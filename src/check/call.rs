@@ -239,6 +239,9 @@ impl Ctx<'_> {
     /// names (with a suggestion) and arguments given twice; returns the slots, the extra
     /// positional values, and whether all went well. `note` is the builtin whose signature
     /// a report shows.
+    ///
+    /// Long because positional, named and variadic arguments are matched in one pass, with
+    /// their errors in the order they are reported.
     #[allow(clippy::type_complexity, reason = "slots and variadic values, both with the span to blame")]
     fn bind_slots(
         &mut self,
@@ -325,6 +328,9 @@ impl Ctx<'_> {
     }
 
     /// Binds arguments to a builtin's parameters; `None` after reporting (or on poison).
+    ///
+    /// Long because it binds in the order its errors are reported: slots, required
+    /// arguments, types, ranges.
     pub(super) fn bind_builtin(&mut self, b: &'static Builtin, mut args: Vec<ArgVal>, call: Span) -> Option<BoundArgs> {
         if let Some(ix) = &mut self.index {
             for name in args.iter().filter_map(|a| a.name.as_ref()) {

@@ -370,6 +370,8 @@ impl Ctx<'_> {
         acc
     }
 
+    /// `a op b` on values. Long because it is one match over the operators and the
+    /// operands' kinds.
     fn binary(&mut self, op: BinOp, a: Value, a_span: Span, b: Value, b_span: Span, span: Span) -> Value {
         use Value::{Num, Vec3};
         if a.is_error() || b.is_error() {

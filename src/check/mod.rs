@@ -351,6 +351,7 @@ impl Ctx<'_> {
         }
     }
 
+    /// Evaluates one statement. Long because it is one match over the statement kinds.
     fn stmt(&mut self, stmt: &ast::Stmt) {
         match &stmt.kind {
             ast::StmtKind::Error => {}

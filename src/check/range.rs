@@ -30,6 +30,9 @@ fn shown(x: f64) -> String {
 
 impl Ctx<'_> {
     /// Reports every object and light outside the renderable range as seen from `camera`.
+    ///
+    /// Long because it is one walk over the camera, the objects and the lights, each with
+    /// its own message.
     pub(super) fn check_range(&mut self, camera: &Camera) {
         if !in_reach(camera.position) {
             let span = camera.span.unwrap_or_default();

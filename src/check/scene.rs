@@ -129,6 +129,9 @@ impl Ctx<'_> {
     }
 
     /// The scene and every diagnostic, with the scene-wide warnings added.
+    ///
+    /// Long because it adds the scene-wide warnings, each its own check over the finished
+    /// scene, in the order they are reported.
     pub(super) fn finish(mut self) -> (Option<Scene>, Vec<Diagnostic>) {
         let mut unused: Vec<(Span, String)> = self
             .lets

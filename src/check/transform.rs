@@ -12,6 +12,9 @@ use crate::span::Span;
 use crate::syntax::ast::TransformOp;
 
 impl Ctx<'_> {
+    /// `target op argument` for a transform (`at`, `rotate`, `scale`, `with`) on a shape,
+    /// mesh, light or profile. Long because it is one match over the operator and the
+    /// operand's kind, each arm with the message for its misuse.
     #[allow(clippy::too_many_arguments, reason = "each span blames a different part of `a op b`")]
     pub(super) fn transform(
         &mut self,

@@ -113,6 +113,9 @@ fn earlier_cover(parts: &[PathBuf], k: usize, i: usize) -> Option<&Path> {
 /// The full image from its parts: every pixel opaque in exactly one part. The parts are
 /// read a row at a time into the image (and a bit a pixel of which are covered), so the
 /// largest 16-bit image render writes merges in the image's own memory.
+///
+/// Long because it is one pass over every part's rows with the checks each part must pass,
+/// which keeps the memory at one image.
 fn merge(parts: &[PathBuf]) -> Result<scnc::render::Image, String> {
     let mut size = None;
     let mut pixels = Vec::new();

@@ -203,6 +203,7 @@ pub(crate) fn worker_pool(threads: Option<u16>) -> Result<rayon::ThreadPool, Str
     pool.build().map_err(|e| format!("cannot start worker threads: {e}"))
 }
 
+/// Runs the command. Long because it is one match over the commands.
 fn run(cli: Cli) -> ExitCode {
     match cli.command {
         Command::Render(args) => render::render_cmd(args),

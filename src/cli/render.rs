@@ -380,6 +380,9 @@ fn evaluate_frame(
 }
 
 /// Lowers and renders one evaluated scene (a still or one frame) to `output`.
+///
+/// Long because it is the render's sequence (lower, trace, report, write), each step with
+/// its own error.
 fn render_scene(
     args: &RenderArgs,
     pool: &rayon::ThreadPool,

@@ -5,6 +5,9 @@ use scnc::trace::Counters;
 use scnc::world::World;
 
 /// The statistics of one render, for stderr.
+///
+/// Long because it is mostly one format string, a line per group of counters, laid out as
+/// the output reads.
 pub(crate) fn stats_text(c: &Counters, g: &World, map: &SourceMap, lower_s: f64, trace_s: f64) -> String {
     let mem = g.memory();
     let rays = c.rays().max(1) as f64;

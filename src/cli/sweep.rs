@@ -41,6 +41,8 @@ pub(crate) struct SweepArgs {
     messages: Messages,
 }
 
+/// `scnc sweep`. Long because it is the sweep's one sequence: compile, pick the ladder,
+/// render and measure each rung, write the chart and the table.
 pub(crate) fn sweep_cmd(args: SweepArgs) -> ExitCode {
     if let Err(e) = std::fs::create_dir_all(&args.output) {
         return usage_error(&format!("cannot create `{}`: {e}", args.output.display()));

@@ -28,6 +28,10 @@ fn flat(p: &[Vec3], t: [u32; 3]) -> bool {
 
 /// Mends `triangles` over the 32-bit corners `p` (`tag` holds a value per triangle
 /// that a split copies, its material). Vertices may be left unused.
+///
+/// Long because mending is one pipeline over shared index arrays (weld, drop degenerate
+/// triangles, split non-manifold edges, orient); its stages share state that splitting
+/// would pass around.
 pub fn mend(p: &[Vec3], triangles: &mut Vec<[u32; 3]>, tag: &mut Vec<u32>) -> Mended {
     let mut out = Mended::default();
     if !triangles.iter().any(|&t| flat(p, t)) {

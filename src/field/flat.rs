@@ -358,6 +358,9 @@ impl Flat {
     /// others repeat a point (so a shape's distance is asked only for the live ones).
     /// It gives only the three result registers' lanes: returning all `N` would copy
     /// them.
+    ///
+    /// Long because it is the interpreter's loop, one arm per instruction, kept in one
+    /// function so each arm's lane loop is a single vector loop.
     #[inline(always)]
     fn run_n<const N: usize, const W: usize>(
         &self,

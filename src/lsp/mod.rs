@@ -351,6 +351,8 @@ impl Server {
         }
     }
 
+    /// The answer to one request. Long because it is one match over the request methods,
+    /// each arm a few lines; a table of handlers would only move the arms.
     fn answer(&mut self, req: Request) -> Result<serde_json::Value, Failure> {
         fn params<P: serde::de::DeserializeOwned>(req: Request) -> Result<P, Failure> {
             serde_json::from_value(req.params).map_err(|e| Failure::from(e.to_string()))

@@ -99,6 +99,9 @@ pub(super) struct Iso {
 /// An isosurface of `shape` sampled and placed as `iso` says, each triangle taking the
 /// material of the shape's nearest part. The distance closures are temporary: they are
 /// not part of the world's memory.
+///
+/// Long because it is one extraction's sequence: the cell checks, the grid, the extraction,
+/// each triangle's material and the warnings of what the grid lost.
 pub(super) fn isosurface_object(
     shape: &Shape,
     iso: Iso,

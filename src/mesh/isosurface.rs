@@ -446,6 +446,9 @@ const fn edge_id(axis: usize, off: [u64; 3]) -> usize {
 /// The faces in `skip` join nothing, which cuts a cycle crossing one twice into two
 /// arcs; `N` bounds the sheets (four cycles of three or more of the twelve edges when
 /// nothing is skipped, at most twelve pieces otherwise).
+///
+/// Long because it traces a cell's cycles and places their vertices over arrays kept on the
+/// stack for the cell; split, they would be passed around or allocated per cell.
 fn sheets<const N: usize>(
     grid: &Grid,
     cell: u64,

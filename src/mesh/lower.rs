@@ -19,6 +19,9 @@ use crate::trace::MaterialTable;
 
 /// Tessellates a shape object at `detail`: a primitive with a generator by it, a plane
 /// as a square reaching the far limit, anything else as an isosurface.
+///
+/// Long because it is one match over how each kind of shape is made a mesh (generator,
+/// plane, sweep, isosurface).
 pub fn tessellate(
     shape: &Shape,
     xf: DAffine3,
@@ -376,6 +379,9 @@ impl Budget {
 }
 
 /// Lowers an explicit `mesh …` object.
+///
+/// Long because it is one match over the mesh sources (generators, isosurface, file), each
+/// charged to the budget before it is made.
 pub fn explicit(
     m: &ir::Mesh,
     to_render: DAffine3,

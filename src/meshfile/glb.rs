@@ -192,6 +192,10 @@ impl MeshFormat for Glb {
 /// Binary glTF: the JSON document, then one binary buffer holding, per part and
 /// material, positions (with their bounds, which glTF requires), normals for smooth
 /// parts, and `u32` indices.
+///
+/// Long because the document is written in the order glTF lays it out (buffer views,
+/// accessors, meshes, nodes, the buffer), which reads against the specification top to
+/// bottom.
 fn glb(export: &Export, w: &mut dyn Write) -> io::Result<()> {
     use serde_json::json;
     let mut bin: Vec<u8> = Vec::new();

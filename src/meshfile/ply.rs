@@ -185,6 +185,9 @@ fn header(bytes: &[u8]) -> Result<(Encoding, Vec<Element>, usize), String> {
 }
 
 /// Reads every element in order, keeping vertex positions and faces.
+///
+/// Long because it reads the header's elements in order, each kind its own branch; PLY
+/// files interleave them.
 fn read(elements: &[Element], values: &mut dyn Values) -> Result<TriMesh, String> {
     let mut file_positions = Vec::new();
     let mut faces: Vec<Vec<u32>> = Vec::new();

@@ -296,6 +296,10 @@ fn spawn<const FX: u8>(hit: &Hit, origin: Vec3A, dir: Vec3A, t_max: f32, media: 
 
 /// The colour seen along `ray` (travelling in `media`) given what it hit (`None`: the
 /// background); `tree` is what its sample may still spend on reflected and refracted rays.
+///
+/// Long because it is the one place the effects apply, in the order light is gathered
+/// (occlusion, direct light and shadows, highlights, reflection, refraction), each
+/// behind its compile-time flag.
 #[allow(clippy::too_many_arguments, reason = "the state a ray is shaded in")]
 fn shade<const FX: u8>(
     g: &dyn Geometry,

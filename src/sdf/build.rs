@@ -26,7 +26,7 @@ pub struct Root {
     /// How a ray marches it.
     pub walk: Walk,
     /// How many times over the distance bound may understate the distance near the
-    /// surface ([`looseness`]); above 1 its hits are confirmed by the gradient
+    /// surface (`looseness`); above 1 its hits are confirmed by the gradient
     /// ([`super::march::refine`]) and its marches take that many times the steps.
     pub loose: f64,
 }
@@ -323,6 +323,10 @@ impl<'a> Builder<'a> {
     }
 
     /// Builds an operator or modifier node in its own frame.
+    ///
+    /// Long because it is one exhaustive match over the operator and modifier nodes, each
+    /// arm the node's pair of closures; a new kind of node fails to compile until it has
+    /// its arm here.
     fn local(&mut self, shape: &Shape, mat: u32) -> (Sdf, SurfSdf) {
         let id = DAffine3::IDENTITY;
         match &shape.kind {

@@ -39,7 +39,7 @@ pub struct SdfObject {
     convex: bool,
     /// How its rays are marched.
     walk: Walk,
-    /// Whether its hits are confirmed by [`march::refine`] ([`build::looseness`] above
+    /// Whether its hits are confirmed by [`march::refine`] (`build::looseness` above
     /// 1), and then how many times the scene's step budget its marches get.
     loose: Option<u32>,
 }

@@ -129,6 +129,8 @@ pub fn error_chart(rows: &[Row], axis: Axis, title: &str) -> Result<Image, Strin
 /// A log–log chart of `series` (empty ones left out), 960×640, axes described by
 /// `(x, y)`, the legend at `legend`. Labels are placed beside their points where they
 /// overlap no label placed before them, and left out where no place is free.
+///
+/// Long because it draws one SVG in reading order: frame, grid and ticks, series, labels.
 pub fn loglog(
     title: &str,
     (x_desc, y_desc): (&str, &str),

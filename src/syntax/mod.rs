@@ -35,6 +35,9 @@ pub fn lex(text: &str, base: u32) -> Vec<(Token<'_>, Span)> {
 
 /// Reports lexical errors, replaces each bad token by the nearest good one (so the parser
 /// reports no second error for the same mistake) and drops comments.
+///
+/// Long because it is one pass over the tokens with a match over each kind of lexical error
+/// and its replacement.
 fn clean_tokens<'s>(tokens: Vec<(Token<'s>, Span)>, diags: &mut Vec<Diagnostic>) -> Vec<(Token<'s>, Span)> {
     let mut out: Vec<(Token<'s>, Span)> = Vec::with_capacity(tokens.len());
     let mut tokens = tokens.into_iter().peekable();

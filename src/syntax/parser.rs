@@ -123,6 +123,10 @@ where
 }
 
 /// The expression parser.
+///
+/// Long because it is one combinator chain, a level per precedence in the order
+/// `grammar/scn.ebnf` lists them; split, the levels would no longer read top to bottom as
+/// the grammar does.
 pub fn expr<'t, 's: 't, I>() -> impl Parser<'t, I, Expr, Extra<'t, 's>> + Clone
 where
     I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
@@ -327,6 +331,9 @@ where
 }
 
 /// The file parser: statements until the end of input.
+///
+/// Long because it is one combinator chain over the statement forms, in the order
+/// `grammar/scn.ebnf` lists them.
 pub fn file<'t, 's: 't, I>() -> impl Parser<'t, I, File, Extra<'t, 's>>
 where
     I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,

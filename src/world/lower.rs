@@ -291,6 +291,9 @@ fn reads_files(obj: &ir::Object) -> bool {
     matches!(&obj.geometry, ir::Body::Mesh(m) if matches!(m.source, ir::MeshSource::File { .. }))
 }
 
+/// Long because it is the one pass that interns materials, spends the triangle budget and
+/// takes reused objects in scene order, so ids and errors do not depend on timing; split,
+/// that order would be spread over several functions.
 #[allow(clippy::too_many_arguments, reason = "prepare_reusing's arguments, and the frame it fills")]
 fn lower_reusing(
     scene: &ir::Scene,

@@ -187,6 +187,9 @@ impl Bvh {
     /// [`closest`](Self::closest) finds up to rounding. Leaves come front to back for the
     /// first active ray. Counts one visit per node for each wanted ray from the first
     /// active one.
+    ///
+    /// Long because the walk keeps its stack and the packet's masks in registers; split
+    /// into calls, they would go through memory on the hottest path of a mesh scene.
     #[inline]
     pub fn each_packet<const N: usize>(
         &self,

@@ -211,6 +211,9 @@ fn json_message(out: &mut Stream, kind: u8, value: serde_json::Value) -> std::io
     out.message(kind, value.to_string().as_bytes())
 }
 
+/// One preview: compile, lower, the coarse pass, the full frame in bands, statistics and
+/// accuracy. Long because it is that sequence, each step able to end the stream (errors, a
+/// newer request, a gone page).
 fn run(studio: &Studio, text: &str, ask: &Ask, out: &mut Stream, current: &Wanted) -> std::io::Result<()> {
     let loader = studio.files.loader();
     let mut compiled = studio.files.compile(text.to_string());
