@@ -332,10 +332,12 @@ impl Scalar for Interval {
         Interval::point(x)
     }
 
+    #[inline]
     fn unary(f: Unary, x: Interval) -> Interval {
         Interval::unary(f, x)
     }
 
+    #[inline]
     fn binary(f: Binary, a: Interval, b: Interval) -> Interval {
         Interval::binary(f, a, b)
     }
@@ -466,6 +468,7 @@ impl<const N: usize> Scalar for Jet<N> {
         Jet { v: Interval::point(x), g: [Interval::point(0.0); N], n: 0.0 }
     }
 
+    #[inline]
     fn unary(f: Unary, x: Jet<N>) -> Jet<N> {
         let v = Interval::unary(f, x.v);
         let one = Interval::point(1.0);
@@ -499,11 +502,17 @@ impl<const N: usize> Scalar for Jet<N> {
         Jet::chain(v, d, x)
     }
 
+    #[inline]
     fn binary(f: Binary, a: Jet<N>, b: Jet<N>) -> Jet<N> {
         let v = Interval::binary(f, a.v, b.v);
         let zero = [Interval::point(0.0); N];
+        // Plain loops rather than `array::from_fn`, whose closure wrapper the compiler
+        // does not always inline: this runs for every instruction of every segment bound.
         let comb = |ka: Interval, kb: Interval| {
-            let g = std::array::from_fn(|i| a.g[i].mul(ka).add(b.g[i].mul(kb)));
+            let mut g = zero;
+            for (gi, (x, y)) in g.iter_mut().zip(a.g.iter().zip(&b.g)) {
+                *gi = x.mul(ka).add(y.mul(kb));
+            }
             Jet::new(v, g, mul0(ka.mag(), a.n) + mul0(kb.mag(), b.n))
         };
         let one = Interval::point(1.0);
@@ -526,7 +535,10 @@ impl<const N: usize> Scalar for Jet<N> {
                 } else if b_wins {
                     Jet { v, ..b }
                 } else {
-                    let g = std::array::from_fn(|i| a.g[i].hull(b.g[i]));
+                    let mut g = zero;
+                    for (gi, (x, y)) in g.iter_mut().zip(a.g.iter().zip(&b.g)) {
+                        *gi = x.hull(*y);
+                    }
                     Jet::new(v, g, a.n.max(b.n))
                 }
             }

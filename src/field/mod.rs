@@ -207,6 +207,7 @@ impl Scalar for Dual {
         Dual { v: x as f32, g: Vec3A::ZERO }
     }
 
+    #[inline]
     fn unary(f: Unary, x: Dual) -> Dual {
         let v = f32::unary(f, x.v);
         let d = match f {
@@ -247,6 +248,7 @@ impl Scalar for Dual {
         Dual::chain(v, d, x)
     }
 
+    #[inline]
     fn binary(f: Binary, a: Dual, b: Dual) -> Dual {
         let v = f32::binary(f, a.v, b.v);
         let g = match f {
