@@ -105,7 +105,7 @@ crate::params! {
 crate::params! {
     /// `mesh file(…)`.
     pub struct FileArgs {
-        /// the mesh file, relative to the scene file: OBJ, or by extension `.stl`, `.ply` or `.glb`
+        /// the mesh file, relative to the scene file: OBJ, or by extension `.stl`, `.ply`, `.glb`, `.3mf` or `.off`
         path: String as Str = required;
         /// whether normals are interpolated across faces
         smooth: bool as Bool = false;

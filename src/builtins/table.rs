@@ -371,7 +371,7 @@ static REST: &[Builtin] = &[
         IsosurfaceArgs::PARAMS,
         "any shape triangulated on a grid of `cell`-sized cells",
     ),
-    gen("file", Gen::File, FileArgs::PARAMS, "a triangle mesh read from an OBJ file, or by extension an STL (`.stl`, z up, mm), PLY (`.ply`), binary glTF (`.glb`) or 3MF (`.3mf`, z up, in its declared unit) file, relative to this file"),
+    gen("file", Gen::File, FileArgs::PARAMS, "a triangle mesh read from an OBJ file, or by extension an STL (`.stl`, z up, mm), PLY (`.ply`), binary glTF (`.glb`), 3MF (`.3mf`, z up, in its declared unit) or OFF (`.off`, z up, mm) file, relative to this file"),
     // Statements.
     Builtin {
         name: "camera",

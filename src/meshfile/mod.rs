@@ -166,6 +166,8 @@ formats! {
     ThreeMf => three_mf::ThreeMf,
     /// Binary glTF 2.0 (`.glb`): one node per object, a PBR material per colour.
     Glb => glb::Glb,
+    /// OFF, OpenSCAD's and CGAL's text format: z up, millimetres, a colour per face.
+    Off => off::Off,
 }
 
 impl Format {
