@@ -241,40 +241,10 @@ fn studio_measures_the_ladder_and_exports_valid_files() {
 fn an_abandoned_heavy_render_does_not_hold_the_next_one() {
     let (_dir, scene) = seed_scene();
     let s = Server::start(&scene);
-    let mut heavy = String::from("let s0 = sphere(1)\n");
-    for i in 1..=15 {
-        let b = "bounds = [[-2, -2, -2], [2, 2, 2]]";
-        heavy += &format!("let s{i} = field(p => min(dist(s{}, p), dist(s{}, p * 1.01)), {b})\n", i - 1, i - 1);
-    }
-    heavy += "camera(position = [0, 0, -4], look_at = [0, 0, 0])\nrender(width = 256, height = 256)\n\
-              light ambient(1)\nobject s15\n";
-    let mut c = TcpStream::connect(("127.0.0.1", s.port)).unwrap();
-    c.set_read_timeout(Some(std::time::Duration::from_secs(60))).unwrap();
-    let head = format!(
-        "POST /api/render?coarse=4 HTTP/1.1\r\nHost: 127.0.0.1:{}\r\nContent-Length: {}\r\n\r\n",
-        s.port,
-        heavy.len()
-    );
-    c.write_all(head.as_bytes()).unwrap();
-    c.write_all(heavy.as_bytes()).unwrap();
-    // The reply's head and the coarse image's `M`: the coarse pass is under way.
-    let mut got = Vec::new();
-    let mut some = [0u8; 256];
-    while !got.windows(7).any(|w| w == b"\"level\"") {
-        let n = c.read(&mut some).expect("the heavy render's first message");
-        assert!(n > 0, "the heavy render ended early: {}", String::from_utf8_lossy(&got));
-        got.extend_from_slice(&some[..n]);
-    }
+    // The coarse image's `M` says the coarse pass is under way.
+    let (c, _) = heavy_render(&s, 15, "render(width = 256, height = 256)\nobject s15\n", b"\"level\"");
     drop(c);
-    let light = "camera(position = [0, 0, -4], look_at = [0, 0, 0])\nrender(width = 64, height = 64)\n\
-                 light ambient(1)\nobject sphere(1)\n";
-    let started = std::time::Instant::now();
-    let (status, body) = s.post("/api/render?coarse=4", light);
-    let took = started.elapsed();
-    assert_eq!(status, 200);
-    let kinds: String = messages(&body).iter().map(|(k, _)| *k as char).collect();
-    assert!(kinds.ends_with('S'), "{kinds}");
-    assert!(took < std::time::Duration::from_secs(4), "the light render took {took:?} behind the heavy one");
+    light_render_comes_back(&s, "the heavy render");
 }
 
 /// A newer request stops an older one's lowering too, not only its render: an
@@ -286,13 +256,27 @@ fn an_abandoned_heavy_render_does_not_hold_the_next_one() {
 fn an_abandoned_lowering_does_not_hold_the_next_render() {
     let (_dir, scene) = seed_scene();
     let s = Server::start(&scene);
+    let object = "render(width = 64, height = 64)\nobject mesh isosurface(s12, cell = 0.005)\n";
+    let (mut c, mut got) = heavy_render(&s, 12, object, b"\"objects\"");
+    light_render_comes_back(&s, "the heavy lowering");
+    // The heavy request is told it was overtaken.
+    let mut rest = Vec::new();
+    let _ = c.read_to_end(&mut rest);
+    got.extend_from_slice(&rest);
+    assert!(got.windows(7).any(|w| w == b"X\x02\0\0\0{}"), "{}", String::from_utf8_lossy(&got));
+}
+
+/// Posts a scene whose field reads the level below twice, `levels` deep (2^levels
+/// sphere evaluations a sample), with `tail` (its render and object statements), and
+/// reads the stream until `marker` has come: the connection and what it sent.
+fn heavy_render(s: &Server, levels: u32, tail: &str, marker: &[u8]) -> (TcpStream, Vec<u8>) {
     let mut heavy = String::from("let s0 = sphere(1)\n");
-    for i in 1..=12 {
+    for i in 1..=levels {
         let b = "bounds = [[-2, -2, -2], [2, 2, 2]]";
         heavy += &format!("let s{i} = field(p => min(dist(s{}, p), dist(s{}, p * 1.01)), {b})\n", i - 1, i - 1);
     }
-    heavy += "camera(position = [0, 0, -4], look_at = [0, 0, 0])\nrender(width = 64, height = 64)\n\
-              light ambient(1)\nobject mesh isosurface(s12, cell = 0.005)\n";
+    heavy += "camera(position = [0, 0, -4], look_at = [0, 0, 0])\nlight ambient(1)\n";
+    heavy += tail;
     let mut c = TcpStream::connect(("127.0.0.1", s.port)).unwrap();
     c.set_read_timeout(Some(std::time::Duration::from_secs(60))).unwrap();
     let head = format!(
@@ -302,14 +286,18 @@ fn an_abandoned_lowering_does_not_hold_the_next_render() {
     );
     c.write_all(head.as_bytes()).unwrap();
     c.write_all(heavy.as_bytes()).unwrap();
-    // The reply's head and the `L` message: the lowering is under way.
     let mut got = Vec::new();
     let mut some = [0u8; 256];
-    while !got.windows(9).any(|w| w == b"\"objects\"") {
+    while !got.windows(marker.len()).any(|w| w == marker) {
         let n = c.read(&mut some).expect("the heavy render's first message");
         assert!(n > 0, "the heavy render ended early: {}", String::from_utf8_lossy(&got));
         got.extend_from_slice(&some[..n]);
     }
+    (c, got)
+}
+
+/// A light scene's render, sent behind `what`, is whole within a few seconds.
+fn light_render_comes_back(s: &Server, what: &str) {
     let light = "camera(position = [0, 0, -4], look_at = [0, 0, 0])\nrender(width = 64, height = 64)\n\
                  light ambient(1)\nobject sphere(1)\n";
     let started = std::time::Instant::now();
@@ -318,12 +306,7 @@ fn an_abandoned_lowering_does_not_hold_the_next_render() {
     assert_eq!(status, 200);
     let kinds: String = messages(&body).iter().map(|(k, _)| *k as char).collect();
     assert!(kinds.ends_with('S'), "{kinds}");
-    assert!(took < std::time::Duration::from_secs(4), "the light render took {took:?} behind the heavy lowering");
-    // The heavy request is told it was overtaken.
-    let mut rest = Vec::new();
-    let _ = c.read_to_end(&mut rest);
-    got.extend_from_slice(&rest);
-    assert!(got.windows(7).any(|w| w == b"X\x02\0\0\0{}"), "{}", String::from_utf8_lossy(&got));
+    assert!(took < std::time::Duration::from_secs(4), "the light render took {took:?} behind {what}");
 }
 
 /// Clients that declare a large body and send one byte of it hold no slot the page
