@@ -80,7 +80,13 @@ pub struct IsoAccuracy {
 impl MeshJob {
     /// The mesh object, ready for tracing.
     pub fn build(self) -> MeshObject {
-        let object = MeshObject::new(&self.mesh, self.xf, self.material, self.per_triangle, self.normals);
+        self.build_until(&|| false)
+    }
+
+    /// [`build`](Self::build) whose BVH build ends early once `stop` says so (see
+    /// [`Bvh::build_until`]): the object is then for the caller to drop.
+    pub fn build_until(self, stop: &(dyn Fn() -> bool + Sync)) -> MeshObject {
+        let object = MeshObject::new_until(&self.mesh, self.xf, self.material, self.per_triangle, self.normals, stop);
         MeshObject { convex: self.convex, isosurface: self.isosurface, ..object }
     }
 }
@@ -164,6 +170,19 @@ impl MeshObject {
         per_triangle: Option<Vec<u32>>,
         normals: Normals,
     ) -> MeshObject {
+        MeshObject::new_until(mesh, xf, material, per_triangle, normals, &|| false)
+    }
+
+    /// [`new`](Self::new) whose BVH build (most of the time of a large mesh) ends early
+    /// once `stop` says so.
+    pub fn new_until(
+        mesh: &TriMesh,
+        xf: DAffine3,
+        material: u32,
+        per_triangle: Option<Vec<u32>>,
+        normals: Normals,
+        stop: &(dyn Fn() -> bool + Sync),
+    ) -> MeshObject {
         let positions: Vec<Vec3A> = mesh.positions.par_iter().map(|p| xf.transform_point3(*p).as_vec3a()).collect();
         // A mirroring map would turn the winding, and so every face normal, inward.
         let mirrored = xf.matrix3.determinant() < 0.0;
@@ -209,7 +228,7 @@ impl MeshObject {
             let [a, b, c] = triangles[i].map(|k| positions[k as usize]);
             Aabb { min: a.min(b).min(c), max: a.max(b).max(c) }
         };
-        let (bvh, order) = Bvh::build_ordered(triangles.len(), bounds, 4);
+        let (bvh, order) = Bvh::build_ordered(triangles.len(), bounds, 4, stop);
         let triangles: Vec<[u32; 3]> = order.par_iter().map(|&k| triangles[k as usize]).collect();
         let shading = match (vertex, corners) {
             (Some(v), _) => Shading::Vertex(v),

@@ -393,7 +393,7 @@ fn lower_reusing(
                     Object { kind: ObjectKind::Sdf(s), bounds, sphere, half_space, hull, span }
                 }
                 Lowered::Mesh(job) => {
-                    let m = job.build();
+                    let m = job.build_until(&|| budget.abandoned());
                     let (bounds, sphere) = (Some(m.bounds()), m.sphere());
                     Object { bounds, sphere, half_space: None, hull: None, kind: ObjectKind::Mesh(Arc::new(m)), span }
                 }

@@ -377,3 +377,34 @@ fn memory_estimate_bounds_what_meshes_keep() {
         }
     }
 }
+
+/// A lowering that stops being wanted stops building its meshes' BVHs too (most of a
+/// large mesh's lowering): `wanted` is asked between objects, once the meshes are made,
+/// and at every BVH subtree of 4,096 or more triangles, and once it says no the result
+/// is `None`. Counted, not timed: told no at its third question, the build asks only a
+/// few more times where a whole build of this mesh asks at each of its large subtrees.
+#[test]
+fn an_unwanted_lowering_stops_in_the_bvh_build() {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::Arc;
+    let text = "camera(position = [0, 0, -4], look_at = [0, 0, 0])\nlight ambient(1)\n\
+                object mesh uvsphere(rings = 200, segments = 400)\n";
+    let scene = crate::support::scene(text);
+    let loader = scnc::source::FsLoader;
+    let asks = |until: usize| {
+        let asked = Arc::new(AtomicUsize::new(0));
+        let counted = Arc::clone(&asked);
+        let wanted: scnc::mesh::lower::Wanted = Arc::new(move || counted.fetch_add(1, Ordering::Relaxed) < until);
+        let limit = scnc::mesh::lower::DEFAULT_MEMORY_LIMIT;
+        let effects = scnc::render::effects::derive(&scene);
+        let lowered = scnc::world::prepare_until(&scene, effects, Mode::Sdf, &loader, limit, wanted).expect("lowers");
+        (lowered.is_some(), asked.load(Ordering::Relaxed))
+    };
+    let (whole, all_asks) = asks(usize::MAX);
+    assert!(whole, "a wanted lowering makes its world");
+    // 160,000 triangles: dozens of subtrees of 4,096 or more.
+    assert!(all_asks > 20, "a whole build asked {all_asks} times");
+    let (made, stopped_asks) = asks(2);
+    assert!(!made, "an unwanted lowering makes nothing");
+    assert!(stopped_asks > 3 && stopped_asks < all_asks / 2, "stopped after {stopped_asks} of {all_asks} questions");
+}

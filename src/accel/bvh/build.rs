@@ -214,12 +214,25 @@ impl Bvh {
     /// Builds over `count` primitives, primitive `i` having the box `bounds(i)`, so a
     /// caller need not hold the boxes besides the builder's own copy.
     pub fn build_with(count: usize, bounds: impl Fn(usize) -> Aabb + Sync, leaf_size: usize) -> Bvh {
+        Bvh::build_until(count, bounds, leaf_size, &|| false)
+    }
+
+    /// [`build_with`](Self::build_with) that ends early once `stop` says so (the studio's
+    /// lowering for a request a newer one replaced): asked at every subtree of 4,096 or
+    /// more primitives, which a stopped build makes one leaf. The tree is then valid but
+    /// useless, for the caller to drop; with `stop` never true it is `build_with`'s.
+    pub fn build_until(
+        count: usize,
+        bounds: impl Fn(usize) -> Aabb + Sync,
+        leaf_size: usize,
+        stop: &(dyn Fn() -> bool + Sync),
+    ) -> Bvh {
         if count == 0 {
             return Bvh::default();
         }
         let mut refs: Vec<Ref> = (0..count).into_par_iter().map(|i| Ref::new(bounds(i), i as u32)).collect();
         let span = refs.par_chunks(PAR_BIN).map(Span::of).reduce(|| Span::EMPTY, Span::union);
-        let root = subtree(&mut refs, 0, span, 0, leaf_size.max(1));
+        let root = subtree(&mut refs, 0, span, 0, leaf_size.max(1), stop);
         // The boxes go before the nodes are laid out, which briefly holds them twice.
         let prims = refs.par_iter().map(Ref::id).collect();
         drop(refs);
@@ -228,11 +241,16 @@ impl Bvh {
         Bvh { nodes, root_box: span.bounds, root, prims }
     }
 
-    /// Builds like [`build`](Self::build) and returns the leaves' primitive order: the
+    /// Builds like [`build_until`](Self::build_until) and returns the leaves' primitive order: the
     /// caller stores its primitives in that order, and the tree then names primitive `k`
     /// by its position `k` (no index array, one indirection less per primitive test).
-    pub fn build_ordered(count: usize, bounds: impl Fn(usize) -> Aabb + Sync, leaf_size: usize) -> (Bvh, Vec<u32>) {
-        let mut bvh = Bvh::build_with(count, bounds, leaf_size);
+    pub fn build_ordered(
+        count: usize,
+        bounds: impl Fn(usize) -> Aabb + Sync,
+        leaf_size: usize,
+        stop: &(dyn Fn() -> bool + Sync),
+    ) -> (Bvh, Vec<u32>) {
+        let mut bvh = Bvh::build_until(count, bounds, leaf_size, stop);
         let order = std::mem::take(&mut bvh.prims);
         (bvh, order)
     }
@@ -240,7 +258,14 @@ impl Bvh {
 
 /// Builds the subtree over `refs`, which start at primitive `start`: in parallel halves
 /// while it is large, serially below.
-fn subtree(refs: &mut [Ref], start: usize, span: Span, depth: usize, leaf_size: usize) -> Sub {
+fn subtree(
+    refs: &mut [Ref],
+    start: usize,
+    span: Span,
+    depth: usize,
+    leaf_size: usize,
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Sub {
     if refs.len() < FORK {
         // At most four a leaf, SAH makes about one interior node per three primitives.
         let mut nodes = Vec::with_capacity(refs.len() / 3);
@@ -249,13 +274,14 @@ fn subtree(refs: &mut [Ref], start: usize, span: Span, depth: usize, leaf_size: 
             leaf => Sub::Leaf(leaf),
         };
     }
-    let Some((mid, left, right)) = split(refs, span, depth, leaf_size) else {
+    let split = if stop() { None } else { split(refs, span, depth, leaf_size) };
+    let Some((mid, left, right)) = split else {
         return Sub::Leaf(Child { index: start as u32, count: refs.len() as u32 });
     };
     let (lo, hi) = refs.split_at_mut(mid);
     let (l, r) = rayon::join(
-        || subtree(lo, start, left, depth + 1, leaf_size),
-        || subtree(hi, start + mid, right, depth + 1, leaf_size),
+        || subtree(lo, start, left, depth + 1, leaf_size, stop),
+        || subtree(hi, start + mid, right, depth + 1, leaf_size, stop),
     );
     Sub::Fork(Box::new([(left.bounds, l), (right.bounds, r)]))
 }

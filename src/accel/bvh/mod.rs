@@ -263,7 +263,7 @@ mod tests {
             .collect();
         let indexed = Bvh::build(&boxes, 4);
         indexed.validate(&boxes).expect("indexed tree");
-        let (ordered, order) = Bvh::build_ordered(boxes.len(), |i| boxes[i], 4);
+        let (ordered, order) = Bvh::build_ordered(boxes.len(), |i| boxes[i], 4, &|| false);
         let reordered: Vec<Aabb> = order.iter().map(|&k| boxes[k as usize]).collect();
         ordered.validate(&reordered).expect("ordered tree");
         for i in 0..200 {
@@ -275,6 +275,28 @@ mod tests {
             assert_eq!(a, b, "the ordered tree visits what the indexed one does");
             assert!(expected.iter().all(|p| a.contains(p)), "ray {i} missed a box: {expected:?} ⊄ {a:?}");
         }
+    }
+
+    /// A build told to stop ends at its next large subtree with a tree that is still
+    /// valid (the studio drops it), asking about once per 4,096 primitives at most; never
+    /// told, it is the plain build's tree.
+    #[test]
+    fn a_stopped_build_ends_early_with_a_valid_tree() {
+        let boxes = scattered(3 * build::PAR_BIN);
+        let asked = std::sync::atomic::AtomicUsize::new(0);
+        let stop = || asked.fetch_add(1, std::sync::atomic::Ordering::Relaxed) >= 2;
+        let stopped = Bvh::build_until(boxes.len(), |i| boxes[i], 4, &stop);
+        stopped.validate(&boxes).expect("a valid tree");
+        let whole = Bvh::build(&boxes, 4);
+        assert!(
+            stopped.node_count() < whole.node_count() / 4,
+            "{} of {} nodes",
+            stopped.node_count(),
+            whole.node_count()
+        );
+        assert!(asked.into_inner() <= boxes.len() / 4096 + 2);
+        let never = Bvh::build_until(boxes.len(), |i| boxes[i], 4, &|| false);
+        assert_eq!((&never.nodes, never.root, &never.prims), (&whole.nodes, whole.root, &whole.prims));
     }
 
     /// Large enough for subtrees built in parallel and nodes binned in parallel chunks:
