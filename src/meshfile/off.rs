@@ -68,6 +68,21 @@ pub fn parse(bytes: &[u8], allowed: u64) -> Result<TriMesh, String> {
         }
         mesh.positions.push(axes::from_file(p, Up::Z));
     }
+    read_faces(&mut lines, faces, &mut mesh)?;
+    if mesh.triangles.is_empty() {
+        return Err("the file has no faces with three distinct corners".into());
+    }
+    Ok(mesh)
+}
+
+/// Reads `faces` face lines into `mesh`'s triangles (its vertices read already),
+/// ear-clipping polygons; an error names the line.
+fn read_faces<'a>(
+    lines: &mut impl Iterator<Item = (usize, &'a str)>,
+    faces: usize,
+    mesh: &mut TriMesh,
+) -> Result<(), String> {
+    let vertices = mesh.positions.len();
     let mut idx = Vec::new();
     for f in 0..faces {
         let (n, line) = lines.next().ok_or_else(|| format!("the file ends after {f} of its {faces} faces"))?;
@@ -102,10 +117,7 @@ pub fn parse(bytes: &[u8], allowed: u64) -> Result<TriMesh, String> {
             }
         }
     }
-    if mesh.triangles.is_empty() {
-        return Err("the file has no faces with three distinct corners".into());
-    }
-    Ok(mesh)
+    Ok(())
 }
 
 /// The OFF format.
