@@ -93,7 +93,7 @@ pub(super) struct Iso {
     pub(super) max_cells: usize,
     /// Asked at every sample: once the lowering is not wanted, every sample reads as far
     /// outside, so the extraction runs out of cells and ends within one evaluation.
-    pub(super) wanted: Option<super::lower::Wanted>,
+    pub(super) wanted: Option<super::Wanted>,
 }
 
 /// An isosurface of `shape` sampled and placed as `iso` says, each triangle taking the

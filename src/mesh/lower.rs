@@ -6,6 +6,7 @@
 use glam::{DAffine3, DVec3};
 
 use super::iso_job::{detail_cell, isosurface_object, unbounded, CellFrom, Iso};
+use super::Wanted;
 use super::{isosurface, Detail, MeshJob, Normals};
 use crate::diag::{codes, Diagnostic};
 use crate::geom::tessellate::count;
@@ -257,10 +258,6 @@ const CONFIRM_FROM: u64 = 64 << 20;
 
 /// The default memory limit for meshes: 4 GiB, room on a laptop and on the test machine.
 pub const DEFAULT_MEMORY_LIMIT: u64 = 4 << 30;
-
-/// Whether a lowering is still wanted: in the studio a newer request makes an older
-/// one's not, and its isosurfaces then end at once (what they made is thrown away).
-pub type Wanted = std::sync::Arc<dyn Fn() -> bool + Send + Sync>;
 
 /// What the scene's meshes may still use: triangles, and bytes at the estimate above.
 #[derive(Clone)]

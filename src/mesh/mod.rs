@@ -25,6 +25,10 @@ use rayon::prelude::*;
 
 pub use detail::Detail;
 
+/// Whether a lowering is still wanted: in the studio a newer request makes an older
+/// one's not, and its isosurfaces and BVH builds then end early (what they made is thrown away).
+pub type Wanted = std::sync::Arc<dyn Fn() -> bool + Send + Sync>;
+
 use crate::geom::TriMesh;
 
 use crate::accel::{Aabb, Bvh, Rays4};

@@ -46,7 +46,7 @@ pub fn parse(bytes: &[u8], allowed: u64) -> Result<TriMesh, String> {
         return Err(format!("line {n}: more than {MAX_ELEMENTS} vertices or faces"));
     }
     // A vertex and a triangle per face at least: refused before anything is allocated.
-    let bytes_needed = (vertices as u64) * 24 + (faces as u64) * 12;
+    let bytes_needed = super::Expansion { vertices: vertices as u64, triangles: faces as u64, uses: 1 }.bytes();
     if bytes_needed > allowed {
         return Err(format!(
             "its {vertices} vertices and {faces} faces take {} as a mesh, more than the {} the memory limit leaves \

@@ -187,25 +187,24 @@ pub fn prepare_within(
 
 /// [`prepare_within`] for a lowering that may stop being wanted (the studio's, once a
 /// newer request comes): `Ok(None)` as soon as `wanted` says so. It is asked between
-/// objects and at every isosurface sample, so an abandoned lowering lets go of the
-/// workers within one evaluation rather than when its meshes are done.
+/// objects, at every isosurface sample and at every large subtree of a mesh's BVH, so an
+/// abandoned lowering lets go of the workers at once rather than when its meshes are
+/// done.
 pub fn prepare_until(
     scene: &ir::Scene,
     effects: crate::render::effects::Effects,
     mode: Mode,
     loader: &dyn Loader,
     memory_limit: u64,
-    wanted: mesh::lower::Wanted,
+    wanted: mesh::Wanted,
 ) -> Result<Option<(Frame, World)>, Diagnostic> {
-    let mut frame = Frame::with_effects(scene, effects);
-    let params = MarchParams { epsilon: scene.settings.epsilon as f32, max_steps: scene.settings.max_steps };
     let budget = mesh::lower::Budget::new(memory_limit).while_wanted(wanted.clone());
-    let world = lower_reusing(scene, &mut frame, mode, params, loader, budget, &mut FrameCache::default(), &|| {});
+    let prepared = prepare_with(scene, effects, mode, loader, budget, &mut FrameCache::default(), &|| {});
     // Not wanted any more: whatever the lowering made or refused is moot.
     if !wanted() {
         return Ok(None);
     }
-    world.map(|w| Some((frame, w)))
+    prepared.map(Some)
 }
 
 /// [`prepare_within`] for one frame of an animation: objects equal to the previous
@@ -225,9 +224,22 @@ pub fn prepare_reusing(
     reuse: &mut FrameCache,
     step: &(dyn Fn() + Sync),
 ) -> Result<(Frame, World), Diagnostic> {
+    let budget = mesh::lower::Budget::new(memory_limit);
+    prepare_with(scene, effects, mode, loader, budget, reuse, step)
+}
+
+/// The frame for `effects` and the scene lowered into a world within `budget`.
+fn prepare_with(
+    scene: &ir::Scene,
+    effects: crate::render::effects::Effects,
+    mode: Mode,
+    loader: &dyn Loader,
+    budget: mesh::lower::Budget,
+    reuse: &mut FrameCache,
+    step: &(dyn Fn() + Sync),
+) -> Result<(Frame, World), Diagnostic> {
     let mut frame = Frame::with_effects(scene, effects);
     let params = MarchParams { epsilon: scene.settings.epsilon as f32, max_steps: scene.settings.max_steps };
-    let budget = mesh::lower::Budget::new(memory_limit);
     let world = lower_reusing(scene, &mut frame, mode, params, loader, budget, reuse, step)?;
     Ok((frame, world))
 }

@@ -394,7 +394,7 @@ fn an_unwanted_lowering_stops_in_the_bvh_build() {
     let asks = |until: usize| {
         let asked = Arc::new(AtomicUsize::new(0));
         let counted = Arc::clone(&asked);
-        let wanted: scnc::mesh::lower::Wanted = Arc::new(move || counted.fetch_add(1, Ordering::Relaxed) < until);
+        let wanted: scnc::mesh::Wanted = Arc::new(move || counted.fetch_add(1, Ordering::Relaxed) < until);
         let limit = scnc::mesh::lower::DEFAULT_MEMORY_LIMIT;
         let effects = scnc::render::effects::derive(&scene);
         let lowered = scnc::world::prepare_until(&scene, effects, Mode::Sdf, &loader, limit, wanted).expect("lowers");

@@ -17,8 +17,8 @@ use std::time::Instant;
 use glam::DQuat;
 
 use scnc::diag::Diagnostic;
-use scnc::mesh::lower::Wanted;
 use scnc::mesh::Detail;
+use scnc::mesh::Wanted;
 use scnc::render::{Frame, Image, PixelRect};
 use scnc::trace::Counters;
 use scnc::world::{Mode, World};
