@@ -29,8 +29,11 @@ pub const MAX_IMAGE_SIDE: u32 = 16_384;
 pub const MAX_PIXELS: u64 = 100_000_000;
 /// Deepest reflection recursion.
 pub const MAX_DEPTH: u32 = 64;
-/// Most samples per pixel.
-pub const MAX_SAMPLES: u32 = 256;
+/// Most bounces of a light-transport path (Russian roulette ends most far sooner).
+pub const MAX_BOUNCES: u32 = 1024;
+/// Most samples per pixel: enough for light transport's converged references (a
+/// render is interruptible, and each sample a pure function of its index).
+pub const MAX_SAMPLES: u32 = 1 << 20;
 /// Largest sphere-tracing step budget.
 pub const MAX_STEPS: u32 = 1_000_000;
 /// The smallest relative hit threshold: a few f32 ulps (2⁻²³ ≈ 1.2e-7) of the distance
@@ -275,7 +278,7 @@ impl dyn Host + '_ {
 
     /// The camera of a `camera` statement whose arguments are bound.
     pub(crate) fn camera(&mut self, a: &BoundArgs, span: Span) -> Option<Camera> {
-        let CameraArgs { position, look_at, up, fov } = CameraArgs::from_args(a);
+        let CameraArgs { position, look_at, up, fov, aperture, focus_distance } = CameraArgs::from_args(a);
         let mut ok = true;
         let view = direction(look_at - position);
         if view.is_none() {
@@ -306,7 +309,7 @@ impl dyn Host + '_ {
                 ok = false;
             }
         }
-        ok.then_some(Camera { position, look_at, up, fov, span: Some(span) })
+        ok.then_some(Camera { position, look_at, up, fov, aperture, focus_distance, span: Some(span) })
     }
 
     /// The settings of a `render` statement whose arguments are bound.
@@ -353,6 +356,8 @@ impl dyn Host + '_ {
             frames: r.frames,
             fps: r.fps,
             cyclic: r.cyclic,
+            bounces: r.bounces,
+            exposure: r.exposure,
             color,
             span: Some(span),
         })
@@ -370,6 +375,10 @@ crate::params! {
         up: DVec3 as Vec3 = [0.0, 1.0, 0.0], Range::NONZERO;
         /// the vertical field of view in degrees
         fov: f64 as Num = (ir::SEED_FOV), Range::open(0.0, 180.0);
+        /// the lens's diameter for depth of field under light transport (0: a pinhole)
+        aperture: f64 as Num = 0.0, Range::closed(0.0, MAX_REACH);
+        /// how far along the view the lens focuses (default: at `look_at`)
+        focus_distance: Option<f64> as Num = derived, Range::gt_le(0.0, MAX_REACH);
     }
 }
 
@@ -402,5 +411,9 @@ crate::params! {
         cyclic: bool as Bool = false;
         /// how colours are read and pixels written: "linear" (the study's) or "srgb"
         color: String as Str = "linear";
+        /// a light-transport path's surface interactions after the camera ray (1: direct light only)
+        bounces: Option<u32> as Int = derived, Range::closed(1.0, MAX_BOUNCES as f64);
+        /// light-transport pixels are scaled by 2^exposure before the tone map
+        exposure: f64 as Num = 0.0, Range::closed(-64.0, 64.0);
     }
 }

@@ -278,6 +278,8 @@ pub enum LightFn {
     Ambient,
     Point,
     Directional,
+    Area,
+    Environment,
 }
 
 /// Functions of one number.

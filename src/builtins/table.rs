@@ -18,7 +18,8 @@ use super::profiles::{
 };
 use super::shapes::{CsgArgs, RepeatArgs, RoundArgs, ShellArgs};
 use super::values::{
-    AmbientArgs, CheckerArgs, DirectionalArgs, GradientArgs, MaterialArgs, NoiseArgs, PointArgs, RgbArgs, StripesArgs,
+    AmbientArgs, AreaArgs, CheckerArgs, DirectionalArgs, EnvironmentArgs, GradientArgs, MaterialArgs, NoiseArgs,
+    PointArgs, RgbArgs, StripesArgs,
 };
 use super::{Builtin, Ctor, Extreme, FieldFn, Gen, LightFn, MathFn, Modifier, NumFn, PatternFn, ProfileFn, Ty, VecFn};
 use crate::ir::field::Unary;
@@ -281,6 +282,20 @@ static REST: &[Builtin] = &[
         DirectionalArgs::PARAMS,
         Ty::Light,
         "a light at infinity, shining from direction `towards`",
+    ),
+    f(
+        "area",
+        Ctor::Light(LightFn::Area),
+        AreaArgs::PARAMS,
+        Ty::Light,
+        "a `size` rectangle of light facing -y, placed with `at` and `rotate`; it lights the scene by light transport",
+    ),
+    f(
+        "environment",
+        Ctor::Light(LightFn::Environment),
+        EnvironmentArgs::PARAMS,
+        Ty::Light,
+        "light of radiance `intensity` arriving from every direction; it lights the scene by light transport",
     ),
     // Maths (angles in degrees). A function of one number checks its argument against
     // its declaration's range: `sqrt`'s, `log`'s and `asin`'s are their domains.

@@ -13,6 +13,9 @@ use crate::sig::Range;
 
 /// Highest index of refraction (germanium's is about 4; nothing in nature reaches 10).
 pub const MAX_IOR: f64 = 10.0;
+/// Highest `emission_strength`: far beyond any real source relative to a white surface,
+/// still far from f32's overflow when shaded.
+pub const MAX_EMISSION: f64 = 1e30;
 /// Most patterns in one pattern, itself included: each is evaluated at every shaded
 /// point, and a blend evaluates both of its paints.
 pub const MAX_PATTERN_NODES: usize = 64;
@@ -32,6 +35,10 @@ crate::params! {
         ior: f64 as Num = 1.0, Range::closed(1.0, MAX_IOR);
         /// how much of each channel the medium absorbs per unit of distance
         absorption: DVec3 as Vec3 = [0.0, 0.0, 0.0], Range::NONNEG;
+        /// the colour of the light it glows with under light transport (black: none)
+        emission: DVec3 as Color = [0.0, 0.0, 0.0];
+        /// how brightly it glows: radiance = `emission` (255 is 1) times this
+        emission_strength: f64 as Num = 1.0, Range::closed(0.0, MAX_EMISSION);
     }
 }
 
@@ -122,6 +129,24 @@ crate::params! {
 }
 
 crate::params! {
+    /// `area(intensity, size)`.
+    pub struct AreaArgs {
+        /// its radiance (1: as bright as a white surface at full light)
+        intensity: f64 as Num = required, Range::NONNEG;
+        /// its width and height `[w, h]` (default `[1, 1]`)
+        size: Option<Value> as List = derived;
+    }
+}
+
+crate::params! {
+    /// `environment(intensity)`.
+    pub struct EnvironmentArgs {
+        /// the radiance arriving from every direction
+        intensity: f64 as Num = required, Range::NONNEG;
+    }
+}
+
+crate::params! {
     /// `directional(intensity, towards, shadows)`.
     pub struct DirectionalArgs {
         /// how bright
@@ -165,6 +190,8 @@ impl dyn Host + '_ {
             transparency: m.transparency,
             ior: m.ior,
             absorption: m.absorption,
+            emission: m.emission,
+            emission_strength: m.emission_strength,
             span: a.call,
         };
         if !m.is_transparent() {
@@ -249,6 +276,33 @@ impl dyn Host + '_ {
         Value::Color(DVec3::new(r, g, b))
     }
 
+    /// An area light's `size`: two finite numbers, neither negative (a zero side makes
+    /// a light that emits nothing).
+    fn size(&mut self, size: Option<&Value>, a: &BoundArgs) -> Option<[f64; 2]> {
+        let Some(v) = size else { return Some([1.0, 1.0]) };
+        if let Value::List(items) = v {
+            if let [Value::Num(w), Value::Num(h)] = items.as_slice() {
+                if w.is_finite() && h.is_finite() && *w >= 0.0 && *h >= 0.0 && w.max(*h) <= super::MAX_REACH {
+                    return Some([*w, *h]);
+                }
+            }
+        }
+        if !v.is_error() {
+            let shown = match v {
+                Value::List(items) => {
+                    let parts: Vec<String> = items
+                        .iter()
+                        .map(|x| if let Value::Num(n) = x { ir::dump_num(*n) } else { format!("a `{}`", x.ty_name()) })
+                        .collect();
+                    format!("[{}]", parts.join(", "))
+                }
+                other => format!("a `{}`", other.ty_name()),
+            };
+            self.range_error(a.span_of("size"), "size", "a width and height `[w, h]`, neither negative", shown);
+        }
+        None
+    }
+
     /// A light (placed later by `at`).
     pub(super) fn light(&mut self, l: LightFn, a: &BoundArgs) -> Value {
         let (kind, intensity, shadows, radius) = match l {
@@ -261,6 +315,19 @@ impl dyn Host + '_ {
                 let DirectionalArgs { intensity, towards, shadows } = DirectionalArgs::from_args(a);
                 (ir::LightKind::Directional { towards }, intensity, shadows, 0.0)
             }
+            LightFn::Area => {
+                let AreaArgs { intensity, size } = AreaArgs::from_args(a);
+                let Some([w, h]) = self.size(size.as_ref(), a) else {
+                    return Value::Error;
+                };
+                let kind = ir::LightKind::Area {
+                    centre: DVec3::ZERO,
+                    u: DVec3::new(w / 2.0, 0.0, 0.0),
+                    v: DVec3::new(0.0, 0.0, h / 2.0),
+                };
+                (kind, intensity, true, 0.0)
+            }
+            LightFn::Environment => (ir::LightKind::Environment, EnvironmentArgs::from_args(a).intensity, true, 0.0),
         };
         Value::Light(Arc::new(ir::Light { kind, intensity, shadows, radius, span: a.call }))
     }

@@ -113,7 +113,8 @@ impl Ctx<'_> {
             }
             let far = match light.kind {
                 LightKind::Point { position } => (position - camera.position).length() + light.radius,
-                LightKind::Ambient | LightKind::Directional { .. } => 0.0,
+                LightKind::Area { centre, u, v } => (centre - camera.position).length() + u.length() + v.length(),
+                LightKind::Ambient | LightKind::Directional { .. } | LightKind::Environment => 0.0,
             };
             if !far.is_finite() || far > MAX_REACH {
                 self.report(

@@ -48,14 +48,25 @@ impl Ctx<'_> {
             Value::Error
         };
         if let Value::Light(light) = &target {
+            let placed = |kind: ir::LightKind| {
+                let mut l = (**light).clone();
+                l.kind = kind;
+                l.span = span;
+                Value::Light(Arc::new(l))
+            };
             return match (op, &light.kind, &arg) {
                 (TransformOp::At, ir::LightKind::Point { .. }, Value::Vec3(p)) => {
-                    let mut l = (**light).clone();
-                    l.kind = ir::LightKind::Point { position: *p };
-                    l.span = span;
-                    Value::Light(Arc::new(l))
+                    placed(ir::LightKind::Point { position: *p })
                 }
-                (TransformOp::At, ir::LightKind::Point { .. }, other) => {
+                (TransformOp::At, ir::LightKind::Area { centre, u, v }, Value::Vec3(p)) => {
+                    placed(ir::LightKind::Area { centre: *centre + *p, u: *u, v: *v })
+                }
+                // About the origin, as a shape turns: a placed rectangle swings with it.
+                (TransformOp::Rotate, ir::LightKind::Area { centre, u, v }, Value::Vec3(deg)) => {
+                    let r = rotation(*deg);
+                    placed(ir::LightKind::Area { centre: r * *centre, u: r * *u, v: r * *v })
+                }
+                (TransformOp::At, ir::LightKind::Point { .. } | ir::LightKind::Area { .. }, other) => {
                     self.report(Diagnostic::error(
                         codes::TYPE_MISMATCH,
                         arg_span,
@@ -64,9 +75,18 @@ impl Ctx<'_> {
                     ));
                     Value::Error
                 }
+                (TransformOp::Rotate, ir::LightKind::Area { .. }, other) => {
+                    self.report(Diagnostic::error(
+                        codes::TYPE_MISMATCH,
+                        arg_span,
+                        format!("expected `vec3`, found `{}`", other.ty_name()),
+                        "angles are a `vec3` of degrees",
+                    ));
+                    Value::Error
+                }
                 _ => bad_target(
                     self,
-                    "only point lights can be placed, with `at`; a directional light takes `towards = […]`",
+                    "point lights are placed with `at`, area lights with `at` and `rotate`; a directional light takes `towards = […]`",
                 ),
             };
         }

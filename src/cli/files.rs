@@ -92,11 +92,56 @@ pub(crate) fn check_output(path: &Path) -> Result<(), String> {
     if path.as_os_str().to_string_lossy().ends_with(std::path::MAIN_SEPARATOR) {
         return Err(format!("cannot write `{shown}`: it names a directory; give a file name ending in `.png`"));
     }
-    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-    if ext.as_deref() != Some("png") {
+    if !is_png(path) {
         return Err(format!("cannot write `{shown}`: scnc writes PNG images; try a `.png` file name"));
     }
     check_output_as(path, "a file name ending in `.png`")
+}
+
+/// [`check_output`] for an image that may also be OpenEXR (`.exr`, linear float).
+pub(crate) fn check_image_output(path: &Path) -> Result<(), String> {
+    if is_exr(path) {
+        return check_output_as(path, "a file name ending in `.exr`");
+    }
+    check_output(path).map_err(|e| {
+        e.replace(
+            "scnc writes PNG images; try a `.png` file name",
+            "scnc writes PNG images, or OpenEXR for linear light; try a `.png` or `.exr` file name",
+        )
+    })
+}
+
+fn extension_is(path: &Path, ext: &str) -> bool {
+    path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case(ext))
+}
+
+/// Whether `path` names a PNG file.
+pub(crate) fn is_png(path: &Path) -> bool {
+    extension_is(path, "png")
+}
+
+/// Whether `path` names an OpenEXR file.
+pub(crate) fn is_exr(path: &Path) -> bool {
+    extension_is(path, "exr")
+}
+
+/// Writes a float image (linear radiance) as OpenEXR, 32-bit float RGB, whole or not at
+/// all: through the `image` crate's codec (the `exr` crate), which the OpenEXR
+/// reference tools and Mitsuba read.
+pub(crate) fn write_exr(path: &Path, image: &scnc::render::Image) -> std::io::Result<()> {
+    if image.depth != BitDepth::Float {
+        return Err(std::io::Error::other("an OpenEXR image holds float samples"));
+    }
+    let values: Vec<f32> = image.pixels.chunks_exact(4).map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]])).collect();
+    let buffer = image::Rgb32FImage::from_raw(image.width, image.height, values)
+        .ok_or_else(|| std::io::Error::other("the image's size and pixels disagree"))?;
+    write_atomic(path, ".exr.tmp", |w| {
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        image::DynamicImage::ImageRgb32F(buffer)
+            .write_to(&mut bytes, image::ImageFormat::OpenExr)
+            .map_err(std::io::Error::other)?;
+        w.write_all(bytes.get_ref())
+    })
 }
 
 /// The usage error for an output path that names a directory or a file in a directory
@@ -238,20 +283,22 @@ fn encode_png(
     depth: BitDepth,
     text: &[(&str, String)],
 ) -> std::io::Result<()> {
+    let depth_bits = match depth {
+        BitDepth::Eight => png::BitDepth::Eight,
+        BitDepth::Sixteen => png::BitDepth::Sixteen,
+        BitDepth::Float => return Err(std::io::Error::other("a PNG has 8 or 16 bits per channel, not float")),
+    };
     write_atomic(path, ".png.tmp", |w| {
         let mut encoder = png::Encoder::new(w, width, height);
         encoder.set_color(colour);
-        encoder.set_depth(match depth {
-            BitDepth::Eight => png::BitDepth::Eight,
-            BitDepth::Sixteen => png::BitDepth::Sixteen,
-        });
+        encoder.set_depth(depth_bits);
         for (key, value) in text {
             encoder.add_text_chunk((*key).to_string(), value.clone()).map_err(std::io::Error::other)?;
         }
         let mut writer = encoder.write_header().map_err(std::io::Error::other)?;
         let mut stream = writer.stream_writer().map_err(std::io::Error::other)?;
         match depth {
-            BitDepth::Eight => stream.write_all(pixels)?,
+            BitDepth::Eight | BitDepth::Float => stream.write_all(pixels)?,
             // PNG's samples are big-endian: converted a row's worth at a time.
             BitDepth::Sixteen => {
                 for chunk in pixels.chunks(1 << 16) {

@@ -177,7 +177,8 @@ fn merge(parts: &[PathBuf]) -> Result<scnc::render::Image, String> {
             covered[word] |= bit;
             let out = &mut pixels[px_bytes * i..px_bytes * (i + 1)];
             match depth {
-                BitDepth::Eight => out.copy_from_slice(&rgba[..3]),
+                // A part is a PNG: never float.
+                BitDepth::Eight | BitDepth::Float => out.copy_from_slice(&rgba[..3]),
                 // The image keeps 16-bit samples in the machine's order; PNG's are big-endian.
                 BitDepth::Sixteen => {
                     for (o, s) in out.chunks_exact_mut(2).zip(rgba.chunks_exact(2)) {

@@ -15,7 +15,9 @@ use scnc::Compiled;
 
 use scnc::render::{BitDepth, PixelRect};
 
-use super::files::{cannot_write, check_output, stop_on_interrupt, write_part_png, write_png, FPS_KEY};
+use super::files::{
+    cannot_write, check_image_output, is_exr, stop_on_interrupt, write_exr, write_part_png, write_png, FPS_KEY,
+};
 use super::frames::{frame_path, is_pattern, parse_frames, FrameChoice};
 use super::progress::{Progress, Reading};
 use super::shared::{Accuracy, Meshing, Messages, Workers};
@@ -249,7 +251,10 @@ impl RenderArgs {
                 })?;
             }
         }
-        check_output(&self.output).map_err(|e| usage_error(&e))?;
+        check_image_output(&self.output).map_err(|e| usage_error(&e))?;
+        if is_exr(&self.output) && (self.region.is_some() || self.tile.is_some()) {
+            return Err(usage_error("a tile or band of an image is written as a PNG part: give a `.png` file name"));
+        }
         if let Err(e) = stop_on_interrupt(interrupted) {
             let _ = writeln!(std::io::stderr(), "warning: {e}");
         }
@@ -418,7 +423,8 @@ fn render_scene(
             return Err(ExitCode::from(1));
         }
     };
-    frame.bit_depth = args.bit_depth;
+    // OpenEXR keeps the light: linear float radiance, never clamped or encoded.
+    frame.bit_depth = if is_exr(output) { scnc::render::BitDepth::Float } else { args.bit_depth };
     let lowered = started.elapsed();
     let region = part.unwrap_or(PixelRect::full(frame.width, frame.height));
     let progress = Progress::new(region.height() as u64, "rows", "rendering");
@@ -428,6 +434,7 @@ fn render_scene(
     let traced = started.elapsed() - lowered;
     let written = match part {
         Some(region) => write_part_png(output, frame.width, frame.height, region, &image),
+        None if is_exr(output) => write_exr(output, &image),
         // An animation's frames carry its rate, which `scnc encode` reads.
         None if scene.settings.frames > 1 => write_png(output, &image, &[(FPS_KEY, scene.settings.fps.to_string())]),
         None => write_png(output, &image, &[]),

@@ -51,6 +51,28 @@ pub(crate) fn stats_text(c: &Counters, g: &World, map: &SourceMap, lower_s: f64,
         mem.closure_bytes,
         mem.top_bvh_bytes,
     );
+    if c.paths > 0 {
+        let lengths: Vec<String> = c
+            .path_lengths
+            .iter()
+            .enumerate()
+            .filter(|(_, &n)| n > 0)
+            .map(|(i, n)| {
+                let last = i + 1 == scnc::trace::PATH_BINS;
+                format!("{i}{}: {n}", if last { "+" } else { "" })
+            })
+            .collect();
+        out.push_str(&format!(
+            "  light transport {} paths, {} light (next-event) rays, {} bounce rays ({:.2} per path)
+    surfaces met per path: {}
+",
+            c.paths,
+            c.light_rays,
+            c.bounce_rays,
+            c.bounce_rays as f64 / c.paths as f64,
+            lengths.join(", ")
+        ));
+    }
     if c.segment_bounds > 0 {
         out.push_str(&format!(
             "  fields          {} bounds along stretches of rays ({:.1} per ray), for segment tracing\n",

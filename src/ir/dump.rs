@@ -60,6 +60,9 @@ impl Dumper<'_> {
             let _ =
                 write!(s, " transparency {} ior {} absorption {}", num(m.transparency), num(m.ior), vec(m.absorption));
         }
+        if m.emits() {
+            let _ = write!(s, " emission {} strength {}", vec(m.emission), num(m.emission_strength));
+        }
         s
     }
 
@@ -187,14 +190,29 @@ pub fn dump(scene: &Scene, map: &SourceMap) -> String {
     let c = &scene.camera;
     d.line(
         0,
-        &format!("camera position {} look_at {} up {} fov {}", vec(c.position), vec(c.look_at), vec(c.up), num(c.fov)),
+        &format!(
+            "camera position {} look_at {} up {} fov {}{}",
+            vec(c.position),
+            vec(c.look_at),
+            vec(c.up),
+            num(c.fov),
+            if c.aperture > 0.0 {
+                format!(
+                    " aperture {} focus_distance {}",
+                    num(c.aperture),
+                    c.focus_distance.map_or("look_at".to_string(), num)
+                )
+            } else {
+                String::new()
+            }
+        ),
         c.span,
     );
     let s = &scene.settings;
     d.line(
         0,
         &format!(
-            "render {}x{} depth {} background {} epsilon {} max_steps {} max_distance {} samples {}{}{}{}",
+            "render {}x{} depth {} background {} epsilon {} max_steps {} max_distance {} samples {}{}{}{}{}{}",
             s.width,
             s.height,
             s.depth,
@@ -213,7 +231,9 @@ pub fn dump(scene: &Scene, map: &SourceMap) -> String {
                 format!(" frames {} fps {}{}", s.frames, num(s.fps), if s.cyclic { " cyclic" } else { "" })
             } else {
                 String::new()
-            }
+            },
+            s.bounces.map_or(String::new(), |b| format!(" bounces {b}")),
+            if s.exposure != 0.0 { format!(" exposure {}", num(s.exposure)) } else { String::new() },
         ),
         s.span,
     );
@@ -222,9 +242,11 @@ pub fn dump(scene: &Scene, map: &SourceMap) -> String {
             LightKind::Ambient => "ambient".to_string(),
             LightKind::Point { position } => format!("point at {}", vec(*position)),
             LightKind::Directional { towards } => format!("directional towards {}", vec(*towards)),
+            LightKind::Area { centre, u, v } => format!("area at {} u {} v {}", vec(*centre), vec(*u), vec(*v)),
+            LightKind::Environment => "environment".to_string(),
         };
         let mut text = format!("light {kind} intensity {}", num(light.intensity));
-        if !matches!(light.kind, LightKind::Ambient) {
+        if !matches!(light.kind, LightKind::Ambient | LightKind::Environment) {
             text.push_str(if light.shadows { " shadows" } else { " no_shadows" });
         }
         if light.radius > 0.0 {

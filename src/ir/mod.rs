@@ -58,6 +58,10 @@ pub struct Camera {
     pub up: DVec3,
     /// Vertical field of view in degrees, in (0, 180).
     pub fov: f64,
+    /// Diameter of the thin lens (0: a pinhole, everything sharp); light transport only.
+    pub aperture: f64,
+    /// Distance along the view at which the lens focuses (`None`: at `look_at`).
+    pub focus_distance: Option<f64>,
     /// The `camera` statement, if any.
     pub span: Option<Span>,
 }
@@ -67,7 +71,15 @@ pub const SEED_FOV: f64 = 53.13010235415598;
 
 impl Default for Camera {
     fn default() -> Camera {
-        Camera { position: DVec3::ZERO, look_at: DVec3::Z, up: DVec3::Y, fov: SEED_FOV, span: None }
+        Camera {
+            position: DVec3::ZERO,
+            look_at: DVec3::Z,
+            up: DVec3::Y,
+            fov: SEED_FOV,
+            aperture: 0.0,
+            focus_distance: None,
+            span: None,
+        }
     }
 }
 
@@ -101,6 +113,12 @@ pub struct Settings {
     /// Whether the animation loops: then `clock` stops one frame short of 1, so the frame
     /// after the last would be the first again.
     pub cyclic: bool,
+    /// Surface interactions of a light-transport path after the camera ray (`None`: not
+    /// given; a scene lit by light transport then takes [`DEFAULT_BOUNCES`]).
+    pub bounces: Option<u32>,
+    /// Exposure in stops: light-transport pixels are scaled by `2^exposure` before the
+    /// tone map.
+    pub exposure: f64,
     /// The `render` statement, if any.
     pub span: Option<Span>,
 }
@@ -121,10 +139,15 @@ impl Default for Settings {
             frames: 1,
             fps: 24.0,
             cyclic: false,
+            bounces: None,
+            exposure: 0.0,
             span: None,
         }
     }
 }
+
+/// Bounces of a scene lit by light transport that does not give `render(bounces = …)`.
+pub const DEFAULT_BOUNCES: u32 = 8;
 
 /// How colours are read and pixels written (`render(color = …)`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -162,6 +185,11 @@ pub struct Material {
     pub ior: f64,
     /// Beer–Lambert absorption inside, per unit of distance, per channel, ≥ 0.
     pub absorption: DVec3,
+    /// The colour a surface glows with, 0–255 per channel: under light transport it
+    /// emits this (255 is radiance 1) times `emission_strength`.
+    pub emission: DVec3,
+    /// What the emission colour is multiplied by.
+    pub emission_strength: f64,
     /// The `material(…)` call.
     pub span: Span,
 }
@@ -176,6 +204,8 @@ impl Material {
             transparency: 0.0,
             ior: 1.0,
             absorption: DVec3::ZERO,
+            emission: DVec3::ZERO,
+            emission_strength: 1.0,
             span: Span::default(),
         }
     }
@@ -183,6 +213,11 @@ impl Material {
     /// Whether light passes through the surface (refraction rays are traced).
     pub fn is_transparent(&self) -> bool {
         self.transparency > 0.0
+    }
+
+    /// Whether the surface glows (and so is a light under light transport).
+    pub fn emits(&self) -> bool {
+        self.emission.max_element() > 0.0 && self.emission_strength > 0.0
     }
 }
 
@@ -201,6 +236,18 @@ pub enum LightKind {
         /// Direction *towards* the light (non-zero, not normalised, as written).
         towards: DVec3,
     },
+    /// A rectangle of light `centre ± u ± v`, emitting from its front, the side
+    /// `u × v` points to (−y before `rotate`).
+    Area {
+        /// Its centre.
+        centre: DVec3,
+        /// Half its width, as a vector along the rectangle.
+        u: DVec3,
+        /// Half its height, as a vector along the rectangle.
+        v: DVec3,
+    },
+    /// Light arriving equally from every direction, seen where rays escape.
+    Environment,
 }
 
 /// A light.

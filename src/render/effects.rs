@@ -121,7 +121,8 @@ fn on_off(on: bool) -> String {
 effect_table! {
     /// Total ambient intensity.
     ambient: f64, "ambient" {
-        derive: |s: &Survey| s.ambient,
+        // Light transport has no ambient term: an environment light is its counterpart.
+        derive: |s: &Survey| if s.transport { 0.0 } else { s.ambient },
         on: |e: &Effects| e.ambient > 0.0,
         show: |e: &Effects| ir::dump_num(e.ambient),
         counts: [],
@@ -151,7 +152,7 @@ effect_table! {
     }
     /// Some material has a Phong highlight.
     specular: bool, "specular", tracer SPECULAR = 4 {
-        derive: |s: &Survey| s.any_material(|m| m.specular.is_some()),
+        derive: |s: &Survey| !s.transport && s.any_material(|m| m.specular.is_some()),
         on: |e: &Effects| e.specular,
         show: |e: &Effects| on_off(e.specular),
         counts: [],
@@ -198,11 +199,35 @@ effect_table! {
         // Occlusion only darkens ambient light; without any there is nothing to occlude.
         derive: |s: &Survey| {
             let reach = s.scene.settings.ambient_occlusion;
-            (reach > 0.0 && s.ambient > 0.0).then_some(reach)
+            (reach > 0.0 && s.ambient > 0.0 && !s.transport).then_some(reach)
         },
         on: |e: &Effects| e.ambient_occlusion.is_some(),
         show: |e: &Effects| e.ambient_occlusion.map_or("off".to_string(), |d| format!("within {}", ir::dump_num(d))),
         counts: [occlusion_rays],
+    }
+    /// Light transport (path tracing) and its bounces, when the scene asks for it: then
+    /// the rows above that belong to Whitted shading (ambient, highlights, reflections,
+    /// refraction, depth, occlusion) are off, and materials and lights are read by the
+    /// physically based model instead (`render::path`).
+    light_transport: Option<u32>, "light transport" {
+        derive: |s: &Survey| s.transport.then(|| s.scene.settings.bounces.unwrap_or(ir::DEFAULT_BOUNCES)),
+        on: |e: &Effects| e.light_transport.is_some(),
+        show: |e: &Effects| e.light_transport.map_or("off".to_string(), |b| format!("{b} bounces")),
+        counts: [paths, light_rays, bounce_rays],
+    }
+    /// Area and environment lights (light transport's own).
+    transport_lights: Vec<usize>, "area and environment lights" {
+        derive: |s: &Survey| s.transport_lights.clone(),
+        on: |e: &Effects| !e.transport_lights.is_empty(),
+        show: |e: &Effects| lights(&e.transport_lights),
+        counts: [],
+    }
+    /// Objects that glow (indices into the scene's objects): lights under light transport.
+    glowing: Vec<usize>, "glowing objects" {
+        derive: |s: &Survey| s.glowing.clone(),
+        on: |e: &Effects| !e.glowing.is_empty(),
+        show: |e: &Effects| lights(&e.glowing),
+        counts: [],
     }
 }
 
@@ -210,6 +235,10 @@ impl Effects {
     /// Every effect on, as `--effects all` asks: the general tracer, for comparisons.
     pub fn all(scene: &Scene) -> Effects {
         let mut e = derive(scene);
+        if e.light_transport.is_some() {
+            // The path tracer has no effect flags: it is one integrator.
+            return e;
+        }
         e.reflections = scene.settings.depth > 0;
         e.refraction = scene.settings.depth > 0;
         e.useful_depth = scene.settings.depth;
@@ -245,14 +274,22 @@ struct Survey<'a> {
     ambient: f64,
     shadow_lights: Vec<usize>,
     unshadowed_lights: Vec<usize>,
+    /// Area and environment lights: only light transport shows them.
+    transport_lights: Vec<usize>,
     /// By object.
     materials: Vec<Vec<ir::Material>>,
+    /// Objects some part of which glows.
+    glowing: Vec<usize>,
+    /// Whether the scene asks for light transport: something glows, an area or
+    /// environment light, or `render(bounces = …)`.
+    transport: bool,
 }
 
 impl<'a> Survey<'a> {
     fn of(scene: &'a Scene) -> Survey<'a> {
         let mut shadow_lights = Vec::new();
         let mut unshadowed_lights = Vec::new();
+        let mut transport_lights = Vec::new();
         let mut ambient = 0.0;
         for (i, l) in scene.lights.iter().enumerate() {
             match l.kind {
@@ -260,10 +297,14 @@ impl<'a> Survey<'a> {
                 LightKind::Point { .. } | LightKind::Directional { .. } if l.intensity == 0.0 => {}
                 LightKind::Point { .. } | LightKind::Directional { .. } if l.shadows => shadow_lights.push(i),
                 LightKind::Point { .. } | LightKind::Directional { .. } => unshadowed_lights.push(i),
+                LightKind::Area { .. } | LightKind::Environment => transport_lights.push(i),
             }
         }
-        let materials = scene.objects.iter().map(|o| materials_of(&o.geometry)).collect();
-        Survey { scene, ambient, shadow_lights, unshadowed_lights, materials }
+        let materials: Vec<Vec<ir::Material>> = scene.objects.iter().map(|o| materials_of(&o.geometry)).collect();
+        let glowing: Vec<usize> =
+            (0..materials.len()).filter(|&i| materials[i].iter().any(ir::Material::emits)).collect();
+        let transport = !transport_lights.is_empty() || !glowing.is_empty() || scene.settings.bounces.is_some();
+        Survey { scene, ambient, shadow_lights, unshadowed_lights, transport_lights, materials, glowing, transport }
     }
 
     fn any_material(&self, test: impl Fn(&ir::Material) -> bool) -> bool {
@@ -271,11 +312,11 @@ impl<'a> Survey<'a> {
     }
 
     fn reflections(&self) -> bool {
-        self.scene.settings.depth > 0 && self.any_material(|m| m.reflective > 0.0)
+        !self.transport && self.scene.settings.depth > 0 && self.any_material(|m| m.reflective > 0.0)
     }
 
     fn refraction(&self) -> bool {
-        self.scene.settings.depth > 0 && self.any_material(ir::Material::is_transparent)
+        !self.transport && self.scene.settings.depth > 0 && self.any_material(ir::Material::is_transparent)
     }
 
     /// A single convex object sees nothing but the background in its reflection, so one

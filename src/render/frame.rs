@@ -66,6 +66,8 @@ pub struct Frame {
     pub color: ColorSpace,
     /// Bits per channel of the image (`--bit-depth`).
     pub bit_depth: super::BitDepth,
+    /// The lights, lens and exposure of light transport, when the effect set has it.
+    pub transport: Option<super::path::Transport>,
 }
 
 impl Frame {
@@ -92,8 +94,11 @@ impl Frame {
                 ir::LightKind::Directional { towards } => {
                     ShadeLight::Directional { towards: towards.normalize().as_vec3a(), intensity: l.intensity as f32 }
                 }
-                // Ambient lights are summed into `ambient`, never listed.
-                ir::LightKind::Ambient => ShadeLight::Directional { towards: Vec3A::Y, intensity: 0.0 },
+                // Ambient lights are summed into `ambient`, area and environment lights
+                // are light transport's (`path::Lights`): never listed here.
+                ir::LightKind::Ambient | ir::LightKind::Area { .. } | ir::LightKind::Environment => {
+                    ShadeLight::Directional { towards: Vec3A::Y, intensity: 0.0 }
+                }
             }
         };
         let is_soft = |i: &&usize| scene.lights[**i].radius > 0.0;
@@ -120,6 +125,7 @@ impl Frame {
             origin,
             color: s.color,
             bit_depth: super::BitDepth::Eight,
+            transport: effects.light_transport.map(|bounces| super::path::Transport::new(scene, &effects, bounces)),
             effects,
         }
     }

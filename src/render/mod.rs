@@ -11,6 +11,7 @@
 
 pub mod effects;
 mod frame;
+pub mod path;
 mod shade;
 mod transmit;
 
@@ -44,6 +45,9 @@ pub enum BitDepth {
     Eight,
     /// 16 bits, 0–65535.
     Sixteen,
+    /// 32-bit float, linear and unclamped: radiance (1 = a white surface at full light,
+    /// 255 in an 8-bit image) for OpenEXR output and measurements.
+    Float,
 }
 
 impl BitDepth {
@@ -52,6 +56,7 @@ impl BitDepth {
         match self {
             BitDepth::Eight => 8,
             BitDepth::Sixteen => 16,
+            BitDepth::Float => 32,
         }
     }
 
@@ -66,12 +71,20 @@ impl BitDepth {
     }
 }
 
-/// Writes a pixel's colour (linear, 0–255, clamped) as `frame` asks: encoded to sRGB or
-/// not, at its bit depth. The study's 8-bit linear pixels round the value to nearest.
+/// Writes a pixel's colour (linear, 0–255, clamped by the integer casts) as `frame`
+/// asks: encoded to sRGB or not, at its bit depth; a float pixel keeps the linear value
+/// unclamped, divided by 255. The study's 8-bit linear pixels round to nearest.
 #[inline]
 fn encode(colour: Vec3A, frame: &Frame, out: &mut Vec<u8>) {
+    if frame.bit_depth == BitDepth::Float {
+        for x in (colour * (1.0 / 255.0)).to_array() {
+            out.extend(x.to_ne_bytes());
+        }
+        return;
+    }
     let v = pattern::encoded(colour, frame.color);
     match frame.bit_depth {
+        BitDepth::Float => {}
         // Values are in [0, 255], so adding one half and truncating rounds to nearest.
         BitDepth::Eight => out.extend((v + 0.5).to_array().map(|x| x as u8)),
         BitDepth::Sixteen => {
@@ -148,6 +161,10 @@ pub fn render_region_until(
     progress: &(dyn Fn() + Sync),
     stop: &(dyn Fn() -> bool + Sync),
 ) -> Option<(Image, Counters)> {
+    if let Some(t) = &frame.transport {
+        let block = |xy, wh, c: &mut Counters| path::block(geometry, frame, t, xy, wh, c);
+        return rows(frame, region, progress, stop, block);
+    }
     effects::specialise(&frame.effects, Rows { geometry, frame, region, progress, stop })
 }
 
@@ -163,16 +180,20 @@ struct Rows<'a> {
 impl effects::Variant for Rows<'_> {
     type Out = Option<(Image, Counters)>;
     fn run<const FX: u8>(self) -> Option<(Image, Counters)> {
-        rows::<FX>(self.geometry, self.frame, self.region, self.progress, self.stop)
+        let (g, frame) = (self.geometry, self.frame);
+        let block = |xy, wh, c: &mut Counters| shade::block::<FX>(g, frame, xy, wh, c);
+        rows(self.frame, self.region, self.progress, self.stop, block)
     }
 }
 
-fn rows<const FX: u8>(
-    geometry: &dyn Geometry,
+/// The pixels of `region`, each 4×4 block of them from `block((x, y), (w, h), counters)`,
+/// strips of four rows in parallel.
+fn rows(
     frame: &Frame,
     region: PixelRect,
     progress: &(dyn Fn() + Sync),
     stop: &(dyn Fn() -> bool + Sync),
+    block: impl Fn((u32, u32), (u32, u32), &mut Counters) -> [Vec3A; 16] + Sync,
 ) -> Option<(Image, Counters)> {
     let stopped = std::sync::atomic::AtomicBool::new(false);
     let (w, h) = (frame.width, frame.height);
@@ -196,7 +217,7 @@ fn rows<const FX: u8>(
                     stopped.store(true, std::sync::atomic::Ordering::Relaxed);
                     break;
                 }
-                let px = shade::block::<FX>(geometry, frame, (x, y), (cols, rows_here), &mut c);
+                let px = block((x, y), (cols, rows_here), &mut c);
                 for (dy, row) in rows.iter_mut().enumerate() {
                     for &colour in &px[4 * dy..4 * dy + cols as usize] {
                         encode(colour, frame, row);

@@ -41,7 +41,18 @@ pub struct Counters {
     /// Samples whose colour was not finite (always 0 unless there is a bug; such a
     /// sample is written as black).
     pub nonfinite_samples: u64,
+    /// Light-transport paths (one per sample of a pixel).
+    pub paths: u64,
+    /// Rays towards a chosen light (next-event estimation).
+    pub light_rays: u64,
+    /// Rays that continue a path in a direction its surface scattered it (BSDF sampling).
+    pub bounce_rays: u64,
+    /// Paths by how many surfaces they met (the last bin: that many or more).
+    pub path_lengths: [u64; PATH_BINS],
 }
+
+/// Bins of [`Counters::path_lengths`].
+pub const PATH_BINS: usize = 10;
 
 impl Counters {
     /// Adds another set of counters.
@@ -62,11 +73,23 @@ impl Counters {
         self.pruned_rays += o.pruned_rays;
         self.tree_budget_hits += o.tree_budget_hits;
         self.nonfinite_samples += o.nonfinite_samples;
+        self.paths += o.paths;
+        self.light_rays += o.light_rays;
+        self.bounce_rays += o.bounce_rays;
+        for (a, b) in self.path_lengths.iter_mut().zip(o.path_lengths) {
+            *a += b;
+        }
     }
 
     /// All rays cast.
     pub fn rays(&self) -> u64 {
-        self.primary_rays + self.shadow_rays + self.reflection_rays + self.refraction_rays + self.occlusion_rays
+        self.primary_rays
+            + self.shadow_rays
+            + self.reflection_rays
+            + self.refraction_rays
+            + self.occlusion_rays
+            + self.light_rays
+            + self.bounce_rays
     }
 }
 

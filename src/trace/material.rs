@@ -25,6 +25,8 @@ pub struct ShadeMaterial {
     pub ior: f32,
     /// Absorption inside, per unit of distance, per channel.
     pub absorption: Vec3A,
+    /// Emitted radiance, linear, 0–255 per channel (255 is radiance 1).
+    pub emission: Vec3A,
 }
 
 impl ShadeMaterial {
@@ -77,6 +79,12 @@ impl MaterialTable {
             transparency: m.transparency as f32,
             ior: m.ior as f32,
             absorption: m.absorption.as_vec3a(),
+            // The colour read as every colour is, then scaled: decoding is not linear.
+            emission: if m.emits() {
+                pattern::linear(m.emission.as_vec3a(), self.space) * m.emission_strength as f32
+            } else {
+                Vec3A::ZERO
+            },
         };
         match self.materials.iter().position(|x| *x == sm) {
             Some(i) => i as u32,

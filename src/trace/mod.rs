@@ -11,7 +11,7 @@ mod material;
 pub mod pattern;
 mod ray;
 
-pub use counters::{count_leaf, take_leaf_evals, Counters};
+pub use counters::{count_leaf, take_leaf_evals, Counters, PATH_BINS};
 pub use geometry::{intersect_each, Geometry, Hit};
 pub use material::{MaterialTable, ShadeMaterial};
 pub use ray::{lanes, spawn_offset, Packet, Ray, NO_OBJECT};

@@ -93,7 +93,7 @@ fn fmt_is_idempotent_and_changes_only_whitespace() {
 fn shipped_examples_are_formatted() {
     let mut failures = Vec::new();
     for dir in
-        ["examples/seed", "examples/features", "examples/animation", "examples/povray", "benches/scenes", "tests/data"]
+        ["examples/seed", "examples/features", "examples/animation", "examples/povray", "examples/light", "benches/scenes", "tests/data"]
     {
         for path in cases(dir) {
             let text = std::fs::read_to_string(&path).expect("reading the example");

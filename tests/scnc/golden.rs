@@ -49,7 +49,7 @@ fn diagnostics() {
 #[test]
 fn examples_check_clean() {
     let mut failures = Vec::new();
-    for dir in ["examples/seed", "examples/features", "examples/animation", "examples/povray"] {
+    for dir in ["examples/seed", "examples/features", "examples/animation", "examples/povray", "examples/light"] {
         for path in cases(dir) {
             if path.file_name().is_some_and(|n| n == "lights.scn") {
                 continue;

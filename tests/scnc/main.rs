@@ -30,4 +30,5 @@ mod studio;
 mod studio_server;
 mod support;
 mod tiles;
+mod transport;
 mod watch;

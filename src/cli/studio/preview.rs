@@ -428,7 +428,7 @@ mod tests {
             look_at: DVec3::ZERO,
             up: DVec3::Y,
             fov: 50.0,
-            span: None,
+            ..scnc::ir::Camera::default()
         }
     }
 

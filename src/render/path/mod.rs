@@ -1,0 +1,399 @@
+//! Light transport: unidirectional path tracing with next-event estimation and multiple
+//! importance sampling, for scenes whose effect set has it (something glows, an area or
+//! environment light, `render(bounces = …)`). Every other scene never reaches this
+//! module and renders as the Whitted tracer always did.
+//!
+//! A path starts at the camera (a thin lens when `aperture > 0`, its pixel position
+//! drawn from a tent filter one pixel wide each side) and meets at most `bounces`
+//! surfaces that scatter it. At each it adds light sampled towards one source of the
+//! light mixture ([`lights`]) and continues in a direction its BSDF ([`bsdf`]) chooses;
+//! emission found either way is weighted by the power heuristic, so every emitter is
+//! sampled both ways and neither technique's weakness shows. Delta lobes (mirror,
+//! glass) and delta lights (points of radius 0, directional lights) take the one
+//! technique that can reach them. Russian roulette ends paths after the third surface
+//! with a chance of survival equal to their throughput's largest channel (at most
+//! 0.95), dividing survivors by it, so it adds noise but no bias. Nothing is clamped.
+//!
+//! Approximations, stated: the η² scaling of radiance across a refracting surface is
+//! left out (it cancels for every path that leaves the glass it entered); light rays
+//! do not pass through glass (a glass-covered light is reached by bounces, as caustics
+//! are); an emitting surface emits from its outside only; a sphere light is opaque and
+//! dark from within.
+//!
+//! Units: radiance 1 is a white surface at full light, written as 255 before the tone
+//! map, which scales by `2^exposure` and clamps to the image's range.
+
+pub mod bsdf;
+pub mod lights;
+pub mod sampler;
+
+use glam::Vec3A;
+
+use self::bsdf::{Bsdf, Lobe};
+use self::lights::Source;
+pub use self::lights::Transport;
+use self::sampler::Sampler;
+use super::transmit::{self, Media};
+use super::{Frame, ShadeLight};
+use crate::trace::{spawn_offset, Counters, Geometry, Hit, Ray, PATH_BINS};
+
+/// Surfaces a path meets before Russian roulette may end it.
+const ROULETTE_AFTER: u32 = 3;
+
+/// The colours (linear, 255 = radiance 1 after exposure, not clamped: the pixel's
+/// encoding clamps, or a float image keeps the value) of a block of up to 4×4 pixels
+/// from `(x, y)`, `w` wide and `h` high; pixel `(dx, dy)` is entry `4·dy + dx`. Each is
+/// the mean of `frame.samples` paths.
+pub(super) fn block(
+    g: &dyn Geometry,
+    frame: &Frame,
+    t: &Transport,
+    (x, y): (u32, u32),
+    (w, h): (u32, u32),
+    c: &mut Counters,
+) -> [Vec3A; 16] {
+    let n = frame.samples.max(1);
+    let mut out = [Vec3A::ZERO; 16];
+    for dy in 0..h {
+        for dx in 0..w {
+            let (px, py) = (x + dx, y + dy);
+            let pixel = py.wrapping_mul(frame.width).wrapping_add(px);
+            let mut sum = Vec3A::ZERO;
+            for s in 0..n {
+                let mut sampler = Sampler::new(pixel, s);
+                let ray = camera_ray(frame, t, (px, py), &mut sampler);
+                c.primary_rays += 1;
+                let mut l = radiance(g, frame, t, ray, &mut sampler, c);
+                if !l.is_finite() {
+                    c.nonfinite_samples += 1;
+                    l = Vec3A::ZERO;
+                }
+                sum += l;
+            }
+            out[(4 * dy + dx) as usize] = sum * (255.0 * t.exposure / n as f32);
+        }
+    }
+    out
+}
+
+/// A tent-distributed offset in (−1, 1) from a number in [0, 1): the pixel filter,
+/// importance-sampled so every sample weighs the same.
+fn tent(u: f32) -> f32 {
+    let u = 2.0 * u;
+    if u < 1.0 {
+        u.sqrt() - 1.0
+    } else {
+        1.0 - (2.0 - u).max(0.0).sqrt()
+    }
+}
+
+/// The camera ray of one sample: through the pixel at a tent-filtered offset, from a
+/// point of the lens when it has an aperture.
+fn camera_ray(frame: &Frame, t: &Transport, (px, py): (u32, u32), s: &mut Sampler) -> Ray {
+    let (u1, u2) = s.next2();
+    let dir = frame.direction(px as f32 + 0.5 + tent(u1), py as f32 + 0.5 + tent(u2));
+    // Drawn whether or not there is a lens, so the later pairs are the same either way.
+    let (l1, l2) = s.next2();
+    if t.lens_radius <= 0.0 {
+        return Ray::new(Vec3A::ZERO, dir, frame.max_distance);
+    }
+    // Every point at the focus distance along the view is sharp: the ray through the
+    // lens point aims where the pinhole ray crosses that plane.
+    let focal = dir * (t.focus / dir.dot(frame.forward).max(1e-6));
+    let r = t.lens_radius * l1.sqrt();
+    let phi = std::f32::consts::TAU * l2;
+    let lens = frame.right.normalize() * (r * phi.cos()) + frame.up.normalize() * (r * phi.sin());
+    Ray::new(lens, (focal - lens).normalize(), frame.max_distance)
+}
+
+/// What a ray meets first.
+enum Event {
+    /// Nothing: it escapes to the environment.
+    Escape,
+    /// A rectangle or sphere of light, with the radiance it sends back along the ray (0
+    /// from behind), at a distance.
+    Lamp(f32, f32),
+    /// A surface.
+    Surface(Hit),
+}
+
+/// The first thing along `ray`: a surface the geometry reports, or one of the lights
+/// light transport draws itself, whichever is nearer.
+fn first_event(g: &dyn Geometry, t: &Transport, ray: &Ray, c: &mut Counters) -> Event {
+    let hit = g.intersect(ray, c);
+    let mut nearest = hit.map_or(ray.t_max, |h| h.t);
+    let mut lamp = None;
+    for r in &t.rects {
+        if let Some(d) = lights::rect_hit(r, ray.origin, ray.dir) {
+            if d < nearest && d >= ray.t_min {
+                nearest = d;
+                lamp = Some(if r.normal.dot(ray.dir) < 0.0 { r.radiance } else { 0.0 });
+            }
+        }
+    }
+    for b in &t.balls[..t.lamps] {
+        if let Some((d, outside)) = lights::ball_hit(b, ray.origin, ray.dir) {
+            if d < nearest && d >= ray.t_min {
+                nearest = d;
+                lamp = Some(if outside { b.radiance } else { 0.0 });
+            }
+        }
+    }
+    match (lamp, hit) {
+        (Some(radiance), _) => Event::Lamp(radiance, nearest),
+        (None, Some(h)) => Event::Surface(h),
+        (None, None) => Event::Escape,
+    }
+}
+
+/// What the previous scattering leaves for weighing emission the next ray finds.
+#[derive(Clone, Copy)]
+struct Previous {
+    /// Where it scattered, and its shading normal there.
+    point: Vec3A,
+    normal: Vec3A,
+    /// The BSDF's density of the direction taken; `None` for a delta lobe or the camera,
+    /// whose emission counts whole.
+    pdf: Option<f32>,
+}
+
+/// The power heuristic's weight of a technique of density `a` against one of `b`.
+fn power(a: f32, b: f32) -> f32 {
+    let (a2, b2) = (a * a, b * b);
+    if a2 + b2 > 0.0 && (a2 + b2).is_finite() {
+        a2 / (a2 + b2)
+    } else if a >= b {
+        1.0
+    } else {
+        0.0
+    }
+}
+
+/// Emission `le` found along a ray scattered by `prev`, in direction `dir`, weighed
+/// against light sampling's chance of the same direction.
+fn found(t: &Transport, prev: &Previous, dir: Vec3A, le: Vec3A) -> Vec3A {
+    match prev.pdf {
+        None => le,
+        Some(p) => le * power(p, t.pdf(prev.point, prev.normal, dir)),
+    }
+}
+
+/// The radiance arriving at the camera along `ray`, in units where 1 is a white surface
+/// at full light.
+///
+/// Long because it is the path loop: each surface met adds its emission, light sampled
+/// towards a source, and chooses how the path goes on, with the media and roulette
+/// carried between — one state machine a reader follows top to bottom.
+fn radiance(g: &dyn Geometry, frame: &Frame, t: &Transport, ray: Ray, s: &mut Sampler, c: &mut Counters) -> Vec3A {
+    c.paths += 1;
+    let mut l = Vec3A::ZERO;
+    let mut beta = Vec3A::ONE;
+    let mut media = Media::AIR;
+    let mut prev = Previous { point: Vec3A::ZERO, normal: Vec3A::ZERO, pdf: None };
+    let mut ray = ray;
+    let mut surfaces = 0u32;
+    loop {
+        let event = first_event(g, t, &ray, c);
+        // Beer–Lambert along the segment inside an absorbing medium.
+        let travelled = match &event {
+            Event::Surface(h) => h.t,
+            Event::Lamp(_, d) => *d,
+            Event::Escape => ray.t_max,
+        };
+        if let Some(left) = media.absorb(frame, travelled) {
+            beta *= left;
+        }
+        let hit = match event {
+            Event::Escape => {
+                if t.environment > 0.0 {
+                    l += beta * found(t, &prev, ray.dir, Vec3A::splat(t.environment));
+                }
+                break;
+            }
+            Event::Lamp(radiance, _) => {
+                if radiance > 0.0 {
+                    l += beta * found(t, &prev, ray.dir, Vec3A::splat(radiance));
+                }
+                break;
+            }
+            Event::Surface(hit) => hit,
+        };
+        surfaces += 1;
+        let view = -ray.dir;
+        let normal = if hit.normal.dot(view) < 0.0 { -hit.normal } else { hit.normal };
+        let material = &frame.materials.materials[hit.material as usize];
+        if !hit.from_inside && material.emission != Vec3A::ZERO {
+            l += beta * found(t, &prev, ray.dir, material.emission * (1.0 / 255.0));
+        }
+        if surfaces > t.bounces {
+            break;
+        }
+        let offset = spawn_offset(hit.point, hit.error);
+        let origin = hit.point + normal * offset;
+        let albedo = material.color_at(hit.point - normal * offset) * (1.0 / 255.0);
+        let glass = material.transparency;
+        let bsdf = Bsdf::new(normal, view, albedo, material.specular, glass, (1.0 - glass) * material.reflective);
+        let (u_light, u_lobe) = s.next2();
+        let u_pos = s.next2();
+        let u_dir = s.next2();
+        let (u_roulette, _) = s.next2();
+        if bsdf.base() > 0.0 {
+            l += beta * sample_light(g, frame, t, &hit, &bsdf, view, origin, &media, (u_light, u_pos), c);
+        }
+        // Where the path goes on.
+        let (dir, weight, pdf, from, next_media) = match bsdf.sample(view, u_lobe, u_dir) {
+            None => break,
+            Some(Lobe::Base(sc)) => (sc.dir, sc.weight, Some(sc.pdf), origin, media),
+            Some(Lobe::Mirror) => (normal * (2.0 * normal.dot(view)) - view, Vec3A::ONE, None, origin, media),
+            Some(Lobe::Glass) => {
+                let beyond = media.crossing(&hit);
+                let (n1, n2) = transmit::indices(frame, &hit, &media, &beyond);
+                let split = transmit::split(view, normal, n1, n2);
+                // Reflect or refract in proportion to the Fresnel reflectance, so each
+                // choice's weight is exactly 1; the number that chose the glass lobe,
+                // rescaled, is uniform again for this choice.
+                let u = (u_lobe / glass).min(0.999_999_9);
+                match split.refracted {
+                    Some(dir) if u >= split.reflectance => (dir, Vec3A::ONE, None, hit.point - normal * offset, beyond),
+                    _ => (normal * (2.0 * normal.dot(view)) - view, Vec3A::ONE, None, origin, media),
+                }
+            }
+        };
+        beta *= weight;
+        if beta == Vec3A::ZERO || !beta.is_finite() {
+            break;
+        }
+        if surfaces >= ROULETTE_AFTER {
+            let q = beta.max_element().min(0.95);
+            if u_roulette >= q {
+                break;
+            }
+            beta /= q;
+        }
+        c.bounce_rays += 1;
+        let dir = dir.normalize();
+        let mut next = Ray::leaving(&hit, from, dir, frame.max_distance);
+        next.inside = next_media.object();
+        media = next_media;
+        prev = Previous { point: from, normal, pdf };
+        ray = next;
+    }
+    c.path_lengths[(surfaces as usize).min(PATH_BINS - 1)] += 1;
+    l
+}
+
+/// Light sampled towards one source chosen uniformly, weighed against the BSDF's chance
+/// of the same direction: `f·cos·Le/pdf` times the power heuristic (delta lights whole).
+#[allow(clippy::too_many_arguments, reason = "the shading state a light ray starts from")]
+fn sample_light(
+    g: &dyn Geometry,
+    frame: &Frame,
+    t: &Transport,
+    hit: &Hit,
+    bsdf: &Bsdf,
+    view: Vec3A,
+    origin: Vec3A,
+    media: &Media,
+    (u_pick, (u1, u2)): (f32, (f32, f32)),
+    c: &mut Counters,
+) -> Vec3A {
+    let k = t.sources.len();
+    if k == 0 {
+        return Vec3A::ZERO;
+    }
+    let chance = 1.0 / k as f32;
+    let source = t.sources[((u_pick * k as f32) as usize).min(k - 1)];
+    let normal = bsdf.normal;
+    let light_ray = |dir: Vec3A, t_max: f32| {
+        let mut r = Ray::leaving(hit, origin, dir, t_max);
+        r.inside = media.object();
+        r
+    };
+    let dir = match source {
+        Source::Delta(i) => {
+            let d = &t.deltas[i];
+            let (dir, dist, irradiance) = match d.light {
+                ShadeLight::Point { position, intensity } => {
+                    let to = position - origin;
+                    let dist = to.length();
+                    if dist <= 0.0 {
+                        return Vec3A::ZERO;
+                    }
+                    (to / dist, dist, intensity / (dist * dist))
+                }
+                ShadeLight::Directional { towards, intensity } => (towards, f32::INFINITY, intensity),
+            };
+            let f = bsdf.eval(view, dir);
+            if f == Vec3A::ZERO {
+                return Vec3A::ZERO;
+            }
+            if d.shadows {
+                c.light_rays += 1;
+                let blocked = g.occluded(&light_ray(dir, dist.min(frame.max_distance)), c);
+                if blocked {
+                    return Vec3A::ZERO;
+                }
+            }
+            return f * (normal.dot(dir) * irradiance / chance);
+        }
+        Source::Rect(i) => {
+            let r = &t.rects[i];
+            let p = r.centre + r.u * (2.0 * u1 - 1.0) + r.v * (2.0 * u2 - 1.0);
+            let to = p - origin;
+            let len = to.length();
+            if len <= 0.0 {
+                return Vec3A::ZERO;
+            }
+            to / len
+        }
+        Source::Ball(i) => {
+            let b = &t.balls[i];
+            match lights::cone(b, origin) {
+                None => uniform_sphere((u1, u2)),
+                Some((cos_max, axis)) => {
+                    let one_minus = lights::cone_solid_angle(b, origin, cos_max) / std::f32::consts::TAU;
+                    let x = u1 * one_minus;
+                    let cos = 1.0 - x;
+                    let sin = (x * (2.0 - x)).max(0.0).sqrt();
+                    let phi = std::f32::consts::TAU * u2;
+                    let (bt, bb) = bsdf::basis(axis);
+                    (bt * (sin * phi.cos()) + bb * (sin * phi.sin()) + axis * cos).normalize()
+                }
+            }
+        }
+        Source::Environment => bsdf::cosine(normal, (u1, u2)).0,
+    };
+    let f = bsdf.eval(view, dir);
+    if f == Vec3A::ZERO {
+        return Vec3A::ZERO;
+    }
+    let p_light = t.pdf(origin, normal, dir);
+    if p_light <= 0.0 || !p_light.is_finite() {
+        return Vec3A::ZERO;
+    }
+    c.light_rays += 1;
+    let le = match first_event(g, t, &light_ray(dir, frame.max_distance), c) {
+        Event::Escape => Vec3A::splat(t.environment),
+        Event::Lamp(radiance, _) => Vec3A::splat(radiance),
+        Event::Surface(h) => {
+            let m = &frame.materials.materials[h.material as usize];
+            if h.from_inside {
+                Vec3A::ZERO
+            } else {
+                m.emission * (1.0 / 255.0)
+            }
+        }
+    };
+    if le == Vec3A::ZERO {
+        return Vec3A::ZERO;
+    }
+    f * le * (normal.dot(dir) * power(p_light, bsdf.pdf(view, dir)) / p_light)
+}
+
+/// A direction uniform over the unit sphere.
+fn uniform_sphere((u1, u2): (f32, f32)) -> Vec3A {
+    let z = 1.0 - 2.0 * u1;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = std::f32::consts::TAU * u2;
+    Vec3A::new(r * phi.cos(), r * phi.sin(), z)
+}

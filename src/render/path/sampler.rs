@@ -1,0 +1,143 @@
+//! Random numbers for light transport: Owen-scrambled, shuffled 2D Sobol points (Burley,
+//! "Practical Hash-based Owen Scrambling", JCGT 2020), one independent scramble per
+//! pixel and per pair of dimensions.
+//!
+//! Each pair of a path's dimensions (the pixel position, the lens, a light choice, a
+//! bounce direction…) is a (0, 2)-sequence in its own right: the first `2^k` samples
+//! of a pixel stratify every pair, so the error falls faster than independent random
+//! numbers give, and the shuffle keeps different pairs from correlating. A sample is a
+//! pure function of (pixel, sample index, dimension): the image is the same on any
+//! thread count, and any subset of the samples can be rendered anywhere.
+
+/// The numbers of one sample of one pixel, drawn in pairs.
+pub struct Sampler {
+    pixel: u32,
+    index: u32,
+    pair: u32,
+}
+
+impl Sampler {
+    /// Sample `index` of the pixel numbered `pixel`.
+    pub fn new(pixel: u32, index: u32) -> Sampler {
+        Sampler { pixel, index, pair: 0 }
+    }
+
+    /// The next pair of numbers in `[0, 1)`.
+    pub fn next2(&mut self) -> (f32, f32) {
+        let seed = hash(self.pixel ^ hash(self.pair.wrapping_add(0x9e37_79b9)));
+        self.pair += 1;
+        let i = nested_uniform_scramble(self.index, seed);
+        let x = nested_uniform_scramble(i.reverse_bits(), hash(seed ^ 0x5bd1_e995));
+        let y = nested_uniform_scramble(sobol_second(i), hash(seed ^ 0x27d4_eb2f));
+        (unit(x), unit(y))
+    }
+
+    /// The next number in `[0, 1)` (half a pair: one-dimensional needs are few).
+    pub fn next1(&mut self) -> f32 {
+        self.next2().0
+    }
+}
+
+/// A 32-bit fraction as a float in `[0, 1)` (rounded down, never to 1).
+fn unit(x: u32) -> f32 {
+    ((x >> 8) as f32) * (1.0 / (1u32 << 24) as f32)
+}
+
+/// The Sobol sequence's second dimension (generator polynomial `x + 1`): its direction
+/// numbers are `v_k = v_{k−1} ^ (v_{k−1} >> 1)` from `v_0 = 2^31`.
+fn sobol_second(mut index: u32) -> u32 {
+    let mut v = 1u32 << 31;
+    let mut out = 0;
+    while index != 0 {
+        if index & 1 != 0 {
+            out ^= v;
+        }
+        index >>= 1;
+        v ^= v >> 1;
+    }
+    out
+}
+
+/// Laine and Karras's hash-based Owen scramble of a bit-reversed value (Burley's
+/// constants): each bit is flipped by a hash of the bits above it.
+fn laine_karras(mut x: u32, seed: u32) -> u32 {
+    x = x.wrapping_add(seed);
+    x ^= x.wrapping_mul(0x6c50_b47c);
+    x ^= x.wrapping_mul(0xb82f_1e52);
+    x ^= x.wrapping_mul(0xc7af_e638);
+    x ^= x.wrapping_mul(0x8d22_f6e6);
+    x
+}
+
+/// An Owen scramble of `x`'s bits, most significant first.
+fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
+    laine_karras(x.reverse_bits(), seed).reverse_bits()
+}
+
+/// A 32-bit integer hash with good avalanche (Wellons's `lowbias32`).
+pub fn hash(mut x: u32) -> u32 {
+    x ^= x >> 16;
+    x = x.wrapping_mul(0x7feb_352d);
+    x ^= x >> 15;
+    x = x.wrapping_mul(0x846c_a68b);
+    x ^= x >> 16;
+    x
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The first `2^k` points of every pair fall one in each of the `2^k` cells of any
+    /// elementary interval layout `2^a × 2^b` with `a + b = k`: the (0, 2) property the
+    /// scramble must keep.
+    #[test]
+    fn every_pair_is_stratified_like_a_0_2_sequence() {
+        for pixel in [0u32, 7, 123_456] {
+            for k in [4u32, 6] {
+                let n = 1u32 << k;
+                let points: Vec<Vec<(f32, f32)>> = (0..n)
+                    .map(|i| {
+                        let mut s = Sampler::new(pixel, i);
+                        (0..4).map(|_| s.next2()).collect()
+                    })
+                    .collect();
+                for pair in 0..4 {
+                    for a in 0..=k {
+                        let (cols, rows) = (1u32 << a, 1u32 << (k - a));
+                        let mut seen = vec![false; n as usize];
+                        for p in &points {
+                            let (x, y) = p[pair];
+                            assert!((0.0..1.0).contains(&x) && (0.0..1.0).contains(&y));
+                            let cell = (x * cols as f32) as u32 + cols * (y * rows as f32) as u32;
+                            assert!(
+                                !seen[cell as usize],
+                                "pixel {pixel}, pair {pair}: two points in one {cols}×{rows} cell"
+                            );
+                            seen[cell as usize] = true;
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Different pixels and different pairs get different points: the scrambles are
+    /// independent, not one pattern repeated.
+    #[test]
+    fn pixels_and_pairs_are_scrambled_apart() {
+        let first = |pixel, pair| {
+            let mut s = Sampler::new(pixel, 0);
+            (0..pair).for_each(|_| {
+                s.next2();
+            });
+            s.next2()
+        };
+        assert_ne!(first(0, 0), first(1, 0));
+        assert_ne!(first(0, 0), first(0, 1));
+        // The mean of many pixels' first points is near the middle.
+        let n = 4096;
+        let mean = (0..n).map(|p| first(p, 2).0).sum::<f32>() / n as f32;
+        assert!((mean - 0.5).abs() < 0.02, "mean {mean}");
+    }
+}
