@@ -358,6 +358,7 @@ impl dyn Host + '_ {
             cyclic: r.cyclic,
             bounces: r.bounces,
             exposure: r.exposure,
+            noise: r.noise,
             color,
             span: Some(span),
         })
@@ -415,5 +416,7 @@ crate::params! {
         bounces: Option<u32> as Int = derived, Range::closed(1.0, MAX_BOUNCES as f64);
         /// light-transport pixels are scaled by 2^exposure before the tone map
         exposure: f64 as Num = 0.0, Range::closed(-64.0, 64.0);
+        /// light transport samples each pixel until its estimated relative error is below this (`samples` the most)
+        noise: Option<f64> as Num = derived, Range::gt_le(0.0, 1.0);
     }
 }

@@ -69,6 +69,10 @@ pub(crate) struct RenderArgs {
     /// Samples per pixel (antialiasing).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_SAMPLES as i64))]
     samples: Option<u32>,
+    /// Under light transport, sample each pixel until its estimated relative error is
+    /// below this (at least 16 samples, at most `--samples`).
+    #[arg(long, value_parser = parse_noise, value_name = "EPSILON")]
+    noise: Option<f64>,
     #[command(flatten)]
     accuracy: Accuracy,
     /// Geometry back-end for shapes (explicit meshes are always meshes).
@@ -117,6 +121,14 @@ pub(crate) struct RenderArgs {
     chunk: u32,
     #[command(flatten)]
     messages: Messages,
+}
+
+/// A relative error in (0, 1].
+fn parse_noise(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(e) if e > 0.0 && e <= 1.0 => Ok(e),
+        _ => Err(format!("`{s}` is not a relative error: give a number greater than 0 and at most 1, like 0.01")),
+    }
 }
 
 /// `8` or `16`.
@@ -197,6 +209,7 @@ impl RenderArgs {
         s.max_distance = self.max_distance.unwrap_or(s.max_distance);
         s.depth = self.depth.unwrap_or(s.depth);
         s.samples = self.samples.unwrap_or(s.samples);
+        s.noise = self.noise.or(s.noise);
         if s.width as u64 * s.height as u64 > MAX_PIXELS {
             return Err(usage_error(&format!("{}×{} is too large: at most {} pixels", s.width, s.height, MAX_PIXELS)));
         }

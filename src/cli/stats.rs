@@ -63,14 +63,17 @@ pub(crate) fn stats_text(c: &Counters, g: &World, map: &SourceMap, lower_s: f64,
             })
             .collect();
         out.push_str(&format!(
-            "  light transport {} paths, {} light (next-event) rays, {} bounce rays ({:.2} per path)
+            "  light transport {} paths ({:.1} samples per pixel), {} light (next-event) rays, {} bounce rays ({:.2} per path)
     surfaces met per path: {}
+    estimated noise: {:.3} % mean relative standard error per pixel
 ",
             c.paths,
+            c.paths as f64 / c.noise_pixels.max(1) as f64,
             c.light_rays,
             c.bounce_rays,
             c.bounce_rays as f64 / c.paths as f64,
-            lengths.join(", ")
+            lengths.join(", "),
+            c.noise_ppm as f64 / c.noise_pixels.max(1) as f64 / 1e4,
         ));
     }
     if c.segment_bounds > 0 {

@@ -119,6 +119,9 @@ pub struct Settings {
     /// Exposure in stops: light-transport pixels are scaled by `2^exposure` before the
     /// tone map.
     pub exposure: f64,
+    /// Adaptive sampling under light transport: each pixel takes samples until its
+    /// estimated relative error is below this (`samples` is then the most it takes).
+    pub noise: Option<f64>,
     /// The `render` statement, if any.
     pub span: Option<Span>,
 }
@@ -141,6 +144,7 @@ impl Default for Settings {
             cyclic: false,
             bounces: None,
             exposure: 0.0,
+            noise: None,
             span: None,
         }
     }

@@ -95,6 +95,25 @@ fn encode(colour: Vec3A, frame: &Frame, out: &mut Vec<u8>) {
     }
 }
 
+impl Image {
+    /// A float image (linear radiance) as the frame's pixels show it: scaled to 0–255,
+    /// clamped and encoded as its colour mode says, 8 bits a channel. Any other image
+    /// is returned as it is.
+    pub fn tone_mapped(&self, frame: &Frame) -> Image {
+        if self.depth != BitDepth::Float {
+            return self.clone();
+        }
+        let mut shown = Frame { bit_depth: BitDepth::Eight, ..frame.clone() };
+        shown.transport = None;
+        let mut pixels = Vec::with_capacity(self.width as usize * self.height as usize * 3);
+        for p in self.pixels.chunks_exact(12) {
+            let c = |i: usize| f32::from_ne_bytes([p[i], p[i + 1], p[i + 2], p[i + 3]]) * 255.0;
+            encode(Vec3A::new(c(0), c(4), c(8)), &shown, &mut pixels);
+        }
+        Image { width: self.width, height: self.height, depth: BitDepth::Eight, pixels }
+    }
+}
+
 /// A rectangle of the image's pixels, `x0..x1` by `y0..y1` (ends exclusive).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PixelRect {

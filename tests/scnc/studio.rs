@@ -363,3 +363,51 @@ fn requests_that_never_arrive_are_timed_out() {
     let (status, _) = s.raw("GET", "/", &[("Content-Length", "x")], b"");
     assert_eq!(status, 400);
 }
+
+/// Under light transport the preview converges: after the first image, passes of ever
+/// more samples arrive, each with a `P` message of the samples a pixel has (doubling up
+/// to the studio's 4,096) and a noise estimate that falls; a newer request stops the
+/// accumulation at once.
+#[test]
+fn light_transport_converges_while_idle_and_an_edit_restarts_it() {
+    let (_dir, scene) = seed_scene();
+    let s = Server::start(&scene);
+    let glow = "camera(position = [0, 0, -4], look_at = [0, 0, 0])\nrender(width = 8, height = 8)\n\
+                object sphere(1) with material(emission = rgb(255, 128, 0))\nobject box(3, 0.1, 3) at [0, -1.2, 0]\n";
+    let (status, body) = s.post("/api/render?coarse=1", glow);
+    assert_eq!(status, 200);
+    let passes: Vec<serde_json::Value> = messages(&body)
+        .into_iter()
+        .filter(|(k, _)| *k == b'P')
+        .map(|(_, p)| serde_json::from_slice(&p).expect("a P message is JSON"))
+        .collect();
+    let samples: Vec<u64> = passes.iter().map(|p| p["samples"].as_u64().expect("samples")).collect();
+    assert_eq!(samples, (1..=12).map(|k| 1u64 << k).collect::<Vec<_>>(), "doubling to 4,096");
+    let noise = |i: usize| passes[i]["noise_percent"].as_f64().expect("noise");
+    assert!(noise(11) < noise(0) / 8.0, "the noise falls: {} then {}", noise(0), noise(11));
+
+    // A larger image converges for long; a light render sent meanwhile comes back at
+    // once, and the accumulation is told it was overtaken.
+    let big = glow.replace("width = 8, height = 8", "width = 128, height = 128");
+    let mut c = TcpStream::connect(("127.0.0.1", s.port)).unwrap();
+    c.set_read_timeout(Some(std::time::Duration::from_secs(60))).unwrap();
+    let head = format!(
+        "POST /api/render?coarse=1 HTTP/1.1\r\nHost: 127.0.0.1:{}\r\nContent-Length: {}\r\n\r\n",
+        s.port,
+        big.len()
+    );
+    c.write_all(head.as_bytes()).unwrap();
+    c.write_all(big.as_bytes()).unwrap();
+    let mut got = Vec::new();
+    let mut some = [0u8; 4096];
+    while !got.windows(9).any(|w| w == b"\"samples\"") {
+        let n = c.read(&mut some).expect("the first pass");
+        assert!(n > 0, "the converging render ended early");
+        got.extend_from_slice(&some[..n]);
+    }
+    light_render_comes_back(&s, "a converging render");
+    let mut rest = Vec::new();
+    let _ = c.read_to_end(&mut rest);
+    got.extend_from_slice(&rest);
+    assert!(got.windows(7).any(|w| w == b"X\x02\0\0\0{}"), "the accumulation was not stopped");
+}

@@ -194,3 +194,23 @@ fn the_error_falls_as_one_over_the_root_of_the_samples() {
     let last = (e1 - e0) / (n1 - n0);
     assert!((last + 0.5).abs() <= 0.1, "slope {last} from 256 to 1,024 samples: {ladder:?}");
 }
+
+/// Adaptive sampling (`render(noise = ε)`) stops a pixel once its error estimate is
+/// below ε: a furnace, where every sample is exact, takes the first 16 samples of every
+/// pixel; a Cornell box takes more where it is noisy and never more than `samples`.
+#[test]
+fn adaptive_sampling_spends_samples_where_the_noise_is() {
+    let furnace = format!("{FURNACE}object sphere(1) at [0, 0, 4] with material(color = rgb(255, 255, 255))\n")
+        .replace("samples = 16", "samples = 1024, noise = 0.01");
+    let (_, c) = radiance(&furnace, 16, Mode::Sdf);
+    assert_eq!(c.paths, 16 * 256, "every pixel stops at its first estimate");
+    let cornell = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/light/cornell.scn"))
+        .expect("the Cornell box example")
+        .replace("samples = 64", "samples = 256, noise = 0.05");
+    let (img, c) = radiance(&cornell, 12, Mode::Sdf);
+    let pixels = 144;
+    assert!(c.paths > 16 * pixels && c.paths < 256 * pixels, "{} paths", c.paths);
+    assert_eq!(c.noise_pixels, pixels);
+    // The same image again: adaptive sampling is deterministic.
+    assert_eq!(radiance(&cornell, 12, Mode::Sdf).0, img);
+}

@@ -248,12 +248,19 @@ fn run(studio: &Studio, text: &str, ask: &Ask, out: &mut Stream, current: &Wante
     let mode = ask.setting(ask.rung, &mut scene);
     json_message(out, b'L', serde_json::json!({ "objects": scene.objects.len() }))?;
     let started = Instant::now();
-    let (frame, world) = match lower(studio, &scene, mode, current) {
+    let (mut frame, world) = match lower(studio, &scene, mode, current) {
         Ok(Some(l)) => l,
         Ok(None) => return out.message(b'X', b"{}"),
         Err(d) => return json_message(out, b'E', diagnostics_json(&compiled.map, &[d])),
     };
     let lower_s = started.elapsed().as_secs_f64();
+    // Light transport converges in front of the user: one sample a pixel first, in float
+    // so later passes can be added to it, then ever more while nothing newer is asked.
+    let converging = frame.transport.is_some();
+    if converging {
+        frame.samples = 1;
+        frame.bit_depth = scnc::render::BitDepth::Float;
+    }
     let meta = |level: &str, width: u32, height: u32| {
         serde_json::json!({
             "level": level, "width": width, "height": height,
@@ -275,7 +282,7 @@ fn run(studio: &Studio, text: &str, ask: &Ask, out: &mut Stream, current: &Wante
             studio.preview.pool.install(|| scnc::render::render_region_until(&world, &small, full, &|| {}, &stop));
         let Some((image, _)) = coarse else { return out.message(b'X', b"{}") };
         trace_s = t.elapsed().as_secs_f64();
-        send_band(out, 0, &image)?;
+        send_band(out, 0, &image.tone_mapped(&small))?;
         let estimate = trace_s * (ask.coarse * ask.coarse) as f64;
         if estimate > SLOW_FULL_SECONDS && estimate <= MAX_FULL_SECONDS {
             // Said before the wait, not after it: an edit that makes the scene slow (a
@@ -310,7 +317,7 @@ fn run(studio: &Studio, text: &str, ask: &Ask, out: &mut Stream, current: &Wante
             studio.preview.pool.install(|| scnc::render::render_region_until(&world, &frame, region, &|| {}, &stop));
         let Some((band, c)) = band else { return out.message(b'X', b"{}") };
         counters.add(&c);
-        send_band(out, y0, &band)?;
+        send_band(out, y0, &band.tone_mapped(&frame))?;
         whole.extend_from_slice(&band.pixels);
         y0 = y1;
     }
@@ -325,9 +332,69 @@ fn run(studio: &Studio, text: &str, ask: &Ask, out: &mut Stream, current: &Wante
             "setting": setting_label(mode, &scene),
         }),
     )?;
+    let image = Image { width: frame.width, height: frame.height, depth: frame.bit_depth, pixels: whole };
+    if converging {
+        return converge(studio, &world, &frame, &image, out, current);
+    }
     if let Some(rung) = ask.rung {
-        let image = Image { width: frame.width, height: frame.height, depth: frame.bit_depth, pixels: whole };
         accuracy(studio, text, ask, rung, &scene, &image, lower_s + full_s, out, current)?;
+    }
+    Ok(())
+}
+
+/// Most samples a pixel the studio accumulates to while the user is idle.
+const MOST_STUDIO_SAMPLES: u32 = 4096;
+
+/// Light transport's preview converging: passes of as many new samples as the image
+/// has (so each halves the noise's variance), each added to the float sums and the
+/// whole image sent, with a `P` message of the samples a pixel has and the noise
+/// estimate, until [`MOST_STUDIO_SAMPLES`] or a newer request. `first` is the float
+/// image of the first sample.
+fn converge(
+    studio: &Studio,
+    world: &scnc::world::World,
+    frame: &scnc::render::Frame,
+    first: &Image,
+    out: &mut Stream,
+    current: &Wanted,
+) -> std::io::Result<()> {
+    let floats = |img: &Image| -> Vec<f32> {
+        img.pixels.chunks_exact(4).map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]])).collect()
+    };
+    let mut sums = floats(first);
+    let mut total = 1u32;
+    let full = PixelRect::full(frame.width, frame.height);
+    let started = Instant::now();
+    while total < MOST_STUDIO_SAMPLES {
+        let mut pass = frame.clone();
+        pass.samples = total;
+        if let Some(t) = &mut pass.transport {
+            t.first_sample = total;
+        }
+        let stop = || !current();
+        let rendered =
+            studio.preview.pool.install(|| scnc::render::render_region_until(world, &pass, full, &|| {}, &stop));
+        let Some((image, c)) = rendered else { return out.message(b'X', b"{}") };
+        for (s, v) in sums.iter_mut().zip(floats(&image)) {
+            *s += v * total as f32;
+        }
+        let done = total * 2;
+        // The pass's estimate for its own samples, scaled to all of them (the error of a
+        // mean falls as the root of its samples).
+        let pass_noise = c.noise_ppm as f64 / c.noise_pixels.max(1) as f64 / 1e6;
+        let noise = pass_noise * (f64::from(total) / f64::from(done)).sqrt();
+        let mean: Vec<u8> = sums.iter().flat_map(|s| (s / done as f32).to_ne_bytes()).collect();
+        let shown = Image { width: frame.width, height: frame.height, depth: frame.bit_depth, pixels: mean };
+        send_band(out, 0, &shown.tone_mapped(frame))?;
+        total = done;
+        json_message(
+            out,
+            b'P',
+            serde_json::json!({
+                "samples": total, "noise_percent": noise * 100.0,
+                "seconds": started.elapsed().as_secs_f64(),
+            }),
+        )?;
     }
     Ok(())
 }

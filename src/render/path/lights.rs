@@ -92,6 +92,12 @@ pub struct Transport {
     pub focus: f32,
     /// Pixels are radiance × this × 255 before the tone map (`2^exposure`).
     pub exposure: f32,
+    /// The relative error adaptive sampling stops at, if it is on.
+    pub noise: Option<f32>,
+    /// The index of a pixel's first sample: a render of samples `first_sample ..
+    /// first_sample + samples` continues one of the samples before (the studio's
+    /// accumulation).
+    pub first_sample: u32,
 }
 
 impl Transport {
@@ -111,6 +117,8 @@ impl Transport {
             lens_radius: (scene.camera.aperture * 0.5) as f32,
             focus: scene.camera.focus_distance.unwrap_or_else(|| (scene.camera.look_at - origin).length()) as f32,
             exposure: 2f64.powf(scene.settings.exposure) as f32,
+            noise: scene.settings.noise.map(|e| e as f32),
+            first_sample: 0,
         };
         let mut glowing = Vec::new();
         for l in &scene.lights {

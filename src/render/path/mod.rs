@@ -52,28 +52,79 @@ pub(super) fn block(
     (w, h): (u32, u32),
     c: &mut Counters,
 ) -> [Vec3A; 16] {
-    let n = frame.samples.max(1);
+    let most = frame.samples.max(1);
     let mut out = [Vec3A::ZERO; 16];
     for dy in 0..h {
         for dx in 0..w {
             let (px, py) = (x + dx, y + dy);
             let pixel = py.wrapping_mul(frame.width).wrapping_add(px);
-            let mut sum = Vec3A::ZERO;
-            for s in 0..n {
-                let mut sampler = Sampler::new(pixel, s);
-                let ray = camera_ray(frame, t, (px, py), &mut sampler);
-                c.primary_rays += 1;
-                let mut l = radiance(g, frame, t, ray, &mut sampler, c);
-                if !l.is_finite() {
-                    c.nonfinite_samples += 1;
-                    l = Vec3A::ZERO;
+            let mut p = Pixel::default();
+            // Adaptive sampling doubles the samples until the error estimate is small
+            // enough: powers of two keep every pair of the sampler stratified.
+            let mut target = if t.noise.is_some() { ADAPTIVE_FIRST.min(most) } else { most };
+            loop {
+                while p.count < target {
+                    let mut sampler = Sampler::new(pixel, t.first_sample.wrapping_add(p.count));
+                    let ray = camera_ray(frame, t, (px, py), &mut sampler);
+                    c.primary_rays += 1;
+                    let mut l = radiance(g, frame, t, ray, &mut sampler, c);
+                    if !l.is_finite() {
+                        c.nonfinite_samples += 1;
+                        l = Vec3A::ZERO;
+                    }
+                    p.add(l);
                 }
-                sum += l;
+                match t.noise {
+                    Some(eps) if p.count < most && p.relative_error(t.exposure) > eps => {
+                        target = target.saturating_mul(2).min(most);
+                    }
+                    _ => break,
+                }
             }
-            out[(4 * dy + dx) as usize] = sum * (255.0 * t.exposure / n as f32);
+            c.noise_pixels += 1;
+            c.noise_ppm += (f64::from(p.relative_error(t.exposure)) * 1e6).min(1e12) as u64;
+            out[(4 * dy + dx) as usize] = p.sum * (255.0 * t.exposure / p.count as f32);
         }
     }
     out
+}
+
+/// Samples adaptive sampling takes before it first estimates a pixel's error.
+pub const ADAPTIVE_FIRST: u32 = 16;
+
+/// One pixel's samples so far: their sum, and their luminance's sum and sum of squares
+/// for the error estimate (in f64: a sum of squares over a million samples in f32 would
+/// lose the variance).
+#[derive(Default)]
+struct Pixel {
+    count: u32,
+    sum: Vec3A,
+    y: f64,
+    y2: f64,
+}
+
+impl Pixel {
+    fn add(&mut self, l: Vec3A) {
+        self.count += 1;
+        self.sum += l;
+        let y = f64::from(l.dot(Vec3A::new(0.2126, 0.7152, 0.0722)));
+        self.y += y;
+        self.y2 += y * y;
+    }
+
+    /// The standard error of the mean luminance over the mean, the mean taken as at
+    /// least 1/256 of white after `exposure` (darker, the error counts as absolute: a
+    /// black pixel's noise is what shows, not its ratio to nothing).
+    fn relative_error(&self, exposure: f32) -> f32 {
+        let n = f64::from(self.count);
+        if n < 2.0 {
+            return f32::INFINITY;
+        }
+        let mean = self.y / n;
+        let var = ((self.y2 - n * mean * mean) / (n - 1.0)).max(0.0);
+        let floor = 1.0 / (256.0 * f64::from(exposure));
+        ((var / n).sqrt() / mean.max(floor)) as f32
+    }
 }
 
 /// A tent-distributed offset in (−1, 1) from a number in [0, 1): the pixel filter,

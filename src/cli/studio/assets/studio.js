@@ -203,6 +203,16 @@ async function render(sourceText, opts = {}) {
           $("status").classList.remove("stale");
           $("status").textContent = "not rendered: the scene has errors (the last image stays)";
           break;
+        case "P": {
+          // Light transport converging while the user is idle.
+          const p = json(payload);
+          canvas.dataset.samples = String(p.samples);
+          $("busy").hidden = true;
+          $("note").textContent =
+            `converging: ${p.samples} samples a pixel, estimated noise ${p.noise_percent.toFixed(2)} % ` +
+            `(${p.seconds.toFixed(1)} s); an edit starts again`;
+          break;
+        }
         case "L": break; // lowering begun: the images follow
         case "X": break;
       }
