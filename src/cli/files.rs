@@ -286,7 +286,9 @@ fn encode_png(
     let depth_bits = match depth {
         BitDepth::Eight => png::BitDepth::Eight,
         BitDepth::Sixteen => png::BitDepth::Sixteen,
-        BitDepth::Float => return Err(std::io::Error::other("a PNG has 8 or 16 bits per channel, not float")),
+        BitDepth::Float | BitDepth::Sums => {
+            return Err(std::io::Error::other("a PNG has 8 or 16 bits per channel, not float"))
+        }
     };
     write_atomic(path, ".png.tmp", |w| {
         let mut encoder = png::Encoder::new(w, width, height);
@@ -298,7 +300,7 @@ fn encode_png(
         let mut writer = encoder.write_header().map_err(std::io::Error::other)?;
         let mut stream = writer.stream_writer().map_err(std::io::Error::other)?;
         match depth {
-            BitDepth::Eight | BitDepth::Float => stream.write_all(pixels)?,
+            BitDepth::Eight | BitDepth::Float | BitDepth::Sums => stream.write_all(pixels)?,
             // PNG's samples are big-endian: converted a row's worth at a time.
             BitDepth::Sixteen => {
                 for chunk in pixels.chunks(1 << 16) {

@@ -6,14 +6,16 @@ use std::process::ExitCode;
 
 use scnc::render::BitDepth;
 
-use super::files::{cannot_write, check_output, overwritten_input, write_png};
+use super::files::{cannot_write, check_image_output, is_exr, overwritten_input, write_exr, write_png};
+use super::passes::{is_pass, merge_passes};
 
 #[derive(clap::Args)]
 pub(crate) struct MergeArgs {
-    /// The parts (PNGs written by `scnc render --region` or `--tile`).
+    /// The parts (PNGs written by `scnc render --region` or `--tile`), or the passes
+    /// (`.scnpass` files written by `scnc render --pass`).
     #[arg(required = true)]
     parts: Vec<PathBuf>,
-    /// The assembled image (PNG).
+    /// The assembled image (PNG; passes may also make an OpenEXR `.exr`).
     #[arg(short, long)]
     output: PathBuf,
 }
@@ -178,7 +180,7 @@ fn merge(parts: &[PathBuf]) -> Result<scnc::render::Image, String> {
             let out = &mut pixels[px_bytes * i..px_bytes * (i + 1)];
             match depth {
                 // A part is a PNG: never float.
-                BitDepth::Eight | BitDepth::Float => out.copy_from_slice(&rgba[..3]),
+                BitDepth::Eight | BitDepth::Float | BitDepth::Sums => out.copy_from_slice(&rgba[..3]),
                 // The image keeps 16-bit samples in the machine's order; PNG's are big-endian.
                 BitDepth::Sixteen => {
                     for (o, s) in out.chunks_exact_mut(2).zip(rgba.chunks_exact(2)) {
@@ -204,8 +206,17 @@ fn merge(parts: &[PathBuf]) -> Result<scnc::render::Image, String> {
 }
 
 pub(crate) fn merge_cmd(args: MergeArgs) -> ExitCode {
-    if let Err(e) = check_output(&args.output) {
+    if let Err(e) = check_image_output(&args.output) {
         return super::usage_error(&e);
+    }
+    let passes = args.parts.iter().filter(|p| is_pass(p)).count();
+    if passes > 0 && passes < args.parts.len() {
+        return super::usage_error("merge either parts of an image (PNGs) or passes of samples (`.scnpass`), not both");
+    }
+    if passes == 0 && is_exr(&args.output) {
+        return super::usage_error(
+            "parts of an image merge into a PNG; passes of samples merge into a PNG or an `.exr`",
+        );
     }
     if let Some(part) = overwritten_input(&args.output, args.parts.iter().map(PathBuf::as_path)) {
         return super::usage_error(&format!(
@@ -214,14 +225,18 @@ pub(crate) fn merge_cmd(args: MergeArgs) -> ExitCode {
             part.display()
         ));
     }
-    let image = match merge(&args.parts) {
+    let depth = if is_exr(&args.output) { BitDepth::Float } else { BitDepth::Eight };
+    let merged = if passes > 0 { merge_passes(&args.parts, depth) } else { merge(&args.parts) };
+    let image = match merged {
         Ok(image) => image,
         Err(e) => {
             let _ = writeln!(std::io::stderr(), "error: {e}");
             return ExitCode::from(1);
         }
     };
-    if let Err(e) = write_png(&args.output, &image, &[]) {
+    let written =
+        if is_exr(&args.output) { write_exr(&args.output, &image) } else { write_png(&args.output, &image, &[]) };
+    if let Err(e) = written {
         let _ = writeln!(std::io::stderr(), "error: {}", cannot_write(&args.output, &e));
         return ExitCode::from(1);
     }

@@ -14,6 +14,7 @@ mod files;
 mod fmt;
 mod frames;
 mod merge;
+mod passes;
 mod progress;
 mod render;
 mod shared;

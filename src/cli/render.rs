@@ -19,6 +19,7 @@ use super::files::{
     cannot_write, check_image_output, is_exr, stop_on_interrupt, write_exr, write_part_png, write_png, FPS_KEY,
 };
 use super::frames::{frame_path, is_pattern, parse_frames, FrameChoice};
+use super::passes::is_pass;
 use super::progress::{Progress, Reading};
 use super::shared::{Accuracy, Meshing, Messages, Workers};
 use super::{compile, report, usage_error, MessageFormat};
@@ -98,6 +99,11 @@ pub(crate) struct RenderArgs {
     /// Render band I of N equal bands of rows (I from 0) as a part, like `--region`.
     #[arg(long, value_parser = parse_tile, value_name = "I/N")]
     tile: Option<(u32, u32)>,
+    /// Under light transport, render pass I of N of the samples (I from 0): samples
+    /// ⌊I·n/N⌋ to ⌊(I+1)·n/N⌋ − 1 of every pixel, written as exact sums to a `.scnpass`
+    /// file, which `scnc merge` adds to the image one render of all the samples makes.
+    #[arg(long, value_parser = parse_pass, value_name = "I/N", conflicts_with_all = ["tile", "region", "noise"])]
+    pass: Option<(u32, u32)>,
     /// Frames of the scene's animation to render, `A..B` (end exclusive) or `N`; every
     /// frame it declares by default. More than one needs `#` in the output name.
     #[arg(long, value_parser = parse_frames, value_name = "A..B")]
@@ -162,6 +168,16 @@ fn parse_tile(s: &str) -> Result<(u32, u32), String> {
     let n: u32 = n.trim().parse().map_err(|_| format!("`{n}` is not a number of bands"))?;
     if n == 0 || i >= n {
         return Err(format!("band {i} of {n}: bands are numbered 0 to N − 1"));
+    }
+    Ok((i, n))
+}
+
+fn parse_pass(s: &str) -> Result<(u32, u32), String> {
+    let (i, n) = s.split_once('/').ok_or_else(|| format!("expected I/N, like 0/4, got `{s}`"))?;
+    let i: u32 = i.trim().parse().map_err(|_| format!("`{i}` is not a pass number"))?;
+    let n: u32 = n.trim().parse().map_err(|_| format!("`{n}` is not a number of passes"))?;
+    if n == 0 || i >= n {
+        return Err(format!("pass {i} of {n}: passes are numbered 0 to N − 1"));
     }
     Ok((i, n))
 }
@@ -264,7 +280,19 @@ impl RenderArgs {
                 })?;
             }
         }
-        check_image_output(&self.output).map_err(|e| usage_error(&e))?;
+        if self.pass.is_some() != is_pass(&self.output) {
+            return Err(usage_error(if self.pass.is_some() {
+                "a pass is written as exact sums to a `.scnpass` file, for `scnc merge`"
+            } else {
+                "a `.scnpass` file holds a pass of samples: give `--pass I/N`"
+            }));
+        }
+        if !is_pass(&self.output) {
+            check_image_output(&self.output).map_err(|e| usage_error(&e))?;
+        } else {
+            super::files::check_output_as(&self.output, "a file name ending in `.scnpass`")
+                .map_err(|e| usage_error(&e))?;
+        }
         if is_exr(&self.output) && (self.region.is_some() || self.tile.is_some()) {
             return Err(usage_error("a tile or band of an image is written as a PNG part: give a `.png` file name"));
         }
@@ -438,6 +466,37 @@ fn render_scene(
     };
     // OpenEXR keeps the light: linear float radiance, never clamped or encoded.
     frame.bit_depth = if is_exr(output) { scnc::render::BitDepth::Float } else { args.bit_depth };
+    let pass = match args.pass {
+        None => None,
+        Some((i, n)) => {
+            let samples = frame.samples;
+            let Some(t) = &mut frame.transport else {
+                let _ = writeln!(
+                    std::io::stderr(),
+                    "error: `--pass` splits light transport's samples, and this scene is not lit by light transport \
+                     (it has no glowing material, area or environment light, or `bounces`)"
+                );
+                return Err(ExitCode::from(2));
+            };
+            let Some((first, count)) = super::passes::range(i, n, samples) else {
+                let _ = writeln!(std::io::stderr(), "error: pass {i} of {n} of {samples} samples holds none");
+                return Err(ExitCode::from(2));
+            };
+            t.first_sample = first;
+            frame.samples = count;
+            frame.bit_depth = scnc::render::BitDepth::Sums;
+            let info = super::passes::PassInfo {
+                width: frame.width,
+                height: frame.height,
+                samples,
+                first,
+                count,
+                exposure: t.exposure,
+                color: scene.settings.color.name().to_string(),
+            };
+            Some(info)
+        }
+    };
     let lowered = started.elapsed();
     let region = part.unwrap_or(PixelRect::full(frame.width, frame.height));
     let progress = Progress::new(region.height() as u64, "rows", "rendering");
@@ -447,6 +506,7 @@ fn render_scene(
     let traced = started.elapsed() - lowered;
     let written = match part {
         Some(region) => write_part_png(output, frame.width, frame.height, region, &image),
+        None if pass.is_some() => super::passes::write_pass(output, pass.as_ref().expect("a pass"), &image),
         None if is_exr(output) => write_exr(output, &image),
         // An animation's frames carry its rate, which `scnc encode` reads.
         None if scene.settings.frames > 1 => write_png(output, &image, &[(FPS_KEY, scene.settings.fps.to_string())]),

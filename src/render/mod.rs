@@ -21,6 +21,7 @@ pub use shade::{MAX_TREE_RAYS, MIN_WEIGHT};
 
 pub use frame::{Frame, ShadeLight};
 
+use crate::ir::ColorSpace;
 use crate::trace::{pattern, take_leaf_evals, Counters, Geometry};
 
 /// A rendered image: RGB, rows top to bottom.
@@ -48,6 +49,10 @@ pub enum BitDepth {
     /// 32-bit float, linear and unclamped: radiance (1 = a white surface at full light,
     /// 255 in an 8-bit image) for OpenEXR output and measurements.
     Float,
+    /// A light-transport pass's exact sums: per channel a 128-bit fixed-point integer
+    /// (`path::SUM_SCALE` per unit of radiance, little-endian), which passes of any split
+    /// add to the same bits.
+    Sums,
 }
 
 impl BitDepth {
@@ -57,6 +62,7 @@ impl BitDepth {
             BitDepth::Eight => 8,
             BitDepth::Sixteen => 16,
             BitDepth::Float => 32,
+            BitDepth::Sums => 128,
         }
     }
 
@@ -76,15 +82,22 @@ impl BitDepth {
 /// unclamped, divided by 255. The study's 8-bit linear pixels round to nearest.
 #[inline]
 fn encode(colour: Vec3A, frame: &Frame, out: &mut Vec<u8>) {
-    if frame.bit_depth == BitDepth::Float {
+    encode_as(colour, frame.color, frame.bit_depth, out);
+}
+
+/// [`encode`] for a colour space and bit depth given on their own (`scnc merge`'s passes
+/// have no frame). A [`BitDepth::Sums`] pixel has no colour to write: it writes nothing.
+#[inline]
+pub fn encode_as(colour: Vec3A, color: ColorSpace, depth: BitDepth, out: &mut Vec<u8>) {
+    if depth == BitDepth::Float {
         for x in (colour * (1.0 / 255.0)).to_array() {
             out.extend(x.to_ne_bytes());
         }
         return;
     }
-    let v = pattern::encoded(colour, frame.color);
-    match frame.bit_depth {
-        BitDepth::Float => {}
+    let v = pattern::encoded(colour, color);
+    match depth {
+        BitDepth::Float | BitDepth::Sums => {}
         // Values are in [0, 255], so adding one half and truncating rounds to nearest.
         BitDepth::Eight => out.extend((v + 0.5).to_array().map(|x| x as u8)),
         BitDepth::Sixteen => {
@@ -182,7 +195,14 @@ pub fn render_region_until(
 ) -> Option<(Image, Counters)> {
     if let Some(t) = &frame.transport {
         let block = |xy, wh, c: &mut Counters| path::block(geometry, frame, t, xy, wh, c);
-        return rows(frame, region, progress, stop, block);
+        let write = |p: &path::PathPixel, out: &mut Vec<u8>| {
+            if frame.bit_depth == BitDepth::Sums {
+                p.write_sums(out);
+            } else {
+                encode(p.colour(t.exposure), frame, out);
+            }
+        };
+        return rows(frame, region, progress, stop, block, write);
     }
     effects::specialise(&frame.effects, Rows { geometry, frame, region, progress, stop })
 }
@@ -201,18 +221,20 @@ impl effects::Variant for Rows<'_> {
     fn run<const FX: u8>(self) -> Option<(Image, Counters)> {
         let (g, frame) = (self.geometry, self.frame);
         let block = |xy, wh, c: &mut Counters| shade::block::<FX>(g, frame, xy, wh, c);
-        rows(self.frame, self.region, self.progress, self.stop, block)
+        let write = |colour: &Vec3A, out: &mut Vec<u8>| encode(*colour, frame, out);
+        rows(self.frame, self.region, self.progress, self.stop, block, write)
     }
 }
 
-/// The pixels of `region`, each 4×4 block of them from `block((x, y), (w, h), counters)`,
-/// strips of four rows in parallel.
-fn rows(
+/// The pixels of `region`, each 4×4 block of them from `block((x, y), (w, h), counters)`
+/// and each pixel's bytes from `write`, strips of four rows in parallel.
+fn rows<P>(
     frame: &Frame,
     region: PixelRect,
     progress: &(dyn Fn() + Sync),
     stop: &(dyn Fn() -> bool + Sync),
-    block: impl Fn((u32, u32), (u32, u32), &mut Counters) -> [Vec3A; 16] + Sync,
+    block: impl Fn((u32, u32), (u32, u32), &mut Counters) -> [P; 16] + Sync,
+    write: impl Fn(&P, &mut Vec<u8>) + Sync,
 ) -> Option<(Image, Counters)> {
     let stopped = std::sync::atomic::AtomicBool::new(false);
     let (w, h) = (frame.width, frame.height);
@@ -238,8 +260,8 @@ fn rows(
                 }
                 let px = block((x, y), (cols, rows_here), &mut c);
                 for (dy, row) in rows.iter_mut().enumerate() {
-                    for &colour in &px[4 * dy..4 * dy + cols as usize] {
-                        encode(colour, frame, row);
+                    for p in &px[4 * dy..4 * dy + cols as usize] {
+                        write(p, row);
                     }
                 }
             }

@@ -204,7 +204,8 @@ object sphere(0.7) at [0, -0.3, 6.5] with material(color = rgb(200, 200, 200))
 /// Every scene the repository ships or tests against: the examples, the bench scenes and
 /// the IR cases.
 fn every_scene() -> Vec<std::path::PathBuf> {
-    let dirs = ["examples", "examples/seed", "examples/features", "examples/animation", "examples/povray", "examples/light"];
+    let dirs =
+        ["examples", "examples/seed", "examples/features", "examples/animation", "examples/povray", "examples/light"];
     let mut out: Vec<_> =
         dirs.iter().chain(["benches/scenes", "tests/data/ir"].iter()).flat_map(|d| cases(d)).collect();
     // A fragment that `include`s are for, not a scene.

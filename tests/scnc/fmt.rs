@@ -92,9 +92,15 @@ fn fmt_is_idempotent_and_changes_only_whitespace() {
 #[test]
 fn shipped_examples_are_formatted() {
     let mut failures = Vec::new();
-    for dir in
-        ["examples/seed", "examples/features", "examples/animation", "examples/povray", "examples/light", "benches/scenes", "tests/data"]
-    {
+    for dir in [
+        "examples/seed",
+        "examples/features",
+        "examples/animation",
+        "examples/povray",
+        "examples/light",
+        "benches/scenes",
+        "tests/data",
+    ] {
         for path in cases(dir) {
             let text = std::fs::read_to_string(&path).expect("reading the example");
             if scnc::fmt::format(&text).is_ok_and(|f| f != text) {

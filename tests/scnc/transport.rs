@@ -214,3 +214,47 @@ fn adaptive_sampling_spends_samples_where_the_noise_is() {
     // The same image again: adaptive sampling is deterministic.
     assert_eq!(radiance(&cornell, 12, Mode::Sdf).0, img);
 }
+
+/// `render --pass I/N` splits the samples and `scnc merge` adds the passes into the very
+/// image one render of all of them makes, bit for bit, as PNG and as OpenEXR, in any
+/// order and for any split; passes that miss or repeat samples, a scene without light
+/// transport, and a pass to a PNG are refused.
+#[test]
+fn passes_merge_into_the_image_of_one_render_bit_for_bit() {
+    use crate::support::{ok, refused, scnc};
+    let dir = tempfile::tempdir().expect("temp dir");
+    let at = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
+    let cornell = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/light/cornell.scn");
+    let small = ["--width", "12", "--height", "12", "--samples", "10"];
+    let render = |out: &str, more: &[&str]| {
+        let mut args = vec!["render", cornell, "-o", out];
+        args.extend_from_slice(&small);
+        args.extend_from_slice(more);
+        scnc(&args)
+    };
+    for ext in ["png", "exr"] {
+        ok(&render(&at(&format!("one.{ext}")), &[]));
+        for n in [2u32, 3, 10] {
+            let mut passes = Vec::new();
+            for i in (0..n).rev() {
+                let p = at(&format!("p{i}-{n}.scnpass"));
+                ok(&render(&p, &["--pass", &format!("{i}/{n}")]));
+                passes.push(p);
+            }
+            let merged = at(&format!("merged-{n}.{ext}"));
+            let mut args = vec!["merge"];
+            args.extend(passes.iter().map(String::as_str));
+            args.extend(["-o", &merged]);
+            ok(&scnc(&args));
+            let (a, b) = (std::fs::read(at(&format!("one.{ext}"))).unwrap(), std::fs::read(&merged).unwrap());
+            assert!(a == b, "{n} passes merged to .{ext} differ from one render");
+        }
+    }
+    let merged = at("m.png");
+    refused(&scnc(&["merge", &at("p0-3.scnpass"), &at("p1-3.scnpass"), "-o", &merged]), 1, "some are missing");
+    refused(&scnc(&["merge", &at("p0-3.scnpass"), &at("p0-2.scnpass"), "-o", &merged]), 1, "overlaps");
+    refused(&render(&at("x.png"), &["--pass", "0/2"]), 2, "`.scnpass`");
+    let seed = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/seed/01-sphere.scn");
+    refused(&scnc(&["render", seed, "--pass", "0/2", "-o", &at("w.scnpass")]), 2, "not lit by light transport");
+    assert!(!std::path::Path::new(&at("w.scnpass")).exists());
+}

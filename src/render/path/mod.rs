@@ -40,10 +40,60 @@ use crate::trace::{spawn_offset, Counters, Geometry, Hit, Ray, PATH_BINS};
 /// Surfaces a path meets before Russian roulette may end it.
 const ROULETTE_AFTER: u32 = 3;
 
-/// The colours (linear, 255 = radiance 1 after exposure, not clamped: the pixel's
-/// encoding clamps, or a float image keeps the value) of a block of up to 4×4 pixels
-/// from `(x, y)`, `w` wide and `h` high; pixel `(dx, dy)` is entry `4·dy + dx`. Each is
-/// the mean of `frame.samples` paths.
+/// Units of a [`PathPixel`]'s sums per unit of radiance: 2³², far below an f32's
+/// resolution of any visible value.
+pub const SUM_SCALE: f64 = 4_294_967_296.0;
+
+/// The most radiance one sample adds to a sum, 2⁷⁴ (about 1.9·10²²): a million
+/// samples of it still fit 128 bits. Only a sample beyond it (an emission strength of
+/// 10³⁰ seen directly) is held to it, and its pixel is white in any image.
+pub const MOST_SAMPLE_RADIANCE: f64 = 18_889_465_931_478_580_854_784.0;
+
+/// A pixel of light transport: the exact sum of its samples' radiance per channel, in
+/// fixed point so that sums of the same samples split any way between passes are the
+/// same bits (`render --pass`, `scnc merge`), and how many samples it has.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PathPixel {
+    /// Radiance × [`SUM_SCALE`], summed.
+    pub sum: [i128; 3],
+    /// Samples summed.
+    pub count: u32,
+}
+
+impl PathPixel {
+    /// Adds one sample's radiance (finite, not negative).
+    pub fn add(&mut self, l: Vec3A) {
+        for (s, v) in self.sum.iter_mut().zip(l.to_array()) {
+            *s += (f64::from(v).min(MOST_SAMPLE_RADIANCE) * SUM_SCALE) as i128;
+        }
+        self.count += 1;
+    }
+
+    /// Adds another pixel's samples (another pass of the same pixel).
+    pub fn merge(&mut self, o: &PathPixel) {
+        for (s, v) in self.sum.iter_mut().zip(o.sum) {
+            *s = s.saturating_add(v);
+        }
+        self.count += o.count;
+    }
+
+    /// The mean radiance × `exposure`, in the tracer's 0–255 units (255 = radiance 1).
+    pub fn colour(&self, exposure: f32) -> Vec3A {
+        let k = 255.0 * f64::from(exposure) / (SUM_SCALE * f64::from(self.count.max(1)));
+        Vec3A::from_array(self.sum.map(|s| (s as f64 * k) as f32))
+    }
+
+    /// The sums as 48 little-endian bytes.
+    pub fn write_sums(&self, out: &mut Vec<u8>) {
+        for s in self.sum {
+            out.extend(s.to_le_bytes());
+        }
+    }
+}
+
+/// The pixels (each a [`PathPixel`]) of a block of up to 4×4 pixels from `(x, y)`, `w`
+/// wide and `h` high; pixel `(dx, dy)` is entry `4·dy + dx`. Each has `frame.samples`
+/// paths, or with adaptive sampling as many as its noise needs.
 pub(super) fn block(
     g: &dyn Geometry,
     frame: &Frame,
@@ -51,14 +101,15 @@ pub(super) fn block(
     (x, y): (u32, u32),
     (w, h): (u32, u32),
     c: &mut Counters,
-) -> [Vec3A; 16] {
+) -> [PathPixel; 16] {
     let most = frame.samples.max(1);
-    let mut out = [Vec3A::ZERO; 16];
+    let mut out = [PathPixel::default(); 16];
     for dy in 0..h {
         for dx in 0..w {
             let (px, py) = (x + dx, y + dy);
             let pixel = py.wrapping_mul(frame.width).wrapping_add(px);
-            let mut p = Pixel::default();
+            let mut p = Noise::default();
+            let mut sums = PathPixel::default();
             // Adaptive sampling doubles the samples until the error estimate is small
             // enough: powers of two keep every pair of the sampler stratified.
             let mut target = if t.noise.is_some() { ADAPTIVE_FIRST.min(most) } else { most };
@@ -73,6 +124,7 @@ pub(super) fn block(
                         l = Vec3A::ZERO;
                     }
                     p.add(l);
+                    sums.add(l);
                 }
                 match t.noise {
                     Some(eps) if p.count < most && p.relative_error(t.exposure) > eps => {
@@ -83,7 +135,7 @@ pub(super) fn block(
             }
             c.noise_pixels += 1;
             c.noise_ppm += (f64::from(p.relative_error(t.exposure)) * 1e6).min(1e12) as u64;
-            out[(4 * dy + dx) as usize] = p.sum * (255.0 * t.exposure / p.count as f32);
+            out[(4 * dy + dx) as usize] = sums;
         }
     }
     out
@@ -92,21 +144,19 @@ pub(super) fn block(
 /// Samples adaptive sampling takes before it first estimates a pixel's error.
 pub const ADAPTIVE_FIRST: u32 = 16;
 
-/// One pixel's samples so far: their sum, and their luminance's sum and sum of squares
-/// for the error estimate (in f64: a sum of squares over a million samples in f32 would
-/// lose the variance).
+/// One pixel's samples so far for the error estimate: their count, and their
+/// luminance's sum and sum of squares (in f64: a sum of squares over a million samples
+/// in f32 would lose the variance).
 #[derive(Default)]
-struct Pixel {
+struct Noise {
     count: u32,
-    sum: Vec3A,
     y: f64,
     y2: f64,
 }
 
-impl Pixel {
+impl Noise {
     fn add(&mut self, l: Vec3A) {
         self.count += 1;
-        self.sum += l;
         let y = f64::from(l.dot(Vec3A::new(0.2126, 0.7152, 0.0722)));
         self.y += y;
         self.y2 += y * y;
