@@ -104,6 +104,13 @@ pub(crate) struct RenderArgs {
     /// file, which `scnc merge` adds to the image one render of all the samples makes.
     #[arg(long, value_parser = parse_pass, value_name = "I/N", conflicts_with_all = ["tile", "region", "noise"])]
     pass: Option<(u32, u32)>,
+    /// Render the pass picked by the task index in this environment variable
+    /// (`SLURM_ARRAY_TASK_ID`, `JOB_COMPLETION_INDEX`, …), of `--passes` N.
+    #[arg(long, value_name = "VAR", requires = "passes", conflicts_with_all = ["pass", "tile", "region", "noise"])]
+    pass_index_from: Option<String>,
+    /// The number of passes with `--pass-index-from`.
+    #[arg(long, value_name = "N", requires = "pass_index_from", value_parser = clap::value_parser!(u32).range(1..))]
+    passes: Option<u32>,
     /// Frames of the scene's animation to render, `A..B` (end exclusive) or `N`; every
     /// frame it declares by default. More than one needs `#` in the output name.
     #[arg(long, value_parser = parse_frames, value_name = "A..B")]
@@ -251,6 +258,20 @@ impl RenderArgs {
         Ok((mode, part))
     }
 
+    /// The pass `--pass`, or `--pass-index-from` with `--passes`, asks for, if any.
+    fn pass(&self) -> Result<Option<(u32, u32)>, String> {
+        let (Some(var), Some(n)) = (&self.pass_index_from, self.passes) else {
+            return Ok(self.pass);
+        };
+        let value =
+            std::env::var(var).map_err(|_| format!("--pass-index-from {var}: the variable `{var}` is not set"))?;
+        match value.trim().parse::<u32>() {
+            Ok(i) if i < n => Ok(Some((i, n))),
+            Ok(i) => Err(format!("--pass-index-from {var}: task {i} of {n} passes (they are numbered 0 to {})", n - 1)),
+            Err(_) => Err(format!("--pass-index-from {var}: `{value}` is not a task index (a whole number from 0)")),
+        }
+    }
+
     /// The region `--region` or `--tile` asks for in a `width × height` image, if any;
     /// an error when it does not fit.
     fn part(&self, width: u32, height: u32) -> Result<Option<PixelRect>, String> {
@@ -280,8 +301,9 @@ impl RenderArgs {
                 })?;
             }
         }
-        if self.pass.is_some() != is_pass(&self.output) {
-            return Err(usage_error(if self.pass.is_some() {
+        let pass = self.pass.is_some() || self.pass_index_from.is_some();
+        if pass != is_pass(&self.output) {
+            return Err(usage_error(if pass {
                 "a pass is written as exact sums to a `.scnpass` file, for `scnc merge`"
             } else {
                 "a `.scnpass` file holds a pass of samples: give `--pass I/N`"
@@ -466,7 +488,8 @@ fn render_scene(
     };
     // OpenEXR keeps the light: linear float radiance, never clamped or encoded.
     frame.bit_depth = if is_exr(output) { scnc::render::BitDepth::Float } else { args.bit_depth };
-    let pass = match args.pass {
+    let asked = args.pass().map_err(|e| usage_error(&e))?;
+    let pass = match asked {
         None => None,
         Some((i, n)) => {
             let samples = frame.samples;
