@@ -412,7 +412,7 @@ crate::params! {
         cyclic: bool as Bool = false;
         /// how colours are read and pixels written: "linear" (the study's) or "srgb"
         color: String as Str = "linear";
-        /// a light-transport path's surface interactions after the camera ray (1: direct light only)
+        /// a light-transport path's surface interactions after the camera ray (1: direct light only; 8 when not given)
         bounces: Option<u32> as Int = derived, Range::closed(1.0, MAX_BOUNCES as f64);
         /// light-transport pixels are scaled by 2^exposure before the tone map
         exposure: f64 as Num = 0.0, Range::closed(-64.0, 64.0);

@@ -160,7 +160,9 @@ impl Ctx<'_> {
                 )
                 .with_hint("try `object sphere(1) at [0, 0, 5]`"),
             );
-        } else if self.lights.is_empty() {
+        } else if self.lights.is_empty()
+            && !self.objects.iter().any(|o| crate::ir::materials_of(&o.geometry).iter().any(crate::ir::Material::emits))
+        {
             self.report(
                 Diagnostic::warning(codes::NO_LIGHTS, end, "the scene has no lights", "every object will be black")
                     .with_hint("try `light ambient(0.2)` and `light point(0.6) at [2, 1, 0]`"),

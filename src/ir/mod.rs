@@ -12,6 +12,7 @@ mod bounds;
 mod convex;
 mod dump;
 pub mod field;
+mod materials;
 mod paint;
 
 use std::path::PathBuf;
@@ -27,6 +28,7 @@ pub use bounds::{
 };
 pub use dump::dump;
 pub(crate) use dump::{num as dump_num, vec as dump_vec};
+pub use materials::materials_of;
 pub use paint::{Paint, Pattern, PatternKind};
 
 use crate::span::Span;

@@ -12,7 +12,7 @@
 
 use std::fmt;
 
-use crate::ir::{self, Body, LightKind, Scene, ShapeKind};
+use crate::ir::{self, LightKind, Scene};
 use crate::trace::Counters;
 
 /// A counter by name, and how to read it.
@@ -300,7 +300,7 @@ impl<'a> Survey<'a> {
                 LightKind::Area { .. } | LightKind::Environment => transport_lights.push(i),
             }
         }
-        let materials: Vec<Vec<ir::Material>> = scene.objects.iter().map(|o| materials_of(&o.geometry)).collect();
+        let materials: Vec<Vec<ir::Material>> = scene.objects.iter().map(|o| ir::materials_of(&o.geometry)).collect();
         let glowing: Vec<usize> =
             (0..materials.len()).filter(|&i| materials[i].iter().any(ir::Material::emits)).collect();
         let transport = !transport_lights.is_empty() || !glowing.is_empty() || scene.settings.bounces.is_some();
@@ -333,48 +333,5 @@ impl<'a> Survey<'a> {
         } else {
             self.scene.settings.depth
         }
-    }
-}
-
-fn materials_of_shape(shape: &ir::Shape, out: &mut Vec<ir::Material>) {
-    if let ShapeKind::Paint { material, .. } = &shape.kind {
-        out.push((**material).clone());
-    }
-    shape.children().iter().for_each(|c| materials_of_shape(c, out));
-}
-
-/// Every material an object can show, plus the default grey when some part has none.
-fn materials_of(geometry: &Body) -> Vec<ir::Material> {
-    let mut out = Vec::new();
-    match geometry {
-        Body::Shape(s) => {
-            materials_of_shape(s, &mut out);
-            if !painted_everywhere(s) {
-                out.push(ir::Material::default_grey());
-            }
-        }
-        Body::Mesh(m) => {
-            out.push(m.material.as_deref().cloned().unwrap_or_else(ir::Material::default_grey));
-            if let ir::MeshSource::Isosurface { shape, .. } = &m.source {
-                materials_of_shape(shape, &mut out);
-            }
-        }
-    }
-    out
-}
-
-/// Whether every leaf of the tree has a material above it.
-fn painted_everywhere(shape: &ir::Shape) -> bool {
-    match &shape.kind {
-        ShapeKind::Paint { .. } => true,
-        // A field's surface is its own: the shapes its body measures paint nothing.
-        ShapeKind::Primitive(_) | ShapeKind::Field { .. } => false,
-        ShapeKind::Warp { .. }
-        | ShapeKind::Displace { .. }
-        | ShapeKind::Csg { .. }
-        | ShapeKind::Round { .. }
-        | ShapeKind::Shell { .. }
-        | ShapeKind::Repeat { .. }
-        | ShapeKind::Transform { .. } => shape.children().iter().all(|c| painted_everywhere(c)),
     }
 }

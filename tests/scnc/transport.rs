@@ -258,3 +258,18 @@ fn passes_merge_into_the_image_of_one_render_bit_for_bit() {
     refused(&scnc(&["render", seed, "--pass", "0/2", "-o", &at("w.scnpass")]), 2, "not lit by light transport");
     assert!(!std::path::Path::new(&at("w.scnpass")).exists());
 }
+
+/// A scene lit only by what glows has lights: no "the scene has no lights" warning;
+/// one with nothing that glows still gets it.
+#[test]
+fn a_glowing_object_is_a_light_to_the_checker() {
+    let lint = |text: &str| {
+        let c = scnc::compile_source("t.scn", std::path::Path::new("t.scn"), text.to_string(), &scnc::source::FsLoader);
+        c.diagnostics.iter().any(|d| d.code == "W0002")
+    };
+    assert!(!lint("object sphere(1) at [0, 0, 5] with material(emission = rgb(255, 255, 255))\n"));
+    assert!(lint(
+        "object sphere(1) at [0, 0, 5] with material(emission = rgb(255, 255, 255), emission_strength = 0)\n"
+    ));
+    assert!(lint("object sphere(1) at [0, 0, 5]\n"));
+}
