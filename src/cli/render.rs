@@ -170,23 +170,22 @@ fn parse_region(s: &str) -> Result<[u32; 4], String> {
 
 /// `I/N` with `0 ≤ I < N`.
 fn parse_tile(s: &str) -> Result<(u32, u32), String> {
+    parse_one_of(s, "band")
+}
+
+/// `I/N` with `I < N`: one of `N` numbered things (bands, passes) named `what`.
+fn parse_one_of(s: &str, what: &str) -> Result<(u32, u32), String> {
     let (i, n) = s.split_once('/').ok_or_else(|| format!("expected I/N, like 0/4, got `{s}`"))?;
-    let i: u32 = i.trim().parse().map_err(|_| format!("`{i}` is not a band number"))?;
-    let n: u32 = n.trim().parse().map_err(|_| format!("`{n}` is not a number of bands"))?;
+    let i: u32 = i.trim().parse().map_err(|_| format!("`{i}` is not a {what} number"))?;
+    let n: u32 = n.trim().parse().map_err(|_| format!("`{n}` is not a number of {what}s"))?;
     if n == 0 || i >= n {
-        return Err(format!("band {i} of {n}: bands are numbered 0 to N − 1"));
+        return Err(format!("{what} {i} of {n}: {what}s are numbered 0 to N − 1"));
     }
     Ok((i, n))
 }
 
 fn parse_pass(s: &str) -> Result<(u32, u32), String> {
-    let (i, n) = s.split_once('/').ok_or_else(|| format!("expected I/N, like 0/4, got `{s}`"))?;
-    let i: u32 = i.trim().parse().map_err(|_| format!("`{i}` is not a pass number"))?;
-    let n: u32 = n.trim().parse().map_err(|_| format!("`{n}` is not a number of passes"))?;
-    if n == 0 || i >= n {
-        return Err(format!("pass {i} of {n}: passes are numbered 0 to N − 1"));
-    }
-    Ok((i, n))
+    parse_one_of(s, "pass")
 }
 
 fn parse_epsilon(s: &str) -> Result<f64, String> {

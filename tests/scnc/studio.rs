@@ -277,20 +277,22 @@ fn heavy_render(s: &Server, levels: u32, tail: &str, marker: &[u8]) -> (TcpStrea
     }
     heavy += "camera(position = [0, 0, -4], look_at = [0, 0, 0])\nlight ambient(1)\n";
     heavy += tail;
+    stream_until(s, "/api/render?coarse=4", &heavy, marker)
+}
+
+/// Posts `text` to `path` and reads the streamed answer until `marker` has come: the
+/// connection, still open, and what it sent.
+fn stream_until(s: &Server, path: &str, text: &str, marker: &[u8]) -> (TcpStream, Vec<u8>) {
     let mut c = TcpStream::connect(("127.0.0.1", s.port)).unwrap();
     c.set_read_timeout(Some(std::time::Duration::from_secs(60))).unwrap();
-    let head = format!(
-        "POST /api/render?coarse=4 HTTP/1.1\r\nHost: 127.0.0.1:{}\r\nContent-Length: {}\r\n\r\n",
-        s.port,
-        heavy.len()
-    );
+    let head = format!("POST {path} HTTP/1.1\r\nHost: 127.0.0.1:{}\r\nContent-Length: {}\r\n\r\n", s.port, text.len());
     c.write_all(head.as_bytes()).unwrap();
-    c.write_all(heavy.as_bytes()).unwrap();
+    c.write_all(text.as_bytes()).unwrap();
     let mut got = Vec::new();
-    let mut some = [0u8; 256];
+    let mut some = [0u8; 4096];
     while !got.windows(marker.len()).any(|w| w == marker) {
-        let n = c.read(&mut some).expect("the heavy render's first message");
-        assert!(n > 0, "the heavy render ended early: {}", String::from_utf8_lossy(&got));
+        let n = c.read(&mut some).expect("the render's first messages");
+        assert!(n > 0, "the render ended early: {}", String::from_utf8_lossy(&got));
         got.extend_from_slice(&some[..n]);
     }
     (c, got)
@@ -389,22 +391,7 @@ fn light_transport_converges_while_idle_and_an_edit_restarts_it() {
     // A larger image converges for long; a light render sent meanwhile comes back at
     // once, and the accumulation is told it was overtaken.
     let big = glow.replace("width = 8, height = 8", "width = 128, height = 128");
-    let mut c = TcpStream::connect(("127.0.0.1", s.port)).unwrap();
-    c.set_read_timeout(Some(std::time::Duration::from_secs(60))).unwrap();
-    let head = format!(
-        "POST /api/render?coarse=1 HTTP/1.1\r\nHost: 127.0.0.1:{}\r\nContent-Length: {}\r\n\r\n",
-        s.port,
-        big.len()
-    );
-    c.write_all(head.as_bytes()).unwrap();
-    c.write_all(big.as_bytes()).unwrap();
-    let mut got = Vec::new();
-    let mut some = [0u8; 4096];
-    while !got.windows(9).any(|w| w == b"\"samples\"") {
-        let n = c.read(&mut some).expect("the first pass");
-        assert!(n > 0, "the converging render ended early");
-        got.extend_from_slice(&some[..n]);
-    }
+    let (mut c, mut got) = stream_until(&s, "/api/render?coarse=1", &big, b"\"samples\"");
     light_render_comes_back(&s, "a converging render");
     let mut rest = Vec::new();
     let _ = c.read_to_end(&mut rest);
