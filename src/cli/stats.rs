@@ -65,15 +65,21 @@ pub(crate) fn stats_text(c: &Counters, g: &World, map: &SourceMap, lower_s: f64,
         out.push_str(&format!(
             "  light transport {} paths ({:.1} samples per pixel), {} light (next-event) rays, {} bounce rays ({:.2} per path)
     surfaces met per path: {}
-    estimated noise: {:.3} % mean relative standard error per pixel
-",
+{}",
             c.paths,
-            c.paths as f64 / c.noise_pixels.max(1) as f64,
+            c.paths as f64 / c.path_pixels.max(1) as f64,
             c.light_rays,
             c.bounce_rays,
             c.bounce_rays as f64 / c.paths as f64,
             lengths.join(", "),
-            c.noise_ppm as f64 / c.noise_pixels.max(1) as f64 / 1e4,
+            if c.noise_pixels > 0 {
+                format!(
+                    "    estimated noise: {:.3} % mean relative standard error per pixel\n",
+                    c.noise_ppm as f64 / c.noise_pixels as f64 / 1e4
+                )
+            } else {
+                "    estimated noise: none (a pixel needs two samples for an estimate)\n".to_string()
+            },
         ));
     }
     if c.segment_bounds > 0 {

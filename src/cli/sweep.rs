@@ -1,7 +1,7 @@
 //! `scnc sweep`: the accuracy ladder written as CSV, Markdown and charts.
 
 use std::io::{IsTerminal, Write};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use scnc::source::FsLoader;
@@ -37,6 +37,14 @@ pub(crate) struct SweepArgs {
     quick: bool,
     #[command(flatten)]
     accuracy: Accuracy,
+    /// Under light transport: the most samples a pixel of the samples ladder (1, 4, 16,
+    /// … up to this); the reference is 16 times as many unless `--reference` gives one.
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    most_samples: u32,
+    /// Under light transport: an OpenEXR image of the scene (linear float, the sweep's
+    /// size) to measure the ladder against instead of rendering a reference.
+    #[arg(long, value_name = "EXR")]
+    reference: Option<PathBuf>,
     #[command(flatten)]
     messages: Messages,
 }
@@ -55,6 +63,12 @@ pub(crate) fn sweep_cmd(args: SweepArgs) -> ExitCode {
     scene.settings.width = args.width.unwrap_or(scene.settings.width);
     scene.settings.height = args.height.unwrap_or(scene.settings.height);
     let (width, height) = (scene.settings.width, scene.settings.height);
+    if scnc::render::effects::derive(&scene).light_transport.is_some() {
+        return samples_sweep(&args, &scene, &compiled.map);
+    }
+    if args.reference.is_some() {
+        return usage_error("`--reference` is for a scene lit by light transport, whose sweep is a ladder of samples");
+    }
     let ladder = match args.accuracy.tolerance {
         Some(tol) => sweep::picked(&scene, tol),
         None => sweep::ladder(args.quick),
@@ -135,6 +149,75 @@ pub(crate) fn sweep_cmd(args: SweepArgs) -> ExitCode {
     }
     let _ = writeln!(std::io::stderr(), "swept {} settings: {}", rows.len(), args.output.join("sweep.md").display());
     ExitCode::SUCCESS
+}
+
+/// `scnc sweep` of a scene lit by light transport: the samples ladder, its table and its
+/// chart of time against error.
+fn samples_sweep(args: &SweepArgs, scene: &scnc::ir::Scene, map: &scnc::source::SourceMap) -> ExitCode {
+    let (width, height) = (scene.settings.width, scene.settings.height);
+    let reference = match &args.reference {
+        None => None,
+        Some(path) => match read_reference(path, width, height) {
+            Ok(r) => Some(r),
+            Err(e) => {
+                let _ = writeln!(std::io::stderr(), "error: {e}");
+                return ExitCode::from(1);
+            }
+        },
+    };
+    let started = std::time::Instant::now();
+    let progress = |what: &str| {
+        let _ = writeln!(std::io::stderr(), "sweep: {what} ({:.1} s)", started.elapsed().as_secs_f64());
+    };
+    let rungs = scnc::study::samples::ladder(args.most_samples);
+    let rows = match scnc::study::samples::run(scene, &rungs, reference, &FsLoader, &progress) {
+        Ok(rows) => rows,
+        Err(d) => {
+            super::report_in(map, &[d], args.messages.message_format);
+            return ExitCode::from(1);
+        }
+    };
+    let name = args.file.file_name().map_or_else(|| args.file.display().to_string(), |n| n.to_string_lossy().into());
+    let title = format!("{name} at {width}×{height}");
+    let text = [
+        ("samples.csv", scnc::study::samples::csv(&rows)),
+        ("samples.md", scnc::study::samples::markdown(&rows, &title)),
+    ];
+    for (file, body) in text {
+        let path = args.output.join(file);
+        if let Err(e) = write_text(&path, &body) {
+            let _ = writeln!(std::io::stderr(), "error: {}", cannot_write(&path, &e));
+            return ExitCode::from(1);
+        }
+    }
+    let path = args.output.join("time-vs-error.png");
+    let written = scnc::study::samples::chart(&rows, &title)
+        .map_err(std::io::Error::other)
+        .and_then(|img| write_png(&path, &img, &[]));
+    if let Err(e) = written {
+        let _ = writeln!(std::io::stderr(), "error: {}", cannot_write(&path, &e));
+        return ExitCode::from(1);
+    }
+    let _ =
+        writeln!(std::io::stderr(), "swept {} sample counts: {}", rows.len(), args.output.join("samples.md").display());
+    ExitCode::SUCCESS
+}
+
+/// A reference image: an OpenEXR file of `width × height`, as linear float RGB.
+fn read_reference(path: &Path, width: u32, height: u32) -> Result<Vec<f32>, String> {
+    let cannot = |e: &dyn std::fmt::Display| format!("cannot read the reference `{}`: {e}", path.display());
+    let mut reader = image::ImageReader::open(path).map_err(|e| cannot(&e))?;
+    reader.limits(image::Limits::default());
+    let img = reader.with_guessed_format().map_err(|e| cannot(&e))?.decode().map_err(|e| cannot(&e))?;
+    if (img.width(), img.height()) != (width, height) {
+        return Err(format!(
+            "the reference `{}` is {}×{}, the sweep renders {width}×{height}",
+            path.display(),
+            img.width(),
+            img.height()
+        ));
+    }
+    Ok(img.to_rgb32f().into_raw())
 }
 
 /// A time cap from 0.01 to 3600 seconds.

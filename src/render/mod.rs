@@ -85,7 +85,7 @@ fn encode(colour: Vec3A, frame: &Frame, out: &mut Vec<u8>) {
     encode_as(colour, frame.color, frame.bit_depth, out);
 }
 
-/// [`encode`] for a colour space and bit depth given on their own (`scnc merge`'s passes
+/// A pixel's colour written as `encode` writes it, for a colour space and bit depth given on their own (`scnc merge`'s passes
 /// have no frame). A [`BitDepth::Sums`] pixel has no colour to write: it writes nothing.
 #[inline]
 pub fn encode_as(colour: Vec3A, color: ColorSpace, depth: BitDepth, out: &mut Vec<u8>) {

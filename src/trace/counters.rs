@@ -49,8 +49,11 @@ pub struct Counters {
     pub bounce_rays: u64,
     /// Paths by how many surfaces they met (the last bin: that many or more).
     pub path_lengths: [u64; PATH_BINS],
-    /// Pixels light transport rendered, and the sum of their estimated relative errors
-    /// (the standard error of the mean's luminance over the mean, in millionths).
+    /// Pixels light transport rendered.
+    pub path_pixels: u64,
+    /// Pixels of two samples or more (which have an error estimate), and the sum of
+    /// their estimated relative errors (the standard error of the mean's luminance over
+    /// the mean, in millionths).
     pub noise_pixels: u64,
     /// See `noise_pixels`.
     pub noise_ppm: u64,
@@ -81,6 +84,7 @@ impl Counters {
         self.paths += o.paths;
         self.light_rays += o.light_rays;
         self.bounce_rays += o.bounce_rays;
+        self.path_pixels += o.path_pixels;
         self.noise_pixels += o.noise_pixels;
         self.noise_ppm += o.noise_ppm;
         for (a, b) in self.path_lengths.iter_mut().zip(o.path_lengths) {

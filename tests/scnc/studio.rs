@@ -386,7 +386,10 @@ fn light_transport_converges_while_idle_and_an_edit_restarts_it() {
     let samples: Vec<u64> = passes.iter().map(|p| p["samples"].as_u64().expect("samples")).collect();
     assert_eq!(samples, (1..=12).map(|k| 1u64 << k).collect::<Vec<_>>(), "doubling to 4,096");
     let noise = |i: usize| passes[i]["noise_percent"].as_f64().expect("noise");
-    assert!(noise(11) < noise(0) / 8.0, "the noise falls: {} then {}", noise(0), noise(11));
+    // The first pass, of one sample a pixel, has no estimate; from 4 to 4,096 samples
+    // the noise falls as the root of their ratio, 32 times.
+    assert!(passes[0]["noise_percent"].is_null());
+    assert!(noise(11) < noise(1) / 8.0, "the noise falls: {} then {}", noise(1), noise(11));
 
     // A larger image converges for long; a light render sent meanwhile comes back at
     // once, and the accumulation is told it was overtaken.

@@ -273,3 +273,41 @@ fn a_glowing_object_is_a_light_to_the_checker() {
     ));
     assert!(lint("object sphere(1) at [0, 0, 5]\n"));
 }
+
+/// `scnc sweep` of a light-transport scene measures the samples ladder: a table whose
+/// error falls rung by rung, a CSV and a chart; a reference of the wrong size is refused.
+#[test]
+fn the_sweep_of_a_light_transport_scene_is_a_samples_ladder() {
+    use crate::support::{ok, refused, scnc};
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("sweep");
+    let out_s = out.to_str().expect("utf-8");
+    let cornell = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/light/cornell.scn");
+    let small = ["--width", "8", "--height", "8", "--most-samples", "64"];
+    let mut args = vec!["sweep", cornell, "-o", out_s];
+    args.extend_from_slice(&small);
+    ok(&scnc(&args));
+    let csv = std::fs::read_to_string(out.join("samples.csv")).expect("samples.csv");
+    let errors: Vec<f64> =
+        csv.lines().skip(1).map(|l| l.split(',').nth(2).expect("a column").parse().expect("a number")).collect();
+    assert_eq!(errors.len(), 4, "1, 4, 16 and 64 samples: {csv}");
+    assert!(errors.windows(2).all(|w| w[1] < w[0]), "the error falls rung by rung: {csv}");
+    assert!(std::fs::read_to_string(out.join("samples.md")).expect("samples.md").contains("Fitted slope"));
+    assert!(std::fs::metadata(out.join("time-vs-error.png")).expect("the chart").len() > 1000);
+    // A reference of another size.
+    let wrong = dir.path().join("wrong.exr");
+    ok(&scnc(&[
+        "render",
+        cornell,
+        "-o",
+        wrong.to_str().expect("utf-8"),
+        "--width",
+        "4",
+        "--height",
+        "4",
+        "--samples",
+        "1",
+    ]));
+    args.extend(["--reference", wrong.to_str().expect("utf-8")]);
+    refused(&scnc(&args), 1, "the sweep renders 8×8");
+}

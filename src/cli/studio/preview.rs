@@ -381,8 +381,11 @@ fn converge(
         let done = total * 2;
         // The pass's estimate for its own samples, scaled to all of them (the error of a
         // mean falls as the root of its samples).
-        let pass_noise = c.noise_ppm as f64 / c.noise_pixels.max(1) as f64 / 1e6;
-        let noise = pass_noise * (f64::from(total) / f64::from(done)).sqrt();
+        // A pass of one sample a pixel has no estimate.
+        let noise = (c.noise_pixels > 0).then(|| {
+            let pass_noise = c.noise_ppm as f64 / c.noise_pixels as f64 / 1e6;
+            100.0 * pass_noise * (f64::from(total) / f64::from(done)).sqrt()
+        });
         let mean: Vec<u8> = sums.iter().flat_map(|s| (s / done as f32).to_ne_bytes()).collect();
         let shown = Image { width: frame.width, height: frame.height, depth: frame.bit_depth, pixels: mean };
         send_band(out, 0, &shown.tone_mapped(frame))?;
@@ -391,7 +394,7 @@ fn converge(
             out,
             b'P',
             serde_json::json!({
-                "samples": total, "noise_percent": noise * 100.0,
+                "samples": total, "noise_percent": noise,
                 "seconds": started.elapsed().as_secs_f64(),
             }),
         )?;

@@ -103,6 +103,9 @@ pub struct Transport {
 impl Transport {
     /// The lights of `scene` in render space, for a scene whose effect set has light
     /// transport with `bounces`.
+    ///
+    /// Long because it is one match over the light kinds, each converted to render space
+    /// and to radiance, then the glowing objects' bounding spheres and the source list.
     pub fn new(scene: &ir::Scene, effects: &Effects, bounces: u32) -> Transport {
         let origin = scene.camera.position;
         let at = |p: DVec3| (p - origin).as_vec3a();

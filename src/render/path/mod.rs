@@ -133,8 +133,11 @@ pub(super) fn block(
                     _ => break,
                 }
             }
-            c.noise_pixels += 1;
-            c.noise_ppm += (f64::from(p.relative_error(t.exposure)) * 1e6).min(1e12) as u64;
+            c.path_pixels += 1;
+            if p.count >= 2 {
+                c.noise_pixels += 1;
+                c.noise_ppm += (f64::from(p.relative_error(t.exposure)) * 1e6).min(1e12) as u64;
+            }
             out[(4 * dy + dx) as usize] = sums;
         }
     }
@@ -412,57 +415,12 @@ fn sample_light(
     };
     let dir = match source {
         Source::Delta(i) => {
-            let d = &t.deltas[i];
-            let (dir, dist, irradiance) = match d.light {
-                ShadeLight::Point { position, intensity } => {
-                    let to = position - origin;
-                    let dist = to.length();
-                    if dist <= 0.0 {
-                        return Vec3A::ZERO;
-                    }
-                    (to / dist, dist, intensity / (dist * dist))
-                }
-                ShadeLight::Directional { towards, intensity } => (towards, f32::INFINITY, intensity),
-            };
-            let f = bsdf.eval(view, dir);
-            if f == Vec3A::ZERO {
-                return Vec3A::ZERO;
-            }
-            if d.shadows {
-                c.light_rays += 1;
-                let blocked = g.occluded(&light_ray(dir, dist.min(frame.max_distance)), c);
-                if blocked {
-                    return Vec3A::ZERO;
-                }
-            }
-            return f * (normal.dot(dir) * irradiance / chance);
+            return delta_light(g, frame, &t.deltas[i], bsdf, view, &light_ray, origin, c) / chance;
         }
-        Source::Rect(i) => {
-            let r = &t.rects[i];
-            let p = r.centre + r.u * (2.0 * u1 - 1.0) + r.v * (2.0 * u2 - 1.0);
-            let to = p - origin;
-            let len = to.length();
-            if len <= 0.0 {
-                return Vec3A::ZERO;
-            }
-            to / len
-        }
-        Source::Ball(i) => {
-            let b = &t.balls[i];
-            match lights::cone(b, origin) {
-                None => uniform_sphere((u1, u2)),
-                Some((cos_max, axis)) => {
-                    let one_minus = lights::cone_solid_angle(b, origin, cos_max) / std::f32::consts::TAU;
-                    let x = u1 * one_minus;
-                    let cos = 1.0 - x;
-                    let sin = (x * (2.0 - x)).max(0.0).sqrt();
-                    let phi = std::f32::consts::TAU * u2;
-                    let (bt, bb) = bsdf::basis(axis);
-                    (bt * (sin * phi.cos()) + bb * (sin * phi.sin()) + axis * cos).normalize()
-                }
-            }
-        }
-        Source::Environment => bsdf::cosine(normal, (u1, u2)).0,
+        other => match light_direction(t, other, origin, normal, (u1, u2)) {
+            Some(dir) => dir,
+            None => return Vec3A::ZERO,
+        },
     };
     let f = bsdf.eval(view, dir);
     if f == Vec3A::ZERO {
@@ -489,6 +447,78 @@ fn sample_light(
         return Vec3A::ZERO;
     }
     f * le * (normal.dot(dir) * power(p_light, bsdf.pdf(view, dir)) / p_light)
+}
+
+/// A direction from `origin` towards a source that is not a delta light: a point of a
+/// rectangle drawn by area, a direction uniform in a sphere's cone (or over all
+/// directions from inside it), or cosine-weighted about `normal` for the environment.
+fn light_direction(t: &Transport, source: Source, origin: Vec3A, normal: Vec3A, (u1, u2): (f32, f32)) -> Option<Vec3A> {
+    Some(match source {
+        Source::Rect(i) => {
+            let r = &t.rects[i];
+            let p = r.centre + r.u * (2.0 * u1 - 1.0) + r.v * (2.0 * u2 - 1.0);
+            let to = p - origin;
+            let len = to.length();
+            if len <= 0.0 {
+                return None;
+            }
+            to / len
+        }
+        Source::Ball(i) => {
+            let b = &t.balls[i];
+            match lights::cone(b, origin) {
+                None => uniform_sphere((u1, u2)),
+                Some((cos_max, axis)) => {
+                    let one_minus = lights::cone_solid_angle(b, origin, cos_max) / std::f32::consts::TAU;
+                    let x = u1 * one_minus;
+                    let cos = 1.0 - x;
+                    let sin = (x * (2.0 - x)).max(0.0).sqrt();
+                    let phi = std::f32::consts::TAU * u2;
+                    let (bt, bb) = bsdf::basis(axis);
+                    (bt * (sin * phi.cos()) + bb * (sin * phi.sin()) + axis * cos).normalize()
+                }
+            }
+        }
+        Source::Environment => bsdf::cosine(normal, (u1, u2)).0,
+        Source::Delta(_) => return None,
+    })
+}
+
+/// The light from one delta light (a point or a directional light), over a shadow ray
+/// when it casts shadows: `f·cos·E` for its irradiance `E` at the point.
+#[allow(clippy::too_many_arguments, reason = "the shading state a light ray starts from")]
+fn delta_light(
+    g: &dyn Geometry,
+    frame: &Frame,
+    d: &lights::Delta,
+    bsdf: &Bsdf,
+    view: Vec3A,
+    light_ray: &dyn Fn(Vec3A, f32) -> Ray,
+    origin: Vec3A,
+    c: &mut Counters,
+) -> Vec3A {
+    let (dir, dist, irradiance) = match d.light {
+        ShadeLight::Point { position, intensity } => {
+            let to = position - origin;
+            let dist = to.length();
+            if dist <= 0.0 {
+                return Vec3A::ZERO;
+            }
+            (to / dist, dist, intensity / (dist * dist))
+        }
+        ShadeLight::Directional { towards, intensity } => (towards, f32::INFINITY, intensity),
+    };
+    let f = bsdf.eval(view, dir);
+    if f == Vec3A::ZERO {
+        return Vec3A::ZERO;
+    }
+    if d.shadows {
+        c.light_rays += 1;
+        if g.occluded(&light_ray(dir, dist.min(frame.max_distance)), c) {
+            return Vec3A::ZERO;
+        }
+    }
+    f * (bsdf.normal.dot(dir) * irradiance)
 }
 
 /// A direction uniform over the unit sphere.

@@ -209,7 +209,8 @@ async function render(sourceText, opts = {}) {
           canvas.dataset.samples = String(p.samples);
           $("busy").hidden = true;
           $("note").textContent =
-            `converging: ${p.samples} samples a pixel, estimated noise ${p.noise_percent.toFixed(2)} % ` +
+            `converging: ${p.samples} samples a pixel, estimated noise ` +
+            `${p.noise_percent === null ? "—" : p.noise_percent.toFixed(2) + " %"} ` +
             `(${p.seconds.toFixed(1)} s); an edit starts again`;
           break;
         }
