@@ -125,23 +125,14 @@ pub(crate) fn is_exr(path: &Path) -> bool {
     extension_is(path, "exr")
 }
 
-/// Writes a float image (linear radiance) as OpenEXR, 32-bit float RGB, whole or not at
-/// all: through the `image` crate's codec (the `exr` crate), which the OpenEXR
-/// reference tools and Mitsuba read.
+/// Writes a float image (linear radiance) as OpenEXR, 32-bit float RGB, uncompressed,
+/// whole or not at all (`cli::exr`; Mitsuba's reader reads it back exactly).
 pub(crate) fn write_exr(path: &Path, image: &scnc::render::Image) -> std::io::Result<()> {
     if image.depth != BitDepth::Float {
         return Err(std::io::Error::other("an OpenEXR image holds float samples"));
     }
     let values: Vec<f32> = image.pixels.chunks_exact(4).map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]])).collect();
-    let buffer = image::Rgb32FImage::from_raw(image.width, image.height, values)
-        .ok_or_else(|| std::io::Error::other("the image's size and pixels disagree"))?;
-    write_atomic(path, ".exr.tmp", |w| {
-        let mut bytes = std::io::Cursor::new(Vec::new());
-        image::DynamicImage::ImageRgb32F(buffer)
-            .write_to(&mut bytes, image::ImageFormat::OpenExr)
-            .map_err(std::io::Error::other)?;
-        w.write_all(bytes.get_ref())
-    })
+    super::exr::write(path, image.width, image.height, &values)
 }
 
 /// The usage error for an output path that names a directory or a file in a directory

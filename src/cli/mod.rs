@@ -10,6 +10,7 @@
 
 mod encode;
 mod export;
+mod exr;
 mod files;
 mod fmt;
 mod frames;

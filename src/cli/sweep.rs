@@ -206,18 +206,12 @@ fn samples_sweep(args: &SweepArgs, scene: &scnc::ir::Scene, map: &scnc::source::
 /// A reference image: an OpenEXR file of `width × height`, as linear float RGB.
 fn read_reference(path: &Path, width: u32, height: u32) -> Result<Vec<f32>, String> {
     let cannot = |e: &dyn std::fmt::Display| format!("cannot read the reference `{}`: {e}", path.display());
-    let mut reader = image::ImageReader::open(path).map_err(|e| cannot(&e))?;
-    reader.limits(image::Limits::default());
-    let img = reader.with_guessed_format().map_err(|e| cannot(&e))?.decode().map_err(|e| cannot(&e))?;
-    if (img.width(), img.height()) != (width, height) {
-        return Err(format!(
-            "the reference `{}` is {}×{}, the sweep renders {width}×{height}",
-            path.display(),
-            img.width(),
-            img.height()
-        ));
+    let bytes = std::fs::read(path).map_err(|e| cannot(&e))?;
+    let (w, h, rgb) = super::exr::decode(&bytes, scnc::check::MAX_PIXELS).map_err(|e| cannot(&e))?;
+    if (w, h) != (width, height) {
+        return Err(format!("the reference `{}` is {w}×{h}, the sweep renders {width}×{height}", path.display()));
     }
-    Ok(img.to_rgb32f().into_raw())
+    Ok(rgb)
 }
 
 /// A time cap from 0.01 to 3600 seconds.
