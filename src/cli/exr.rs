@@ -9,8 +9,6 @@
 //! table of each scanline's offset, then per scanline its `y`, its byte count and its
 //! channels one after another, in the channel list's alphabetical order (B, G, R).
 
-use std::path::Path;
-
 const MAGIC: [u8; 4] = [0x76, 0x2f, 0x31, 0x01];
 /// Version 2, single-part scanline, short names.
 const VERSION: [u8; 4] = [2, 0, 0, 0];
@@ -68,12 +66,6 @@ pub(crate) fn encode(width: u32, height: u32, rgb: &[f32]) -> Vec<u8> {
         }
     }
     out
-}
-
-/// Writes `rgb` as an OpenEXR file, whole or not at all.
-pub(crate) fn write(path: &Path, width: u32, height: u32, rgb: &[f32]) -> std::io::Result<()> {
-    let bytes = encode(width, height, rgb);
-    super::files::write_atomic(path, ".exr.tmp", |w| w.write_all(&bytes))
 }
 
 /// A reader over a file's bytes that fails instead of running past the end.

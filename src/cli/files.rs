@@ -132,7 +132,8 @@ pub(crate) fn write_exr(path: &Path, image: &scnc::render::Image) -> std::io::Re
         return Err(std::io::Error::other("an OpenEXR image holds float samples"));
     }
     let values: Vec<f32> = image.pixels.chunks_exact(4).map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]])).collect();
-    super::exr::write(path, image.width, image.height, &values)
+    let bytes = super::exr::encode(image.width, image.height, &values);
+    write_atomic(path, ".exr.tmp", |w| w.write_all(&bytes))
 }
 
 /// The usage error for an output path that names a directory or a file in a directory

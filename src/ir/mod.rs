@@ -14,6 +14,7 @@ mod dump;
 pub mod field;
 mod materials;
 mod paint;
+mod view;
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -28,8 +29,9 @@ pub use bounds::{
 };
 pub use dump::dump;
 pub(crate) use dump::{num as dump_num, vec as dump_vec};
-pub use materials::materials_of;
+pub use materials::{materials_of, Material};
 pub use paint::{Paint, Pattern, PatternKind};
+pub use view::{Camera, ColorSpace, Light, LightKind, Settings, DEFAULT_BOUNCES, SEED_FOV};
 
 use crate::span::Span;
 
@@ -47,228 +49,6 @@ pub struct Scene {
     /// The names `let` gave materials, by the span of their `material(…)` call (what
     /// exported files call them).
     pub material_names: Vec<(Span, String)>,
-}
-
-/// A pinhole camera.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Camera {
-    /// Eye position.
-    pub position: DVec3,
-    /// A point the camera looks at (never equal to `position`).
-    pub look_at: DVec3,
-    /// Up hint (never parallel to the view direction).
-    pub up: DVec3,
-    /// Vertical field of view in degrees, in (0, 180).
-    pub fov: f64,
-    /// Diameter of the thin lens (0: a pinhole, everything sharp); light transport only.
-    pub aperture: f64,
-    /// Distance along the view at which the lens focuses (`None`: at `look_at`).
-    pub focus_distance: Option<f64>,
-    /// The `camera` statement, if any.
-    pub span: Option<Span>,
-}
-
-/// The study's vertical field of view: a 1×1 viewport at distance 1, `2·atan(0.5)` in degrees.
-pub const SEED_FOV: f64 = 53.13010235415598;
-
-impl Default for Camera {
-    fn default() -> Camera {
-        Camera {
-            position: DVec3::ZERO,
-            look_at: DVec3::Z,
-            up: DVec3::Y,
-            fov: SEED_FOV,
-            aperture: 0.0,
-            focus_distance: None,
-            span: None,
-        }
-    }
-}
-
-/// Image size and tracer knobs from `render(…)`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Settings {
-    /// Image width in pixels.
-    pub width: u32,
-    /// Image height in pixels.
-    pub height: u32,
-    /// Reflection recursion depth (0 = no reflection rays).
-    pub depth: u32,
-    /// Background colour, 0–255 per channel.
-    pub background: DVec3,
-    /// Sphere-tracing hit threshold, relative to the distance travelled (see `sdf`).
-    pub epsilon: f64,
-    /// Sphere-tracing step budget per ray.
-    pub max_steps: u32,
-    /// Far limit of every ray.
-    pub max_distance: f64,
-    /// Samples per pixel (antialiasing), a perfect square is not required.
-    pub samples: u32,
-    /// Reach of ambient occlusion in world units (0 = off).
-    pub ambient_occlusion: f64,
-    /// How colours are read and pixels written.
-    pub color: ColorSpace,
-    /// Frames of the animation (1: a still).
-    pub frames: u32,
-    /// Frames per second, for encoding an animation.
-    pub fps: f64,
-    /// Whether the animation loops: then `clock` stops one frame short of 1, so the frame
-    /// after the last would be the first again.
-    pub cyclic: bool,
-    /// Surface interactions of a light-transport path after the camera ray (`None`: not
-    /// given; a scene lit by light transport then takes [`DEFAULT_BOUNCES`]).
-    pub bounces: Option<u32>,
-    /// Exposure in stops: light-transport pixels are scaled by `2^exposure` before the
-    /// tone map.
-    pub exposure: f64,
-    /// Adaptive sampling under light transport: each pixel takes samples until its
-    /// estimated relative error is below this (`samples` is then the most it takes).
-    pub noise: Option<f64>,
-    /// The `render` statement, if any.
-    pub span: Option<Span>,
-}
-
-impl Default for Settings {
-    fn default() -> Settings {
-        Settings {
-            width: 500,
-            height: 500,
-            depth: 5,
-            background: DVec3::splat(245.0),
-            epsilon: 1e-4,
-            max_steps: 512,
-            max_distance: 1000.0,
-            samples: 1,
-            ambient_occlusion: 0.0,
-            color: ColorSpace::Linear,
-            frames: 1,
-            fps: 24.0,
-            cyclic: false,
-            bounces: None,
-            exposure: 0.0,
-            noise: None,
-            span: None,
-        }
-    }
-}
-
-/// Bounces of a scene lit by light transport that does not give `render(bounces = …)`.
-pub const DEFAULT_BOUNCES: u32 = 8;
-
-/// How colours are read and pixels written (`render(color = …)`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ColorSpace {
-    /// The study's: colours are shaded as written and pixels are those numbers, 0–255.
-    Linear,
-    /// Colours are sRGB-encoded (as colour pickers give them): decoded to linear light
-    /// for shading, and pixels are encoded back to sRGB.
-    Srgb,
-}
-
-impl ColorSpace {
-    /// The name `render(color = …)` takes.
-    pub fn name(self) -> &'static str {
-        match self {
-            ColorSpace::Linear => "linear",
-            ColorSpace::Srgb => "srgb",
-        }
-    }
-}
-
-/// A surface material: the study's Phong terms, and a transparent medium behind the
-/// surface when `transparency` > 0.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Material {
-    /// Colour, 0–255 per channel, or a pattern.
-    pub color: Paint,
-    /// Phong exponent; `None` for no highlight (the study's −1).
-    pub specular: Option<f64>,
-    /// Reflectivity in [0, 1].
-    pub reflective: f64,
-    /// The share of light passing into the surface, in [0, 1] (0 = opaque).
-    pub transparency: f64,
-    /// Index of refraction of the medium inside, in [1, 10] (1 = air: no bending).
-    pub ior: f64,
-    /// Beer–Lambert absorption inside, per unit of distance, per channel, ≥ 0.
-    pub absorption: DVec3,
-    /// The colour a surface glows with, 0–255 per channel: under light transport it
-    /// emits this (255 is radiance 1) times `emission_strength`.
-    pub emission: DVec3,
-    /// What the emission colour is multiplied by.
-    pub emission_strength: f64,
-    /// The `material(…)` call.
-    pub span: Span,
-}
-
-impl Material {
-    /// The colour of an object with no material anywhere above it: light grey, matte.
-    pub fn default_grey() -> Material {
-        Material {
-            color: Paint::Solid(DVec3::splat(200.0)),
-            specular: None,
-            reflective: 0.0,
-            transparency: 0.0,
-            ior: 1.0,
-            absorption: DVec3::ZERO,
-            emission: DVec3::ZERO,
-            emission_strength: 1.0,
-            span: Span::default(),
-        }
-    }
-
-    /// Whether light passes through the surface (refraction rays are traced).
-    pub fn is_transparent(&self) -> bool {
-        self.transparency > 0.0
-    }
-
-    /// Whether the surface glows (and so is a light under light transport).
-    pub fn emits(&self) -> bool {
-        self.emission.max_element() > 0.0 && self.emission_strength > 0.0
-    }
-}
-
-/// What kind of light.
-#[derive(Clone, Debug, PartialEq)]
-pub enum LightKind {
-    /// Lights every point equally.
-    Ambient,
-    /// A point light.
-    Point {
-        /// Where it is.
-        position: DVec3,
-    },
-    /// A light at infinity.
-    Directional {
-        /// Direction *towards* the light (non-zero, not normalised, as written).
-        towards: DVec3,
-    },
-    /// A rectangle of light `centre ± u ± v`, emitting from its front, the side
-    /// `u × v` points to (−y before `rotate`).
-    Area {
-        /// Its centre.
-        centre: DVec3,
-        /// Half its width, as a vector along the rectangle.
-        u: DVec3,
-        /// Half its height, as a vector along the rectangle.
-        v: DVec3,
-    },
-    /// Light arriving equally from every direction, seen where rays escape.
-    Environment,
-}
-
-/// A light.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Light {
-    /// Its kind and placement.
-    pub kind: LightKind,
-    /// Intensity, ≥ 0.
-    pub intensity: f64,
-    /// Whether it casts shadows (`shadows = false` opts out).
-    pub shadows: bool,
-    /// Radius for soft shadows (0 = hard).
-    pub radius: f64,
-    /// The light's expression.
-    pub span: Span,
 }
 
 /// One `object` statement.
