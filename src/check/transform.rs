@@ -66,21 +66,14 @@ impl Ctx<'_> {
                     let r = rotation(*deg);
                     placed(ir::LightKind::Area { centre: r * *centre, u: r * *u, v: r * *v })
                 }
-                (TransformOp::At, ir::LightKind::Point { .. } | ir::LightKind::Area { .. }, other) => {
+                (TransformOp::At, ir::LightKind::Point { .. } | ir::LightKind::Area { .. }, other)
+                | (TransformOp::Rotate, ir::LightKind::Area { .. }, other) => {
+                    let label = if op == TransformOp::At { "a position is a `vec3`" } else { "angles are a `vec3` of degrees" };
                     self.report(Diagnostic::error(
                         codes::TYPE_MISMATCH,
                         arg_span,
                         format!("expected `vec3`, found `{}`", other.ty_name()),
-                        "a position is a `vec3`",
-                    ));
-                    Value::Error
-                }
-                (TransformOp::Rotate, ir::LightKind::Area { .. }, other) => {
-                    self.report(Diagnostic::error(
-                        codes::TYPE_MISMATCH,
-                        arg_span,
-                        format!("expected `vec3`, found `{}`", other.ty_name()),
-                        "angles are a `vec3` of degrees",
+                        label,
                     ));
                     Value::Error
                 }

@@ -131,7 +131,7 @@ pub(crate) fn write_exr(path: &Path, image: &scnc::render::Image) -> std::io::Re
     if image.depth != BitDepth::Float {
         return Err(std::io::Error::other("an OpenEXR image holds float samples"));
     }
-    let values: Vec<f32> = image.pixels.chunks_exact(4).map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]])).collect();
+    let values = image.floats();
     let bytes = super::exr::encode(image.width, image.height, &values);
     write_atomic(path, ".exr.tmp", |w| w.write_all(&bytes))
 }

@@ -116,14 +116,19 @@ impl Image {
         if self.depth != BitDepth::Float {
             return self.clone();
         }
-        let mut shown = Frame { bit_depth: BitDepth::Eight, ..frame.clone() };
-        shown.transport = None;
         let mut pixels = Vec::with_capacity(self.width as usize * self.height as usize * 3);
-        for p in self.pixels.chunks_exact(12) {
-            let c = |i: usize| f32::from_ne_bytes([p[i], p[i + 1], p[i + 2], p[i + 3]]) * 255.0;
-            encode(Vec3A::new(c(0), c(4), c(8)), &shown, &mut pixels);
+        for c in self.floats().chunks_exact(3) {
+            encode_as(Vec3A::new(c[0], c[1], c[2]) * 255.0, frame.color, BitDepth::Eight, &mut pixels);
         }
         Image { width: self.width, height: self.height, depth: BitDepth::Eight, pixels }
+    }
+
+    /// A float image's values, three a pixel (empty for any other depth).
+    pub fn floats(&self) -> Vec<f32> {
+        if self.depth != BitDepth::Float {
+            return Vec::new();
+        }
+        self.pixels.chunks_exact(4).map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]])).collect()
     }
 }
 

@@ -50,12 +50,7 @@ fn render(
     frame.bit_depth = BitDepth::Float;
     let started = std::time::Instant::now();
     let (image, counters) = crate::render::render(&world, &frame, &|| {});
-    Ok((floats(&image), started.elapsed().as_secs_f64(), counters))
-}
-
-/// A float image's values.
-pub fn floats(image: &Image) -> Vec<f32> {
-    image.pixels.chunks_exact(4).map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]])).collect()
+    Ok((image.floats(), started.elapsed().as_secs_f64(), counters))
 }
 
 /// Renders each rung of `rungs` and measures it against `reference` (float radiance of

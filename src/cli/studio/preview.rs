@@ -358,10 +358,7 @@ fn converge(
     out: &mut Stream,
     current: &Wanted,
 ) -> std::io::Result<()> {
-    let floats = |img: &Image| -> Vec<f32> {
-        img.pixels.chunks_exact(4).map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]])).collect()
-    };
-    let mut sums = floats(first);
+    let mut sums = first.floats();
     let mut total = 1u32;
     let full = PixelRect::full(frame.width, frame.height);
     let started = Instant::now();
@@ -375,7 +372,7 @@ fn converge(
         let rendered =
             studio.preview.pool.install(|| scnc::render::render_region_until(world, &pass, full, &|| {}, &stop));
         let Some((image, c)) = rendered else { return out.message(b'X', b"{}") };
-        for (s, v) in sums.iter_mut().zip(floats(&image)) {
+        for (s, v) in sums.iter_mut().zip(image.floats()) {
             *s += v * total as f32;
         }
         let done = total * 2;

@@ -114,8 +114,8 @@ pub(super) fn block(
             // enough: powers of two keep every pair of the sampler stratified.
             let mut target = if t.noise.is_some() { ADAPTIVE_FIRST.min(most) } else { most };
             loop {
-                while p.count < target {
-                    let mut sampler = Sampler::new(pixel, t.first_sample.wrapping_add(p.count));
+                while sums.count < target {
+                    let mut sampler = Sampler::new(pixel, t.first_sample.wrapping_add(sums.count));
                     let ray = camera_ray(frame, t, (px, py), &mut sampler);
                     c.primary_rays += 1;
                     let mut l = radiance(g, frame, t, ray, &mut sampler, c);
@@ -127,16 +127,16 @@ pub(super) fn block(
                     sums.add(l);
                 }
                 match t.noise {
-                    Some(eps) if p.count < most && p.relative_error(t.exposure) > eps => {
+                    Some(eps) if sums.count < most && p.relative_error(sums.count, t.exposure) > eps => {
                         target = target.saturating_mul(2).min(most);
                     }
                     _ => break,
                 }
             }
             c.path_pixels += 1;
-            if p.count >= 2 {
+            if sums.count >= 2 {
                 c.noise_pixels += 1;
-                c.noise_ppm += (f64::from(p.relative_error(t.exposure)) * 1e6).min(1e12) as u64;
+                c.noise_ppm += (f64::from(p.relative_error(sums.count, t.exposure)) * 1e6).min(1e12) as u64;
             }
             out[(4 * dy + dx) as usize] = sums;
         }
@@ -147,29 +147,27 @@ pub(super) fn block(
 /// Samples adaptive sampling takes before it first estimates a pixel's error.
 pub const ADAPTIVE_FIRST: u32 = 16;
 
-/// One pixel's samples so far for the error estimate: their count, and their
-/// luminance's sum and sum of squares (in f64: a sum of squares over a million samples
-/// in f32 would lose the variance).
+/// One pixel's samples so far for the error estimate: their luminance's sum and sum of
+/// squares (in f64: a sum of squares over a million samples in f32 would lose the
+/// variance).
 #[derive(Default)]
 struct Noise {
-    count: u32,
     y: f64,
     y2: f64,
 }
 
 impl Noise {
     fn add(&mut self, l: Vec3A) {
-        self.count += 1;
         let y = f64::from(l.dot(Vec3A::new(0.2126, 0.7152, 0.0722)));
         self.y += y;
         self.y2 += y * y;
     }
 
-    /// The standard error of the mean luminance over the mean, the mean taken as at
+    /// The standard error of the mean luminance of `count` samples over the mean, the mean taken as at
     /// least 1/256 of white after `exposure` (darker, the error counts as absolute: a
     /// black pixel's noise is what shows, not its ratio to nothing).
-    fn relative_error(&self, exposure: f32) -> f32 {
-        let n = f64::from(self.count);
+    fn relative_error(&self, count: u32, exposure: f32) -> f32 {
+        let n = f64::from(count);
         if n < 2.0 {
             return f32::INFINITY;
         }
