@@ -21,6 +21,8 @@ pub struct Compiled {
     root: Option<source::FileId>,
     /// The files and parses later evaluations ([`Compiled::at`]) reuse.
     reuse: check::Reuse,
+    /// The parameters' values given from outside, for every evaluation.
+    overrides: check::Overrides,
 }
 
 impl Compiled {
@@ -29,7 +31,7 @@ impl Compiled {
     /// spans point into `map`. Returns the scene, or `None`, and that frame's diagnostics.
     pub fn at(&mut self, time: check::Time, loader: &dyn Loader) -> (Option<ir::Scene>, Vec<Diagnostic>) {
         match self.root {
-            Some(root) => check::check_at(&mut self.map, root, loader, time, &mut self.reuse),
+            Some(root) => check::check_at(&mut self.map, root, loader, time, &mut self.reuse, &self.overrides),
             None => (None, self.diagnostics.clone()),
         }
     }
@@ -71,6 +73,17 @@ impl Compiled {
 /// over [`source::MAX_FILE_BYTES`] is refused whatever it came from (a file, or an
 /// editor's open document).
 pub fn compile_source(name: &str, path: &Path, text: String, loader: &dyn Loader) -> Compiled {
+    compile_source_with(name, path, text, loader, check::Overrides::default())
+}
+
+/// [`compile_source`] with the scene's parameters set by `overrides`.
+pub fn compile_source_with(
+    name: &str,
+    path: &Path,
+    text: String,
+    loader: &dyn Loader,
+    overrides: check::Overrides,
+) -> Compiled {
     let mut map = SourceMap::new();
     let bytes = text.len();
     let root = if bytes > source::MAX_FILE_BYTES { None } else { map.add(name, path, text) };
@@ -84,11 +97,18 @@ pub fn compile_source(name: &str, path: &Path, text: String, loader: &dyn Loader
             format!("the file has {bytes} bytes"),
         )
         .with_note(format!("a source file may have at most {} MiB", source::MAX_FILE_BYTES >> 20));
-        return Compiled { map, scene: None, diagnostics: vec![d], root: None, reuse: check::Reuse::default() };
+        return Compiled {
+            map,
+            scene: None,
+            diagnostics: vec![d],
+            root: None,
+            reuse: check::Reuse::default(),
+            overrides,
+        };
     };
     let mut reuse = check::Reuse::default();
-    let (scene, diagnostics) = check::check_at(&mut map, root, loader, check::Time::STILL, &mut reuse);
-    Compiled { map, scene, diagnostics, root: Some(root), reuse }
+    let (scene, diagnostics) = check::check_at(&mut map, root, loader, check::Time::STILL, &mut reuse, &overrides);
+    Compiled { map, scene, diagnostics, root: Some(root), reuse, overrides }
 }
 
 /// The stack of the thread compiles run on: deep enough for every nesting the limits in
@@ -149,8 +169,23 @@ pub fn with_big_stack<T: Send>(f: impl FnOnce() -> T + Send) -> Result<T, NoThre
 /// [`compile_source`] on a thread of [`COMPILER_STACK`]; when the thread cannot be had,
 /// the file with that error (E0709) and no scene.
 pub fn compile_file(name: &str, path: &Path, text: String, loader: &(dyn Loader + Sync)) -> Compiled {
-    with_big_stack_on(text, |text| compile_source(name, path, text, loader)).unwrap_or_else(|(e, text)| {
-        let (map, d) = e.in_file(name, path, text);
-        Compiled { map, scene: None, diagnostics: vec![d], root: None, reuse: check::Reuse::default() }
-    })
+    compile_file_with(name, path, text, loader, check::Overrides::default())
+}
+
+/// [`compile_file`] with the scene's parameters set by `overrides`.
+pub fn compile_file_with(
+    name: &str,
+    path: &Path,
+    text: String,
+    loader: &(dyn Loader + Sync),
+    overrides: check::Overrides,
+) -> Compiled {
+    let kept = overrides.clone();
+    with_big_stack_on(text, |text| compile_source_with(name, path, text, loader, overrides)).unwrap_or_else(
+        |(e, text)| {
+            let (map, d) = e.in_file(name, path, text);
+            let reuse = check::Reuse::default();
+            Compiled { map, scene: None, diagnostics: vec![d], root: None, reuse, overrides: kept }
+        },
+    )
 }

@@ -342,6 +342,10 @@ pub mod codes {
     pub const NOT_A_LIGHT: &str = "E0502";
     /// An animation's frame count, rate or looping differ between its frames.
     pub const ANIMATION_CHANGES: &str = "E0503";
+    /// A `param` declared where it cannot be, or with a default, range or step it cannot have.
+    pub const BAD_PARAM: &str = "E0504";
+    /// A value given for a parameter (`-D`, a parameter set, the studio) that it cannot take.
+    pub const BAD_PARAM_VALUE: &str = "E0505";
     /// Included file cannot be read.
     pub const INCLUDE_READ: &str = "E0600";
     /// Include cycle.

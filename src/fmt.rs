@@ -56,7 +56,14 @@ struct Formatter<'t> {
 /// which the callers tell by the bracket depth.
 fn starts_statement(t: &Token<'_>, prev: Option<&Token<'_>>) -> bool {
     match t {
-        Token::Let | Token::Object | Token::Light | Token::Camera | Token::Render | Token::For | Token::Include => true,
+        Token::Let
+        | Token::Param
+        | Token::Object
+        | Token::Light
+        | Token::Camera
+        | Token::Render
+        | Token::For
+        | Token::Include => true,
         Token::If => prev.is_none_or(|p| matches!(p, Token::LBrace | Token::RBrace)) || !operand_expected(prev),
         _ => false,
     }

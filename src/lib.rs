@@ -47,6 +47,7 @@ pub mod fmt;
 pub mod geom;
 pub mod ir;
 pub mod lsp;
+pub mod measure;
 pub mod mesh;
 pub mod meshfile;
 pub mod primitive;
@@ -61,5 +62,6 @@ pub mod trace;
 pub mod world;
 
 pub use compile::{
-    compile_file, compile_source, with_big_stack, with_big_stack_on, Compiled, NoThread, COMPILER_STACK,
+    compile_file, compile_file_with, compile_source, compile_source_with, with_big_stack, with_big_stack_on, Compiled,
+    NoThread, COMPILER_STACK,
 };

@@ -19,6 +19,7 @@ mod expr;
 mod field;
 mod include;
 pub mod index;
+mod param;
 mod range;
 mod scene;
 mod time;
@@ -40,6 +41,7 @@ use crate::source::{FileId, Loader, SourceMap};
 use crate::span::Span;
 use crate::syntax::ast;
 use env::{Binding, Captured, Env, Found};
+pub use param::{Override, Overrides};
 pub use range::{MAX_INTENSITY, MAX_REACH, MIN_SIZE};
 pub use time::{Reuse, Time};
 
@@ -123,6 +125,10 @@ struct Ctx<'a> {
     env: Env,
     /// The environments of the callers of the calls in progress, innermost last.
     outer: Vec<Env>,
+    /// Values given to the scene's parameters from outside its file.
+    overrides: &'a Overrides,
+    /// The `param`s declared so far.
+    params: Vec<ir::SceneParam>,
     /// `let` definitions by span, and whether each was ever used.
     lets: HashMap<Span, (String, bool)>,
     camera: Option<Camera>,
@@ -392,6 +398,7 @@ impl Ctx<'_> {
                     ix.set_params(name.span, names.iter().map(|n| n.to_string()).collect());
                 }
             }
+            ast::StmtKind::Param(p) => self.param(p, stmt.span),
             ast::StmtKind::Object(e) => {
                 let v = self.expr(e);
                 self.object(v, e, stmt.span);
@@ -550,6 +557,7 @@ struct Input<'a> {
     loader: &'a dyn Loader,
     time: Time,
     reuse: &'a mut Reuse,
+    overrides: &'a Overrides,
 }
 
 #[allow(clippy::type_complexity, reason = "the three results of one compile")]
@@ -558,7 +566,7 @@ fn run(
     indexed: bool,
     cancel: &dyn Fn() -> bool,
 ) -> Option<(Option<Scene>, Vec<Diagnostic>, Option<index::Index>)> {
-    let Input { map, root, loader, time, reuse } = input;
+    let Input { map, root, loader, time, reuse, overrides } = input;
     let dir: Rc<Path> = Rc::from(map.file(root).path.parent().unwrap_or(Path::new("")));
     let mut ctx = Ctx {
         map,
@@ -579,6 +587,8 @@ fn run(
         includes: 0,
         env: Env::default(),
         outer: Vec::new(),
+        overrides,
+        params: Vec::new(),
         lets: HashMap::new(),
         camera: None,
         settings: None,
@@ -605,6 +615,7 @@ fn run(
     };
     ctx.reuse.start();
     ctx.run_file(root);
+    ctx.unknown_overrides();
     if ctx.cancelled {
         return None;
     }
@@ -617,19 +628,21 @@ fn run(
 /// through `loader`. Returns the scene when there are no errors, and every diagnostic.
 /// The scene is a still, or the first frame of its animation (`clock` and `frame` are 0).
 pub fn check(map: &mut SourceMap, root: FileId, loader: &dyn Loader) -> (Option<Scene>, Vec<Diagnostic>) {
-    check_at(map, root, loader, Time::STILL, &mut Reuse::default())
+    check_at(map, root, loader, Time::STILL, &mut Reuse::default(), &Overrides::default())
 }
 
-/// [`check`] at `time`, reusing the files and parses of earlier evaluations of the same
-/// scene in `map` that `reuse` remembers (and remembering this one's).
+/// [`check`] at `time`, its parameters set by `overrides`, reusing the files and parses
+/// of earlier evaluations of the same scene in `map` that `reuse` remembers (and
+/// remembering this one's).
 pub fn check_at(
     map: &mut SourceMap,
     root: FileId,
     loader: &dyn Loader,
     time: Time,
     reuse: &mut Reuse,
+    overrides: &Overrides,
 ) -> (Option<Scene>, Vec<Diagnostic>) {
-    let input = Input { map, root, loader, time, reuse };
+    let input = Input { map, root, loader, time, reuse, overrides };
     // Nothing cancels this compile, so there is always a result.
     run(input, false, &|| false).map(|(scene, diags, _)| (scene, diags)).unwrap_or_default()
 }
@@ -643,7 +656,8 @@ pub fn check_indexed(
     loader: &dyn Loader,
     cancel: &dyn Fn() -> bool,
 ) -> Option<(Option<Scene>, Vec<Diagnostic>, index::Index)> {
-    let input = Input { map, root, loader, time: Time::STILL, reuse: &mut Reuse::default() };
+    let none = Overrides::default();
+    let input = Input { map, root, loader, time: Time::STILL, reuse: &mut Reuse::default(), overrides: &none };
     let (scene, diags, index) = run(input, true, cancel)?;
     Some((scene, diags, index.unwrap_or_default()))
 }

@@ -217,6 +217,7 @@ impl Ctx<'_> {
             lights: self.lights,
             objects: self.objects,
             material_names,
+            params: self.params,
         };
         (Some(scene), diags)
     }

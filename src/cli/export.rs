@@ -9,7 +9,7 @@ use std::time::Instant;
 use clap::ValueEnum;
 
 use super::progress::Reading;
-use super::shared::{Accuracy, Meshing, Messages, Workers};
+use super::shared::{Accuracy, Meshing, Messages, Params, Workers};
 use scnc::diag::codes;
 use scnc::diag::Diagnostic;
 use scnc::export::report::MeshReport;
@@ -123,6 +123,8 @@ pub(crate) struct ExportArgs {
     workers: Workers,
     #[command(flatten)]
     messages: Messages,
+    #[command(flatten)]
+    params: Params,
 }
 
 /// Warnings about how a scene renders, which an export leaves out.
@@ -175,7 +177,9 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
         Ok(p) => p,
         Err(e) => return usage_error(&e),
     };
-    let Some(mut compiled) = compile(&args.file, args.messages.message_format) else { return ExitCode::from(1) };
+    let Some(mut compiled) = compile(&args.file, args.messages.message_format, &args.params) else {
+        return ExitCode::from(1);
+    };
     // What only a render sees (lights, the camera's view, a field's marching cost) is
     // not the export's business.
     compiled.diagnostics.retain(|d| d.is_error() || !RENDER_ONLY.contains(&d.code));

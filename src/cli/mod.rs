@@ -14,6 +14,7 @@ mod exr;
 mod files;
 mod fmt;
 mod frames;
+mod measure;
 mod merge;
 mod passes;
 mod progress;
@@ -61,6 +62,8 @@ enum Command {
         files: Vec<PathBuf>,
         #[command(flatten)]
         messages: shared::Messages,
+        #[command(flatten)]
+        params: shared::Params,
         /// Print nothing on success (no summary line).
         #[arg(long, short)]
         quiet: bool,
@@ -79,6 +82,9 @@ enum Command {
     /// Write the scene's objects as a mesh file (STL, OBJ, PLY, 3MF or glb), meshed as
     /// `render --geometry mesh` meshes them (written whole or not at all).
     Export(export::ExportArgs),
+    /// Measure each object: volume, centre of mass, bounding box and inertia as intervals
+    /// proved from its distance bound, beside its mesh's figures and surface area.
+    Measure(measure::MeasureArgs),
     /// Render a scene across a ladder of accuracy settings for both back-ends and write
     /// time, work, memory and error for each to DIR/sweep.csv and DIR/sweep.md.
     Sweep(SweepArgs),
@@ -99,6 +105,16 @@ enum Command {
         #[arg(long, short)]
         quiet: bool,
     },
+    /// Print the scene's parameters (its `param`s) as JSON: name, type, default, the
+    /// value `-D` or `--set-name` gives, range, step, choices, description and group.
+    Params {
+        /// The scene file.
+        file: PathBuf,
+        #[command(flatten)]
+        messages: shared::Messages,
+        #[command(flatten)]
+        params: shared::Params,
+    },
     /// Print the evaluated scene IR.
     Ir {
         /// The scene file.
@@ -108,42 +124,53 @@ enum Command {
         frame: u32,
         #[command(flatten)]
         messages: shared::Messages,
+        #[command(flatten)]
+        params: shared::Params,
     },
 }
 
-/// Reads and compiles a file. A file that cannot be read has no source to point into, so
-/// it is reported here, in the requested format, and `None` returned (exit 1).
-pub(crate) fn compile(path: &Path, format: MessageFormat) -> Option<Compiled> {
+/// Reads and compiles a file, its parameters set by `params`. A file that cannot be read
+/// has no source to point into, nor has a parameter-set file that cannot be read: either
+/// is reported here, in the requested format, and `None` returned (exit 1).
+pub(crate) fn compile(path: &Path, format: MessageFormat, params: &shared::Params) -> Option<Compiled> {
     let name = path.display().to_string();
+    let overrides = match params.overrides() {
+        Ok(o) => o,
+        Err(message) => {
+            let file = params.sets.as_deref().map_or(name.clone(), |p| p.display().to_string());
+            file_error(&file, scnc::diag::codes::BAD_PARAM_VALUE, &message, "the parameter sets", format);
+            return None;
+        }
+    };
     match FsLoader.read(path) {
-        Ok(text) => Some(scnc::compile_file(&name, path, text, &FsLoader)),
+        Ok(text) => Some(scnc::compile_file_with(&name, path, text, &FsLoader, overrides)),
         Err(e) => {
-            let code = scnc::diag::codes::INCLUDE_READ;
             let message = format!("cannot read `{name}`: {}", scnc::source::io_reason(&e));
-            let line = match format {
-                MessageFormat::Human => format!("error[{code}]: {message}"),
-                // The documented fields of every diagnostic: a file that cannot be read
-                // is blamed on a zero-length span at its start.
-                MessageFormat::Json => serde_json::json!({
-                    "severity": "error", "code": code, "message": message,
-                    "span": {
-                        "file": name, "byte_start": 0, "byte_end": 0, "line_start": 1, "column_start": 1,
-                        "line_end": 1, "column_end": 1, "label": "cannot be read",
-                    },
-                    "related": [], "notes": [], "hints": [], "fixes": [],
-                })
-                .to_string(),
-            };
-            match format {
-                MessageFormat::Human => {
-                    let _ = writeln!(std::io::stderr(), "{line}");
-                }
-                // Machine output goes to stdout, as cargo's and rustc's does.
-                MessageFormat::Json => {
-                    let _ = writeln!(std::io::stdout(), "{line}");
-                }
-            }
+            file_error(&name, scnc::diag::codes::INCLUDE_READ, &message, "cannot be read", format);
             None
+        }
+    }
+}
+
+/// Prints an error about a whole file (one that could not be read), blamed on a
+/// zero-length span at its start.
+fn file_error(name: &str, code: &str, message: &str, label: &str, format: MessageFormat) {
+    match format {
+        MessageFormat::Human => {
+            let _ = writeln!(std::io::stderr(), "error[{code}]: {message}");
+        }
+        // The documented fields of every diagnostic. Machine output goes to stdout, as
+        // cargo's and rustc's does.
+        MessageFormat::Json => {
+            let line = serde_json::json!({
+                "severity": "error", "code": code, "message": message,
+                "span": {
+                    "file": name, "byte_start": 0, "byte_end": 0, "line_start": 1, "column_start": 1,
+                    "line_end": 1, "column_end": 1, "label": label,
+                },
+                "related": [], "notes": [], "hints": [], "fixes": [],
+            });
+            let _ = writeln!(std::io::stdout(), "{line}");
         }
     }
 }
@@ -211,6 +238,7 @@ fn run(cli: Cli) -> ExitCode {
         Command::Render(args) => render::render_cmd(args),
         Command::Watch(args) => watch::watch_cmd(args),
         Command::Sweep(args) => sweep::sweep_cmd(args),
+        Command::Measure(args) => measure::measure_cmd(args),
         Command::Export(args) => export::export_cmd(args),
         Command::Studio(args) => studio::studio_cmd(args),
         Command::Merge(args) => merge::merge_cmd(args),
@@ -225,11 +253,11 @@ fn run(cli: Cli) -> ExitCode {
                 ExitCode::from(1)
             }
         },
-        Command::Check { files, messages: shared::Messages { message_format }, quiet } => {
+        Command::Check { files, messages: shared::Messages { message_format }, params, quiet } => {
             let mut failed = false;
             let (mut objects, mut lights, mut warnings) = (0, 0, 0);
             for file in &files {
-                match compile(file, message_format) {
+                match compile(file, message_format, &params) {
                     Some(c) => {
                         failed |= report(&c, message_format);
                         warnings += c.diagnostics.iter().filter(|d| !d.is_error()).count();
@@ -257,8 +285,18 @@ fn run(cli: Cli) -> ExitCode {
             }
             ExitCode::SUCCESS
         }
-        Command::Ir { file, frame, messages: shared::Messages { message_format } } => {
-            let Some(mut compiled) = compile(&file, message_format) else { return ExitCode::from(1) };
+        Command::Params { file, messages: shared::Messages { message_format }, params } => {
+            let Some(compiled) = compile(&file, message_format, &params) else { return ExitCode::from(1) };
+            if report(&compiled, message_format) {
+                return ExitCode::from(1);
+            }
+            let listed = compiled.scene.as_ref().map_or_else(Vec::new, |s| s.params.iter().map(param_json).collect());
+            let text = serde_json::to_string_pretty(&serde_json::json!({ "parameters": listed })).unwrap_or_default();
+            let _ = writeln!(std::io::stdout().lock(), "{text}");
+            ExitCode::SUCCESS
+        }
+        Command::Ir { file, frame, messages: shared::Messages { message_format }, params } => {
+            let Some(mut compiled) = compile(&file, message_format, &params) else { return ExitCode::from(1) };
             // Frame 0's diagnostics, unless another frame is asked for and frame 0 has no
             // errors: then that frame's own (its warnings include frame 0's that still hold).
             let later = compiled.scene.as_ref().map(|s| s.settings.clone()).filter(|_| frame > 0);
@@ -287,6 +325,22 @@ fn run(cli: Cli) -> ExitCode {
             ExitCode::SUCCESS
         }
     }
+}
+
+/// One parameter as `scnc params` lists it (null where the scene says nothing).
+pub(crate) fn param_json(p: &scnc::ir::SceneParam) -> serde_json::Value {
+    let choices: Option<Vec<_>> = (!p.choices.is_empty()).then(|| p.choices.iter().map(|c| c.to_json()).collect());
+    serde_json::json!({
+        "name": p.name,
+        "type": p.default.ty(),
+        "default": p.default.to_json(),
+        "value": p.value.to_json(),
+        "range": p.range.map(|(lo, hi)| [lo, hi]),
+        "step": p.step,
+        "choices": choices,
+        "description": p.description,
+        "group": p.group,
+    })
 }
 
 /// `n thing` or `n things`.

@@ -21,7 +21,7 @@ use super::files::{
 use super::frames::{frame_path, is_pattern, parse_frames, FrameChoice};
 use super::passes::is_pass;
 use super::progress::{Progress, Reading};
-use super::shared::{Accuracy, Meshing, Messages, Workers};
+use super::shared::{Accuracy, Meshing, Messages, Params, Workers};
 use super::{compile, report, usage_error, MessageFormat};
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -134,6 +134,8 @@ pub(crate) struct RenderArgs {
     chunk: u32,
     #[command(flatten)]
     messages: Messages,
+    #[command(flatten)]
+    pub(crate) params: Params,
 }
 
 /// A relative error in (0, 1].
@@ -332,7 +334,7 @@ pub(crate) struct Attempt {
 }
 
 pub(crate) fn render_once(args: &RenderArgs, pool: &rayon::ThreadPool) -> Attempt {
-    let Some(compiled) = compile(&args.file, args.messages.message_format) else {
+    let Some(compiled) = compile(&args.file, args.messages.message_format, &args.params) else {
         return Attempt { files: vec![args.file.clone()], result: Err(ExitCode::from(1)) };
     };
     let files: Vec<PathBuf> = compiled.map.files().map(|(_, f)| f.path.clone()).collect();

@@ -2,6 +2,7 @@
 //! command that takes it, so its name, values, default and help read the same in each
 //! (`tests/scnc/cli.rs` holds `docs/cli.md` to what `--help` says).
 
+use scnc::source::Loader;
 use scnc::study::tolerance::Tolerance;
 
 use super::MessageFormat;
@@ -54,7 +55,7 @@ pub(crate) struct Meshing {
 }
 
 /// A detail: `low`, `high` or a number of rings.
-fn parse_detail(s: &str) -> Result<scnc::mesh::Detail, String> {
+pub(crate) fn parse_detail(s: &str) -> Result<scnc::mesh::Detail, String> {
     match s {
         "low" => Ok(scnc::mesh::Detail::Low),
         "high" => Ok(scnc::mesh::Detail::High),
@@ -79,4 +80,68 @@ fn parse_bytes(s: &str) -> Result<u64, String> {
         Some(bytes) if bytes > 0 => Ok(bytes),
         _ => Err(format!("`{s}` must be greater than 0 and at most {} bytes", u64::MAX)),
     }
+}
+
+/// `-D`, `--params` and `--set-name`: values for the scene's `param`s.
+#[derive(clap::Args, Clone, Default)]
+pub(crate) struct Params {
+    /// Set a scene parameter (a `param` of the file) for this run, `-D width=30`; may be
+    /// repeated, and wins over `--set-name`.
+    #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = scnc::check::Overrides::parse_define)]
+    pub(crate) define: Vec<scnc::check::Override>,
+    /// A parameter-set file: JSON in the shape of OpenSCAD's customizer files,
+    /// `{"parameterSets": {"large": {"width": "30"}}}`.
+    #[arg(long = "params", value_name = "FILE", requires = "set_name")]
+    pub(crate) sets: Option<std::path::PathBuf>,
+    /// The set of `--params` to use.
+    #[arg(long, value_name = "NAME", requires = "sets")]
+    pub(crate) set_name: Option<String>,
+}
+
+impl Params {
+    /// The values given: the named set's first, then each `-D` in order (the last given
+    /// for a name wins); what is wrong with the set file otherwise.
+    pub(crate) fn overrides(&self) -> Result<scnc::check::Overrides, String> {
+        let mut all = Vec::new();
+        if let (Some(path), Some(name)) = (&self.sets, &self.set_name) {
+            all = read_set(path, name)?;
+        }
+        all.extend(self.define.iter().cloned());
+        Ok(scnc::check::Overrides(all))
+    }
+}
+
+/// The values of set `name` in the parameter-set file at `path`.
+fn read_set(path: &std::path::Path, name: &str) -> Result<Vec<scnc::check::Override>, String> {
+    let file = path.display();
+    let text = scnc::source::FsLoader
+        .read(path)
+        .map_err(|e| format!("cannot read the parameter sets `{file}`: {}", scnc::source::io_reason(&e)))?;
+    let json: serde_json::Value = serde_json::from_str(&text).map_err(|e| format!("`{file}` is not JSON: {e}"))?;
+    let sets = json
+        .get("parameterSets")
+        .and_then(serde_json::Value::as_object)
+        .ok_or_else(|| format!("`{file}` has no `parameterSets` object"))?;
+    let set = sets.get(name).and_then(serde_json::Value::as_object).ok_or_else(|| {
+        let names: Vec<&str> = sets.keys().map(String::as_str).collect();
+        format!("`{file}` has no set `{name}`; its sets are: {}", names.join(", "))
+    })?;
+    set.iter()
+        .map(|(param, value)| {
+            // OpenSCAD writes every value as a string; numbers, booleans and [r, g, b]
+            // written as JSON are read too.
+            let text = match value {
+                serde_json::Value::String(s) => s.clone(),
+                serde_json::Value::Number(n) => n.to_string(),
+                serde_json::Value::Bool(b) => b.to_string(),
+                serde_json::Value::Array(c) if c.len() == 3 && c.iter().all(serde_json::Value::is_number) => {
+                    let parts: Vec<String> = c.iter().map(ToString::to_string).collect();
+                    format!("rgb({})", parts.join(", "))
+                }
+                other => return Err(format!("`{file}`: set `{name}` gives `{param}` the value {other}, which is not a number, truth value, string or colour")),
+            };
+            let origin = format!("`\"{param}\": {value}` of set `{name}` in `{file}`");
+            Ok(scnc::check::Override { name: param.clone(), text, origin })
+        })
+        .collect()
 }

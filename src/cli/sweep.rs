@@ -9,7 +9,7 @@ use scnc::study::sweep::{Options, PeakMemory, Step};
 use scnc::study::{chart, report as table, sweep};
 
 use super::files::{cannot_write, write_png, write_text};
-use super::shared::{Accuracy, Messages};
+use super::shared::{Accuracy, Messages, Params};
 use super::{compile, report, usage_error};
 
 #[derive(clap::Args)]
@@ -47,6 +47,8 @@ pub(crate) struct SweepArgs {
     reference: Option<PathBuf>,
     #[command(flatten)]
     messages: Messages,
+    #[command(flatten)]
+    params: Params,
 }
 
 /// `scnc sweep`. Long because it is the sweep's one sequence: compile, pick the ladder,
@@ -55,7 +57,9 @@ pub(crate) fn sweep_cmd(args: SweepArgs) -> ExitCode {
     if let Err(e) = std::fs::create_dir_all(&args.output) {
         return usage_error(&format!("cannot create `{}`: {e}", args.output.display()));
     }
-    let Some(compiled) = compile(&args.file, args.messages.message_format) else { return ExitCode::from(1) };
+    let Some(compiled) = compile(&args.file, args.messages.message_format, &args.params) else {
+        return ExitCode::from(1);
+    };
     if report(&compiled, args.messages.message_format) {
         return ExitCode::from(1);
     }

@@ -14,6 +14,7 @@ mod dump;
 pub mod field;
 mod materials;
 mod paint;
+mod param;
 mod view;
 
 use std::path::PathBuf;
@@ -31,6 +32,7 @@ pub use dump::dump;
 pub(crate) use dump::{num as dump_num, vec as dump_vec};
 pub use materials::{materials_of, Material};
 pub use paint::{Paint, Pattern, PatternKind};
+pub use param::{ParamValue, SceneParam};
 pub use view::{Camera, ColorSpace, Light, LightKind, Settings, DEFAULT_BOUNCES, SEED_FOV};
 
 use crate::span::Span;
@@ -49,6 +51,8 @@ pub struct Scene {
     /// The names `let` gave materials, by the span of their `material(…)` call (what
     /// exported files call them).
     pub material_names: Vec<(Span, String)>,
+    /// The scene's `param`s in source order, with the values this evaluation used.
+    pub params: Vec<SceneParam>,
 }
 
 /// One `object` statement.

@@ -86,7 +86,7 @@ pub struct Symbol {
 /// Kinds of outline symbols.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SymbolKind {
-    /// `let name = value`.
+    /// `let name = value` or `param name = value`.
     Value,
     /// `let name(params) = body`.
     Function,
@@ -102,7 +102,7 @@ pub enum SymbolKind {
     Conditional,
 }
 
-const STATEMENT_KEYWORDS: [&str; 7] = ["let", "object", "light", "camera", "render", "for", "include"];
+const STATEMENT_KEYWORDS: [&str; 8] = ["let", "param", "object", "light", "camera", "render", "for", "include"];
 
 impl Analysis {
     /// Compiles `text` as the file at `path` (includes resolve relative to it); `None`
@@ -470,6 +470,7 @@ fn symbols_of(stmts: &[ast::Stmt], map: &SourceMap) -> Vec<Symbol> {
                     let list: Vec<&str> = params.iter().map(|p| p.name.as_str()).collect();
                     symbol(format!("{}({})", name.name, list.join(", ")), SymbolKind::Function, s.span, name.span)
                 }
+                ast::StmtKind::Param(p) => symbol(p.name.name.clone(), SymbolKind::Value, s.span, p.name.span),
                 ast::StmtKind::Object(e) => {
                     symbol(format!("object {}", head(e, map)), SymbolKind::Object, s.span, e.span)
                 }

@@ -222,7 +222,8 @@ fn three_mf(export: &Export, units: &str, w: &mut dyn Write) -> io::Result<()> {
             "[Content_Types].xml",
             "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<Types xmlns=\"http://schemas.openxmlformats.org/package/2006/content-types\">\
              <Default Extension=\"rels\" ContentType=\"application/vnd.openxmlformats-package.relationships+xml\"/>\
-             <Default Extension=\"model\" ContentType=\"application/vnd.ms-package.3dmanufacturing-3dmodel+xml\"/></Types>\n",
+             <Default Extension=\"model\" ContentType=\"application/vnd.ms-package.3dmanufacturing-3dmodel+xml\"/>\
+             <Default Extension=\"config\" ContentType=\"text/xml\"/></Types>\n",
         ),
         (
             "_rels/.rels",
@@ -239,26 +240,72 @@ fn three_mf(export: &Export, units: &str, w: &mut dyn Write) -> io::Result<()> {
     let vertices: usize = export.parts.iter().map(|p| p.mesh.positions.len()).sum();
     let most_xml = (vertices as u64 * 80) + (export.triangle_count() as u64 * 80);
     zip.start_file("3D/3dmodel.model", options.large_file(most_xml > 1 << 31)).map_err(io::Error::other)?;
+    let used = used(export);
+    let orders: Vec<Vec<u32>> = export.parts.iter().map(|p| by_material(p, &used)).collect();
     let mut model = io::BufWriter::with_capacity(1 << 16, &mut zip);
-    xml_model(export, units, &mut model)?;
+    xml_model(export, units, &used, &orders, &mut model)?;
     model.flush()?;
     drop(model);
+    zip.start_file("Metadata/Slic3r_PE_model.config", options).map_err(io::Error::other)?;
+    zip.write_all(slicer_config(export, &used, &orders).as_bytes())?;
     zip.finish().map_err(io::Error::other)?;
     Ok(())
+}
+
+/// A part's triangles ordered by their material's slot (stable, so each material's run
+/// keeps the mesh's order): a slicer's volume is a contiguous run of an object's triangles.
+fn by_material(part: &Part, used: &[u32]) -> Vec<u32> {
+    let mut order: Vec<u32> = (0..part.mesh.triangles.len() as u32).collect();
+    order.sort_by_key(|&t| slot(used, part.materials[t as usize]));
+    order
+}
+
+/// PrusaSlicer's own description of the objects (`Metadata/Slic3r_PE_model.config`,
+/// which PrusaSlicer and its descendants read): each object's name, and one *volume*
+/// per material — a run of the object's triangles, named after the material, printed
+/// with extruder N for the N-th colour of the file's base materials. The core
+/// specification's materials colour the triangles; they do not say which filament
+/// prints them, and PrusaSlicer prints a part with one extruder without this.
+fn slicer_config(export: &Export, used: &[u32], orders: &[Vec<u32>]) -> String {
+    use std::fmt::Write as _;
+    let mut out = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<config>\n");
+    for (k, (p, order)) in export.parts.iter().zip(orders).enumerate() {
+        let _ = writeln!(out, " <object id=\"{}\" instances_count=\"1\">", k + 2);
+        let _ = writeln!(out, "  <metadata type=\"object\" key=\"name\" value=\"{}\"/>", p.name);
+        let mut first = 0;
+        while first < order.len() {
+            let m = p.materials[order[first] as usize];
+            let run = order[first..].iter().take_while(|&&t| p.materials[t as usize] == m).count();
+            let extruder = slot(used, m) + 1;
+            let _ = writeln!(out, "  <volume firstid=\"{first}\" lastid=\"{}\">", first + run - 1);
+            let _ = writeln!(out, "   <metadata type=\"volume\" key=\"name\" value=\"{}\"/>", material_name(export, m));
+            let _ = writeln!(out, "   <metadata type=\"volume\" key=\"extruder\" value=\"{extruder}\"/>");
+            out.push_str("  </volume>\n");
+            first += run;
+        }
+        out.push_str(" </object>\n");
+    }
+    out.push_str("</config>\n");
+    out
 }
 
 /// The 3MF model: one `basematerials` group holding every colour used (core
 /// specification, section 5.1), one mesh object per part whose triangles name their
 /// material, and a build item per object.
-fn xml_model(export: &Export, units: &str, out: &mut dyn Write) -> io::Result<()> {
-    let used = used(export);
+fn xml_model(
+    export: &Export,
+    units: &str,
+    used: &[u32],
+    orders: &[Vec<u32>],
+    out: &mut dyn Write,
+) -> io::Result<()> {
     write!(
         out,
         "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<model unit=\"{units}\" xml:lang=\"en-US\" \
          xmlns=\"http://schemas.microsoft.com/3dmanufacturing/core/2015/02\">\n\
          <metadata name=\"Application\">scnc</metadata>\n<resources>\n<basematerials id=\"1\">\n"
     )?;
-    for &m in &used {
+    for &m in used {
         writeln!(
             out,
             "<base name=\"{}\" displaycolor=\"{}\"/>",
@@ -267,8 +314,8 @@ fn xml_model(export: &Export, units: &str, out: &mut dyn Write) -> io::Result<()
         )?;
     }
     out.write_all(b"</basematerials>\n")?;
-    for (k, p) in export.parts.iter().enumerate() {
-        let first = p.materials.first().map_or(0, |&m| slot(&used, m));
+    for (k, (p, order)) in export.parts.iter().zip(orders).enumerate() {
+        let first = order.first().map_or(0, |&t| slot(used, p.materials[t as usize]));
         writeln!(
             out,
             "<object id=\"{}\" name=\"{}\" type=\"model\" pid=\"1\" pindex=\"{first}\">\n<mesh>\n<vertices>",
@@ -280,11 +327,12 @@ fn xml_model(export: &Export, units: &str, out: &mut dyn Write) -> io::Result<()
             writeln!(out, "<vertex x=\"{x}\" y=\"{y}\" z=\"{z}\"/>")?;
         }
         out.write_all(b"</vertices>\n<triangles>\n")?;
-        for (t, [a, b, c]) in p.mesh.triangles.iter().enumerate() {
+        for &t in order {
+            let [a, b, c] = p.mesh.triangles[t as usize];
             writeln!(
                 out,
                 "<triangle v1=\"{a}\" v2=\"{b}\" v3=\"{c}\" pid=\"1\" p1=\"{}\"/>",
-                slot(&used, p.materials[t])
+                slot(used, p.materials[t as usize])
             )?;
         }
         out.write_all(b"</triangles>\n</mesh>\n</object>\n")?;

@@ -47,6 +47,8 @@ pub enum StmtKind {
         /// The value or function body.
         value: Expr,
     },
+    /// `param name = default …`: a value the command line or the studio may set.
+    Param(Box<ParamDecl>),
     /// `for var in start..end { body }` (end exclusive) or `for var in list { body }`.
     For {
         /// Loop variable and what it runs over.
@@ -70,6 +72,32 @@ pub enum StmtKind {
     },
     /// A statement that failed to parse (already reported).
     Error,
+}
+
+/// `param name = default [in lo .. hi | in [choices]] [step s] ["description"] [group "name"]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParamDecl {
+    /// The parameter's name, read like a `let`'s.
+    pub name: Ident,
+    /// Its value unless overridden.
+    pub default: Expr,
+    /// The values it may take: `lo .. hi` (both included) or a list of choices.
+    pub domain: Option<ParamDomain>,
+    /// A slider's step.
+    pub step: Option<Expr>,
+    /// What it means, for people (the string literal, unquoted).
+    pub description: Option<String>,
+    /// The heading the customizer shows it under.
+    pub group: Option<String>,
+}
+
+/// The values a parameter may take.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ParamDomain {
+    /// `lo .. hi`, both ends included.
+    Range(Expr, Expr),
+    /// A list of the allowed values.
+    Choices(Expr),
 }
 
 /// `var in start..end` or `var in list`: one loop variable and what it runs over.

@@ -8,7 +8,9 @@
 use chumsky::input::ValueInput;
 use chumsky::prelude::*;
 
-use super::ast::{Arg, BinOp, Expr, ExprKind, File, Generator, Ident, Iterable, Stmt, StmtKind, TransformOp};
+use super::ast::{
+    Arg, BinOp, Expr, ExprKind, File, Generator, Ident, Iterable, ParamDecl, ParamDomain, Stmt, StmtKind, TransformOp,
+};
 use super::token::Token;
 use crate::span::Span;
 
@@ -318,6 +320,7 @@ where
 {
     one_of([
         Token::Let,
+        Token::Param,
         Token::Object,
         Token::Light,
         Token::For,
@@ -362,6 +365,28 @@ where
             .map(|((name, params), value)| StmtKind::Let { name, params, value })
             .labelled("let statement")
             .as_context();
+        let string = select! { Token::Str(s) => unescape(s) }.labelled("string");
+        // `step` and `group` are words only here, so scenes may still name values so.
+        let word = |w: &'static str| select! { Token::Ident(s) if s == w => () }.labelled(w);
+        let domain = just(Token::In)
+            .ignore_then(e.clone().then(just(Token::DotDot).ignore_then(e.clone()).or_not()))
+            .map(|(first, last)| match last {
+                Some(last) => ParamDomain::Range(first, last),
+                None => ParamDomain::Choices(first),
+            });
+        let param = just(Token::Param)
+            .ignore_then(ident())
+            .then_ignore(just(Token::Eq))
+            .then(e.clone())
+            .then(domain.or_not())
+            .then(word("step").ignore_then(e.clone()).or_not())
+            .then(string.or_not())
+            .then(word("group").ignore_then(string).or_not())
+            .map(|(((((name, default), domain), step), description), group)| {
+                StmtKind::Param(Box::new(ParamDecl { name, default, domain, step, description, group }))
+            })
+            .labelled("param statement")
+            .as_context();
         // A body left open at the end of the file ends there (its missing `}` is still
         // reported): failing the whole loop instead made every enclosing open loop parse
         // what follows twice, once inside and once after recovery, 2ⁿ times for n levels.
@@ -396,7 +421,7 @@ where
             .labelled("include statement")
             .as_context();
 
-        choice((camera, render, light, object, let_, for_, if_, include))
+        choice((camera, render, light, object, let_, param, for_, if_, include))
             .map_with(|kind, e| {
                 #[cfg(test)]
                 tests::STATEMENTS_BUILT.with(|c| c.set(c.get() + 1));

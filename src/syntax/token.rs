@@ -27,6 +27,9 @@ pub enum Token<'src> {
     /// `include`
     #[token("include")]
     Include,
+    /// `param`
+    #[token("param")]
+    Param,
     /// `camera`
     #[token("camera")]
     Camera,
@@ -204,8 +207,8 @@ impl Token<'_> {
 
     /// The keywords of the language, as written (the highlighting grammar must list them all).
     pub const KEYWORDS: &'static [&'static str] = &[
-        "let", "object", "light", "for", "in", "include", "camera", "render", "at", "rotate", "scale", "with", "mesh",
-        "true", "false", "if", "then", "else", "and", "or", "not",
+        "let", "param", "object", "light", "for", "in", "include", "camera", "render", "at", "rotate", "scale", "with",
+        "mesh", "true", "false", "if", "then", "else", "and", "or", "not",
     ];
 }
 
@@ -218,6 +221,7 @@ impl fmt::Display for Token<'_> {
             Token::For => "for",
             Token::In => "in",
             Token::Include => "include",
+            Token::Param => "param",
             Token::Camera => "camera",
             Token::Render => "render",
             Token::At => "at",

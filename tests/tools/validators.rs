@@ -65,3 +65,37 @@ pub fn lib3mf_reads_3mf_exports_strictly() {
         assert_eq!(said.trim(), expected, "{scene}");
     }
 }
+
+/// PrusaSlicer (Debian's `prusa-slicer`, headless) slices a two-colour export with two
+/// extruders and no painting: each material is a volume with its extruder, so each layer
+/// of two side-by-side parts changes tool. Without scnc's
+/// `Metadata/Slic3r_PE_model.config` it printed everything with the first extruder.
+pub fn prusaslicer_slices_two_colours_with_two_extruders() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = dir.path().join("two.scn");
+    std::fs::write(
+        &scene,
+        "let red = material(color = rgb(200, 30, 30))\nlet blue = material(color = rgb(30, 60, 200))\n\
+         object box([1, 1, 1]) at [-1.2, 0, 0] with red\n\
+         object union(box([1, 1, 1]) with blue, sphere(0.5) at [0, 1, 0] with red) at [1.2, 0, 0]\n",
+    )
+    .unwrap();
+    let (threemf, gcode) = (dir.path().join("two.3mf"), dir.path().join("two.gcode"));
+    let out = scnc(&["export", scene.to_str().unwrap(), "-o", threemf.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let run = std::process::Command::new("prusa-slicer")
+        .args(["--export-gcode", "--nozzle-diameter", "0.4,0.4", "--temperature", "210,210"])
+        .args(["--first-layer-temperature", "210,210", "--filament-diameter", "1.75,1.75", "--retract-length", "1,1"])
+        .arg("-o")
+        .arg(&gcode)
+        .arg(&threemf)
+        .output()
+        .expect("prusa-slicer runs");
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let text = std::fs::read_to_string(&gcode).unwrap();
+    let count = |p: &str| text.lines().filter(|l| l.starts_with(p)).count();
+    let (t0, t1, layers) = (count("T0"), count("T1"), count(";LAYER_CHANGE"));
+    assert!(t0 > 0 && t1 > 0, "tool changes: T0 {t0}, T1 {t1}");
+    // Below the sphere both boxes print in every layer, one with each extruder.
+    assert!(2 * (t0 + t1) >= layers, "{layers} layers but only {} tool changes", t0 + t1);
+}

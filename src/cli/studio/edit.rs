@@ -5,6 +5,7 @@
 //! Positions cross between the page's UTF-16 units and the compiler's bytes in
 //! [`super::diagnostics`].
 
+use scnc::check::Overrides;
 use scnc::lsp::analysis::{Analysis, CandidateKind};
 use scnc::meshfile::{Format, WriteOptions};
 use scnc::source::{FileId, SourceMap};
@@ -38,6 +39,32 @@ pub(crate) fn check(studio: &Studio, text: String) -> Reply {
     let a = analyse(studio, text);
     studio.files.watch(a.map.files().map(|(_, f)| f.path.clone()).collect());
     Reply::json(&serde_json::json!({ "diagnostics": diagnostics_json(&a.map, &a.diagnostics) }))
+}
+
+/// The scene's parameters with the values the page's controls (`set`) give them, each
+/// with the UTF-16 range of its default in the text (where writing a value back puts
+/// it); or the diagnostics that keep it from compiling.
+pub(crate) fn params(studio: &Studio, text: String, set: &Overrides) -> Reply {
+    let compiled = studio.files.compile(text, set);
+    let Some(scene) = &compiled.scene else {
+        return Reply::json(&serde_json::json!({
+            "diagnostics": diagnostics_json(&compiled.map, &compiled.diagnostics),
+        }));
+    };
+    let root = compiled.map.file(FileId(0)).text.as_str();
+    let list: Vec<serde_json::Value> = scene
+        .params
+        .iter()
+        .map(|p| {
+            let mut j = crate::cli::param_json(p);
+            let (_, range) = compiled.map.local_range(p.default_span);
+            j["from"] = to_utf16(root, range.start).into();
+            j["to"] = to_utf16(root, range.end).into();
+            j["source"] = p.value.source().into();
+            j
+        })
+        .collect();
+    Reply::json(&serde_json::json!({ "params": list }))
 }
 
 /// The hover text at UTF-16 position `pos`.
@@ -111,7 +138,7 @@ pub(crate) fn save(studio: &Studio, text: String) -> Reply {
 
 /// The text with its camera statement (or a new one) set to the page's view, formatted.
 pub(crate) fn camera_line(studio: &Studio, text: String, view: &View) -> Reply {
-    let compiled = studio.files.compile(text.clone());
+    let compiled = studio.files.compile(text.clone(), &Overrides::default());
     let Some(scene) = &compiled.scene else {
         return Reply::json(&serde_json::json!({
             "diagnostics": diagnostics_json(&compiled.map, &compiled.diagnostics),
@@ -165,14 +192,14 @@ fn insert_before_first_statement(text: &str, line: &str) -> String {
 
 /// The scene as a mesh file to download, as `scnc export` writes it with its defaults
 /// (detail high; z up for STL and 3MF, which are for printing, y up otherwise).
-pub(crate) fn export(studio: &Studio, text: String, format: &str) -> Reply {
+pub(crate) fn export(studio: &Studio, text: String, set: &Overrides, format: &str) -> Reply {
     use scnc::export::Placement;
     let Some(format) = Format::from_name(format).filter(|f| f.one_file()) else {
         let names: Vec<&str> = downloads().map(Format::name).collect();
         return Reply::text(400, &format!("`{format}`: the studio exports {}", names.join(", ")));
     };
     let (mime, ext) = (format.mime(), format.extensions()[0]);
-    let compiled = studio.files.compile(text);
+    let compiled = studio.files.compile(text, set);
     let Some(scene) = &compiled.scene else {
         return Reply::text(422, "the scene has errors: fix them to export");
     };

@@ -5,6 +5,7 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, Weak};
 
+use scnc::check::Overrides;
 use scnc::source::{FsLoader, Loader};
 
 use super::http::{Req, Stream};
@@ -26,6 +27,8 @@ pub(crate) struct Files {
     watcher: Mutex<Option<notify::RecommendedWatcher>>,
     /// Open pages' event streams.
     listeners: Mutex<Vec<Stream>>,
+    /// The parameters `scnc studio -D …` set, under the page's own.
+    pub(crate) params: Overrides,
     /// The text the studio itself last saved: its own save coming back from the
     /// watcher is no news (and would undo keys typed since).
     saved: Mutex<Option<String>>,
@@ -34,7 +37,7 @@ pub(crate) struct Files {
 impl Files {
     /// The file at `path`: it need not exist yet (the first save makes it), but its
     /// directory must, and if it exists it must be a scene-sized regular file.
-    pub(crate) fn open(path: &Path) -> Result<Files, String> {
+    pub(crate) fn open(path: &Path, params: Overrides) -> Result<Files, String> {
         let name = path.file_name().ok_or_else(|| format!("`{}` does not name a file", path.display()))?;
         let dir = crate::cli::files::parent_dir(path)
             .canonicalize()
@@ -53,6 +56,7 @@ impl Files {
             watcher: Mutex::new(None),
             listeners: Mutex::new(Vec::new()),
             saved: Mutex::new(None),
+            params,
         })
     }
 
@@ -65,10 +69,13 @@ impl Files {
         }
     }
 
-    /// `text` compiled as the file (its includes read through [`Files::loader`]).
-    pub(crate) fn compile(&self, text: String) -> scnc::Compiled {
+    /// `text` compiled as the file (its includes read through [`Files::loader`]), its
+    /// parameters set by the command line's `-D` and then by the page's controls (`page`).
+    pub(crate) fn compile(&self, text: String, page: &Overrides) -> scnc::Compiled {
         let name = self.root.file_name().map_or_else(|| "scene".into(), |n| n.to_string_lossy().into_owned());
-        scnc::compile_file(&name, &self.root, text, &self.loader())
+        let mut set = self.params.clone();
+        set.0.extend(page.0.iter().cloned());
+        scnc::compile_file_with(&name, &self.root, text, &self.loader(), set)
     }
 
     /// The loader compiles use: the disk, below the file's directory only.

@@ -31,7 +31,7 @@ use std::sync::{Arc, Mutex};
 use files::lock;
 use http::{Reply, Req};
 
-use super::shared::Workers;
+use super::shared::{Params, Workers};
 use super::usage_error;
 
 #[derive(clap::Args)]
@@ -48,6 +48,8 @@ pub(crate) struct StudioArgs {
     host: IpAddr,
     #[command(flatten)]
     workers: Workers,
+    #[command(flatten)]
+    params: Params,
     /// Write the port listened on to this file (for tests and scripts with `--port 0`).
     #[arg(long, hide = true)]
     port_file: Option<PathBuf>,
@@ -72,7 +74,11 @@ pub(crate) struct Studio {
 }
 
 pub(crate) fn studio_cmd(args: StudioArgs) -> ExitCode {
-    let files = match files::Files::open(&args.file) {
+    let set = match args.params.overrides() {
+        Ok(set) => set,
+        Err(e) => return usage_error(&e),
+    };
+    let files = match files::Files::open(&args.file, set) {
         Ok(f) => f,
         Err(e) => return usage_error(&e),
     };
@@ -222,17 +228,19 @@ fn handle(studio: &Arc<Studio>, mut req: Req) {
         ("POST", path) if path.starts_with("/api/") => match req.body() {
             Ok(text) => match path {
                 "/api/check" => edit::check(studio, text),
+                "/api/params" => edit::params(studio, text, &page_params(&req)),
                 "/api/hover" => edit::hover(studio, text, req.query_u32("pos")),
                 "/api/complete" => edit::complete(studio, text, req.query_u32("pos")),
                 "/api/signature" => edit::signature(studio, text, req.query_u32("pos")),
                 "/api/pick" => {
                     let at = |k: &str| req.query_f64(k).unwrap_or(-1.0);
-                    preview::pick(studio, text, &preview::View::from_query(&req), at("x"), at("y"))
+                    let view = preview::View::from_query(&req);
+                    preview::pick(studio, text, &page_params(&req), &view, at("x"), at("y"))
                 }
                 "/api/format" => edit::format(text),
                 "/api/save" => edit::save(studio, text),
                 "/api/camera" => edit::camera_line(studio, text, &preview::View::from_query(&req)),
-                "/api/export" => edit::export(studio, text, req.query("format").unwrap_or("stl")),
+                "/api/export" => edit::export(studio, text, &page_params(&req), req.query("format").unwrap_or("stl")),
                 _ => Reply::text(404, "no such page"),
             },
             Err(reply) => reply,
@@ -241,4 +249,17 @@ fn handle(studio: &Arc<Studio>, mut req: Req) {
         _ => Reply::text(405, "method not allowed"),
     };
     req.reply(reply);
+}
+
+/// The values the page's parameter controls set (the query's `set`, a JSON object of
+/// names to values as text); none when it sends none or something else.
+pub(crate) fn page_params(req: &Req) -> scnc::check::Overrides {
+    let given: serde_json::Map<String, serde_json::Value> =
+        req.query("set").and_then(|s| serde_json::from_str(s).ok()).unwrap_or_default();
+    let set = given.into_iter().filter_map(|(name, value)| {
+        let text = value.as_str()?.to_string();
+        let origin = format!("the studio's `{name}` control ({text})");
+        Some(scnc::check::Override { name, text, origin })
+    });
+    scnc::check::Overrides(set.collect())
 }

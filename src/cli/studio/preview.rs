@@ -16,6 +16,7 @@ use std::time::Instant;
 
 use glam::DQuat;
 
+use scnc::check::Overrides;
 use scnc::diag::Diagnostic;
 use scnc::mesh::Detail;
 use scnc::mesh::Wanted;
@@ -130,6 +131,7 @@ pub(crate) fn render(studio: &Arc<Studio>, mut req: Req) {
         mesh: req.query("backend") == Some("mesh"),
         rung: req.query("rung").and_then(|r| r.parse::<usize>().ok()).filter(|r| *r < SDF_RUNGS.len()),
         frame: req.query_u32("frame"),
+        set: super::page_params(&req),
     };
     let previews = &studio.preview;
     let id = previews.newest.fetch_add(1, Ordering::AcqRel) + 1;
@@ -148,8 +150,8 @@ pub(crate) fn render(studio: &Arc<Studio>, mut req: Req) {
 /// The object under the point `(x, y)` of the preview (fractions of its width and
 /// height) with the page's view: the span of its `object` statement, in the page's
 /// UTF-16 offsets, or `null` where the ray meets nothing (or the text has errors).
-pub(crate) fn pick(studio: &Studio, text: String, view: &View, x: f64, y: f64) -> Reply {
-    let mut compiled = studio.files.compile(text);
+pub(crate) fn pick(studio: &Studio, text: String, set: &Overrides, view: &View, x: f64, y: f64) -> Reply {
+    let mut compiled = studio.files.compile(text, set);
     let Some(mut scene) = compiled.scene.take() else { return Reply::json(&serde_json::Value::Null) };
     scene.camera = view.apply(&scene.camera);
     let always: Wanted = Arc::new(|| true);
@@ -173,6 +175,8 @@ struct Ask {
     /// The accuracy slider's rung, if the page shows it.
     rung: Option<usize>,
     frame: u32,
+    /// The page's parameter controls.
+    set: Overrides,
 }
 
 impl Ask {
@@ -216,7 +220,7 @@ fn json_message(out: &mut Stream, kind: u8, value: serde_json::Value) -> std::io
 /// newer request, a gone page).
 fn run(studio: &Studio, text: &str, ask: &Ask, out: &mut Stream, current: &Wanted) -> std::io::Result<()> {
     let loader = studio.files.loader();
-    let mut compiled = studio.files.compile(text.to_string());
+    let mut compiled = studio.files.compile(text.to_string(), &ask.set);
     let Some(first) = compiled.scene.take() else {
         return json_message(out, b'E', diagnostics_json(&compiled.map, &compiled.diagnostics));
     };

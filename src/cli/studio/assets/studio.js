@@ -22,6 +22,11 @@ const state = {
   render: null, // the AbortController of the render in flight
   checkSeq: 0,
   lastText: "",
+  params: {}, // the parameter controls' values (name → text); the file keeps its own
+  paramList: [], // the scene's params, as /api/params last listed them
+  paramsFor: null, // the text that list is of
+  paramShape: "", // what the controls were built from
+  paramSeq: 0,
 };
 
 let editor = null;
@@ -33,6 +38,7 @@ function query(extra) {
     backend: state.backend, frame: state.frame, ...extra,
   });
   if (state.rung !== null) p.set("rung", state.rung);
+  if (Object.keys(state.params).length) p.set("set", JSON.stringify(state.params));
   return p.toString();
 }
 
@@ -240,7 +246,119 @@ async function render(sourceText, opts = {}) {
 function edited(newText) {
   state.lastText = newText;
   check(newText);
+  loadParams(newText);
   render(newText);
+}
+
+// --- parameters (the customizer) -----------------------------------------------------
+
+async function loadParams(text) {
+  const seq = ++state.paramSeq;
+  try {
+    const set = new URLSearchParams({ set: JSON.stringify(state.params) });
+    const r = await (await post(`/api/params?${set}`, text)).json();
+    // A scene with errors keeps the last controls: they come back when it compiles.
+    if (seq === state.paramSeq && r.params) { state.paramsFor = text; showParams(r.params); }
+  } catch (e) { /* the server is gone: the status line says so on the next render */ }
+}
+
+/** The `#rrggbb` of a colour parameter's `[r, g, b]`. */
+const hex = (c) => "#" + c.map((x) => Math.round(x).toString(16).padStart(2, "0")).join("");
+
+/** A value as the control's text: what `-D` would say. */
+const asText = (p, v) => (p.type === "color" ? hex(v) : String(v));
+
+function showParams(list) {
+  state.paramList = list;
+  for (const k of Object.keys(state.params)) if (!list.some((p) => p.name === k)) delete state.params[k];
+  $("params-panel").hidden = list.length === 0;
+  const shape = JSON.stringify(list.map((p) => [p.name, p.type, p.default, p.range, p.step, p.choices, p.description, p.group]));
+  // Controls under the user's hand are not rebuilt while only the values change.
+  if (shape === state.paramShape) return;
+  state.paramShape = shape;
+  const box = $("params");
+  box.replaceChildren();
+  let group = null;
+  for (const p of list) {
+    if (p.group && p.group !== group) {
+      const h = document.createElement("h4");
+      h.textContent = p.group;
+      box.append(h);
+    }
+    group = p.group;
+    box.append(paramControl(p));
+  }
+}
+
+/** One parameter's row: its name, a control fitting its type, range and choices, and its value. */
+function paramControl(p) {
+  const row = document.createElement("label");
+  row.className = "param";
+  row.title = p.description || "";
+  const name = document.createElement("span");
+  name.className = "name";
+  name.textContent = p.description ? `${p.name} — ${p.description}` : p.name;
+  const out = document.createElement("output");
+  const current = state.params[p.name] ?? asText(p, p.default);
+  let input;
+  if (p.choices) {
+    input = document.createElement("select");
+    for (const c of p.choices) {
+      const o = document.createElement("option");
+      o.value = asText(p, c);
+      o.textContent = p.type === "str" ? c : asText(p, c);
+      input.append(o);
+    }
+  } else {
+    input = document.createElement("input");
+    if (p.type === "bool") input.type = "checkbox";
+    else if (p.type === "color") input.type = "color";
+    else if (p.type === "num" && p.range) {
+      input.type = "range";
+      [input.min, input.max] = p.range;
+      input.step = p.step ?? "any";
+    } else if (p.type === "num") { input.type = "number"; input.step = p.step ?? "any"; }
+    else input.type = "text";
+  }
+  input.dataset.param = p.name;
+  input.dataset.testid = `param-${p.name}`;
+  if (input.type === "checkbox") input.checked = current === "true"; else input.value = current;
+  out.textContent = input.type === "range" ? current : "";
+  const changed = () => {
+    const text = input.type === "checkbox" ? String(input.checked) : input.value;
+    state.params[p.name] = text;
+    if (input.type === "range") out.textContent = text;
+    // Only the preview changes: the file keeps its value until written back.
+    render(ScnEditor.textOf(editor));
+  };
+  input.addEventListener(input.type === "checkbox" || input.tagName === "SELECT" ? "change" : "input", changed);
+  row.append(name, input, out);
+  return row;
+}
+
+/** Writes the controls' values into the file's `param` lines, as *View → camera* does the view. */
+async function writeParams() {
+  const text = ScnEditor.textOf(editor);
+  if (state.paramsFor !== text) await loadParams(text);
+  if (state.paramsFor !== text) return;
+  const edits = state.paramList
+    .filter((p) => state.params[p.name] !== undefined)
+    .map((p) => {
+      const v = state.params[p.name];
+      return { from: p.from, to: p.to, insert: p.type === "str" ? JSON.stringify(v) : v };
+    })
+    .sort((a, b) => b.from - a.from);
+  let out = text;
+  for (const e of edits) out = out.slice(0, e.from) + e.insert + out.slice(e.to);
+  state.params = {};
+  state.paramShape = "";
+  if (out !== text) ScnEditor.replaceText(editor, out); else edited(text);
+}
+
+function resetParams() {
+  state.params = {};
+  state.paramShape = "";
+  edited(ScnEditor.textOf(editor));
 }
 
 async function save() {
@@ -264,7 +382,8 @@ async function writeCamera() {
 
 async function exportAs(format) {
   try {
-    const r = await post(`/api/export?format=${format}`, ScnEditor.textOf(editor));
+    const set = new URLSearchParams({ format, set: JSON.stringify(state.params) });
+    const r = await post(`/api/export?${set}`, ScnEditor.textOf(editor));
     const name = (r.headers.get("Content-Disposition") || "").match(/filename="([^"]+)"/)?.[1] || `scene.${format}`;
     const a = document.createElement("a");
     a.href = URL.createObjectURL(await r.blob());
@@ -355,6 +474,8 @@ $("frame").oninput = () => { state.frame = Number($("frame").value); viewChanged
 $("save").onclick = save;
 $("format").onclick = format;
 $("write-camera").onclick = writeCamera;
+$("params-write").onclick = (e) => { e.preventDefault(); writeParams(); };
+$("params-reset").onclick = (e) => { e.preventDefault(); resetParams(); };
 $("reset-view").onclick = () => { state.view = homeView(); viewChanged(); };
 $("backend").onchange = () => { state.backend = $("backend").value; viewChanged(); };
 function rungChanged() {
