@@ -334,8 +334,18 @@ fn slow_request_bodies_do_not_block_the_page() {
     let (status, _) = s.raw("GET", "/", &[], b"");
     assert_eq!(status, 200);
     assert!(started.elapsed() < std::time::Duration::from_secs(5), "GET / took {:?}", started.elapsed());
-    let (status, _) = s.post("/api/check", "light ambient(1)\n");
-    assert_eq!(status, 429, "a body past the eighth from one client");
+    // The slow bodies are admitted as the server's threads get to them, later on a busy
+    // machine: once eight are in hand, a ninth from the same client is refused.
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    loop {
+        let (status, _) = s.post("/api/check", "light ambient(1)\n");
+        if status == 429 {
+            break;
+        }
+        assert_eq!(status, 200, "a body before the eighth is in hand is answered");
+        assert!(std::time::Instant::now() < deadline, "a body past the eighth from one client was never refused");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
     drop(slow);
     let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
     loop {
