@@ -269,8 +269,7 @@ impl Ctx<'_> {
     pub(super) fn unknown_overrides(&mut self) {
         let names: Vec<String> = self.params.iter().map(|p| p.name.clone()).collect();
         let unknown: Vec<_> = self.overrides.0.iter().filter(|o| !names.contains(&o.name)).cloned().collect();
-        let start =
-            self.map.files().next().map_or(Span::default(), |(_, f)| Span::new(f.base as usize, f.base as usize));
+        let start = self.file_start();
         for o in unknown {
             let mut d = Diagnostic::error(
                 codes::BAD_PARAM_VALUE,

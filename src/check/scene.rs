@@ -146,7 +146,7 @@ impl Ctx<'_> {
                     .with_hint(format!("if this is intentional, try naming it `_{name}`")),
             );
         }
-        let end = self.map.files().next().map_or(Span::default(), |(_, f)| Span::new(f.base as usize, f.base as usize));
+        let end = self.file_start();
         let has_errors = self.diags.iter().any(Diagnostic::is_error);
         if has_errors {
             // Objects and lights were dropped with their errors; do not warn about their absence.
@@ -224,6 +224,11 @@ impl Ctx<'_> {
 }
 
 impl Ctx<'_> {
+    /// An empty span at the start of the root file: where scene-wide diagnostics point.
+    pub(super) fn file_start(&self) -> Span {
+        self.map.files().next().map_or(Span::default(), |(_, f)| Span::new(f.base as usize, f.base as usize))
+    }
+
     /// `base`, or `base_2`, `base_3`, … if an earlier object has it. Each base
     /// remembers its next number, so 100,000 `sphere`s take linear time.
     fn unique_name(&mut self, base: String) -> String {

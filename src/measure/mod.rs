@@ -247,18 +247,15 @@ fn prove(shapes: &[&std::sync::Arc<Shape>], lo: DVec3, hi: DVec3, opts: &Measure
     });
     let m = |i: usize| Bounds::new(lo_m[i], hi_m[i]);
     let inertia = inertia_intervals(v, [m(1), m(2), m(3)], [m(4), m(5), m(6)], [m(7), m(8), m(9)]);
-    let corner = |pick: fn(&(DVec3, DVec3)) -> DVec3, outer: bool, k: usize| {
-        let b = if outer { r.outer } else { r.inner };
-        b.map(|b| pick(&b)[k] + origin[k])
+    // Each corner lies between the box of what was proved inside and the box of
+    // everything not proved outside (none proved inside: no inner end).
+    let shift = |b: Option<(DVec3, DVec3)>, none: f64| {
+        b.map_or((DVec3::splat(none), DVec3::splat(-none)), |(a, z)| (a + origin, z + origin))
     };
-    let min = std::array::from_fn(|k| {
-        let lo = corner(|b| b.0, true, k).unwrap_or(f64::NAN);
-        Bounds::new(lo, corner(|b| b.0, false, k).unwrap_or(f64::INFINITY))
-    });
-    let max = std::array::from_fn(|k| {
-        let hi = corner(|b| b.1, true, k).unwrap_or(f64::NAN);
-        Bounds::new(corner(|b| b.1, false, k).unwrap_or(f64::NEG_INFINITY), hi)
-    });
+    let (outer_lo, outer_hi) = shift(r.outer, f64::NAN);
+    let (inner_lo, inner_hi) = shift(r.inner, f64::INFINITY);
+    let min = std::array::from_fn(|k| Bounds::new(outer_lo[k], inner_lo[k]));
+    let max = std::array::from_fn(|k| Bounds::new(inner_hi[k], outer_hi[k]));
     Proved { volume: v, centre, min, max, inertia, met: r.met, stated, cells: r.cells, cell: 2.0 * r.finest }
 }
 

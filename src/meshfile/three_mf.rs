@@ -256,7 +256,7 @@ fn three_mf(export: &Export, units: &str, w: &mut dyn Write) -> io::Result<()> {
 /// keeps the mesh's order): a slicer's volume is a contiguous run of an object's triangles.
 fn by_material(part: &Part, used: &[u32]) -> Vec<u32> {
     let mut order: Vec<u32> = (0..part.mesh.triangles.len() as u32).collect();
-    order.sort_by_key(|&t| slot(used, part.materials[t as usize]));
+    order.sort_by_cached_key(|&t| slot(used, part.materials[t as usize]));
     order
 }
 
