@@ -350,6 +350,8 @@ pub mod codes {
     pub const INCLUDE_READ: &str = "E0600";
     /// Include cycle.
     pub const INCLUDE_CYCLE: &str = "E0601";
+    /// A font that cannot be read, or text it cannot lay out.
+    pub const BAD_FONT: &str = "E0602";
     /// Nesting too deep (brackets or expressions).
     pub const TOO_DEEP: &str = "E0700";
     /// Too many loop iterations in total.
@@ -396,6 +398,8 @@ pub mod codes {
     pub const SMALL_TURN: &str = "W0010";
     /// A shape whose one distance evaluation is estimated to do a great deal of work.
     pub const COSTLY: &str = "W0011";
+    /// Characters the font has no glyph for.
+    pub const MISSING_GLYPH: &str = "W0012";
     /// Parts of a shape too small for its isosurface's cell, left out of the mesh.
     pub const LOST_PARTS: &str = "W0801";
     /// Isosurface edges left on four triangles where parts are thinner than the cell.

@@ -26,6 +26,7 @@ pub(crate) mod profiles;
 mod reference;
 pub(crate) mod shapes;
 mod table;
+pub(crate) mod text;
 mod value;
 pub(crate) mod values;
 pub use construct::{
@@ -50,6 +51,8 @@ pub trait Host {
     fn in_field_body(&self) -> bool;
     /// The directory of the file being evaluated: a mesh file's path is relative to it.
     fn file_dir(&self) -> &Path;
+    /// The bytes of a file (a font) the scene names, at most `limit` of them.
+    fn read_file(&self, path: &Path, limit: u64) -> std::io::Result<Vec<u8>>;
 }
 
 /// Arguments bound to a builtin's parameters, after arity, name and type checks.
@@ -259,6 +262,7 @@ pub enum ProfileFn {
     Shell,
     Extrude,
     Revolve,
+    Text,
 }
 
 /// The patterns.

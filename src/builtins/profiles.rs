@@ -180,6 +180,7 @@ impl dyn Host + '_ {
                 };
                 Some(Profile { body, region, min: inner.min - t / 2.0, max: inner.max + t / 2.0 })
             }
+            ProfileFn::Text => self.text(a),
             ProfileFn::Extrude | ProfileFn::Revolve => {
                 return match self.sweep(f, a) {
                     Some(kind) => self.shape(Some(kind), a.call),
@@ -456,7 +457,8 @@ impl dyn Host + '_ {
             | ProfileFn::Rect
             | ProfileFn::Polygon
             | ProfileFn::Round
-            | ProfileFn::Shell => None,
+            | ProfileFn::Shell
+            | ProfileFn::Text => None,
         }
     }
 

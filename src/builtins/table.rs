@@ -194,6 +194,13 @@ static REST: &[Builtin] = &[
         "a simple polygon through `points`, either winding, with an exact signed distance",
     ),
     f(
+        "text",
+        Ctor::Profile(ProfileFn::Text),
+        super::text::TextArgs::PARAMS,
+        Ty::Profile,
+        "glyphs of `string` in the bundled DejaVu Sans or a `font` file, the em `size` across, the first glyph at `u = 0` on the baseline `v = 0`, with an exact signed distance",
+    ),
+    f(
         "round",
         Ctor::Profile(ProfileFn::Round),
         RoundProfileArgs::PARAMS,

@@ -188,6 +188,10 @@ impl Host for Ctx<'_> {
     fn file_dir(&self) -> &Path {
         &self.dir
     }
+
+    fn read_file(&self, path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
+        self.loader.read_bytes(path, limit)
+    }
 }
 
 impl<'a> Ctx<'a> {

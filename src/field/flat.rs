@@ -268,7 +268,7 @@ pub struct Flat {
 }
 
 impl Flat {
-    /// `tape` flattened, or `None` if it needs more than `FLAT_REGS` registers.
+    /// `tape` flattened, or `None` if it needs more than `FLAT_REGS` registers or reads an outline.
     pub fn new(tape: &Tape) -> Option<Flat> {
         // The point's coordinates first, in registers no instruction writes.
         let inputs = tape.regs as u16;
@@ -327,6 +327,9 @@ impl Flat {
                 Op::Noise(s, q) => {
                     Ins { code: Code::Noise, out, a: q[0] as u16, b: q[1] as u16, c: q[2] as u16, k: f32::from_bits(s) }
                 }
+                // An outline's distance is a search over its segments in f64, not an
+                // instruction: such a body runs on the tape.
+                Op::Outline(..) => return None,
             };
             ins.push(next);
         }

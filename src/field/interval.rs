@@ -10,6 +10,7 @@ use std::ops::{Add, Div, Mul, Sub};
 
 use super::tape::Scalar;
 use crate::geom::noise::{NOISE_RANGE, NOISE_SLOPE};
+use crate::geom::outline::Outline;
 use crate::ir::field::{Binary, Unary};
 
 /// A closed interval `[lo, hi]` (`lo ≤ hi`, either may be infinite).
@@ -321,6 +322,18 @@ fn pow(a: Interval, b: Interval) -> Interval {
     Interval::ALL
 }
 
+/// An outline's signed distance over the box `u × v`: its value at the middle, give or
+/// take the half-diagonal; anything where the box is unbounded.
+fn outline_over(o: &Outline, u: Interval, v: Interval) -> Interval {
+    let (r, s) = (u.radius(), v.radius());
+    if !(r.is_finite() && s.is_finite()) {
+        return Interval::ALL;
+    }
+    let d = o.nearest(glam::DVec2::new(u.mid(), v.mid())).d;
+    let reach = r.hypot(s);
+    Interval::new(d - reach, d + reach)
+}
+
 impl Scalar for Interval {
     type Point = [Interval; 3];
 
@@ -359,6 +372,12 @@ impl Scalar for Interval {
 
     fn noise(_: [Interval; 3], _: u32) -> Interval {
         Interval::new(-NOISE_RANGE, NOISE_RANGE)
+    }
+
+    /// Within the box's half-diagonal of the distance at its middle: an exact distance
+    /// changes no faster than the point moves.
+    fn outline(o: &Outline, u: Interval, v: Interval) -> Interval {
+        outline_over(o, u, v)
     }
 }
 
@@ -605,5 +624,17 @@ impl<const N: usize> Scalar for Jet<N> {
             Interval::new(-c, c)
         });
         Jet::new(Interval::new(-NOISE_RANGE, NOISE_RANGE), g, s)
+    }
+
+    /// Its value as [`Interval`]'s, its gradient a unit vector in `[u, v]` carried
+    /// through the chain rule, as `length` of a vector of two.
+    fn outline(o: &Outline, u: Jet<N>, v: Jet<N>) -> Jet<N> {
+        let zero = <Jet<N> as Scalar>::constant(0.0);
+        let q = [u, v, zero];
+        let g = std::array::from_fn(|i| {
+            let c = Jet::column(&q, i);
+            Interval::new(-c, c)
+        });
+        Jet::new(outline_over(o, u.v, v.v), g, Jet::stretch(&q))
     }
 }

@@ -23,6 +23,7 @@ pub use tape::{Distances, NoDistances, Op, Reg, Scalar, Tape};
 
 use glam::Vec3A;
 
+use crate::geom::outline::Outline;
 use crate::ir::field::{Binary, Unary};
 
 /// Degrees to radians, in f32.
@@ -117,6 +118,10 @@ impl Scalar for f32 {
 
     fn noise(q: [f32; 3], seed: u32) -> f32 {
         crate::geom::noise(glam::DVec3::new(q[0] as f64, q[1] as f64, q[2] as f64), seed) as f32
+    }
+
+    fn outline(o: &Outline, u: f32, v: f32) -> f32 {
+        o.nearest(glam::DVec2::new(f64::from(u), f64::from(v))).d as f32
     }
 }
 
@@ -319,6 +324,11 @@ impl Scalar for Dual {
         let p = glam::DVec3::new(q[0].v as f64, q[1].v as f64, q[2].v as f64);
         let (n, g) = crate::geom::noise::noise_gradient(p, seed);
         Dual { v: n as f32, g: q[0].g * g.x as f32 + q[1].g * g.y as f32 + q[2].g * g.z as f32 }
+    }
+
+    fn outline(o: &Outline, u: Dual, v: Dual) -> Dual {
+        let n = o.nearest(glam::DVec2::new(f64::from(u.v), f64::from(v.v)));
+        Dual { v: n.d as f32, g: u.g * n.g.x as f32 + v.g * n.g.y as f32 }
     }
 }
 

@@ -6,6 +6,7 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
+use crate::geom::outline::Outline;
 use crate::ir::field::{Binary, FieldExpr, FieldKind, FieldTy, Unary};
 use crate::ir::Shape;
 
@@ -35,6 +36,8 @@ pub enum Op {
     Dist(u32, [Reg; 3]),
     /// Gradient noise at the point of three registers (already divided by the size).
     Noise(u32, [Reg; 3]),
+    /// The signed distance of the tape's `i`-th outline at the `[u, v]` of two registers.
+    Outline(u32, [Reg; 2]),
 }
 
 /// What a [`Tape`] is evaluated over: f32 for marching, dual numbers for normals,
@@ -56,6 +59,8 @@ pub trait Scalar: Copy {
     fn length(v: [Self; 3]) -> Self;
     /// Gradient noise at `q`.
     fn noise(q: [Self; 3], seed: u32) -> Self;
+    /// The signed distance of `o` at `[u, v]` (exact, so its slope is 1).
+    fn outline(o: &Outline, u: Self, v: Self) -> Self;
 }
 
 /// How a tape's `dist` instructions are answered for one scalar type.
@@ -84,6 +89,8 @@ pub struct Tape {
     pub out: Vec<Reg>,
     /// The shapes `dist` reads, by index.
     pub shapes: Vec<Arc<Shape>>,
+    /// The outlines read, by index.
+    pub outlines: Vec<Arc<Outline>>,
 }
 
 /// Value numbering: an SSA value per distinct instruction.
@@ -92,6 +99,7 @@ struct Builder {
     seen: HashMap<OpKey, u32>,
     memo: HashMap<*const FieldExpr, Vec<u32>>,
     shapes: Vec<Arc<Shape>>,
+    outlines: Vec<Arc<Outline>>,
 }
 
 /// An instruction as a hash key (constants by their bits).
@@ -107,6 +115,7 @@ enum OpKey {
     Length([u32; 3]),
     Dist(u32, [u32; 3]),
     Noise(u32, [u32; 3]),
+    Outline(u32, [u32; 2]),
 }
 
 impl Builder {
@@ -122,6 +131,7 @@ impl Builder {
             Op::Length(v) => OpKey::Length(v),
             Op::Dist(i, q) => OpKey::Dist(i, q),
             Op::Noise(s, q) => OpKey::Noise(s, q),
+            Op::Outline(i, q) => OpKey::Outline(i, q),
         };
         if let Some(&id) = self.seen.get(&key) {
             return id;
@@ -242,6 +252,17 @@ impl Builder {
                 let q: Vec<u32> = q.iter().map(|&c| self.binary(Binary::Mul, c, inv)).collect();
                 vec![self.push(Op::Noise(*seed, [q[0], q[1], q[2]]))]
             }
+            FieldKind::Outline(o, at) => {
+                let q = self.expr(at);
+                let i = match self.outlines.iter().position(|s| Arc::ptr_eq(s, o)) {
+                    Some(i) => i,
+                    None => {
+                        self.outlines.push(o.clone());
+                        self.outlines.len() - 1
+                    }
+                } as u32;
+                vec![self.push(Op::Outline(i, [q[0], q[1]]))]
+            }
         }
     }
 }
@@ -255,6 +276,7 @@ impl Op {
             Op::Binary(_, a, b) => vec![a, b],
             Op::Select(c, a, b) => vec![c, a, b],
             Op::Length(v) | Op::Dist(_, v) | Op::Noise(_, v) => v.to_vec(),
+            Op::Outline(_, v) => v.to_vec(),
         }
     }
 
@@ -270,6 +292,7 @@ impl Op {
             Op::Length(v) => Op::Length(v.map(map)),
             Op::Dist(i, v) => Op::Dist(i, v.map(map)),
             Op::Noise(s, v) => Op::Noise(s, v.map(map)),
+            Op::Outline(i, v) => Op::Outline(i, v.map(map)),
         }
     }
 }
@@ -277,7 +300,13 @@ impl Op {
 impl Tape {
     /// Compiles `e` (a number, vector or truth value).
     pub fn new(e: &Arc<FieldExpr>) -> Tape {
-        let mut b = Builder { ssa: Vec::new(), seen: HashMap::new(), memo: HashMap::new(), shapes: Vec::new() };
+        let mut b = Builder {
+            ssa: Vec::new(),
+            seen: HashMap::new(),
+            memo: HashMap::new(),
+            shapes: Vec::new(),
+            outlines: Vec::new(),
+        };
         let outs = b.expr(e);
         // Only what the result needs, in order: dead values (an unused branch's parts
         // after folding) are dropped.
@@ -327,7 +356,7 @@ impl Tape {
             ops.push((renamed, out));
         }
         let out = outs.iter().map(|&o| reg_of[o as usize]).collect();
-        Tape { ops, regs: regs.max(1), out, shapes: b.shapes }
+        Tape { ops, regs: regs.max(1), out, shapes: b.shapes, outlines: b.outlines }
     }
 
     /// The type of value the tape computes.
@@ -356,6 +385,7 @@ impl Tape {
                 Op::Length(v) => S::length(v.map(r)),
                 Op::Dist(i, q) => dist.dist(i, q.map(r)),
                 Op::Noise(seed, q) => S::noise(q.map(r), seed),
+                Op::Outline(i, [u, v]) => S::outline(&self.outlines[i as usize], r(u), r(v)),
             };
             regs[out as usize] = v;
         }

@@ -2,8 +2,10 @@
 //! meshes and the parametric generators that make them.
 
 pub mod axes;
+pub mod font;
 pub mod hull;
 pub mod noise;
+pub mod outline;
 pub mod polygon;
 pub mod region;
 pub mod slab;

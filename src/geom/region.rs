@@ -5,12 +5,16 @@
 //! the engine behind the `geo` crate's, robust where edges meet or overlap), and each
 //! resulting outline with its holes is triangulated (iTriangle) into the prism's caps.
 
+use std::sync::Arc;
+
 use glam::DVec2;
 use i_triangle::float::triangulatable::Triangulatable;
 use i_triangle::i_overlay::core::fill_rule::FillRule;
 use i_triangle::i_overlay::core::overlay_rule::OverlayRule;
+use i_triangle::i_overlay::float::simplify::SimplifyShape;
 use i_triangle::i_overlay::float::single::SingleFloatOverlay;
 
+use super::outline::{Outline, Seg};
 use super::TriMesh;
 
 /// How a region's parts combine.
@@ -38,6 +42,8 @@ pub enum Region {
     },
     /// Sharp CSG of regions.
     Csg(Combine, Vec<Region>),
+    /// Closed curves filled by the non-zero rule (`text`'s glyphs).
+    Outline(Arc<Outline>),
 }
 
 /// Polygons (outlines, each followed by its holes) in iOverlay's form.
@@ -55,6 +61,7 @@ impl Region {
             Region::Polygon(c) => Region::Polygon(c.iter().map(|p| f(*p)).collect()),
             Region::Circle { centre, r } => Region::Circle { centre: f(*centre), r: r * k },
             Region::Csg(op, parts) => Region::Csg(*op, parts.iter().map(|p| p.moved(f, k)).collect()),
+            Region::Outline(o) => Region::Outline(Arc::new(o.moved(f))),
         }
     }
 
@@ -65,6 +72,7 @@ impl Region {
             Region::Polygon(_) => 0.0,
             Region::Circle { r, .. } => *r,
             Region::Csg(_, parts) => parts.iter().map(Region::largest_radius).fold(0.0, f64::max),
+            Region::Outline(o) => o.equivalent_radius(),
         }
     }
 
@@ -74,6 +82,7 @@ impl Region {
             Region::Polygon(c) => c.iter().all(|p| p.abs().max_element() < MAX_COORDINATE),
             Region::Circle { centre, r } => centre.abs().max_element() + r < MAX_COORDINATE,
             Region::Csg(_, parts) => parts.iter().all(Region::in_reach),
+            Region::Outline(o) => o.min.abs().max(o.max.abs()).max_element() < MAX_COORDINATE,
         }
     }
 
@@ -99,6 +108,9 @@ impl Region {
                 let first = parts.next().unwrap_or_default();
                 parts.fold(first, |acc, p| acc.overlay(&p, rule, FillRule::NonZero))
             }
+            // Each curve's share of a circle's sides by how far it turns (`sides` of the
+            // outline's equivalent radius), the contours resolved into outlines with holes.
+            Region::Outline(o) => o.polygons(sides(o.equivalent_radius())).simplify_shape(FillRule::NonZero),
         }
     }
 }
@@ -117,6 +129,17 @@ impl Region {
                 }));
             }
             Region::Csg(Combine::Union, parts) => parts.iter().for_each(|p| p.hull_points(out)),
+            // A quadratic lies in the triangle of its control points.
+            Region::Outline(o) => {
+                for (_, contour) in o.contours() {
+                    for seg in contour {
+                        match *seg {
+                            Seg::Line(a, b) => out.extend([a, b]),
+                            Seg::Quad(a, b, c) => out.extend([a, b, c]),
+                        }
+                    }
+                }
+            }
             Region::Csg(_, parts) => {
                 if let Some(first) = parts.first() {
                     first.hull_points(out);
@@ -150,7 +173,7 @@ impl Region {
     pub fn is_convex_polygon(&self) -> bool {
         match self {
             Region::Polygon(c) => is_convex_union(c.clone(), area(c)),
-            Region::Circle { .. } | Region::Csg(..) => false,
+            Region::Circle { .. } | Region::Csg(..) | Region::Outline(_) => false,
         }
     }
 
@@ -164,7 +187,7 @@ impl Region {
                 let both = c.iter().flat_map(|p| [*p, DVec2::new(-p.x, p.y)]).collect();
                 is_convex_union(both, 2.0 * area(c))
             }
-            Region::Polygon(_) | Region::Circle { .. } | Region::Csg(..) => false,
+            Region::Polygon(_) | Region::Circle { .. } | Region::Csg(..) | Region::Outline(_) => false,
         }
     }
 }

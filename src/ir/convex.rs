@@ -225,7 +225,7 @@ fn facts(e: &Arc<FieldExpr>, memo: &mut HashMap<*const FieldExpr, [Fact; 3]>) ->
                 _ => [OTHER; 3],
             }
         }
-        FieldKind::Select(..) | FieldKind::Dist(..) | FieldKind::Noise { .. } => [OTHER; 3],
+        FieldKind::Select(..) | FieldKind::Dist(..) | FieldKind::Noise { .. } | FieldKind::Outline(..) => [OTHER; 3],
     };
     memo.insert(Arc::as_ptr(e), out);
     out

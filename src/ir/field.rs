@@ -184,6 +184,8 @@ pub enum FieldKind {
         /// The seed.
         seed: u32,
     },
+    /// The signed distance of a 2D outline (`text`'s glyphs) at the `x` and `y` of a point.
+    Outline(Arc<crate::geom::outline::Outline>, Arc<FieldExpr>),
 }
 
 impl Unary {
@@ -393,7 +395,8 @@ impl FieldExpr {
             FieldKind::Component(x, _)
             | FieldKind::Unary(_, x)
             | FieldKind::Dist(_, x)
-            | FieldKind::Noise { at: x, .. } => vec![x],
+            | FieldKind::Noise { at: x, .. }
+            | FieldKind::Outline(_, x) => vec![x],
             FieldKind::Vector(xs) => xs.iter().collect(),
             FieldKind::Binary(_, a, b) => vec![a, b],
             FieldKind::Select(c, a, b) => vec![c, a, b],
@@ -446,6 +449,7 @@ impl FieldExpr {
                 FieldKind::Select(c, a, b) => FieldKind::Select(w(c), w(a), w(b)),
                 FieldKind::Dist(s, at) => FieldKind::Dist(s.clone(), w(at)),
                 FieldKind::Noise { at, size, seed } => FieldKind::Noise { at: w(at), size: *size, seed: *seed },
+                FieldKind::Outline(o, at) => FieldKind::Outline(o.clone(), w(at)),
             };
             let out = FieldExpr::new(kind, e.ty);
             memo.insert(Arc::as_ptr(e), out.clone());
@@ -505,6 +509,10 @@ impl FieldExpr {
             }
             FieldKind::Dist(s, q) => Val::Num(dist(s, v(q))),
             FieldKind::Noise { at, size, seed } => Val::Num(crate::geom::noise(v(at) / *size, *seed)),
+            FieldKind::Outline(o, at) => {
+                let q = v(at);
+                Val::Num(o.nearest(glam::DVec2::new(q.x, q.y)).d)
+            }
         }
     }
 
@@ -615,6 +623,11 @@ fn write_expr(out: &mut String, e: &Arc<FieldExpr>, outer: u8, shapes: &[Arc<Sha
             out.push_str("noise3(");
             write_expr(out, at, 0, shapes, limit);
             let _ = write!(out, ", {}, {seed})", num(*size));
+        }
+        FieldKind::Outline(o, at) => {
+            let _ = write!(out, "outline({:?}, ", o.label);
+            write_expr(out, at, 0, shapes, limit);
+            out.push(')');
         }
     }
     if paren {

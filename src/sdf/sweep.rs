@@ -4,8 +4,11 @@
 //! its gradient instead of by the field interpreter, which paid a dispatch per
 //! operation for a polygon's dozens (`benches/scenes/library-100.scn`, one kind at a time).
 
+use std::sync::Arc;
+
 use glam::{Vec2, Vec3A};
 
+use crate::geom::outline::Outline;
 use crate::geom::region::{Combine, Region};
 use crate::ir::Sweep;
 
@@ -18,6 +21,8 @@ enum Flat {
     Circle(Vec2, f32),
     /// Sharp CSG.
     Csg(Combine, Vec<Flat>),
+    /// Glyphs: their exact distance, searched in f64.
+    Outline(Arc<Outline>),
 }
 
 impl Flat {
@@ -26,6 +31,7 @@ impl Flat {
             Region::Polygon(c) => Flat::Polygon(c.iter().map(|p| p.as_vec2()).collect()),
             Region::Circle { centre, r } => Flat::Circle(centre.as_vec2(), *r as f32),
             Region::Csg(op, parts) => Flat::Csg(*op, parts.iter().map(Flat::new).collect()),
+            Region::Outline(o) => Flat::Outline(o.clone()),
         }
     }
 
@@ -33,6 +39,10 @@ impl Flat {
     fn eval(&self, p: Vec2) -> (f32, Vec2) {
         match self {
             Flat::Polygon(c) => polygon(c, p),
+            Flat::Outline(o) => {
+                let n = o.nearest(p.as_dvec2());
+                (n.d as f32, n.g.as_vec2())
+            }
             Flat::Circle(centre, r) => {
                 let w = p - *centre;
                 let len = w.length();
@@ -144,6 +154,7 @@ impl Swept {
                     Flat::Polygon(c) => c.len() * std::mem::size_of::<Vec2>(),
                     Flat::Circle(..) => 0,
                     Flat::Csg(_, parts) => parts.iter().map(of).sum(),
+                    Flat::Outline(o) => o.bytes(),
                 }
         }
         std::mem::size_of::<Swept>() + of(&self.flat)

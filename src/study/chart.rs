@@ -18,11 +18,7 @@ fn register_font() {
     FONT.call_once(|| {
         // The bundled font is a valid TrueType file; if it were not, text would be missing
         // from the chart and drawing would report the error.
-        let _ = plotters::style::register_font(
-            "sans-serif",
-            FontStyle::Normal,
-            include_bytes!("../../assets/DejaVuSans.ttf"),
-        );
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, crate::geom::font::DEFAULT_FONT);
     });
 }
 

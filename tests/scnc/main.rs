@@ -31,6 +31,7 @@ mod stability;
 mod studio;
 mod studio_server;
 mod support;
+mod text;
 mod tiles;
 mod transport;
 mod watch;

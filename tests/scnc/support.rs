@@ -177,11 +177,15 @@ impl Rng {
     }
 }
 
-/// Writes `files` (name, bytes) into a new temporary directory.
+/// Writes `files` (name, bytes; a name may have directories) into a new temporary directory.
 pub fn files(list: &[(&str, &[u8])]) -> tempfile::TempDir {
     let dir = tempfile::tempdir().expect("temp dir");
     for (name, bytes) in list {
-        std::fs::write(dir.path().join(name), bytes).expect("writing");
+        let at = dir.path().join(name);
+        if let Some(parent) = at.parent() {
+            std::fs::create_dir_all(parent).expect("a directory");
+        }
+        std::fs::write(at, bytes).expect("writing");
     }
     dir
 }
