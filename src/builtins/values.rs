@@ -13,6 +13,10 @@ use crate::sig::Range;
 
 /// Highest index of refraction (germanium's is about 4; nothing in nature reaches 10).
 pub const MAX_IOR: f64 = 10.0;
+/// Highest `density`: far beyond any material's in any unit a scene is likely drawn in
+/// (osmium is 22.6 g/cm³, 2.26e-5 g/mm³, 22,600 kg/m³).
+pub const MAX_DENSITY: f64 = 1e12;
+
 /// Highest `emission_strength`: far beyond any real source relative to a white surface,
 /// still far from f32's overflow when shaded.
 pub const MAX_EMISSION: f64 = 1e30;
@@ -39,6 +43,8 @@ crate::params! {
         emission: DVec3 as Color = [0.0, 0.0, 0.0];
         /// how brightly it glows: radiance = `emission` (255 is 1) times this
         emission_strength: f64 as Num = 1.0, Range::closed(0.0, MAX_EMISSION);
+        /// mass per unit volume, for `scnc measure`'s mass and inertia
+        density: f64 as Num = 1.0, Range::gt_le(0.0, MAX_DENSITY);
     }
 }
 
@@ -192,6 +198,7 @@ impl dyn Host + '_ {
             absorption: m.absorption,
             emission: m.emission,
             emission_strength: m.emission_strength,
+            density: m.density,
             span: a.call,
         };
         if !m.is_transparent() {

@@ -130,6 +130,7 @@ fn json(m: &Measured) -> serde_json::Value {
     let proved = m.proved.as_ref().map(|p| {
         serde_json::json!({
             "volume": iv(&p.volume),
+            "mass": iv(&p.mass),
             "centre_of_mass": p.centre.iter().map(iv).collect::<Vec<_>>(),
             "bounds": { "min": p.min.iter().map(iv).collect::<Vec<_>>(), "max": p.max.iter().map(iv).collect::<Vec<_>>() },
             "inertia": p.inertia.iter().map(|row| row.iter().map(iv).collect::<Vec<_>>()).collect::<Vec<_>>(),
@@ -141,12 +142,12 @@ fn json(m: &Measured) -> serde_json::Value {
     });
     let mesh = m.mesh.as_ref().map(|e| {
         serde_json::json!({
-            "volume": e.volume, "surface_area": e.area, "centre_of_mass": e.centre.to_array(),
+            "volume": e.volume, "mass": e.mass, "surface_area": e.area, "centre_of_mass": e.centre.to_array(),
             "bounds": { "min": e.min.to_array(), "max": e.max.to_array() }, "inertia": e.inertia,
             "triangles": e.triangles,
         })
     });
-    serde_json::json!({ "object": m.name, "proved": proved, "mesh": mesh })
+    serde_json::json!({ "object": m.name, "density": m.density, "proved": proved, "mesh": mesh })
 }
 
 /// A figure as `lo … hi`, with as many digits as tell the ends apart.
@@ -165,7 +166,15 @@ fn num(x: f64) -> String {
 
 /// One object's rows.
 fn table(m: &Measured, line: &str) -> String {
-    let mut t = format!("{}{line}\n", m.name);
+    let density = match m.density {
+        Some(1.0) => String::new(),
+        Some(d) => format!(", density {d}"),
+        None if m.span.is_none() => {
+            ", objects of different densities (not proved as one; the mesh weighs each by its own)".into()
+        }
+        None => ", parts of different densities (mass and inertia at density 1)".into(),
+    };
+    let mut t = format!("{}{line}{density}\n", m.name);
     let row = |t: &mut String, what: &str, proved: String, mesh: String| {
         t.push_str(&format!("  {what:<16} {proved:<44} {mesh}\n"));
     };
@@ -179,6 +188,7 @@ fn table(m: &Measured, line: &str) -> String {
         or_dash(p.map(|p| format!("{} (±{:.3} %)", range(&p.volume), 50.0 * p.volume.relative_width()))),
         or_dash(e.map(|e| num(e.volume))),
     );
+    row(&mut t, "mass", or_dash(p.map(|p| range(&p.mass))), or_dash(e.map(|e| num(e.mass))));
     row(&mut t, "surface area", "— (no bound: see docs/measure.md)".into(), or_dash(e.map(|e| num(e.area))));
     for (k, axis) in ["x", "y", "z"].iter().enumerate() {
         let what = format!("centre {axis}");

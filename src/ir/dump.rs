@@ -63,6 +63,10 @@ impl Dumper<'_> {
         if m.emits() {
             let _ = write!(s, " emission {} strength {}", vec(m.emission), num(m.emission_strength));
         }
+        // Only a density given shows, so scenes without one dump as before.
+        if m.density != 1.0 {
+            let _ = write!(s, " density {}", num(m.density));
+        }
         s
     }
 

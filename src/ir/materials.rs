@@ -28,6 +28,8 @@ pub struct Material {
     pub emission: DVec3,
     /// What the emission colour is multiplied by.
     pub emission_strength: f64,
+    /// Mass per unit volume (`scnc measure`), > 0; 1 when not given.
+    pub density: f64,
     /// The `material(…)` call.
     pub span: Span,
 }
@@ -44,6 +46,7 @@ impl Material {
             absorption: DVec3::ZERO,
             emission: DVec3::ZERO,
             emission_strength: 1.0,
+            density: 1.0,
             span: Span::default(),
         }
     }

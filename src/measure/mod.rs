@@ -82,13 +82,15 @@ pub const MIN_SHARE: u64 = 1 << 16;
 pub struct Proved {
     /// The volume.
     pub volume: Bounds,
+    /// The mass: the volume times the object's density.
+    pub mass: Bounds,
     /// The centre of mass (uniform density).
     pub centre: [Bounds; 3],
     /// The bounding box's least corner, per axis.
     pub min: [Bounds; 3],
     /// Its greatest corner.
     pub max: [Bounds; 3],
-    /// The inertia tensor about the centre of mass at unit density, row by row.
+    /// The inertia tensor about the centre of mass at the object's density, row by row.
     pub inertia: [[Bounds; 3]; 3],
     /// Whether the volume's interval is within the tolerance (else the cell budget ran out).
     pub met: bool,
@@ -106,6 +108,8 @@ pub struct Proved {
 pub struct Estimated {
     /// The volume.
     pub volume: f64,
+    /// The mass: the volume times the density.
+    pub mass: f64,
     /// The surface area.
     pub area: f64,
     /// The centre of mass.
@@ -114,7 +118,7 @@ pub struct Estimated {
     pub min: DVec3,
     /// The greatest corner.
     pub max: DVec3,
-    /// The inertia tensor about the centre of mass at unit density.
+    /// The inertia tensor about the centre of mass at the object's density.
     pub inertia: [[f64; 3]; 3],
     /// Triangles.
     pub triangles: usize,
@@ -127,6 +131,9 @@ pub struct Measured {
     pub name: String,
     /// Its `object` statement (none for the total).
     pub span: Option<Span>,
+    /// Its materials' density (`material(density = …)`, 1 when none is given); `None`
+    /// when its parts have different ones, and then its mass and inertia are at density 1.
+    pub density: Option<f64>,
     /// From the distance bound: none for an explicit mesh (its mesh is exact) or an
     /// unbounded shape.
     pub proved: Option<Proved>,
@@ -142,11 +149,14 @@ pub fn measure(scene: &Scene, opts: &MeasureOptions, loader: &dyn Loader) -> Res
     let opts = &MeasureOptions { cells: (opts.cells / integrations.max(1)).max(MIN_SHARE), ..*opts };
     let mut out = Vec::with_capacity(scene.objects.len() + 1);
     for (object, mesh) in scene.objects.iter().zip(meshes) {
+        let density = density_of(&object.geometry);
+        let rho = density.unwrap_or(1.0);
         let proved = match &object.geometry {
-            Body::Shape(shape) => ir::shape_bounds(shape).map(|b| prove(&[shape], b.min, b.max, opts)),
+            Body::Shape(shape) => ir::shape_bounds(shape).map(|b| prove(&[shape], b.min, b.max, opts).weighed(rho)),
             Body::Mesh(_) => None,
         };
-        out.push(Measured { name: object.name.clone(), span: Some(object.span), proved, mesh });
+        let mesh = mesh.map(|m| m.weighed(rho));
+        out.push(Measured { name: object.name.clone(), span: Some(object.span), density, proved, mesh });
     }
     if scene.objects.len() > 1 {
         out.push(total(scene, &out, opts));
@@ -154,8 +164,55 @@ pub fn measure(scene: &Scene, opts: &MeasureOptions, loader: &dyn Loader) -> Res
     Ok(out)
 }
 
-/// The scene as one solid: the union of its shapes proved as one, the meshes summed.
+/// The density every part of `geometry` has, or `None` when parts differ: a part's is
+/// the innermost material's above it (1 where none is).
+fn density_of(geometry: &Body) -> Option<f64> {
+    fn leaves(shape: &Shape, above: f64, out: &mut Vec<f64>) {
+        let here = match &shape.kind {
+            ShapeKind::Paint { material, .. } => material.density,
+            _ => above,
+        };
+        if shape.children().is_empty() {
+            out.push(here);
+        }
+        shape.children().iter().for_each(|c| leaves(c, here, out));
+    }
+    let mut all = Vec::new();
+    match geometry {
+        Body::Shape(s) => leaves(s, 1.0, &mut all),
+        Body::Mesh(m) => all.push(m.material.as_ref().map_or(1.0, |m| m.density)),
+    }
+    let first = *all.first()?;
+    all.iter().all(|d| *d == first).then_some(first)
+}
+
+impl Proved {
+    /// The figures at density `rho`: the mass and the inertia scale by it.
+    fn weighed(mut self, rho: f64) -> Proved {
+        self.mass = Bounds::new(self.volume.lo * rho, self.volume.hi * rho);
+        for row in &mut self.inertia {
+            for b in row {
+                *b = Bounds::new(b.lo * rho, b.hi * rho);
+            }
+        }
+        self
+    }
+}
+
+impl Estimated {
+    /// The figures at density `rho`: the mass and the inertia scale by it.
+    fn weighed(mut self, rho: f64) -> Estimated {
+        self.mass = self.volume * rho;
+        self.inertia = self.inertia.map(|row| row.map(|x| x * rho));
+        self
+    }
+}
+
+/// The scene as one solid: the union of its shapes proved as one (when every object has
+/// the same density), the meshes' moments summed weighted by their densities.
 fn total(scene: &Scene, each: &[Measured], opts: &MeasureOptions) -> Measured {
+    let densities: Option<Vec<f64>> = each.iter().map(|m| m.density).collect();
+    let density = densities.as_ref().and_then(|d| d.iter().all(|x| *x == d[0]).then(|| d[0]));
     let shapes: Vec<&std::sync::Arc<Shape>> = scene
         .objects
         .iter()
@@ -165,16 +222,16 @@ fn total(scene: &Scene, each: &[Measured], opts: &MeasureOptions) -> Measured {
         })
         .collect();
     let boxes: Option<Vec<ir::DAabb>> = shapes.iter().map(|s| ir::shape_bounds(s)).collect();
-    let proved = match boxes {
-        Some(b) if shapes.len() == scene.objects.len() => {
+    let proved = match (boxes, density) {
+        (Some(b), Some(rho)) if shapes.len() == scene.objects.len() => {
             let lo = b.iter().fold(DVec3::INFINITY, |a, x| a.min(x.min));
             let hi = b.iter().fold(DVec3::NEG_INFINITY, |a, x| a.max(x.max));
-            Some(prove(&shapes, lo, hi, opts))
+            Some(prove(&shapes, lo, hi, opts).weighed(rho))
         }
         _ => None,
     };
     let estimates: Option<Vec<&Estimated>> = each.iter().map(|m| m.mesh.as_ref()).collect();
-    let mesh = estimates.filter(|e| !e.is_empty()).map(|e| {
+    let mesh = estimates.filter(|e| !e.is_empty() && densities.is_some()).map(|e| {
         let mut sum = Moments::default();
         let mut area = 0.0;
         for m in &e {
@@ -184,7 +241,8 @@ fn total(scene: &Scene, each: &[Measured], opts: &MeasureOptions) -> Measured {
         let (min, max) =
             e.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(a, z), m| (a.min(m.min), z.max(m.max)));
         Estimated {
-            volume: sum.volume(),
+            volume: e.iter().map(|m| m.volume).sum(),
+            mass: sum.volume(),
             area,
             centre: sum.centre(),
             min,
@@ -193,12 +251,13 @@ fn total(scene: &Scene, each: &[Measured], opts: &MeasureOptions) -> Measured {
             triangles: e.iter().map(|m| m.triangles).sum(),
         }
     });
-    Measured { name: "total".into(), span: None, proved, mesh }
+    Measured { name: "total".into(), span: None, density, proved, mesh }
 }
 
-/// The ten integrals back from a mesh's figures (about the origin), for summing objects.
+/// The ten integrals of the mass back from a mesh's figures (about the origin), for
+/// summing objects: their zeroth is the mass.
 fn from_figures(m: &Estimated) -> Moments {
-    let (v, c, i) = (m.volume, m.centre, m.inertia);
+    let (v, c, i) = (m.mass, m.centre, m.inertia);
     // Second moments about the centre from the inertia tensor: C = tr(I)/2·E − I.
     let half = 0.5 * (i[0][0] + i[1][1] + i[2][2]);
     let cxx = half - i[0][0];
@@ -256,7 +315,7 @@ fn prove(shapes: &[&std::sync::Arc<Shape>], lo: DVec3, hi: DVec3, opts: &Measure
     let (inner_lo, inner_hi) = shift(r.inner, f64::INFINITY);
     let min = std::array::from_fn(|k| Bounds::new(outer_lo[k], inner_lo[k]));
     let max = std::array::from_fn(|k| Bounds::new(inner_hi[k], outer_hi[k]));
-    Proved { volume: v, centre, min, max, inertia, met: r.met, stated, cells: r.cells, cell: 2.0 * r.finest }
+    Proved { volume: v, mass: v, centre, min, max, inertia, met: r.met, stated, cells: r.cells, cell: 2.0 * r.finest }
 }
 
 /// The inertia tensor about the centre of mass from intervals of the volume, the first
@@ -314,6 +373,7 @@ fn mesh_estimates(
             let centre = m.centre() + origin;
             Some(Estimated {
                 volume: m.volume(),
+                mass: m.volume(),
                 area,
                 centre,
                 min,
