@@ -4,7 +4,8 @@
 //! (`crate::field::lipschitz`), so `scnc ir` shows it and a steep field is reported
 //! where it is written.
 
-use std::sync::Arc;
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
 
 use glam::DVec3;
 
@@ -95,6 +96,15 @@ fn round_up(x: f64) -> f64 {
 
 /// Slope bounds above this or below its inverse are reported (W0007).
 const STEEP: f64 = 2.5;
+
+/// Slope estimates of the bodies analysed so far, by their instructions (constants to
+/// the bit), box and the spheres their `dist` shapes are known by. The analysis is a
+/// deterministic function of those, and up to a 32³ grid of interval evaluations: the
+/// studio compiles on every keystroke and would analyse every unchanged body again.
+static ESTIMATES: Mutex<Option<HashMap<String, Estimate>>> = Mutex::new(None);
+
+/// Most estimates kept; past it the memo starts again.
+const MAX_ESTIMATES: usize = 256;
 
 /// Trigonometry in a body whose argument turns by less than this many degrees over the
 /// body's domain was most likely written in radians (W0010).
@@ -336,10 +346,25 @@ impl dyn Host + '_ {
         Some(Lipschitz { value, given: false })
     }
 
-    /// The bound of the slope of `tape` over `domain`.
+    /// The bound of the slope of `tape` over `domain`, analysed once per distinct body.
     fn estimate(&self, tape: &Tape, domain: Option<DAabb>) -> Estimate {
-        let spheres = tape.shapes.iter().map(|s| ir::shape_sphere(s)).collect();
-        lipschitz(tape, domain, &SlopeDistances { spheres })
+        let spheres: Vec<_> = tape.shapes.iter().map(|s| ir::shape_sphere(s)).collect();
+        // An outline is known by its address only, which a later one may reuse.
+        let key = tape.outlines.is_empty().then(|| format!("{:?}{:?}{domain:?}{spheres:?}", tape.ops, tape.out));
+        let memo = || ESTIMATES.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        if let Some(found) = key.as_ref().and_then(|k| memo().as_ref().and_then(|m| m.get(k).cloned())) {
+            return found;
+        }
+        let e = lipschitz(tape, domain, &SlopeDistances { spheres });
+        if let Some(k) = key {
+            let mut m = memo();
+            let m = m.get_or_insert_with(HashMap::new);
+            if m.len() >= MAX_ESTIMATES {
+                m.clear();
+            }
+            m.insert(k, e.clone());
+        }
+        e
     }
 
     /// Where a displaced shape can reach and how far out its surface can move: the

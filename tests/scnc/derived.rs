@@ -73,7 +73,8 @@ const MAPS: &[&str] = &[
 
 /// Profiles a sweep is given: a disc, a rectangle across the axis, a concave polygon (an
 /// L) and a triangle; and profiles moved and combined: a plate with two holes, a smooth
-/// union of a disc and a turned bar, an intersection of a scaled rectangle and a disc.
+/// union of a disc and a turned bar, an intersection of a scaled rectangle and a disc;
+/// glyphs, alone and cut from a plate.
 const PROFILES: &[&str] = &[
     "circle(0.3)",
     "rect(0.4, 0.3)",
@@ -82,6 +83,8 @@ const PROFILES: &[&str] = &[
     "subtract(rect(0.6, 0.4) at [0.6, 0], circle(0.15) at [0.4, 0], circle(0.1) at [0.85, 0.1])",
     "union(circle(0.25) at [0.3, 0], rect(0.1, 0.4) rotate 30 at [0.6, 0], smooth = 0.1)",
     "intersect(rect(0.5, 0.3) scale 1.2 at [0.5, 0], circle(0.5) at [0.6, 0.1])",
+    "text(\"Ag\", size = 0.6) at [0.1, -0.2]",
+    "subtract(rect(0.6, 0.4) at [0.6, 0], text(\"o\", size = 0.5, halign = \"center\", valign = \"center\") at [0.6, 0])",
 ];
 
 /// Transforms a sampled shape is seen through.

@@ -139,3 +139,81 @@ fn fonts_beside_the_scene_and_bad_fonts() {
         assert!(!png.exists());
     }
 }
+
+/// A glyph's distance at random points equals the distance to its outline flattened
+/// densely and independently (ttf-parser's points, each quadratic at 2,000 points) within
+/// 10⁻⁴ em, and its sign is the non-zero winding of those polygons, for glyphs with
+/// holes, several contours and tight curves.
+#[test]
+fn glyph_distances_match_a_dense_flattening() {
+    use glam::DVec2;
+    use scnc::geom::font::{lay_out, HAlign, Layout, VAlign, DEFAULT_FONT};
+    struct Dense {
+        rings: Vec<Vec<DVec2>>,
+        last: DVec2,
+        scale: f64,
+    }
+    impl ttf_parser::OutlineBuilder for Dense {
+        fn move_to(&mut self, x: f32, y: f32) {
+            self.last = DVec2::new(f64::from(x), f64::from(y)) * self.scale;
+            self.rings.push(vec![self.last]);
+        }
+        fn line_to(&mut self, x: f32, y: f32) {
+            self.last = DVec2::new(f64::from(x), f64::from(y)) * self.scale;
+            self.rings.last_mut().unwrap().push(self.last);
+        }
+        fn quad_to(&mut self, x1: f32, y1: f32, x: f32, y: f32) {
+            let (a, b) = (self.last, DVec2::new(f64::from(x1), f64::from(y1)) * self.scale);
+            let c = DVec2::new(f64::from(x), f64::from(y)) * self.scale;
+            for i in 1..=2000 {
+                let t = f64::from(i) / 2000.0;
+                let s = 1.0 - t;
+                self.rings.last_mut().unwrap().push(a * (s * s) + b * (2.0 * s * t) + c * (t * t));
+            }
+            self.last = c;
+        }
+        fn curve_to(&mut self, _: f32, _: f32, _: f32, _: f32, _: f32, _: f32) {
+            unreachable!("DejaVu Sans is TrueType");
+        }
+        fn close(&mut self) {}
+    }
+    let face = ttf_parser::Face::parse(DEFAULT_FONT, 0).unwrap();
+    let layout = Layout { size: 1.0, halign: HAlign::Left, valign: VAlign::Baseline, spacing: 1.0, line_spacing: 1.0 };
+    let mut rng = crate::support::Rng(0x7e47);
+    for c in ['g', '@', 'B', '8', '&', 'ß'] {
+        let outline = lay_out(DEFAULT_FONT, &c.to_string(), &layout).unwrap().outline.unwrap();
+        let glyph = face.glyph_index(c).unwrap();
+        let mut dense = Dense { rings: Vec::new(), last: DVec2::ZERO, scale: 1.0 / f64::from(face.units_per_em()) };
+        face.outline_glyph(glyph, &mut dense).unwrap();
+        // The layout starts the ink at u = 0.
+        let shift = DVec2::new(f64::from(face.glyph_bounding_box(glyph).unwrap().x_min) * dense.scale, 0.0);
+        let rings: Vec<Vec<DVec2>> = dense.rings.iter().map(|r| r.iter().map(|p| *p - shift).collect()).collect();
+        let segment = |p: DVec2, a: DVec2, b: DVec2| {
+            let d = b - a;
+            let t = ((p - a).dot(d) / d.length_squared().max(1e-300)).clamp(0.0, 1.0);
+            (p - (a + d * t)).length()
+        };
+        for _ in 0..200 {
+            let p =
+                outline.min - 0.2 + DVec2::new(rng.f32() as f64, rng.f32() as f64) * (outline.max - outline.min + 0.4);
+            let mut near = f64::INFINITY;
+            let mut winding = 0;
+            for r in &rings {
+                for i in 0..r.len() {
+                    let (a, b) = (r[i], r[(i + 1) % r.len()]);
+                    near = near.min(segment(p, a, b));
+                    if a.y <= p.y && p.y < b.y && (b - a).perp_dot(p - a) > 0.0 {
+                        winding += 1;
+                    } else if b.y <= p.y && p.y < a.y && (b - a).perp_dot(p - a) < 0.0 {
+                        winding -= 1;
+                    }
+                }
+            }
+            let d = outline.nearest(p).d;
+            assert!((d.abs() - near).abs() < 1e-4, "{c} at {p}: {d} against {near}");
+            if near > 1e-3 {
+                assert_eq!(d < 0.0, winding != 0, "{c} at {p}: sign");
+            }
+        }
+    }
+}

@@ -117,6 +117,14 @@ fn main() {
             eprintln!("note: prusa-slicer is not installed, so its slicing test is ignored (optional)");
         }
     }
+    // POV-Ray too: `apt-get install povray` runs the comparison of text layouts.
+    let povray = probe(Tool::Answers("povray", "--version"));
+    if !povray.1 {
+        #[allow(clippy::print_stderr, reason = "said once, before the run, where cargo shows it")]
+        {
+            eprintln!("note: povray is not installed, so the text layout comparison is ignored (optional)");
+        }
+    }
     let trials = vec![
         trial("studio_in_a_browser", chromium, false, page::studio_in_a_browser),
         trial("studio_helps_as_you_work", chromium, false, page::studio_helps_as_you_work),
@@ -136,6 +144,7 @@ fn main() {
             prusa,
             validators::prusaslicer_slices_two_colours_with_two_extruders,
         ),
+        optional_trial("povray_lays_text_out_as_scnc_does", povray, validators::povray_lays_text_out_as_scnc_does),
     ];
     let missing: Vec<&str> =
         [chromium, nvim, admesh, lib3mf].into_iter().filter(|(_, present)| !present).map(|(t, _)| t.name()).collect();

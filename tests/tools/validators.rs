@@ -99,3 +99,85 @@ pub fn prusaslicer_slices_two_colours_with_two_extruders() {
     // Below the sphere both boxes print in every layer, one with each extruder.
     assert!(2 * (t0 + t1) >= layers, "{layers} layers but only {} tool changes", t0 + t1);
 }
+
+/// Text laid out by scnc and by POV-Ray's `text` object in the same font (the bundled
+/// DejaVu Sans) covers the same pixels, at 256×256 without antialiasing, to 0.3 % of
+/// them on both back-ends. (`scripts/text-vs-povray.sh` adds `ö`: POV-Ray does not kern
+/// `W` with it, though the font's `kern` table does, so that pair differs by its 120 units.)
+pub fn povray_lays_text_out_as_scnc_does() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let font = std::fs::canonicalize("assets/DejaVuSans.ttf").expect("the bundled font");
+    let scene = dir.path().join("text.scn");
+    std::fs::write(
+        &scene,
+        "camera(position = [1.25, 0.3, -6], look_at = [1.25, 0.3, 0], fov = 26)\n\
+         render(width = 256, height = 256, background = rgb(0, 0, 0))\nlight ambient(1)\n\
+         object extrude(text(\"Hello, World!\\ngyp @ 8\", size = 0.5), 0.001) rotate [-90, 0, 0] with material(rgb(255, 255, 255))\n",
+    )
+    .unwrap();
+    // POV-Ray has no line breaks: the second line is one line height lower (DejaVu Sans:
+    // ascender 1901 − descender −483 + gap 0 = 2384 of 2048 units per em).
+    let pov = dir.path().join("text.pov");
+    let f = font.display();
+    std::fs::write(
+        &pov,
+        format!(
+            "#version 3.7;\nglobal_settings {{ assumed_gamma 1 charset utf8 }}\n\
+             camera {{ perspective location <1.25, 0.3, -6> look_at <1.25, 0.3, 0> right x up y angle 26 }}\n\
+             background {{ rgb 0 }}\nunion {{\n\
+             text {{ ttf \"{f}\" \"Hello, World!\" 0.002, 0 scale 0.5 }}\n\
+             text {{ ttf \"{f}\" \"gyp @ 8\" 0.002, 0 scale 0.5 translate <0, -0.5 * 2384 / 2048, 0> }}\n\
+             translate <0, 0, -0.001> pigment {{ rgb 1 }} finish {{ ambient 1 diffuse 0 }} }}\n"
+        ),
+    )
+    .unwrap();
+    let ppm = dir.path().join("pov.ppm");
+    let run = std::process::Command::new("povray")
+        .arg(format!("+I{}", pov.display()))
+        .arg(format!("+O{}", ppm.display()))
+        .args(["+FP", "+W256", "+H256", "-D", "-A"])
+        .output()
+        .expect("povray runs");
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let theirs = ppm_mask(&std::fs::read(&ppm).unwrap());
+    for (mode, extra) in [("sdf", &[][..]), ("mesh", &["--geometry", "mesh", "--tolerance", "0.0002"][..])] {
+        let png = dir.path().join(format!("{mode}.png"));
+        let mut args = vec!["render", scene.to_str().unwrap(), "-o", png.to_str().unwrap()];
+        args.extend(extra);
+        let out = scnc(&args);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let img = image::open(&png).unwrap().to_rgb8();
+        let ours: Vec<bool> = img.pixels().map(|p| u32::from(p[0]) + u32::from(p[1]) + u32::from(p[2]) > 381).collect();
+        let differ = ours.iter().zip(&theirs).filter(|(a, b)| a != b).count();
+        let ink = theirs.iter().filter(|b| **b).count();
+        assert!(ink > 3000, "POV-Ray drew {ink} pixels of text");
+        assert!(differ * 1000 <= 3 * ours.len(), "{mode}: {differ} of {} pixels differ from POV-Ray", ours.len());
+    }
+}
+
+/// The pixels of a binary PPM (`P6`) that are lit, in reading order.
+fn ppm_mask(bytes: &[u8]) -> Vec<bool> {
+    let mut fields = Vec::new();
+    let mut at = 0;
+    while fields.len() < 4 {
+        while bytes[at].is_ascii_whitespace() {
+            at += 1;
+        }
+        if bytes[at] == b'#' {
+            while bytes[at] != b'\n' {
+                at += 1;
+            }
+            continue;
+        }
+        let start = at;
+        while !bytes[at].is_ascii_whitespace() {
+            at += 1;
+        }
+        fields.push(String::from_utf8_lossy(&bytes[start..at]).into_owned());
+    }
+    let (w, h): (usize, usize) = (fields[1].parse().unwrap(), fields[2].parse().unwrap());
+    bytes[at + 1..at + 1 + w * h * 3]
+        .chunks(3)
+        .map(|p| u32::from(p[0]) + u32::from(p[1]) + u32::from(p[2]) > 381)
+        .collect()
+}
