@@ -8,7 +8,7 @@ use rayon::prelude::*;
 use super::{isosurface, octree, parts, IsoAccuracy, MeshJob, Normals};
 use crate::diag::{codes, Diagnostic};
 use crate::geom::TriMesh;
-use crate::ir::{self, Shape};
+use crate::ir::{self, Shape, ShapeKind};
 use crate::sdf::Builder;
 use crate::span::Span;
 use crate::trace::MaterialTable;
@@ -165,14 +165,17 @@ pub(super) fn isosurface_object(
         isosurface::IsoError::NoSurface => no_surface(shape, &*dist, (&bounds, across), cell, span, from),
     })?;
     let mesh = surface.mesh;
-    let per_triangle = mesh
-        .triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
-            mat(((a + b + c) / 3.0).as_vec3a()).mat
-        })
-        .collect();
+    let centroid = |t: &[u32; 3]| {
+        let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+        ((a + b + c) / 3.0).as_vec3a()
+    };
+    // One material over the whole shape is the common case, and a material lookup at a
+    // smooth union's point walks its parts as a distance does: asked once, not per triangle.
+    let (material, per_triangle) = if one_material(shape) {
+        (mesh.triangles.first().map_or(material, |t| mat(centroid(t)).mat), None)
+    } else {
+        (material, Some(mesh.triangles.par_iter().map(|t| mat(centroid(t)).mat).collect()))
+    };
     let mut solid = Vec::new();
     parts::solid_parts(shape, grid, &mut solid);
     let lost = parts::lost(&solid, &lattice, &*dist);
@@ -186,12 +189,25 @@ pub(super) fn isosurface_object(
         mesh,
         xf: place,
         material,
-        per_triangle: Some(per_triangle),
+        per_triangle,
         normals: if smooth { Normals::Vertex } else { Normals::Flat },
         convex: false,
         warnings,
         isosurface: Some(IsoAccuracy { cell, farthest }),
     })
+}
+
+/// Whether every point of `shape` shows one material: it has no `with material` below
+/// its top, where transforms and at most one material may stand.
+fn one_material(shape: &Shape) -> bool {
+    fn unpainted(s: &Shape) -> bool {
+        !matches!(s.kind, ShapeKind::Paint { .. }) && s.children().iter().all(|c| unpainted(c))
+    }
+    match &shape.kind {
+        ShapeKind::Transform { child, .. } => one_material(child),
+        ShapeKind::Paint { child, .. } => unpainted(child),
+        _ => unpainted(shape),
+    }
 }
 
 /// The warning for parts an isosurface at `cell` lost, of `total` solid parts of a
