@@ -237,13 +237,7 @@ impl Builder {
             }
             FieldKind::Dist(shape, q) => {
                 let q = self.expr(q);
-                let i = match self.shapes.iter().position(|s| Arc::ptr_eq(s, shape)) {
-                    Some(i) => i,
-                    None => {
-                        self.shapes.push(shape.clone());
-                        self.shapes.len() - 1
-                    }
-                } as u32;
+                let i = index_of(&mut self.shapes, shape);
                 vec![self.push(Op::Dist(i, [q[0], q[1], q[2]]))]
             }
             FieldKind::Noise { at, size, seed } => {
@@ -254,17 +248,20 @@ impl Builder {
             }
             FieldKind::Outline(o, at) => {
                 let q = self.expr(at);
-                let i = match self.outlines.iter().position(|s| Arc::ptr_eq(s, o)) {
-                    Some(i) => i,
-                    None => {
-                        self.outlines.push(o.clone());
-                        self.outlines.len() - 1
-                    }
-                } as u32;
+                let i = index_of(&mut self.outlines, o);
                 vec![self.push(Op::Outline(i, [q[0], q[1]]))]
             }
         }
     }
+}
+
+/// The index of `item` in `list` (the same `Arc`), added at the end when it is not there.
+fn index_of<T>(list: &mut Vec<Arc<T>>, item: &Arc<T>) -> u32 {
+    let i = list.iter().position(|s| Arc::ptr_eq(s, item)).unwrap_or_else(|| {
+        list.push(item.clone());
+        list.len() - 1
+    });
+    i as u32
 }
 
 impl Op {

@@ -85,7 +85,12 @@ struct Pen<'a> {
     tolerance: f64,
 }
 
-impl Pen<'_> {
+impl<'a> Pen<'a> {
+    /// A pen placing points by `at`, turning cubics into quadratics within `tolerance`.
+    fn new(at: &'a dyn Fn(f64, f64) -> DVec2, tolerance: f64) -> Pen<'a> {
+        Pen { at, contours: Vec::new(), current: Vec::new(), start: DVec2::ZERO, last: DVec2::ZERO, tolerance }
+    }
+
     fn finish(&mut self) {
         if self.last != self.start {
             self.current.push(Seg::Line(self.last, self.start));
@@ -219,14 +224,7 @@ pub fn lay_out(font: &[u8], text: &str, layout: &Layout) -> Result<Laid, String>
         for g in placed {
             let origin = DVec2::new(g.u + shift, baseline);
             let at = move |x: f64, y: f64| origin + DVec2::new(x, y) * scale;
-            let mut pen = Pen {
-                at: &at,
-                contours: Vec::new(),
-                current: Vec::new(),
-                start: DVec2::ZERO,
-                last: DVec2::ZERO,
-                tolerance: CUBIC_TOLERANCE_EM * layout.size,
-            };
+            let mut pen = Pen::new(&at, CUBIC_TOLERANCE_EM * layout.size);
             if face.outline_glyph(g.glyph, &mut pen).is_some() {
                 pen.finish();
             }
@@ -320,14 +318,7 @@ mod tests {
     #[test]
     fn cubics_become_close_quadratics() {
         let at = |x: f64, y: f64| DVec2::new(x, y);
-        let mut pen = Pen {
-            at: &at,
-            contours: Vec::new(),
-            current: Vec::new(),
-            start: DVec2::ZERO,
-            last: DVec2::ZERO,
-            tolerance: 1e-5,
-        };
+        let mut pen = Pen::new(&at, 1e-5);
         pen.move_to(0.0, 0.0);
         pen.curve_to(0.0, 1.0, 1.0, 1.0, 1.0, 0.0);
         pen.close();
