@@ -10,7 +10,6 @@ use clap::ValueEnum;
 
 use super::progress::Reading;
 use super::shared::{Accuracy, Meshing, Messages, Params, Workers};
-use scnc::diag::codes;
 use scnc::diag::Diagnostic;
 use scnc::export::report::MeshReport;
 use scnc::export::{Export, Placement, Up};
@@ -127,10 +126,6 @@ pub(crate) struct ExportArgs {
     params: Params,
 }
 
-/// Warnings about how a scene renders, which an export leaves out.
-const RENDER_ONLY: [&str; 5] =
-    [codes::NO_LIGHTS, codes::USELESS_LIGHT, codes::BEHIND_CAMERA, codes::NO_EFFECT, codes::STEEP_FIELD];
-
 /// A scale from 1e-12 to 1e12, which keeps a renderable scene finite in f32.
 fn parse_scale(s: &str) -> Result<f64, String> {
     let x: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
@@ -180,9 +175,7 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
     let Some(mut compiled) = compile(&args.file, args.messages.message_format, &args.params) else {
         return ExitCode::from(1);
     };
-    // What only a render sees (lights, the camera's view, a field's marching cost) is
-    // not the export's business.
-    compiled.diagnostics.retain(|d| d.is_error() || !RENDER_ONLY.contains(&d.code));
+    super::drop_render_only(&mut compiled);
     if report(&compiled, args.messages.message_format) {
         return ExitCode::from(1);
     }

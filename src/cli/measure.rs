@@ -6,7 +6,6 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use scnc::diag::codes;
 use scnc::measure::{Bounds, MeasureOptions, Measured};
 use scnc::source::FsLoader;
 
@@ -57,10 +56,7 @@ pub(crate) fn measure_cmd(args: MeasureArgs) -> ExitCode {
         Err(e) => return usage_error(&e),
     };
     let Some(mut compiled) = compile(&args.file, format, &args.params) else { return ExitCode::from(1) };
-    // What only a render sees is not a measurement's business.
-    compiled
-        .diagnostics
-        .retain(|d| d.is_error() || ![codes::NO_LIGHTS, codes::USELESS_LIGHT, codes::BEHIND_CAMERA].contains(&d.code));
+    super::drop_render_only(&mut compiled);
     if report(&compiled, format) {
         return ExitCode::from(1);
     }

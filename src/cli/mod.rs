@@ -152,6 +152,21 @@ pub(crate) fn compile(path: &Path, format: MessageFormat, params: &shared::Param
     }
 }
 
+/// Warnings about how a scene renders (lights, the camera's view, a field's marching
+/// cost), which commands that do not render (export, measure, params) leave out.
+const RENDER_ONLY: [&str; 5] = [
+    scnc::diag::codes::NO_LIGHTS,
+    scnc::diag::codes::USELESS_LIGHT,
+    scnc::diag::codes::BEHIND_CAMERA,
+    scnc::diag::codes::NO_EFFECT,
+    scnc::diag::codes::STEEP_FIELD,
+];
+
+/// Drops the warnings only a render needs from `compiled`.
+pub(crate) fn drop_render_only(compiled: &mut Compiled) {
+    compiled.diagnostics.retain(|d| d.is_error() || !RENDER_ONLY.contains(&d.code));
+}
+
 /// Prints an error about a whole file (one that could not be read), blamed on a
 /// zero-length span at its start.
 fn file_error(name: &str, code: &str, message: &str, label: &str, format: MessageFormat) {
@@ -286,7 +301,8 @@ fn run(cli: Cli) -> ExitCode {
             ExitCode::SUCCESS
         }
         Command::Params { file, messages: shared::Messages { message_format }, params } => {
-            let Some(compiled) = compile(&file, message_format, &params) else { return ExitCode::from(1) };
+            let Some(mut compiled) = compile(&file, message_format, &params) else { return ExitCode::from(1) };
+            drop_render_only(&mut compiled);
             if report(&compiled, message_format) {
                 return ExitCode::from(1);
             }

@@ -90,3 +90,24 @@ fn a_set_a_define_and_the_written_value_render_alike() {
     assert!(scnc(&["render", SCENE, "-o", &default]).status.success());
     assert_ne!(read(&a), read(&default), "the set changed nothing");
 }
+
+/// Commands that do not render leave out what only a render needs: a part with no
+/// lights and no camera lists its parameters, measures and exports without a warning.
+#[test]
+fn commands_that_do_not_render_say_nothing_of_lights() {
+    let text = "param size = 10 in 2 .. 30 \"Letter size, mm\"\nobject extrude(text(\"scnc\", size = size), 1)\n";
+    let dir = crate::support::files(&[("tag.scn", text.as_bytes())]);
+    let scene = dir.path().join("tag.scn");
+    let out = dir.path().join("tag.stl");
+    let (scene, out) = (crate::support::path(&scene), crate::support::path(&out));
+    for args in [
+        vec!["params", scene],
+        vec!["measure", scene, "--cells", "100000"],
+        vec!["export", scene, "-o", out, "-D", "size=12"],
+    ] {
+        let run = scnc(&args);
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert!(run.status.success(), "{args:?}: {err}");
+        assert!(!err.contains("W0002") && !err.contains("Warning"), "{args:?}: {err}");
+    }
+}
