@@ -359,6 +359,7 @@ impl dyn Host + '_ {
             bounces: r.bounces,
             exposure: r.exposure,
             noise: r.noise,
+            clamp: r.clamp,
             color,
             span: Some(span),
         })
@@ -418,5 +419,7 @@ crate::params! {
         exposure: f64 as Num = 0.0, Range::closed(-64.0, 64.0);
         /// light transport samples each pixel until its estimated relative error is below this (`samples` the most)
         noise: Option<f64> as Num = derived, Range::gt_le(0.0, 1.0);
+        /// light transport scales a sample down until no channel brings more than this radiance (biased: fireflies lose their light; none when not given)
+        clamp: Option<f64> as Num = derived, Range::gt_le(0.0, MAX_REACH);
     }
 }

@@ -81,6 +81,13 @@ pub(crate) fn stats_text(c: &Counters, g: &World, map: &SourceMap, lower_s: f64,
                 "    estimated noise: none (a pixel needs two samples for an estimate)\n".to_string()
             },
         ));
+        if c.clamped_samples > 0 {
+            out.push_str(&format!(
+                "    clamped: {} samples scaled down to `clamp` ({:.3} % of paths; their excess light is lost)\n",
+                c.clamped_samples,
+                100.0 * c.clamped_samples as f64 / c.paths.max(1) as f64
+            ));
+        }
     }
     if c.segment_bounds > 0 {
         out.push_str(&format!(

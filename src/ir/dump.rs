@@ -216,7 +216,7 @@ pub fn dump(scene: &Scene, map: &SourceMap) -> String {
     d.line(
         0,
         &format!(
-            "render {}x{} depth {} background {} epsilon {} max_steps {} max_distance {} samples {}{}{}{}{}{}{}",
+            "render {}x{} depth {} background {} epsilon {} max_steps {} max_distance {} samples {}{}{}{}{}{}{}{}",
             s.width,
             s.height,
             s.depth,
@@ -239,6 +239,7 @@ pub fn dump(scene: &Scene, map: &SourceMap) -> String {
             s.bounces.map_or(String::new(), |b| format!(" bounces {b}")),
             if s.exposure != 0.0 { format!(" exposure {}", num(s.exposure)) } else { String::new() },
             s.noise.map_or(String::new(), |e| format!(" noise {}", num(e))),
+            s.clamp.map_or(String::new(), |c| format!(" clamp {}", num(c))),
         ),
         s.span,
     );

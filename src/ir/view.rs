@@ -79,6 +79,9 @@ pub struct Settings {
     /// Adaptive sampling under light transport: each pixel takes samples until its
     /// estimated relative error is below this (`samples` is then the most it takes).
     pub noise: Option<f64>,
+    /// Under light transport, the most radiance one sample may bring in any channel: a
+    /// brighter sample is scaled down to it, its hue kept (biased; `None`: unclamped).
+    pub clamp: Option<f64>,
     /// The `render` statement, if any.
     pub span: Option<Span>,
 }
@@ -102,6 +105,7 @@ impl Default for Settings {
             bounces: None,
             exposure: 0.0,
             noise: None,
+            clamp: None,
             span: None,
         }
     }

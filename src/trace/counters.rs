@@ -41,6 +41,8 @@ pub struct Counters {
     /// Samples whose colour was not finite (always 0 unless there is a bug; such a
     /// sample is written as black).
     pub nonfinite_samples: u64,
+    /// Light-transport samples scaled down to `render(clamp = …)`.
+    pub clamped_samples: u64,
     /// Light-transport paths (one per sample of a pixel).
     pub paths: u64,
     /// Rays towards a chosen light (next-event estimation).
@@ -81,6 +83,7 @@ impl Counters {
         self.pruned_rays += o.pruned_rays;
         self.tree_budget_hits += o.tree_budget_hits;
         self.nonfinite_samples += o.nonfinite_samples;
+        self.clamped_samples += o.clamped_samples;
         self.paths += o.paths;
         self.light_rays += o.light_rays;
         self.bounce_rays += o.bounce_rays;

@@ -311,3 +311,29 @@ fn the_sweep_of_a_light_transport_scene_is_a_samples_ladder() {
     args.extend(["--reference", wrong.to_str().expect("utf-8")]);
     refused(&scnc(&args), 1, "the sweep renders 8×8");
 }
+
+/// `render(clamp = c)` scales down only the samples brighter than `c` in some channel:
+/// above every sample it changes no pixel; low, no pixel (a mean of samples) is above
+/// `c` (the small bright light is in view, and lights the floor through a glass ball),
+/// and the image has lost light (clamping is biased, so it is never the default).
+#[test]
+fn clamping_cuts_fireflies_and_only_them() {
+    let text = |clamp: &str| {
+        format!(
+            "camera(position = [0, 1, -4], look_at = [0, 0.5, 0])\nrender(samples = 16, bounces = 4{clamp})\n\
+             object box([3, 0.05, 3]) at [0, -0.05, 0] with material(color = rgb(200, 200, 200))\n\
+             object sphere(0.5) at [0, 0.5, 0] with material(color = rgb(255, 255, 255), transparency = 1, ior = 1.5)\n\
+             object sphere(0.06) at [0.6, 1.6, 0.2] with material(emission = rgb(255, 240, 220), emission_strength = 400)\n"
+        )
+    };
+    let (free, c) = radiance(&text(""), 24, Mode::Sdf);
+    assert_eq!(c.clamped_samples, 0);
+    let (high, c) = radiance(&text(", clamp = 1e12"), 24, Mode::Sdf);
+    assert_eq!((free.clone(), 0), (high, c.clamped_samples), "a clamp above every sample is no clamp");
+    let (low, c) = radiance(&text(", clamp = 2"), 24, Mode::Sdf);
+    assert!(c.clamped_samples > 0);
+    assert!(low.iter().all(|v| *v <= 2.0 + 1e-4), "{}", low.iter().fold(0.0f32, |a, b| a.max(*b)));
+    assert!(free.iter().any(|v| *v > 2.0), "the scene has fireflies to clamp");
+    let sum = |v: &[f32]| v.iter().map(|x| f64::from(*x)).sum::<f64>();
+    assert!(sum(&low) < sum(&free));
+}

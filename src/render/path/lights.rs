@@ -94,6 +94,8 @@ pub struct Transport {
     pub exposure: f32,
     /// The relative error adaptive sampling stops at, if it is on.
     pub noise: Option<f32>,
+    /// The most radiance a sample brings in any channel, if clamped.
+    pub clamp: Option<f32>,
     /// The index of a pixel's first sample: a render of samples `first_sample ..
     /// first_sample + samples` continues one of the samples before (the studio's
     /// accumulation).
@@ -121,6 +123,7 @@ impl Transport {
             focus: scene.camera.focus_distance.unwrap_or_else(|| (scene.camera.look_at - origin).length()) as f32,
             exposure: 2f64.powf(scene.settings.exposure) as f32,
             noise: scene.settings.noise.map(|e| e as f32),
+            clamp: scene.settings.clamp.map(|c| c as f32),
             first_sample: 0,
         };
         let mut glowing = Vec::new();

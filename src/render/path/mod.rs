@@ -123,6 +123,13 @@ pub(super) fn block(
                         c.nonfinite_samples += 1;
                         l = Vec3A::ZERO;
                     }
+                    if let Some(most) = t.clamp {
+                        let top = l.max_element();
+                        if top > most {
+                            l *= most / top;
+                            c.clamped_samples += 1;
+                        }
+                    }
                     p.add(l);
                     sums.add(l);
                 }
