@@ -69,12 +69,15 @@ impl dyn Host + '_ {
         let laid = match font::lay_out(&bytes, &args.string, &layout) {
             Ok(l) => l,
             Err(why) => {
-                let span = if why.starts_with("not a") { a.span_of("font") } else { a.span_of("string") };
+                let blamed = match why {
+                    font::LayoutError::Font(_) => "font",
+                    font::LayoutError::Text(_) => "string",
+                };
                 self.report(Diagnostic::error(
                     codes::BAD_FONT,
-                    span,
+                    a.span_of(blamed),
                     format!("cannot lay out the text in `{font_name}`"),
-                    why,
+                    why.to_string(),
                 ));
                 return None;
             }

@@ -64,6 +64,23 @@ pub struct Layout {
     pub line_spacing: f64,
 }
 
+/// Why text could not be laid out: the font's fault, or the string's.
+#[derive(Debug, PartialEq)]
+pub enum LayoutError {
+    /// The bytes are no font this reads.
+    Font(String),
+    /// The text is past a limit.
+    Text(String),
+}
+
+impl std::fmt::Display for LayoutError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LayoutError::Font(why) | LayoutError::Text(why) => f.write_str(why),
+        }
+    }
+}
+
 /// Laid-out text.
 #[derive(Debug)]
 pub struct Laid {
@@ -190,14 +207,14 @@ struct Placed {
 ///
 /// Long because it is the layout in order: the face, each line's pen with its kerning,
 /// the alignment of lines and of the whole, and the outlines.
-pub fn lay_out(font: &[u8], text: &str, layout: &Layout) -> Result<Laid, String> {
-    let face = Face::parse(font, 0).map_err(|e| format!("not a TrueType or OpenType font ({e})"))?;
+pub fn lay_out(font: &[u8], text: &str, layout: &Layout) -> Result<Laid, LayoutError> {
+    let face = Face::parse(font, 0).map_err(|e| LayoutError::Font(format!("not a TrueType or OpenType font ({e})")))?;
     let upem = f64::from(face.units_per_em());
     if upem <= 0.0 {
-        return Err("the font states no units per em".into());
+        return Err(LayoutError::Font("the font states no units per em".into()));
     }
     if text.chars().count() > MAX_CHARS {
-        return Err(format!("more than {MAX_CHARS} characters"));
+        return Err(LayoutError::Text(format!("more than {MAX_CHARS} characters")));
     }
     let scale = layout.size / upem;
     let line_height =
@@ -265,22 +282,19 @@ pub fn lay_out(font: &[u8], text: &str, layout: &Layout) -> Result<Laid, String>
                 contours.push((group, c));
             }
             if segments > MAX_SEGMENTS {
-                return Err(format!("more than {MAX_SEGMENTS} outline segments"));
+                return Err(LayoutError::Text(format!("more than {MAX_SEGMENTS} outline segments")));
             }
         }
     }
-    let label = text.to_string();
-    let mut outline = Outline::new(contours, label);
-    if let Some(o) = &outline {
+    let mut outline = Outline::new(contours, text.to_string());
+    if let Some(o) = &mut outline {
         let dv = match layout.valign {
             VAlign::Baseline => 0.0,
             VAlign::Top => -o.max.y,
             VAlign::Center => -(o.min.y + o.max.y) / 2.0,
             VAlign::Bottom => -o.min.y,
         };
-        if dv != 0.0 {
-            outline = Some(o.moved(&|p| p + DVec2::new(0.0, dv)));
-        }
+        o.translate(DVec2::new(0.0, dv));
     }
     let family = face
         .names()

@@ -30,13 +30,6 @@ impl Seg {
             Seg::Quad(a, b, c) => Seg::Quad(f(a), f(b), f(c)),
         }
     }
-
-    /// Where it starts.
-    pub fn start(&self) -> DVec2 {
-        match *self {
-            Seg::Line(a, _) | Seg::Quad(a, _, _) => a,
-        }
-    }
 }
 
 /// A closed contour: each segment starts where the last ended.
@@ -137,6 +130,23 @@ impl Outline {
             + segs * std::mem::size_of::<Seg>()
             + self.pieces.len() * std::mem::size_of::<Piece>()
             + self.groups.len() * std::mem::size_of::<Group>()
+    }
+
+    /// The outline moved by `d`: a translation keeps every split, so nothing is rebuilt.
+    pub fn translate(&mut self, d: DVec2) {
+        for (_, contour) in &mut self.contours {
+            for seg in contour.iter_mut() {
+                *seg = seg.moved(&|p| p + d);
+            }
+        }
+        for piece in &mut self.pieces {
+            piece.p = piece.p.map(|p| p + d);
+            (piece.min, piece.max) = (piece.min + d, piece.max + d);
+        }
+        for group in &mut self.groups {
+            (group.min, group.max) = (group.min + d, group.max + d);
+        }
+        (self.min, self.max) = (self.min + d, self.max + d);
     }
 
     /// How many segments it has once split where `y` turns.
