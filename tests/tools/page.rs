@@ -125,20 +125,22 @@ pub fn studio_in_a_browser() {
     let downloads = tempfile::tempdir().unwrap();
     b.downloads_to(downloads.path());
     b.click("[data-testid=export-stl]");
+    // Chromium may show the file under its final name while still writing it, so wait
+    // until it reads whole (a binary STL states its triangle count up front).
     let start = Instant::now();
-    let stl = loop {
+    let mesh = loop {
         let found = std::fs::read_dir(downloads.path())
             .unwrap()
             .filter_map(|e| e.ok().map(|e| e.path()))
             .find(|p| p.extension().is_some_and(|e| e == "stl"));
-        if let Some(p) = found {
-            break p;
+        let read = found.map(|p| std::fs::File::open(p).and_then(|mut f| stl_io::read_stl(&mut f)));
+        match read {
+            Some(Ok(mesh)) => break mesh,
+            Some(Err(e)) => assert!(start.elapsed() < limit, "the STL never read whole: {e}"),
+            None => assert!(start.elapsed() < limit, "no STL was downloaded"),
         }
-        assert!(start.elapsed() < limit, "no STL was downloaded");
         std::thread::sleep(Duration::from_millis(50));
     };
-    let mut file = std::fs::File::open(&stl).unwrap();
-    let mesh = stl_io::read_stl(&mut file).expect("a valid STL");
     assert!(mesh.faces.len() > 1000, "{} triangles", mesh.faces.len());
     mesh.validate().expect("an STL whose faces name its vertices");
     b.screenshot(&shots.join("7-exported.png"));
