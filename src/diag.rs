@@ -402,8 +402,6 @@ pub mod codes {
     pub const MISSING_GLYPH: &str = "W0012";
     /// Parts of a shape too small for its isosurface's cell, left out of the mesh.
     pub const LOST_PARTS: &str = "W0801";
-    /// Isosurface edges left on four triangles where parts are thinner than the cell.
-    pub const PINCHED_EDGES: &str = "W0802";
     /// An unbounded object left out of an export.
     pub const SKIPPED_UNBOUNDED: &str = "W0803";
     /// An object with no triangles, left out of an export.

@@ -229,6 +229,9 @@ pub(crate) fn export_cmd(args: ExportArgs) -> ExitCode {
     if args.stats {
         for part in &export.parts {
             let _ = writeln!(err, "  {}", part_stats(part, &compiled.map));
+            if let Some(fit) = part.fit {
+                let _ = writeln!(err, "    {}", fit_stats(&fit, part.mesh.triangles.len()));
+            }
         }
     }
     ExitCode::SUCCESS
@@ -284,7 +287,7 @@ impl ExportArgs {
         let detail: Detail = match self.accuracy.tolerance {
             Some(tol) => {
                 let detail = scnc::study::tolerance::mesh_detail(scene, tol);
-                let _ = writeln!(std::io::stderr(), "tolerance {tol}: picked detail {}", detail.rings());
+                let _ = writeln!(std::io::stderr(), "tolerance {tol}: picked {}", detail.describe());
                 detail
             }
             None => self.meshing.detail,
@@ -361,6 +364,17 @@ fn part_stats(part: &scnc::meshfile::Part, map: &scnc::source::SourceMap) -> Str
         hi.x,
         hi.y,
         hi.z,
+    )
+}
+
+/// The second line of `--stats` for an isosurface made under a tolerance: its measured
+/// deviation from the surface.
+pub(crate) fn fit_stats(fit: &scnc::meshfile::IsoFit, triangles: usize) -> String {
+    let unresolved = if fit.unresolved > 0 { format!(", {} not resolved", fit.unresolved) } else { String::new() };
+    format!(
+        "deviation from the surface: max {:.3e}, mean {:.3e} ({} points sampled on every triangle{unresolved}; \
+         {} of {triangles} triangles proved within the tolerance everywhere)",
+        fit.max, fit.mean, fit.samples, fit.proved
     )
 }
 

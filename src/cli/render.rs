@@ -247,7 +247,7 @@ impl RenderArgs {
                 }
                 GeometryKind::Mesh => {
                     detail = scnc::study::tolerance::mesh_detail(scene, tol);
-                    format!("detail {}", detail.rings())
+                    detail.describe()
                 }
             };
             let _ = writeln!(std::io::stderr(), "tolerance {tol}: picked {picked}");

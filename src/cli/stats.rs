@@ -120,12 +120,18 @@ pub(crate) fn stats_text(c: &Counters, g: &World, map: &SourceMap, lower_s: f64,
                 m.bvh_depth
             ));
             if let Some(iso) = m.isosurface {
-                out.push_str(&format!(
-                    "; isosurface cell {:.3e}, farthest vertex {:.3e} ({:.3} cell)",
-                    iso.cell,
-                    iso.farthest,
-                    iso.farthest / iso.cell
-                ));
+                if iso.coarsest > iso.cell {
+                    out.push_str(&format!("; isosurface cells {:.3e} to {:.3e}", iso.cell, iso.coarsest));
+                } else {
+                    out.push_str(&format!("; isosurface cell {:.3e}", iso.cell));
+                }
+                out.push_str(&format!(", farthest vertex {:.3e} ({:.3} cell)", iso.farthest, iso.farthest / iso.cell));
+                if let Some(d) = iso.deviation {
+                    out.push_str(&format!(
+                        "; deviation from the surface max {:.3e}, mean {:.3e} ({} points sampled, {} of {} triangles proved)",
+                        d.max, d.mean, d.samples, d.proved, m.triangles
+                    ));
+                }
             }
             out.push('\n');
         }

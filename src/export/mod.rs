@@ -21,7 +21,7 @@ use crate::span::Span;
 use crate::trace::MaterialTable;
 
 pub use crate::geom::axes::Up;
-pub use crate::meshfile::{Colour, Export, Group, Part};
+pub use crate::meshfile::{Colour, Export, Group, IsoFit, Part};
 
 /// How scene coordinates become the file's.
 #[derive(Clone, Copy, Debug)]
@@ -61,11 +61,10 @@ pub fn collect_refined(
     let (mut result, mut detail) = (collect(detail), detail);
     for _ in 0..REFINEMENTS {
         let Ok(e) = &result else { break };
-        let thin = [codes::PINCHED_EDGES, codes::LOST_VOLUME];
-        if !e.warnings.iter().any(|w| thin.contains(&w.code)) {
+        if !e.warnings.iter().any(|w| w.code == codes::LOST_VOLUME) {
             break;
         }
-        let finer = Detail::N((detail.rings() as f64 * 1.3).ceil() as u32);
+        let finer = detail.finer(1.3);
         refining(detail, finer);
         match collect(finer) {
             Err(_) => break,
@@ -211,6 +210,16 @@ fn part(name: String, job: mesh::MeshJob, span: Span, frame: Placement) -> Part 
     }
     triangles.iter_mut().flatten().for_each(|i| *i = new_index[*i as usize]);
     let positions = kept;
+    // Measured in the frame the mesh was made in: lengths scale by the placement's
+    // stretch (a transform and the file's scale; turns and the up axis keep them).
+    let stretch = job.xf.matrix3.determinant().abs().cbrt() * frame.scale;
+    let fit = job.isosurface.and_then(|iso| iso.deviation).map(|d| IsoFit {
+        max: d.max * stretch,
+        mean: d.mean * stretch,
+        samples: d.samples,
+        proved: d.proved,
+        unresolved: d.unresolved,
+    });
     Part {
         name,
         span,
@@ -219,6 +228,7 @@ fn part(name: String, job: mesh::MeshJob, span: Span, frame: Placement) -> Part 
         smooth: job.normals != mesh::Normals::Flat,
         degenerate,
         rounded_away,
+        fit,
     }
 }
 

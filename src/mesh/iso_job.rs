@@ -5,6 +5,8 @@
 use glam::{DAffine3, Vec3A};
 use rayon::prelude::*;
 
+use super::samples::IsoField;
+use super::tree::{Deviation, Plan};
 use super::{isosurface, octree, parts, IsoAccuracy, MeshJob, Normals};
 use crate::diag::{codes, Diagnostic};
 use crate::geom::TriMesh;
@@ -72,6 +74,8 @@ pub(super) enum CellFrom {
     Scene,
     /// `--detail` in mesh mode.
     Detail,
+    /// `--tolerance`: the cells follow the error.
+    Tolerance,
 }
 
 /// How an isosurface is sampled and placed.
@@ -82,8 +86,11 @@ pub(super) struct Iso {
     pub(super) place: DAffine3,
     /// Material of parts that have none.
     pub(super) material: u32,
-    /// Cell size in the grid's units.
+    /// Cell size in the grid's units: every cell's, or under a tolerance the coarsest
+    /// the detail's cell would have been (the finest then follows the tolerance).
     pub(super) cell: f64,
+    /// The tolerance the mesh must meet, in the grid's frame: cells follow the error.
+    pub(super) deviation: Option<Deviation>,
     /// Interpolated normals.
     pub(super) smooth: bool,
     /// What set `cell`, for the hint of a failure.
@@ -108,7 +115,7 @@ pub(super) fn isosurface_object(
     span: Span,
     materials: &mut MaterialTable,
 ) -> Result<MeshJob, Diagnostic> {
-    let Iso { grid, place, material, cell, smooth, from, max_cells, wanted } = iso;
+    let Iso { grid, place, material, cell, deviation, smooth, from, max_cells, wanted } = iso;
     let bounds = ir::shape_bounds(shape).ok_or_else(|| unbounded(shape.span))?.transform(&grid);
     // A cell as large as the shape samples a few points around it: the mesh would be a
     // sliver or nothing, so it is refused like a grid that finds no surface.
@@ -124,6 +131,7 @@ pub(super) fn isosurface_object(
         return Err(match from {
             CellFrom::Scene => d.with_hint(format!("try `cell = {}` or less", ir::dump_num(across / 20.0))),
             CellFrom::Detail => d.with_hint("try a higher `--detail`"),
+            CellFrom::Tolerance => d.with_hint("try a smaller `--tolerance`"),
         });
     }
     let (dist, mat) = Builder::new(materials).build(shape, grid, material);
@@ -149,20 +157,38 @@ pub(super) fn isosurface_object(
                 d.with_hint(format!("try `cell = {}` or more", ir::dump_num((min_cell * 1.001 * 1e6).ceil() / 1e6)))
             }
             CellFrom::Detail => d.with_hint("try a lower `--detail`"),
+            CellFrom::Tolerance => d.with_hint("try a larger `--tolerance`, or a larger `--memory-limit`"),
         }
     };
-    let lattice = octree::Grid::new(bounds.min, bounds.max, cell).map_err(|side| {
+    let mut solid = Vec::new();
+    parts::solid_parts(shape, grid, &mut solid);
+    // Under a tolerance the finest cell is half the smallest bound over the box, and a
+    // leaf may stay as coarse as an eighth of the shape.
+    let finest = match deviation {
+        Some(d) => (0.5 * d.over(bounds.min, bounds.max)).max(across * 1e-6).min(cell),
+        None => cell,
+    };
+    let lattice = octree::Grid::new(bounds.min, bounds.max, finest).map_err(|side| {
         // Too many cells on a side for a key: a closed surface across the grid crosses
         // about as many cells as a cube's six faces, so the cell must grow for both the
         // key and the cell limit.
         let cells = 6.0 * side * side;
-        let for_keys = cell * side / (1u64 << octree::MAX_LEVELS) as f64;
-        let for_limit = cell * (cells / max_cells as f64).sqrt();
+        let for_keys = finest * side / (1u64 << octree::MAX_LEVELS) as f64;
+        let for_limit = finest * (cells / max_cells as f64).sqrt();
         too_fine(cells, for_keys.max(for_limit))
     })?;
-    let surface = isosurface::extract_within(&*dist, &lattice, max_cells).map_err(|e| match e {
+    let plan = match deviation {
+        Some(deviation) => Plan::Within {
+            deviation,
+            coarsest: (across / 8.0 / finest).log2().floor().clamp(0.0, f64::from(lattice.levels)) as u32,
+            parts: solid.iter().map(|p| (p.min, p.max)).collect(),
+        },
+        None => Plan::Uniform,
+    };
+    let field = IsoField { dist: &*dist, surf: &*mat };
+    let surface = isosurface::extract_within(field, &lattice, &plan, max_cells).map_err(|e| match e {
         isosurface::IsoError::TooManyCells { cells, min_cell } => too_fine(cells, min_cell),
-        isosurface::IsoError::NoSurface => no_surface(shape, &*dist, (&bounds, across), cell, span, from),
+        isosurface::IsoError::NoSurface => no_surface(shape, &*dist, (&bounds, across), finest, span, from),
     })?;
     let mesh = surface.mesh;
     let centroid = |t: &[u32; 3]| {
@@ -176,13 +202,10 @@ pub(super) fn isosurface_object(
     } else {
         (material, Some(mesh.triangles.par_iter().map(|t| mat(centroid(t)).mat).collect()))
     };
-    let mut solid = Vec::new();
-    parts::solid_parts(shape, grid, &mut solid);
     let lost = parts::lost(&solid, &lattice, &*dist);
-    let warnings = lost_parts(&lost, solid.len(), span, cell, across, from)
+    let warnings = lost_parts(&lost, solid.len(), span, finest, across, from)
         .into_iter()
-        .chain(pinched(surface.pinched, span, cell, across, from))
-        .chain(if lost.is_empty() { lost_volume(&mesh, &*dist, &bounds, span, cell, across, from) } else { None })
+        .chain(if lost.is_empty() { lost_volume(&mesh, &*dist, &bounds, span, finest, across, from) } else { None })
         .collect();
     let farthest = mesh.positions.par_iter().map(|p| f64::from(dist(p.as_vec3a()).abs())).reduce(|| 0.0, f64::max);
     Ok(MeshJob {
@@ -193,7 +216,13 @@ pub(super) fn isosurface_object(
         normals: if smooth { Normals::Vertex } else { Normals::Flat },
         convex: false,
         warnings,
-        isosurface: Some(IsoAccuracy { cell, farthest }),
+        isosurface: Some(IsoAccuracy {
+            cell: surface.cells.0,
+            coarsest: surface.cells.1,
+            farthest,
+            deviation: surface.deviation,
+            doubled: surface.doubled,
+        }),
     })
 }
 
@@ -260,14 +289,19 @@ fn no_surface(
             "the shape is thinner than a cell everywhere, or much smaller than its box, so the mesh would be empty",
         )
     };
-    let (scene, detail) = if nesting >= 3 {
-        ("try a smaller `cell`, or nest fewer levels", "try a higher `--detail`, or nest fewer levels")
+    let (scene, detail, tolerance) = if nesting >= 3 {
+        (
+            "try a smaller `cell`, or nest fewer levels",
+            "try a higher `--detail`, or nest fewer levels",
+            "try a smaller `--tolerance`, or nest fewer levels",
+        )
     } else {
-        ("try a smaller `cell`", "try a higher `--detail`")
+        ("try a smaller `cell`", "try a higher `--detail`", "try a smaller `--tolerance`")
     };
     d.with_hint(match from {
         CellFrom::Scene => scene,
         CellFrom::Detail => detail,
+        CellFrom::Tolerance => tolerance,
     })
 }
 
@@ -323,6 +357,7 @@ fn lost_parts(
             let rings = detail_for(across, needed);
             d.with_hint(format!("try `--detail {}` or a `--tolerance` below {}", short(rings), approx(needed / 2.0)))
         }
+        CellFrom::Tolerance => d.with_hint(format!("try a `--tolerance` below {}", approx(needed / 2.0))),
     })
 }
 
@@ -391,6 +426,7 @@ fn lost_volume(
             short(detail_for(across, cell / 2.0)),
             approx(cell / 4.0)
         )),
+        CellFrom::Tolerance => d.with_hint(format!("try a `--tolerance` below {}", approx(cell))),
     })
 }
 
@@ -402,26 +438,4 @@ fn percent(r: f64) -> String {
     } else {
         format!("{p:.0} %")
     }
-}
-
-/// The warning for `edges` of an isosurface at `cell` left on four triangles; `None`
-/// when there are none.
-fn pinched(edges: usize, span: Span, cell: f64, across: f64, from: CellFrom) -> Option<Diagnostic> {
-    if edges == 0 {
-        return None;
-    }
-    let plural = if edges == 1 { "edge lies" } else { "edges lie" };
-    let d = Diagnostic::warning(
-        codes::PINCHED_EDGES,
-        span,
-        format!("{edges} isosurface {plural} on four triangles: parts are thinner than the cell"),
-        format!("meshed at cell {}", approx(cell)),
-    )
-    .with_note(
-        "the mesh is closed, but not manifold at those edges; tools that need a manifold (slicers) may refuse it",
-    );
-    Some(match from {
-        CellFrom::Scene => d.with_hint(format!("try `cell = {}` or less", approx(cell / 2.0))),
-        CellFrom::Detail => d.with_hint(format!("try `--detail {}` or more", short(detail_for(across, cell / 2.0)))),
-    })
 }

@@ -1,292 +1,168 @@
-//! Isosurface extraction by dual contouring on the cells an octree keeps
-//! ([`octree`](super::octree)): every finest cell the surface crosses gets one vertex per
-//! sheet of surface inside it, placed by a quadric error function
-//! (`mesh::qef`) on the tangent planes at its edge crossings, so that a box keeps
-//! its edges and corners; every grid edge the surface crosses gets a quad joining the
-//! vertices of the four cells around it.
+//! Isosurface extraction: dual contouring on an adaptive octree, refined by the error
+//! it measures.
 //!
-//! **Closed and manifold.** A cell's sheets are the cycles its crossed edges form when
-//! each face pairs the crossed edges on it (two crossings pair up; four, on a face whose
-//! diagonal corners agree, pair by the asymptotic decider of the face's bilinear
-//! interpolant). A face's pairing depends on its four corner values only, which both
-//! cells sharing it read from one table, so both see the same pairs. Then a mesh edge
-//! between two sheets across a face lies on exactly the two quads of that face's paired
-//! grid edges, and the quads around a sheet's vertex form one fan: every edge has two
-//! triangles and every vertex one disk — except where one sheet crosses a face twice
-//! from both sides (a part thinner than a cell), which `split_doubled_faces` mends
-//! where it can and counts where it cannot. A crossed edge's four cells all hold a crossing,
-//! so the octree keeps them; should rounding drop one, it is added and the step repeated.
-//! Quads are wound outward (from the inside end of their grid edge).
+//! 1. The cells ([`super::tree`]): split where the surface may pass, down to the finest
+//!    cell everywhere ([`Plan::Uniform`]) or only as far as the surface's shape needs
+//!    under a tolerance ([`Plan::Within`]).
+//! 2. The crossed edges of the subdivision with the leaves around each
+//!    ([`super::dual`]), and the mesh on them ([`super::contour`]): a vertex per sheet of
+//!    surface in a leaf, placed by a quadric error function on the tangent planes at its
+//!    crossings (`mesh::qef`, so that a box keeps its edges and corners), a polygon per
+//!    crossed edge. Closed and manifold by construction, at every tolerance.
+//! 3. Under a tolerance, the mesh is measured against the field on every triangle
+//!    ([`super::deviation`]); the leaves of triangles found farther than the tolerance
+//!    are split, and steps 2–3 repeat ([`ROUNDS`] times at most).
+//!
+//! Memory grows with the leaves near the surface (what the error needs), not with the
+//! box: what the field was found to be is kept once ([`super::samples`]) for every round.
 
-use glam::{DVec3, Vec3A};
+use glam::Vec3A;
 use rayon::prelude::*;
 
-use super::octree::{key, unkey, Grid};
-use super::qef::Qef;
+use super::deviation::{self, MeasuredDeviation};
+use super::octree::Grid;
+use super::samples::{IsoField, Samples, ENTRY_BYTES};
+use super::tree::{Plan, TooMany, Tree};
 use crate::geom::TriMesh;
+use crate::sdf::Surf;
 
-/// Bytes a finest cell takes at the peak of extraction (its key, its share of corner
-/// values and crossings, its sheets and their triangles): a memory budget allows its
-/// bytes over this many cells.
-pub const CELL_BYTES: u64 = 200;
+/// Bytes a leaf takes at the peak of extraction (its share of the tree, of the sampled
+/// values and crossings, its edges' polygon records, its vertices and triangles): a
+/// memory budget allows its bytes over this many leaves.
+pub const CELL_BYTES: u64 = 400;
 
-/// Most finest cells one isosurface may refine when no budget says otherwise (about 1 GB
-/// of working memory).
+/// Most leaves one isosurface may refine when no budget says otherwise (about 1.6 GB of
+/// working memory).
 pub const MAX_CELLS: usize = 4_000_000;
+
+/// Rounds of measuring and splitting under a tolerance.
+pub const ROUNDS: usize = 8;
 
 /// Why an isosurface could not be made.
 #[derive(Clone, Debug, PartialEq)]
 pub enum IsoError {
-    /// The surface would refine more cells than [`MAX_CELLS`].
+    /// The surface would refine more leaves than the limit.
     TooManyCells {
-        /// Cells it is expected to refine.
+        /// Leaves it is expected to refine.
         cells: f64,
-        /// The smallest cell size expected to stay within the limit.
+        /// The smallest finest cell expected to stay within the limit.
         min_cell: f64,
     },
     /// No sign change was found: the shape is thinner than a cell everywhere (or empty).
     NoSurface,
 }
 
-/// A grid edge by the key of its lower end and its axis.
-type EdgeKey = (u64, u8);
-
-/// A crossed grid edge: where the surface crosses it and the surface's normal there.
-#[derive(Clone, Copy)]
-struct Crossing {
-    point: DVec3,
-    normal: DVec3,
-}
-
-/// A cell's sheets: which sheet each of its twelve edges belongs to ([`NO_SHEET`] when
-/// the edge is not crossed), the index of its first sheet's vertex, and the faces one
-/// sheet crosses twice (bit `n` for face `n`).
-#[derive(Clone, Copy)]
-struct Sheets {
-    of_edge: [u8; 12],
-    first: u32,
-    doubled: u8,
-}
-
-const NO_SHEET: u8 = u8::MAX;
-
 /// An extracted isosurface.
 #[derive(Debug)]
 pub struct Surface {
-    /// The triangles, closed and wound outward.
+    /// The triangles, closed, manifold and wound outward.
     pub mesh: TriMesh,
-    /// Edges left on four triangles: where a part thinner than a cell crosses a cell
-    /// face twice from both sides and the sheets could not be split (0 otherwise).
-    pub pinched: usize,
+    /// Faces crossed twice by two sheets (a part thinner than its cell), given a vertex
+    /// per segment so that the mesh stays manifold there.
+    pub doubled: usize,
     /// Pairs of triangles that still cross each other after [`super::unfold`].
     pub crossing_pairs: usize,
+    /// The leaves the mesh was made on.
+    pub leaves: usize,
+    /// The smallest and largest leaf that holds a vertex.
+    pub cells: (f64, f64),
+    /// The deviation from the surface, measured on every triangle (under a tolerance).
+    pub deviation: Option<MeasuredDeviation>,
+    /// Rounds of splitting the measurement asked for.
+    pub rounds: usize,
 }
 
-/// Extracts the zero set of `f` on `grid`, refining at most [`MAX_CELLS`] cells.
-pub fn extract(f: &(dyn Fn(Vec3A) -> f32 + Sync), grid: &Grid) -> Result<Surface, IsoError> {
-    extract_within(f, grid, MAX_CELLS)
+/// The gradient of a distance bound by central differences on a tetrahedron, for a
+/// field that has no gradient of its own (tests, plain closures).
+pub fn by_differences(dist: &(dyn Fn(Vec3A) -> f32 + Sync), h: f32) -> impl Fn(Vec3A) -> Surf + Sync + '_ {
+    move |p: Vec3A| {
+        let g: Vec3A =
+            [Vec3A::new(1.0, -1.0, -1.0), Vec3A::new(-1.0, -1.0, 1.0), Vec3A::new(-1.0, 1.0, -1.0), Vec3A::ONE]
+                .into_iter()
+                .map(|k| k * dist(p + k * h))
+                .sum();
+        Surf { d: dist(p), g, mat: 0 }
+    }
 }
 
-/// Extracts the zero set of `f` on `grid`, refining at most `max_cells` cells.
-pub fn extract_within(f: &(dyn Fn(Vec3A) -> f32 + Sync), grid: &Grid, max_cells: usize) -> Result<Surface, IsoError> {
+/// Extracts the zero set of `dist` on every cell of `grid` (its gradient by
+/// differences), refining at most [`MAX_CELLS`] leaves.
+pub fn extract(dist: &(dyn Fn(Vec3A) -> f32 + Sync), grid: &Grid) -> Result<Surface, IsoError> {
+    let surf = by_differences(dist, (grid.cell * 0.01) as f32);
+    extract_within(IsoField { dist, surf: &surf }, grid, &Plan::Uniform, MAX_CELLS)
+}
+
+/// Extracts the zero set of `field` on `grid` as `plan` says, refining at most
+/// `max_cells` leaves.
+///
+/// Long because it is the one sequence of the extraction: the cells, their crossed
+/// edges (mended where rounding left a cell empty), the mesh, and the rounds of
+/// measuring and splitting.
+pub fn extract_within(field: IsoField, grid: &Grid, plan: &Plan, max_cells: usize) -> Result<Surface, IsoError> {
     let too_many = |cells: f64| IsoError::TooManyCells {
         cells,
         // A surface's cell count goes with the inverse square of the cell.
         min_cell: grid.cell * (cells / max_cells as f64).sqrt(),
     };
-    let mut cells = grid.surface_cells(f, max_cells).map_err(too_many)?;
-    // Ask for the working memory's address space before using it: a cap (ulimit -v) or a
-    // strict overcommit policy refuses here, as a too-fine grid, not by aborting midway.
-    if !crate::source::system_gives((cells.len() as u64).saturating_mul(CELL_BYTES)) {
-        return Err(too_many(max_cells as f64 * 2.0));
-    }
-    let (corners, values, edges, rings) = loop {
-        let corners = corner_values(f, grid, &cells);
-        // Each cell's eight corners, looked up once (the table is large: lookups miss
-        // the cache, and every later step reads a cell's corners).
-        let values: Vec<[f32; 8]> = cells.par_iter().map(|&c| cell_values(&corners, c)).collect();
-        let edges = crossed_edges(&cells, &values);
-        // The cells around each crossed edge, by index: found once, for the check here
-        // and for the quads.
-        let rings: Vec<[Option<usize>; 4]> =
-            edges.par_iter().map(|&e| around(e).map(|c| cells.binary_search(&c?).ok())).collect();
-        let mut missing: Vec<u64> = edges
+    let samples = Samples::new(field, *grid, matches!(plan, Plan::Within { .. }));
+    let mut tree = Tree::build(*grid, &samples, plan, max_cells).map_err(|TooMany::Cells(c)| too_many(c))?;
+    let mut rounds = 0;
+    loop {
+        // Ask for the working memory's address space before using it: a cap (ulimit -v)
+        // or a strict overcommit policy refuses here, as a too-fine grid, not by
+        // aborting midway.
+        if !crate::source::system_gives((tree.leaf_count() as u64).saturating_mul(CELL_BYTES)) {
+            return Err(too_many(max_cells as f64 * 2.0));
+        }
+        let edges = loop {
+            let found = super::dual::crossed(&tree, &samples);
+            if found.empties.is_empty() {
+                break found.edges;
+            }
+            for &(depth, index) in &found.empties {
+                tree.fill(depth as usize, index);
+            }
+            tree.renumber(&samples);
+        };
+        if edges.is_empty() {
+            return Err(IsoError::NoSurface);
+        }
+        let contoured = super::contour::contour(&tree, &samples, &edges);
+        let mut mesh = contoured.mesh;
+        let sizes: Vec<f64> =
+            contoured.leaf_of.iter().map(|&l| grid.cell * f64::from(1u32 << tree.leaf(l).1)).collect();
+        let crossing_pairs = super::unfold::unfold(&mut mesh, &contoured.mass, &sizes);
+        let cells = sizes.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &s| (lo.min(s), hi.max(s)));
+        let done = |mesh: TriMesh, deviation: Option<MeasuredDeviation>, rounds: usize| Surface {
+            mesh,
+            doubled: contoured.doubled,
+            crossing_pairs,
+            leaves: tree.leaf_count(),
+            cells,
+            deviation,
+            rounds,
+        };
+        let Plan::Within { deviation: bound, .. } = plan else {
+            return Ok(done(mesh, None, rounds));
+        };
+        let found = deviation::measure(&mesh, field, &|p| bound.at(p));
+        // The leaves of every vertex of a triangle found too far, and of every vertex
+        // found too far: the finest ones cannot be split.
+        let mut split: Vec<u32> = found
+            .triangles
             .par_iter()
-            .zip(&rings)
-            .flat_map_iter(|(&e, ring)| around(e).into_iter().zip(ring).filter_map(|(c, i)| i.is_none().then_some(c?)))
+            .flat_map_iter(|&(t, _)| mesh.triangles[t as usize].map(|v| contoured.leaf_of[v as usize]))
+            .chain(found.vertices.par_iter().map(|&(v, _)| contoured.leaf_of[v as usize]))
+            .filter(|&l| tree.leaf(l).1 > 0)
             .collect();
-        if missing.is_empty() {
-            break (corners, values, edges, rings);
+        split.par_sort_unstable();
+        split.dedup();
+        if split.is_empty() || rounds == ROUNDS {
+            return Ok(done(mesh, Some(found.measured), rounds));
         }
-        missing.par_sort_unstable();
-        missing.dedup();
-        cells.extend(missing);
-        cells.par_sort_unstable();
-        if cells.len() > max_cells {
-            return Err(too_many(cells.len() as f64));
-        }
-    };
-    if edges.is_empty() {
-        return Err(IsoError::NoSurface);
+        tree.split(&split, &samples, plan, max_cells).map_err(|TooMany::Cells(c)| too_many(c))?;
+        rounds += 1;
     }
-    let crossings: Vec<Crossing> = edges.par_iter().map(|&e| crossing(f, grid, &corners, e)).collect();
-
-    // One vertex per sheet of every cell, in cell order.
-    let mut per_cell: Vec<(Sheets, Vec<[DVec3; 2]>)> =
-        cells.par_iter().zip(&values).map(|(&c, v)| sheets::<4>(grid, c, v, &edges, &crossings, 0)).collect();
-    // Where a part is thinner than a cell, one sheet can cross an ambiguous face twice,
-    // in both cells of the face: the two vertices would then share four quads' edge.
-    let pinched = split_doubled_faces(grid, &cells, &values, &edges, &crossings, &mut per_cell);
-    let mut mesh = TriMesh::default();
-    let mut mass = Vec::new();
-    let mut sheets_of = Vec::with_capacity(per_cell.len());
-    for (mut s, vertices) in per_cell {
-        s.first = mesh.positions.len() as u32;
-        mesh.positions.extend(vertices.iter().map(|v| v[0]));
-        mass.extend(vertices.iter().map(|v| v[1]));
-        sheets_of.push(s);
-    }
-    let quads: Vec<[[u32; 3]; 2]> = edges
-        .par_iter()
-        .zip(&rings)
-        .filter_map(|(&(corner, axis), ring)| {
-            let mut v = [0u32; 4];
-            for (n, i) in ring.iter().enumerate() {
-                let s = &sheets_of[(*i)?];
-                let sheet = s.of_edge[local_edge(axis as usize, corner, cells[(*i)?])];
-                v[n] = s.first + u32::from((sheet != NO_SHEET).then_some(sheet)?);
-            }
-            let [a, b, c, d] = v;
-            Some(if inside(corner_value(&corners, corner)) { [[a, b, c], [a, c, d]] } else { [[a, c, b], [a, d, c]] })
-        })
-        .collect();
-    mesh.triangles = quads.into_iter().flatten().collect();
-    let crossing_pairs = super::unfold::unfold(&mut mesh, &mass, grid.cell);
-    super::pinch::split(&mut mesh, grid.cell);
-    Ok(Surface { mesh, pinched, crossing_pairs })
-}
-
-/// Splits sheets that cross a face twice from both sides. Leaving the face's pairing
-/// out of one cell cuts its sheet into arcs, each joining one end of each of the face's
-/// segments. Where the arcs join ends that are neighbours around the face (as the
-/// face's other resolution would) every quad edge at the face is shared by two quads
-/// again, consistently wound, provided the cell across keeps its one sheet there: so a
-/// cell is either split (at one or more faces, each checked) or a partner, never both.
-/// A cell split at two faces usually leaves four arcs each joining the two faces, which
-/// no check accepts, so along a thin tube of doubled cells about every third face stays
-/// as it was (closed, its edge on four triangles). On the random CSG trees of the
-/// mesher's tests this removes 86–100 % of the four-triangle edges (eight shapes, at a
-/// sixtieth of their bounds). Returns the number of faces still crossed twice from
-/// both sides, each an edge on four triangles.
-fn split_doubled_faces(
-    grid: &Grid,
-    cells: &[u64],
-    values: &[[f32; 8]],
-    edges: &[EdgeKey],
-    crossings: &[Crossing],
-    per_cell: &mut [(Sheets, Vec<[DVec3; 2]>)],
-) -> usize {
-    let doubled = |per_cell: &[(Sheets, Vec<[DVec3; 2]>)], i: usize, n: u8| per_cell[i].0.doubled & (1 << n) != 0;
-    // Each face doubled on both sides, once, from its lower cell.
-    let faces: Vec<(usize, u8, usize)> = (0..cells.len())
-        .into_par_iter()
-        .filter(|&i| per_cell[i].0.doubled != 0)
-        .flat_map_iter(|i| {
-            let per_cell = &*per_cell;
-            (0..6u8).filter_map(move |n| {
-                let j = neighbour(cells[i], n).and_then(|k| cells.binary_search(&k).ok())?;
-                (i < j && doubled(per_cell, i, n) && doubled(per_cell, j, n ^ 1)).then_some((i, n, j))
-            })
-        })
-        .collect();
-    // The cell's sheets with the faces of `mask` left out, if every one comes apart
-    // into two arcs joining neighbouring ends.
-    let split = |i: usize, mask: u8| {
-        let s = sheets::<12>(grid, cells[i], &values[i], edges, crossings, mask);
-        let apart = (0..6).filter(|n| mask & (1 << n) != 0).all(|n| {
-            let o = FACES[n].edges.map(|e| s.0.of_edge[e]);
-            o[0] != o[2] && ((o[0] == o[1] && o[2] == o[3]) || (o[0] == o[3] && o[1] == o[2]))
-        });
-        apart.then_some(s)
-    };
-    // Per cell: absent when not involved, `None` for a partner, the faces it is split at.
-    let mut state: std::collections::HashMap<usize, Option<u8>> = std::collections::HashMap::new();
-    for &(i, n, j) in &faces {
-        for (c, face, partner) in [(i, n, j), (j, n ^ 1, i)] {
-            let now = match state.get(&c) {
-                None => 0,
-                Some(Some(faces)) => *faces,
-                Some(None) => continue,
-            };
-            if matches!(state.get(&partner), Some(Some(_))) {
-                continue;
-            }
-            if let Some(s) = split(c, now | 1 << face) {
-                per_cell[c] = s;
-                state.insert(c, Some(now | 1 << face));
-                state.insert(partner, None);
-                break;
-            }
-        }
-    }
-    // A face stays pinched while it is still doubled on both sides (a split elsewhere
-    // in a cell can also part its segments).
-    faces.iter().filter(|&&(i, n, j)| doubled(per_cell, i, n) && doubled(per_cell, j, n ^ 1)).count()
-}
-
-/// The values of `f` at every corner of `cells`, sorted by key.
-fn corner_values(f: &(dyn Fn(Vec3A) -> f32 + Sync), grid: &Grid, cells: &[u64]) -> Vec<(u64, f32)> {
-    let mut keys: Vec<u64> = cells
-        .par_iter()
-        .flat_map_iter(|&c| {
-            let c = unkey(c);
-            (0..8).map(move |n| shifted(c, corner_offset(n)))
-        })
-        .collect();
-    keys.par_sort_unstable();
-    keys.dedup();
-    keys.into_par_iter().map(|k| (k, f(grid.point(unkey(k)).as_vec3a()))).collect()
-}
-
-/// The value at a grid point of the table.
-fn corner_value(corners: &[(u64, f32)], at: u64) -> f32 {
-    match corners.binary_search_by_key(&at, |&(k, _)| k) {
-        Ok(i) => corners[i].1,
-        // Every corner of every cell is in the table.
-        Err(_) => f32::INFINITY,
-    }
-}
-
-/// The values at a cell's corners, by corner index.
-fn cell_values(corners: &[(u64, f32)], cell: u64) -> [f32; 8] {
-    let c = unkey(cell);
-    std::array::from_fn(|n| corner_value(corners, shifted(c, corner_offset(n))))
-}
-
-/// The key of the grid point at offsets `off` from `c`.
-fn shifted(c: [u64; 3], off: [u64; 3]) -> u64 {
-    key([c[0] + off[0], c[1] + off[1], c[2] + off[2]])
-}
-
-/// The cell across face `n` (axis `n / 2`, the high side when `n` is odd) of `cell`,
-/// unless that is below the grid.
-fn neighbour(cell: u64, n: u8) -> Option<u64> {
-    let mut c = unkey(cell);
-    let axis = (n / 2) as usize;
-    c[axis] = if n % 2 == 1 { c[axis] + 1 } else { c[axis].checked_sub(1)? };
-    Some(key(c))
-}
-
-/// The offsets of corner `n` (x + 2y + 4z) from a cell's lowest corner.
-const fn corner_offset(n: usize) -> [u64; 3] {
-    [(n & 1) as u64, ((n >> 1) & 1) as u64, (n >> 2) as u64]
-}
-
-/// Whether local edge `e` of a cell with corner values `v` is crossed.
-fn crossed(v: &[f32; 8], e: usize) -> bool {
-    let (off, axis) = edge_start(e);
-    let start = corner_index(off);
-    inside(v[start]) != inside(v[start + (1 << axis)])
 }
 
 /// Whether a value is inside the shape. NaN counts as outside.
@@ -294,270 +170,20 @@ pub(super) fn inside(v: f32) -> bool {
     v < 0.0
 }
 
-/// The corner index (x + 2y + 4z) at offsets `off` from a cell's lowest corner.
-const fn corner_index(off: [u64; 3]) -> usize {
-    (off[0] + 2 * off[1] + 4 * off[2]) as usize
-}
-
-/// A cell's local edge numbering: the edge along `axis` whose lower end is at offsets
-/// `b1` along the next axis and `b2` along the one after is `4·axis + b1 + 2·b2`.
-const fn edge_start(e: usize) -> ([u64; 3], usize) {
-    let axis = e / 4;
-    let mut off = [0u64; 3];
-    off[(axis + 1) % 3] = (e & 1) as u64;
-    off[(axis + 2) % 3] = ((e >> 1) & 1) as u64;
-    (off, axis)
-}
-
-/// The local number of the grid edge along `axis` from grid point `corner`, in `cell`.
-fn local_edge(axis: usize, corner: u64, cell: u64) -> usize {
-    let (p, c) = (unkey(corner), unkey(cell));
-    edge_id(axis, [p[0] - c[0], p[1] - c[1], p[2] - c[2]])
-}
-
-/// The four cells around a grid edge, in the order that winds its quad about the
-/// edge's axis (`None` beyond the grid's low boundary).
-fn around((corner, axis): EdgeKey) -> [Option<u64>; 4] {
-    let p = unkey(corner);
-    let (u, w) = ((axis as usize + 1) % 3, (axis as usize + 2) % 3);
-    [(0, 0), (1, 0), (1, 1), (0, 1)].map(|(du, dw)| {
-        let mut c = p;
-        c[u] = (p[u] + du).checked_sub(1)?;
-        c[w] = (p[w] + dw).checked_sub(1)?;
-        Some(key(c))
-    })
-}
-
-/// Every grid edge of `cells` whose ends lie on opposite sides, sorted.
-fn crossed_edges(cells: &[u64], values: &[[f32; 8]]) -> Vec<EdgeKey> {
-    let mut edges: Vec<EdgeKey> = cells
-        .par_iter()
-        .zip(values)
-        .flat_map_iter(|(&cell, v)| {
-            let c = unkey(cell);
-            (0..12).filter(|&e| crossed(v, e)).map(move |e| {
-                let (off, axis) = edge_start(e);
-                (shifted(c, off), axis as u8)
-            })
-        })
-        .collect();
-    edges.par_sort_unstable();
-    edges.dedup();
-    edges
-}
-
-/// Where the surface crosses a grid edge, by false position on `f` (Illinois variant,
-/// from the linear estimate until `f` is within a ten-thousandth of a cell of zero:
-/// along a cell's edge a distance field is nearly linear and that takes a step or two,
-/// more where the edge passes a kink of a CSG field), and its normal there from four
-/// samples on a tetrahedron (the crossings are most of an isosurface's evaluations of
-/// a large CSG tree).
-fn crossing(
-    f: &(dyn Fn(Vec3A) -> f32 + Sync),
-    grid: &Grid,
-    corners: &[(u64, f32)],
-    (corner, axis): EdgeKey,
-) -> Crossing {
-    let start = unkey(corner);
-    let mut end = start;
-    end[axis as usize] += 1;
-    let (p0, p1) = (grid.point(start), grid.point(end));
-    let at = |t: f64| f((p0 + (p1 - p0) * t).as_vec3a()) as f64;
-    let (mut a, mut fa) = (0.0, corner_value(corners, corner) as f64);
-    let (mut b, mut fb) = (1.0, corner_value(corners, key(end)) as f64);
-    let mut side = 0;
-    for _ in 0..12 {
-        let t = (a - fa * (b - a) / (fb - fa)).clamp(a, b);
-        let ft = at(t);
-        if ft.abs() < 1e-4 * grid.cell || !ft.is_finite() {
-            a = t;
-            b = t;
-            break;
-        }
-        if (ft < 0.0) == (fa < 0.0) {
-            (a, fa) = (t, ft);
-            if side == -1 {
-                fb *= 0.5;
-            }
-            side = -1;
-        } else {
-            (b, fb) = (t, ft);
-            if side == 1 {
-                fa *= 0.5;
-            }
-            side = 1;
-        }
-    }
-    let point = p0 + (p1 - p0) * ((a + b) * 0.5);
-    let h = grid.cell * 0.01;
-    let g: DVec3 = [DVec3::new(1.0, -1.0, -1.0), DVec3::new(-1.0, -1.0, 1.0), DVec3::new(-1.0, 1.0, -1.0), DVec3::ONE]
-        .into_iter()
-        .map(|k| k * f((point + k * h).as_vec3a()) as f64)
-        .sum();
-    // A flat spot of f (no gradient at this step): the edge's own direction, outward.
-    let along = (p1 - p0).normalize() * if fa < 0.0 { 1.0 } else { -1.0 };
-    let normal = g.try_normalize().unwrap_or(along);
-    Crossing { point, normal }
-}
-
-/// A face of a cell: its corners in cyclic order A, B, C, D (around the face), and the
-/// local edges AB, BC, CD, DA.
-struct Face {
-    corners: [usize; 4],
-    edges: [usize; 4],
-}
-
-/// The six faces of a cell.
-const FACES: [Face; 6] = faces();
-
-const fn faces() -> [Face; 6] {
-    let mut out = [const { Face { corners: [0; 4], edges: [0; 4] } }; 6];
-    let mut n = 0;
-    while n < 6 {
-        let (axis, side) = (n / 2, (n % 2) as u64);
-        let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
-        // Corners at (u, w) = (0,0), (1,0), (1,1), (0,1) on this face.
-        let uw = [(0, 0), (1, 0), (1, 1), (0, 1)];
-        let mut offs = [[0u64; 3]; 4];
-        let mut corners = [0; 4];
-        let mut m = 0;
-        while m < 4 {
-            offs[m][axis] = side;
-            offs[m][u] = uw[m].0;
-            offs[m][w] = uw[m].1;
-            corners[m] = corner_index(offs[m]);
-            m += 1;
-        }
-        // AB runs along u from A, BC along w from B, CD along u from D, DA along w from A.
-        let edges = [edge_id(u, offs[0]), edge_id(w, offs[1]), edge_id(u, offs[3]), edge_id(w, offs[0])];
-        out[n] = Face { corners, edges };
-        n += 1;
-    }
-    out
-}
-
-/// The local number of the edge along `axis` whose lower end is at offsets `off`.
-const fn edge_id(axis: usize, off: [u64; 3]) -> usize {
-    4 * axis + (off[(axis + 1) % 3] + 2 * off[(axis + 2) % 3]) as usize
-}
-
-/// A cell's sheets and their vertices: the cycles its crossed edges form under each
-/// face's pairing, each placed by the QEF of its crossings and kept inside the cell.
-/// The faces in `skip` join nothing, which cuts a cycle crossing one twice into two
-/// arcs; `N` bounds the sheets (four cycles of three or more of the twelve edges when
-/// nothing is skipped, at most twelve pieces otherwise).
-///
-/// Long because it traces a cell's cycles and places their vertices over arrays kept on the
-/// stack for the cell; split, they would be passed around or allocated per cell.
-fn sheets<const N: usize>(
-    grid: &Grid,
-    cell: u64,
-    v: &[f32; 8],
-    edges: &[EdgeKey],
-    crossings: &[Crossing],
-    skip: u8,
-) -> (Sheets, Vec<[DVec3; 2]>) {
-    let c = unkey(cell);
-    let crossed: [bool; 12] = std::array::from_fn(|e| crossed(v, e));
-    // Union-find over the twelve edges, joined by each face's pairs.
-    let mut parent: [usize; 12] = std::array::from_fn(|e| e);
-    fn root(parent: &mut [usize; 12], mut e: usize) -> usize {
-        while parent[e] != e {
-            parent[e] = parent[parent[e]];
-            e = parent[e];
-        }
-        e
-    }
-    for (n, face) in FACES.iter().enumerate() {
-        if skip & (1 << n) != 0 {
-            continue;
-        }
-        let mut on = [0; 4];
-        let mut count = 0;
-        for m in (0..4).filter(|&m| crossed[face.edges[m]]) {
-            on[count] = m;
-            count += 1;
-        }
-        let pairs: [(usize, usize); 2] = match count {
-            2 => [(on[0], on[1]); 2],
-            4 => {
-                let [a, b, cc, d] = face.corners.map(|k| v[k] as f64);
-                // The bilinear interpolant's saddle: A and C (same sign) connect through
-                // the face's middle when it has their sign. A flat saddle counts as
-                // separating the inside corners.
-                let denominator = a + cc - b - d;
-                let connected = if denominator != 0.0 {
-                    let saddle = (a * cc - b * d) / denominator;
-                    (saddle < 0.0) == (a < 0.0)
-                } else {
-                    a >= 0.0
-                };
-                // Connected A–C cut off B (between AB and BC) and D (CD, DA).
-                if connected {
-                    [(0, 1), (2, 3)]
-                } else {
-                    [(1, 2), (3, 0)]
-                }
-            }
-            _ => continue,
-        };
-        for (x, y) in pairs {
-            let (rx, ry) = (root(&mut parent, face.edges[x]), root(&mut parent, face.edges[y]));
-            parent[rx] = ry;
-        }
-    }
-    // A face whose four crossed edges all end up in one sheet: its two segments are
-    // joined through the rest of the cell.
-    let doubled = FACES.iter().enumerate().fold(0u8, |mask, (n, face)| {
-        let four = face.edges.iter().all(|&e| crossed[e]);
-        let one = four && root(&mut parent, face.edges[0]) == root(&mut parent, face.edges[2]);
-        mask | (u8::from(one && skip & (1 << n) == 0) << n)
-    });
-    // Sheets numbered in the order of their lowest edge; one QEF each.
-    let mut of_edge = [NO_SHEET; 12];
-    let mut qefs = [Qef::default(); N];
-    let mut count = 0;
-    let mut sheet_of_root = [NO_SHEET; 12];
-    for e in (0..12).filter(|&e| crossed[e]) {
-        let r = root(&mut parent, e);
-        if sheet_of_root[r] == NO_SHEET {
-            sheet_of_root[r] = count as u8;
-            count += 1;
-        }
-        of_edge[e] = sheet_of_root[r];
-        let (off, axis) = edge_start(e);
-        if let Ok(i) = edges.binary_search(&(shifted(c, off), axis as u8)) {
-            let x = crossings[i];
-            qefs[of_edge[e] as usize].add(x.point, x.normal);
-        }
-    }
-    let lo = grid.point(c);
-    let hi = lo + grid.cell;
-    // Each vertex with its mass point, where an unfolding moves it (`unfold`).
-    let vertices = qefs[..count].iter().map(|q| [q.solve().clamp(lo, hi), q.mass_point()]).collect();
-    (Sheets { of_edge, first: 0, doubled }, vertices)
+/// The memory a mesh of `leaves` leaves takes while it is made, by [`CELL_BYTES`]; the
+/// samples' tables are counted in it.
+pub fn working_bytes(leaves: usize) -> u64 {
+    (leaves as u64).saturating_mul(CELL_BYTES).max(ENTRY_BYTES)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::tree::Deviation;
+    use glam::DVec3;
 
     fn grid(r: f64, cell: f64) -> Grid {
         Grid::new(DVec3::splat(-r), DVec3::splat(r), cell).unwrap()
-    }
-
-    /// The face table: each face's edges join its corners in cycle.
-    #[test]
-    fn face_edges_join_their_corners() {
-        for face in &FACES {
-            for m in 0..4 {
-                let (off, axis) = edge_start(face.edges[m]);
-                let a = corner_index(off);
-                let ends = [a, a + (1 << axis)];
-                let (x, y) = (face.corners[m], face.corners[(m + 1) % 4]);
-                assert!(ends.contains(&x) && ends.contains(&y), "edge {} does not join {x} and {y}", face.edges[m]);
-            }
-        }
     }
 
     #[test]
@@ -616,21 +242,13 @@ mod tests {
     /// Connected components of a mesh, by shared vertices.
     fn components(m: &TriMesh) -> usize {
         let mut parent: Vec<usize> = (0..m.positions.len()).collect();
-        fn root(p: &mut [usize], mut i: usize) -> usize {
-            while p[i] != i {
-                p[i] = p[p[i]];
-                i = p[i];
-            }
-            i
-        }
         for t in &m.triangles {
             for k in 1..3 {
-                let (a, b) = (root(&mut parent, t[0] as usize), root(&mut parent, t[k] as usize));
-                parent[a] = b;
+                crate::mesh::cube::join(&mut parent, t[0] as usize, t[k] as usize);
             }
         }
         let used: std::collections::BTreeSet<usize> =
-            m.triangles.iter().flatten().map(|&v| root(&mut parent, v as usize)).collect();
+            m.triangles.iter().flatten().map(|&v| crate::mesh::cube::root(&mut parent, v as usize)).collect();
         used.len()
     }
 
@@ -655,5 +273,39 @@ mod tests {
         assert!(matches!(extract(&f, &grid(1.0, 2e-4)), Err(IsoError::TooManyCells { .. })));
         let thin = |p: Vec3A| p.length() - 1e-4;
         assert_eq!(extract(&thin, &grid(1.0, 0.3)).err(), Some(IsoError::NoSurface));
+    }
+
+    /// Under a tolerance a sphere is meshed with cells far coarser than the finest, and
+    /// every sample of every triangle lies within the tolerance of the surface (checked
+    /// here again with the exact distance, at 66 points a triangle).
+    #[test]
+    fn a_tolerance_is_met_with_coarse_cells() {
+        let dist = |p: Vec3A| p.length() - 1.0;
+        let surf = |p: Vec3A| Surf { d: p.length() - 1.0, g: p.normalize_or_zero(), mat: 0 };
+        for t in [1e-2, 1e-3] {
+            let g = grid(1.0, t / 2.0);
+            let plan =
+                Plan::Within { deviation: Deviation::absolute(t), coarsest: g.levels.saturating_sub(2), parts: vec![] };
+            let s = extract_within(IsoField { dist: &dist, surf: &surf }, &g, &plan, MAX_CELLS).expect("surface");
+            assert_eq!(s.mesh.open_edges(), (0, 0), "t {t}");
+            let d = s.deviation.expect("measured");
+            assert_eq!(d.over, 0, "t {t}: {d:?}");
+            assert!(s.cells.1 > 8.0 * g.cell, "t {t}: leaves {:?} against the finest {}", s.cells, g.cell);
+            let worst = s
+                .mesh
+                .triangles
+                .iter()
+                .flat_map(|tri| {
+                    let [a, b, c] = tri.map(|i| s.mesh.positions[i as usize]);
+                    (0..=10).flat_map(move |i| {
+                        (0..=10 - i).map(move |j| {
+                            let (u, v) = (i as f64 / 10.0, j as f64 / 10.0);
+                            (a + (b - a) * u + (c - a) * v).length() - 1.0
+                        })
+                    })
+                })
+                .fold(0.0f64, |m, d| m.max(d.abs()));
+            assert!(worst <= t, "t {t}: a point of the mesh is {worst} from the sphere");
+        }
     }
 }

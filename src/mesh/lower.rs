@@ -129,8 +129,9 @@ pub fn tessellate(
                 place: DAffine3::IDENTITY,
                 material,
                 cell,
+                deviation: detail.deviation(),
                 smooth: false,
-                from: CellFrom::Detail,
+                from: if detail.deviation().is_some() { CellFrom::Tolerance } else { CellFrom::Detail },
                 max_cells: budget.cells_allowed(),
                 wanted: budget.wanted.clone(),
             };
@@ -418,6 +419,7 @@ pub fn explicit(
                 place: xf,
                 material,
                 cell: *cell,
+                deviation: None,
                 smooth: m.smooth,
                 from: CellFrom::Scene,
                 max_cells: budget.cells_allowed(),

@@ -7,7 +7,11 @@
 //! everything else and primitives without a generator by `isosurface`) and every mesh.
 //! A plane shape becomes a finite square reaching `max_distance` around the camera.
 
+pub mod contour;
+pub mod cube;
 mod detail;
+pub mod deviation;
+pub mod dual;
 mod iso_job;
 pub(crate) use iso_job::approx;
 pub mod isosurface;
@@ -16,6 +20,8 @@ pub mod octree;
 pub mod parts;
 pub mod pinch;
 mod qef;
+pub mod samples;
+pub mod tree;
 pub mod triangle;
 pub mod twist;
 pub mod unfold;
@@ -70,15 +76,21 @@ pub struct MeshJob {
     pub isosurface: Option<IsoAccuracy>,
 }
 
-/// An isosurface's cell and measured accuracy, both in the units of the frame it was
+/// An isosurface's cells and measured accuracy, all in the units of the frame it was
 /// sampled in (the shape's own for `mesh isosurface(…)`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct IsoAccuracy {
-    /// The finest cell's side.
+    /// The smallest leaf's side that holds a vertex.
     pub cell: f64,
+    /// The largest leaf's side that holds a vertex.
+    pub coarsest: f64,
     /// The largest `|f|` at a vertex: the farthest a vertex lies from the surface where
     /// the distance function is exact, a lower bound on it elsewhere.
     pub farthest: f64,
+    /// Its deviation from the surface measured on every triangle (under a tolerance).
+    pub deviation: Option<deviation::MeasuredDeviation>,
+    /// Faces two sheets crossed twice, kept manifold with a vertex per segment.
+    pub doubled: usize,
 }
 
 impl MeshJob {

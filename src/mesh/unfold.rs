@@ -8,6 +8,9 @@
 
 use std::collections::HashMap;
 
+use foldhash::fast::FixedState;
+use rayon::prelude::*;
+
 use glam::DVec3;
 
 use crate::geom::TriMesh;
@@ -22,16 +25,25 @@ const ROUNDS: usize = 4;
 /// --tolerance 0.01`; docs/performance.md, "Measurements behind the code").
 const PULLED: f64 = 0.25;
 
-/// Unfolds `mesh` (vertex `i`'s mass point is `mass[i]`; triangles span about a `cell`)
+/// Unfolds `mesh` (vertex `i`'s mass point is `mass[i]`, its cell `size[i]` across)
 /// and returns the pairs still crossing.
-pub fn unfold(mesh: &mut TriMesh, mass: &[DVec3], cell: f64) -> usize {
-    let pulled: Vec<bool> =
-        mesh.positions.iter().zip(mass).map(|(p, m)| p.distance_squared(*m) > (PULLED * cell).powi(2)).collect();
+pub fn unfold(mesh: &mut TriMesh, mass: &[DVec3], size: &[f64]) -> usize {
+    let pulled: Vec<bool> = mesh
+        .positions
+        .iter()
+        .zip(mass)
+        .zip(size)
+        .map(|((p, m), s)| p.distance_squared(*m) > (PULLED * s).powi(2))
+        .collect();
     let near: Vec<usize> =
         (0..mesh.triangles.len()).filter(|&t| mesh.triangles[t].iter().any(|&v| pulled[v as usize])).collect();
     if near.is_empty() {
         return 0;
     }
+    // Bins of the near triangles' typical cell.
+    let mut near_sizes: Vec<f64> = near.iter().flat_map(|&t| mesh.triangles[t]).map(|v| size[v as usize]).collect();
+    near_sizes.sort_unstable_by(f64::total_cmp);
+    let cell = near_sizes[near_sizes.len() / 2];
     // Found once, over where the corners are and where they may move to.
     let candidates = candidates(mesh, mass, &near, cell);
     for _ in 0..ROUNDS {
@@ -68,56 +80,76 @@ fn crossing(mesh: &TriMesh, candidates: &[(usize, usize)]) -> Vec<(usize, usize)
 }
 
 /// Pairs that share no corner, one of them among `near`, whose reach (the bounds of
-/// their corners and of the corners' mass points `mass`) meets in a grid of `cell`-sized
-/// bins: the only pairs that can cross, before or after corners move.
-fn candidates(mesh: &TriMesh, mass: &[DVec3], near: &[usize], cell: f64) -> Vec<(usize, usize)> {
+/// their corners and of the corners' mass points `mass`) overlaps: the only pairs that
+/// can cross, before or after corners move. The near triangles are binned in a grid of
+/// bins as large as the largest near reach (so each lies in at most eight); every
+/// triangle looks for them in the bins its reach overlaps, or among the occupied bins
+/// when it overlaps more than those.
+fn candidates(mesh: &TriMesh, mass: &[DVec3], near: &[usize], _cell: f64) -> Vec<(usize, usize)> {
     let reach = |t: usize| {
         let v = mesh.triangles[t].map(|i| i as usize);
         let ps = v.iter().flat_map(|&i| [mesh.positions[i], mass[i]]);
         ps.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)))
     };
-    let bin = |p: DVec3| (p / cell).floor().as_i64vec3().to_array();
-    // The bins a reach overlaps (a sliver across many is binned by its lower corner only).
-    let overlapped = |(lo, hi): (DVec3, DVec3)| {
+    let near_reach: Vec<(DVec3, DVec3)> = near.iter().map(|&t| reach(t)).collect();
+    let size = near_reach.iter().map(|(lo, hi)| (*hi - *lo).max_element()).fold(0.0f64, f64::max);
+    if size.is_nan() || size <= 0.0 || !size.is_finite() {
+        return Vec::new();
+    }
+    let bin = |p: DVec3| (p / size).floor().as_i64vec3().to_array();
+    let mut bins: HashMap<[i64; 3], Vec<u32>, FixedState> = HashMap::default();
+    for (k, &(lo, hi)) in near_reach.iter().enumerate() {
         let ([x0, y0, z0], [x1, y1, z1]) = (bin(lo), bin(hi));
-        let many = (x1 - x0) * (y1 - y0) * (z1 - z0) > 64;
-        let (x1, y1, z1) = if many { (x0, y0, z0) } else { (x1, y1, z1) };
-        (x0..=x1).flat_map(move |x| (y0..=y1).flat_map(move |y| (z0..=z1).map(move |z| [x, y, z])))
-    };
-    let mut bins: HashMap<[i64; 3], Vec<(u32, DVec3, DVec3)>> = HashMap::new();
-    for &t in near {
-        for b in overlapped(reach(t)) {
-            bins.entry(b).or_default();
-        }
-    }
-    // Every triangle in a bin of a near one, with its reach, worked out once: only those
-    // can cross it.
-    for t in 0..mesh.triangles.len() {
-        let (lo, hi) = reach(t);
-        for b in overlapped((lo, hi)) {
-            if let Some(list) = bins.get_mut(&b) {
-                list.push((t as u32, lo, hi));
-            }
-        }
-    }
-    let mut is_near = vec![false; mesh.triangles.len()];
-    near.iter().for_each(|&t| is_near[t] = true);
-    let mut pairs = Vec::new();
-    for list in bins.values() {
-        for (k, &(a, la, ha)) in list.iter().enumerate() {
-            for &(b, lb, hb) in &list[k + 1..] {
-                let (a, b) = (a as usize, b as usize);
-                let (ta, tb) = (mesh.triangles[a], mesh.triangles[b]);
-                if (!is_near[a] && !is_near[b]) || ta.iter().any(|v| tb.contains(v)) {
-                    continue;
-                }
-                if !(la.cmpgt(hb).any() || lb.cmpgt(ha).any()) {
-                    pairs.push((a.min(b), a.max(b)));
+        for x in x0..=x1 {
+            for y in y0..=y1 {
+                for z in z0..=z1 {
+                    bins.entry([x, y, z]).or_default().push(k as u32);
                 }
             }
         }
     }
-    pairs.sort_unstable();
+    let occupied: Vec<([i64; 3], &Vec<u32>)> = bins.iter().map(|(b, l)| (*b, l)).collect();
+    let overlaps = |(la, ha): (DVec3, DVec3), (lb, hb): (DVec3, DVec3)| !(la.cmpgt(hb).any() || lb.cmpgt(ha).any());
+    let mut pairs: Vec<(usize, usize)> = (0..mesh.triangles.len())
+        .into_par_iter()
+        .fold(Vec::new, |mut found, t| {
+            let r = reach(t);
+            let ([x0, y0, z0], [x1, y1, z1]) = (bin(r.0), bin(r.1));
+            let tt = mesh.triangles[t];
+            let mut check = |list: &[u32]| {
+                for &k in list {
+                    let u = near[k as usize];
+                    if u != t
+                        && !mesh.triangles[u].iter().any(|v| tt.contains(v))
+                        && overlaps(r, near_reach[k as usize])
+                    {
+                        found.push((t.min(u), t.max(u)));
+                    }
+                }
+            };
+            let count = (x1 - x0 + 1).saturating_mul(y1 - y0 + 1).saturating_mul(z1 - z0 + 1);
+            if count <= occupied.len() as i64 {
+                for x in x0..=x1 {
+                    for y in y0..=y1 {
+                        for z in z0..=z1 {
+                            if let Some(list) = bins.get(&[x, y, z]) {
+                                check(list);
+                            }
+                        }
+                    }
+                }
+            } else {
+                for (b, list) in &occupied {
+                    if (x0..=x1).contains(&b[0]) && (y0..=y1).contains(&b[1]) && (z0..=z1).contains(&b[2]) {
+                        check(list);
+                    }
+                }
+            }
+            found
+        })
+        .flatten()
+        .collect();
+    pairs.par_sort_unstable();
     pairs.dedup();
     pairs
 }
@@ -175,7 +207,7 @@ mod tests {
         let mut mass = mesh.positions.clone();
         // The second triangle's mass points lie above the first.
         mass[3].z = 0.1;
-        assert_eq!(unfold(&mut mesh, &mass, 0.5), 0);
+        assert_eq!(unfold(&mut mesh, &mass, &[0.5; 9]), 0);
         assert_eq!(mesh.positions[3].z, 0.1);
     }
 }

@@ -18,7 +18,7 @@ use glam::DVec3;
 
 pub use crate::geom::axes::Up;
 use crate::geom::TriMesh;
-pub use model::{Colour, Export, Group, Part};
+pub use model::{Colour, Export, Group, IsoFit, Part};
 pub use three_mf::DEFAULT_3MF_UNIT;
 
 /// How a format's files are read.

@@ -52,6 +52,25 @@ pub struct Part {
     pub degenerate: usize,
     /// Of those, the ones with area in f64 that f32 coordinates took away.
     pub rounded_away: usize,
+    /// For an isosurface made under a tolerance, how far it was measured from its
+    /// surface.
+    pub fit: Option<IsoFit>,
+}
+
+/// How far an isosurface's mesh was measured from the surface it was made of, in the
+/// file's units (`mesh::deviation`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IsoFit {
+    /// The largest distance found from a sampled point to the surface.
+    pub max: f64,
+    /// The mean over the sampled points.
+    pub mean: f64,
+    /// Points sampled.
+    pub samples: usize,
+    /// Triangles proved within the tolerance everywhere (not only at their samples).
+    pub proved: usize,
+    /// Samples whose distance could not be found (left out of `max` and `mean`).
+    pub unresolved: usize,
 }
 
 impl Part {

@@ -51,9 +51,7 @@ impl Setting {
     pub fn label(&self) -> String {
         match self {
             Setting::Sdf { epsilon, max_steps } => format!("epsilon {} steps {max_steps}", short_exp(*epsilon)),
-            Setting::Mesh(Detail::Low) => "detail low".into(),
-            Setting::Mesh(Detail::High) => "detail high".into(),
-            Setting::Mesh(Detail::N(n)) => format!("detail {n}"),
+            Setting::Mesh(detail) => detail.describe(),
         }
     }
 }

@@ -10,10 +10,10 @@
 //!   at most `r·(1 − cos(π/N))`; every curved primitive is tessellated with at least
 //!   `rings` sides per turn, so the detail is the smallest `rings` that keeps
 //!   `r·(1 − cos(π/rings))` under the bound for every object (for `pixel`, the bound at the
-//!   object's nearest distance). Boxes are exact. Isosurfaces (CSG and modifiers) use a
-//!   cell of `diameter / (4·rings)`, planned as deviating by half a cell: dual contouring
-//!   measures a tenth of a cell on smooth surfaces and guarantees the cell's diagonal
-//!   (`mesh::isosurface`).
+//!   object's nearest distance). Boxes are exact. Isosurfaces (CSG and modifiers) are
+//!   given the bound itself (for `pixel`, a pixel's footprint at each point's distance
+//!   from the camera): their cells are split until the mesh, measured on every triangle,
+//!   lies within it (`mesh::isosurface`).
 //! - **Normals**: a curved primitive's mesh shades with its analytic normals, exact at
 //!   the vertices, so a pixel's colour errs mostly by where the facet put the hit. That
 //!   is all a matte surface shows; glass and mirrors also show what lies behind or in
@@ -25,6 +25,7 @@
 //!   sphere over a floor, is then within 1.5 % of the SDF sphere's pixels at `pixel`.
 
 use crate::ir::{self, Body, DomainOp, ExactMesh, Facets, Scene, Shape, ShapeKind};
+use crate::mesh::tree::Deviation;
 use crate::mesh::Detail;
 
 /// A geometric error bound.
@@ -164,7 +165,8 @@ fn scene_extent(scene: &Scene) -> f64 {
     2.0 * spheres.iter().map(|(c, r)| (*c - centre).length() + r).fold(0.0, f64::max)
 }
 
-/// The mesh detail for `tol`.
+/// The mesh detail for `tol`: the rings its curved primitives need, and for isosurfaces
+/// the bound itself (their cells follow the error: `mesh::tree`).
 pub fn mesh_detail(scene: &Scene, tol: Tolerance) -> Detail {
     let mut rings = 3u32;
     let extent = scene_extent(scene);
@@ -176,7 +178,7 @@ pub fn mesh_detail(scene: &Scene, tol: Tolerance) -> Detail {
                 pixel_angle(scene) * depth_range(scene, &o.geometry).map_or(1.0, |(near, _)| near.max(1e-6))
             }
         };
-        let (radius, iso) = curvature_radius(shape, 1.0);
+        let (radius, _) = curvature_radius(shape, 1.0);
         // What a glass or mirror object shows moves by its normals' error times the
         // distance to it (see the module's doc).
         let bound = if radius > 0.0 && bends_light(shape) {
@@ -190,11 +192,10 @@ pub fn mesh_detail(scene: &Scene, tol: Tolerance) -> Detail {
             let n = (std::f64::consts::PI / ratio.acos().max(1e-9)).ceil();
             rings = rings.max(n.min(2048.0) as u32);
         }
-        if let Some(diameter) = iso {
-            // Half a cell of diameter / (4·rings) under the bound.
-            let n = (diameter / (8.0 * bound)).ceil();
-            rings = rings.max(n.min(2048.0) as u32);
-        }
     }
-    Detail::N(rings.clamp(3, 2048))
+    let deviation = match tol {
+        Tolerance::Absolute(t) => Deviation::absolute(t),
+        Tolerance::Pixel => Deviation { absolute: 0.0, per_distance: pixel_angle(scene), eye: scene.camera.position },
+    };
+    Detail::Within { rings: rings.clamp(3, 2048), deviation }
 }

@@ -369,7 +369,7 @@ fn lower_reusing(
                 (ir::Body::Shape(shape), Mode::Mesh(detail)) => Lowered::Mesh(mesh::lower::tessellate(
                     shape,
                     to_render,
-                    detail,
+                    detail.in_frame(&to_render),
                     max_distance,
                     &mut budget,
                     builder.materials,

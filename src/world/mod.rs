@@ -28,7 +28,7 @@ use crate::sdf::{MarchParams, SdfObject};
 use crate::span::Span;
 
 /// Which back-end renders shapes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Mode {
     /// Sphere tracing.
     Sdf,

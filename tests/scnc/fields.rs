@@ -222,7 +222,6 @@ fn the_gyroid_sheet_meshes_closed_with_its_volume() {
     let b = scnc::ir::shape_bounds(shape).expect("bounded");
     let grid = Grid::new(b.min, b.max, 0.02).expect("grid");
     let surface = extract(&*f, &grid).expect("a surface");
-    assert_eq!(surface.pinched, 0, "pinched edges");
     assert_eq!(surface.mesh.open_edges(), (0, 0), "open or non-manifold edges");
     let meshed = surface.mesh.signed_volume();
 

@@ -24,8 +24,8 @@ fn meshed(shape: &str, cell: f64) -> (Sdf, Option<TriMesh>) {
     let grid = Grid::new(b.min, b.max, cell).expect("grid");
     match extract(&*f, &grid) {
         Ok(surface) => {
-            // Every edge off two triangles is one the mesher counted (and warns of).
-            assert_eq!(surface.mesh.open_edges(), (surface.pinched, 2 * surface.pinched), "{shape:?}");
+            // Closed and manifold by construction, thin parts included.
+            assert_eq!(surface.mesh.open_edges(), (0, 0), "{shape:?}");
             (f, Some(surface.mesh))
         }
         Err(IsoError::NoSurface) => (f, None),
@@ -41,10 +41,8 @@ fn assert_closed_manifold_outward(name: &str, m: &TriMesh) {
 }
 
 /// Closed and consistently oriented: every directed edge is matched by as many uses of
-/// its reverse, so the mesh has no boundary. Where a part is thinner than a cell, a few
-/// edges may still be shared by four triangles (a sheet crossing one cell face twice on
-/// both sides of it, where splitting it fails), and a sliver's volume may round either
-/// way, so this checks less than [`assert_closed_manifold_outward`].
+/// its reverse, so the mesh has no boundary. A sliver's volume may round either way, so
+/// this checks less than [`assert_closed_manifold_outward`].
 fn assert_closed_oriented(name: &str, m: &TriMesh) {
     let mut directed = std::collections::HashMap::new();
     for t in &m.triangles {
@@ -131,24 +129,24 @@ fn smooth_operators_mesh_closed() {
     }
 }
 
-/// Thin shells, where one sheet crosses a cell face twice from both sides: the split
-/// of such sheets keeps the mesh closed and leaves few edges on four triangles (261 of
-/// 34,008 triangles' edges before it for the first, 6 after).
+/// Thin shells, where one sheet crosses a cell face twice from both sides (261 and 69
+/// edges lay on four triangles before such faces got a vertex per segment): every edge
+/// on two triangles, every vertex on one fan, at several cells.
 #[test]
-fn sheets_crossing_a_face_twice_are_split() {
-    for (shape, before) in
-        [("shell(shell(sphere(0.562), 0.122), 0.029)", 261), ("shell(torus(0.917, 0.182), 0.043)", 69)]
-    {
+fn sheets_crossing_a_face_twice_stay_manifold() {
+    for shape in ["shell(shell(sphere(0.562), 0.122), 0.029)", "shell(torus(0.917, 0.182), 0.043)"] {
         let s = scene(&format!("light ambient(1)\nobject {shape}\n"));
         let scnc::ir::Body::Shape(ir) = &s.objects[0].geometry else { panic!("not a shape") };
         let b = scnc::ir::shape_bounds(ir).expect("bounded");
-        let cell = (b.max - b.min).length() / 60.0;
-        let (f, m) = meshed(shape, cell);
-        let m = m.expect("a surface");
-        assert_closed_oriented(shape, &m);
-        assert_within_a_diagonal(shape, &m, &f, cell);
-        let four = m.open_edges().0;
-        assert!(four * 10 <= before, "{shape}: {four} edges not on two triangles (unsplit: {before})");
+        for fraction in [30.0, 60.0, 97.0] {
+            let cell = (b.max - b.min).length() / fraction;
+            let (f, m) = meshed(shape, cell);
+            let m = m.expect("a surface");
+            assert_closed_oriented(shape, &m);
+            assert_eq!(m.open_edges(), (0, 0), "{shape} at cell {cell}");
+            assert!(scnc::mesh::pinch::pinched(&m).is_empty(), "{shape} at cell {cell}: pinched vertices");
+            assert_within_a_diagonal(shape, &m, &f, cell);
+        }
     }
 }
 
@@ -213,8 +211,8 @@ fn isosurfaces_at_sharp_corners_have_no_crossing_triangles() {
 }
 
 /// A gyroid sheet meshed at a cell wider than the sheet is thick (0.099 against a wall
-/// about 0.05 thick): where two fans of triangles met at one vertex (12 vertices before
-/// `mesh::pinch`), each fan has its own, and the mesh stays closed.
+/// about 0.05 thick): every vertex has one fan of triangles (12 vertices had two before
+/// faces crossed twice got a vertex per segment), and the mesh stays closed.
 #[test]
 fn thin_sheets_mesh_without_pinched_vertices() {
     let gyroid = "field(p => max(abs(sin(450 * p.x) * cos(450 * p.y) + sin(450 * p.y) * cos(450 * p.z) \
