@@ -472,21 +472,34 @@ fn decide(samples: &Samples, plan: &Plan, origin: [u32; 3], level: u32, todo: &T
     let size = samples.cell() * f64::from(1u32 << level);
     let lo = samples.point(origin);
     let hi = lo + size;
-    // The parts whose box this cell meets and that are smaller than twice the cell: a
-    // child no larger than half a part holds a grid point inside it. Until those and the
-    // coarsest level allow a leaf, no lattice is read: the children read their own.
+    // The parts whose box this cell meets and that are smaller than the cell: a cell no
+    // larger than a part has lattice points at most half the part apart, so one lies
+    // inside it, and the test below sees it. Until those and the coarsest level allow a
+    // leaf, no lattice is read, unless the children will read theirs: then it is handed
+    // down.
     let near: Vec<u32> = todo
         .parts
         .iter()
         .flat_map(|p| p.iter().copied())
         .filter(|&i| {
             let (a, b) = boxes[i as usize];
-            a.cmple(hi).all() && b.cmpge(lo).all() && (b - a).min_element() < 2.0 * size
+            a.cmple(hi).all() && b.cmpge(lo).all() && (b - a).min_element() < size
         })
         .collect();
     if !near.is_empty() || level > *coarsest {
+        let children_tested = level - 1 <= *coarsest
+            && near.iter().all(|&i| (boxes[i as usize].1 - boxes[i as usize].0).min_element() >= 0.5 * size);
+        let children = if children_tested && level >= 2 {
+            let values = match &todo.known {
+                Known::Lattice(l) => **l,
+                Known::Nothing | Known::Corners(_) => lattice_values(samples, origin, level),
+            };
+            children_known(samples, origin, level, &values)
+        } else {
+            unknown_children(samples)
+        };
         let parts = (!near.is_empty()).then(|| near.into());
-        return Decided::Split { parts, children: unknown_children(samples) };
+        return Decided::Split { parts, children };
     }
     let values = match &todo.known {
         Known::Lattice(l) => **l,
