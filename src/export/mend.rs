@@ -5,6 +5,8 @@
 //! corners welded, as a mesher would), and a cap — three distinct corners on a line —
 //! is removed by splitting the neighbour across its long edge at the middle corner, the
 //! standard cap removal (Botsch et al., *Polygon Mesh Processing*, 2010, §6.2).
+//! Corners an ulp or two apart (`NEAR_ULPS`) are welded like coincident ones: the needle
+//! between them has area, but not a facing a 32-bit reader agrees on.
 
 use std::collections::HashMap;
 
@@ -20,10 +22,29 @@ pub struct Mended {
     pub dropped: usize,
 }
 
+/// How near, in units of the last place of the corners' largest coordinate, two corners
+/// of a triangle count as one point. The isosurface mesher can put two feature vertices
+/// a rounding apart (a box corner on a cell's face, reached from both sides); in f32 they
+/// land an ulp or so apart and the needle between them has a normal no 32-bit reader
+/// recomputes alike (admesh "fixed" one half an ulp of its largest coordinate wide).
+/// Welding moves a corner by at most this. Legitimate needles stay: the poles of a sphere
+/// at `--detail 2048` have edges about 20 ulps long.
+const NEAR_ULPS: f64 = 2.0;
+
 /// Whether a triangle of these corners has no area.
 fn flat(p: &[Vec3], t: [u32; 3]) -> bool {
     let [a, b, c] = t.map(|i| p[i as usize]);
     (b - a).cross(c - a).length_squared() == 0.0
+}
+
+/// The edge (k, k+1) of `t` whose ends are [`NEAR_ULPS`] apart or nearer, if any.
+fn needle(p: &[Vec3], t: [u32; 3]) -> Option<usize> {
+    let q = t.map(|i| p[i as usize].as_dvec3());
+    let scale = q.iter().map(|v| v.abs().max_element()).fold(0.0, f64::max);
+    let near = NEAR_ULPS * f64::from(f32::EPSILON) * scale;
+    let len = |k: usize| (q[(k + 1) % 3] - q[k]).length();
+    let short = (0..3).min_by(|&x, &y| len(x).total_cmp(&len(y)))?;
+    (len(short) <= near).then_some(short)
 }
 
 /// Mends `triangles` over the 32-bit corners `p` (`tag` holds a value per triangle
@@ -34,10 +55,11 @@ fn flat(p: &[Vec3], t: [u32; 3]) -> bool {
 /// would pass around.
 pub fn mend(p: &[Vec3], triangles: &mut Vec<[u32; 3]>, tag: &mut Vec<u32>) -> Mended {
     let mut out = Mended::default();
-    if !triangles.iter().any(|&t| flat(p, t)) {
+    if !triangles.iter().any(|&t| flat(p, t) || needle(p, t).is_some()) {
         return out;
     }
-    // Weld corners that round to one point along an edge of a flat triangle.
+    // Weld the ends of a needle's short edge (corners that round to one point, or so
+    // near that no 32-bit reader can tell the triangle's facing).
     let mut root: Vec<u32> = (0..p.len() as u32).collect();
     fn find(root: &mut [u32], mut i: u32) -> u32 {
         while root[i as usize] != i {
@@ -47,9 +69,10 @@ pub fn mend(p: &[Vec3], triangles: &mut Vec<[u32; 3]>, tag: &mut Vec<u32>) -> Me
         i
     }
     for &t in triangles.iter() {
+        let short = needle(p, t);
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);
-            if a != b && p[a as usize] == p[b as usize] {
+            if a != b && (p[a as usize] == p[b as usize] || short == Some(k)) {
                 let (ra, rb) = (find(&mut root, a), find(&mut root, b));
                 root[ra.max(rb) as usize] = ra.min(rb);
             }
@@ -184,6 +207,23 @@ mod tests {
         assert_eq!(m.dropped, 0);
         assert!(closed(&t), "{t:?}");
         assert!(t.iter().all(|&t| !flat(&p, t)));
+    }
+
+    #[test]
+    fn corners_ulps_apart_are_welded_and_near_ones_kept() {
+        // 4 an ulp beside corner 1: 0 4 1 and 4 2 1 have a short edge no 32-bit reader
+        // orients (the isosurface mesher put two feature vertices there).
+        let (p, mut t) = tetrahedron_with(Vec3::new(2.0, 2.0 * f32::EPSILON, 0.0));
+        let mut tag = vec![0; t.len()];
+        let m = mend(&p, &mut t, &mut tag);
+        assert_eq!(m, Mended { removed: 2, dropped: 0 });
+        assert!(closed(&t), "{t:?}");
+        assert!(t.iter().all(|&t| !flat(&p, t)));
+        // A corner a hundred thousandth from another is kept.
+        let (p, mut t) = tetrahedron_with(Vec3::new(2.0, 1e-5, 0.0));
+        let before = t.clone();
+        assert_eq!(mend(&p, &mut t, &mut vec![0; 6]), Mended::default());
+        assert_eq!(t, before);
     }
 
     /// A needle: a disc of radius 1e-12 extruded, every cap triangle flat in f32. Each

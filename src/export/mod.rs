@@ -123,10 +123,7 @@ pub fn collect(
     let mut warnings: Vec<Diagnostic> = warnings;
     let mut parts = Vec::with_capacity(jobs.len());
     for (job, span, name) in jobs {
-        let p = part(name.clone(), job, span, frame);
-        if let Some(coarse) = too_coarse_for_f32(&p.mesh) {
-            return Err(collapsed(span, coarse));
-        }
+        let p = part(name.clone(), job, span, frame).map_err(|coarse| collapsed(span, coarse))?;
         if !p.mesh.triangles.is_empty() {
             parts.push(p);
         } else if p.rounded_away > 0 {
@@ -176,8 +173,12 @@ fn material_names(scene: &Scene, spans: &[Span]) -> Vec<String> {
 }
 
 /// Object `name`'s mesh in the file's frame, without its zero-area triangles.
-fn part(name: String, job: mesh::MeshJob, span: Span, frame: Placement) -> Part {
+fn part(name: String, job: mesh::MeshJob, span: Span, frame: Placement) -> Result<Part, String> {
     let positions: Vec<DVec3> = job.mesh.positions.iter().map(|&p| frame.place(job.xf.transform_point3(p))).collect();
+    // Judged before mending, which would weld such an object away to nothing.
+    if let Some(coarse) = too_coarse_for_f32(&positions) {
+        return Err(coarse);
+    }
     // The reflection into the file's frame turns every triangle inside out; a transform
     // that mirrors (negative determinant) turns it back.
     let mirrored = job.xf.matrix3.determinant() < 0.0;
@@ -220,7 +221,7 @@ fn part(name: String, job: mesh::MeshJob, span: Span, frame: Placement) -> Part 
         proved: d.proved,
         unresolved: d.unresolved,
     });
-    Part {
+    Ok(Part {
         name,
         span,
         mesh: crate::geom::TriMesh { positions, triangles },
@@ -229,19 +230,18 @@ fn part(name: String, job: mesh::MeshJob, span: Span, frame: Placement) -> Part 
         degenerate,
         rounded_away,
         fit,
-    }
+    })
 }
 
 /// How many f32 steps an object must span on every axis: rounding then moves a vertex
 /// by at most a hundredth of the object's extent.
 const MIN_F32_STEPS: f64 = 50.0;
 
-/// Why f32 coordinates cannot hold `mesh` where it stands, if they cannot: an axis
+/// Why f32 coordinates cannot hold an object at `positions`, if they cannot: an axis
 /// along which it spans fewer than [`MIN_F32_STEPS`] steps of f32 at its coordinates
 /// (a 0.01 sphere at 1e6, where f32 steps by 0.0625, is written as a flat disk).
-fn too_coarse_for_f32(mesh: &crate::geom::TriMesh) -> Option<String> {
-    let (lo, hi) =
-        mesh.positions.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+fn too_coarse_for_f32(positions: &[DVec3]) -> Option<String> {
+    let (lo, hi) = positions.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
     (0..3).find_map(|k| {
         let extent = hi[k] - lo[k];
         let step = lo[k].abs().max(hi[k].abs()) * f64::from(f32::EPSILON);
