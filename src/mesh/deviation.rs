@@ -156,6 +156,61 @@ fn probe(field: IsoField, p: DVec3, normal: DVec3, t: f64, halvings: u32) -> Pro
     Probe { within: false, distance: far, bound: f64::INFINITY, found: false }
 }
 
+/// How far `p` lies from the surface of `field`: the nearest sign change along `normal`,
+/// the gradient and 27 other directions (between the two, and to a cube's faces, edges
+/// and corners), within `reach` or the first doubling of it (up to 64 times) that finds
+/// one, each bisected to a thousandth of the reach. Where the surface is locally flat the
+/// nearest of those directions lies within about 20° of the true one, so this is at most
+/// about 7 % over the distance, and never under the nearest crossing found. For
+/// measuring a mesh made elsewhere; `None` when no sign change was found.
+pub fn distance(field: IsoField, p: DVec3, normal: DVec3, reach: f64) -> Option<f64> {
+    let v = field.at(p);
+    if v == 0.0 {
+        return Some(0.0);
+    }
+    if !v.is_finite() {
+        return None;
+    }
+    let towards = -v.signum();
+    let gradient = field.normal(p);
+    let mut dirs = vec![normal];
+    dirs.extend(gradient);
+    dirs.extend(gradient.map(|g| (g + normal).normalize_or_zero()));
+    dirs.extend(
+        (0..27)
+            .filter(|&n| n != 13)
+            .map(|n| DVec3::new((n % 3) as f64 - 1.0, (n / 3 % 3) as f64 - 1.0, (n / 9) as f64 - 1.0).normalize()),
+    );
+    let at = |dir: DVec3, s: f64| field.at(p + dir * (towards * s));
+    for k in 0..=REACH_DOUBLINGS {
+        let r = reach * 2f64.powi(k);
+        let nearest = dirs
+            .iter()
+            .filter(|d| d.length_squared() > 0.0)
+            .filter_map(|&dir| {
+                let f = at(dir, r);
+                if f * v > 0.0 {
+                    return None;
+                }
+                let (mut lo, mut hi) = (0.0, r);
+                while hi - lo > reach * 1e-3 {
+                    let mid = 0.5 * (lo + hi);
+                    if at(dir, mid) * v > 0.0 {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                Some(hi)
+            })
+            .fold(f64::INFINITY, f64::min);
+        if nearest.is_finite() {
+            return Some(nearest);
+        }
+    }
+    None
+}
+
 /// Halvings of a vertex's bracket: its proved bound within an eighth of the tolerance.
 const VERTEX_HALVINGS: u32 = 3;
 
