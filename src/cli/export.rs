@@ -281,8 +281,7 @@ impl ExportArgs {
     }
 
     /// The scene meshed at the detail the flags ask for. A tolerance promises a mesh
-    /// good enough to use, so it is refined where an isosurface is pinched or lost
-    /// volume ([`scnc::export::collect_refined`]).
+    /// good enough to use, so it is refined where an isosurface lost volume ([`scnc::export::collect_refined`]).
     fn mesh(&self, scene: &scnc::ir::Scene, format: Format) -> (Result<Export, Diagnostic>, Detail, Up) {
         let detail: Detail = match self.accuracy.tolerance {
             Some(tol) => {

@@ -40,11 +40,11 @@ impl Placement {
     }
 }
 
-/// How many times [`collect_refined`] refines a pinched isosurface (×1.3 each).
+/// How many times [`collect_refined`] refines an isosurface that lost volume (×1.3 each).
 pub const REFINEMENTS: usize = 3;
 
 /// [`collect`], refined where the mesh is not good enough to use: while an isosurface
-/// is pinched or lost volume (a part thinner than its cell), the detail grows 1.3× and
+/// lost volume (a sheet thinner than its cell, W0804), the detail grows 1.3× and
 /// the scene is meshed again, [`REFINEMENTS`] times at most. A finer grid over the
 /// cell limit keeps the coarser mesh and its warning. `refining(from, to)` is told each
 /// step; the detail the result was made at comes back with it.

@@ -1,6 +1,6 @@
 //! An isosurface made into a mesh job: the cell a detail level stands for, the
 //! extraction within the memory budget, each triangle's material, and the warnings of
-//! what the grid lost (parts, pinched edges, volume), each with the cell that keeps it.
+//! what the grid lost (parts, volume), each with the cell that keeps it.
 
 use glam::{DAffine3, Vec3A};
 use rayon::prelude::*;

@@ -210,7 +210,7 @@ pub(crate) fn export(studio: &Studio, text: String, set: &Overrides, format: &st
     let limit = scnc::mesh::lower::DEFAULT_MEMORY_LIMIT;
     let loader = studio.files.loader();
     let skip_unbounded = format.for_printing();
-    // Refined where an isosurface is pinched or lost volume, as `scnc export
+    // Refined where an isosurface lost volume, as `scnc export
     // --tolerance` does: a download is meant to be used.
     let (collected, _) = studio.preview.pool.install(|| {
         let high = scnc::mesh::Detail::High;
