@@ -420,7 +420,7 @@ fn pair(tree: &Tree, samples: &Samples, leaf: u32, neighbour: u32, on: &[u32], e
     let mut sorted: Vec<(u64, u32)> = on.iter().map(|&e| (place(e), e)).collect();
     sorted.sort_unstable();
     let n = sorted.len();
-    let at_a = super::isosurface::inside(corner(0, 0));
+    let at_a = super::samples::inside(corner(0, 0));
     let one_a_side = n == 4 && (0..4).all(|k| sorted[k].0 / s2 == k as u64);
     // The sign whose runs along the border are cut off.
     let cut_inside = if one_a_side {

@@ -231,8 +231,8 @@ impl Walk<'_> {
                 (self.samples.value(start), self.samples.value(end))
             }
         };
-        let inside = super::isosurface::inside(v0);
-        if inside == super::isosurface::inside(v1) {
+        let inside = super::samples::inside(v0);
+        if inside == super::samples::inside(v1) {
             return;
         }
         let ids = around.map(|n| match self.slot(n) {

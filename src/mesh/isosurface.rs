@@ -174,11 +174,6 @@ pub fn extract_within(field: IsoField, grid: &Grid, plan: &Plan, max_cells: usiz
     }
 }
 
-/// Whether a value is inside the shape. NaN counts as outside.
-pub(super) fn inside(v: f32) -> bool {
-    v < 0.0
-}
-
 /// The memory a mesh of `leaves` leaves takes while it is made, by [`CELL_BYTES`]; the
 /// samples' tables are counted in it.
 pub fn working_bytes(leaves: usize) -> u64 {

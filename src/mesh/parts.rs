@@ -7,8 +7,8 @@
 use glam::{DAffine3, DVec3, Vec3A};
 use rayon::prelude::*;
 
-use super::isosurface::inside;
 use super::octree::Grid;
+use super::samples::inside;
 use crate::ir::{self, CsgOp, Shape, ShapeKind};
 use crate::span::Span;
 

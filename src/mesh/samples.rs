@@ -198,6 +198,11 @@ pub fn crossing(field: IsoField, p0: DVec3, p1: DVec3, f0: f32, f1: f32, cell: f
     Crossing { point, normal: field.normal(point).unwrap_or(along) }
 }
 
+/// Whether a value is inside the shape. NaN counts as outside.
+pub(super) fn inside(v: f32) -> bool {
+    v < 0.0
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -505,8 +505,7 @@ fn decide(samples: &Samples, plan: &Plan, origin: [u32; 3], level: u32, todo: &T
         Known::Lattice(l) => **l,
         Known::Nothing | Known::Corners(_) => lattice_values(samples, origin, level),
     };
-    let lattice =
-        Lattice { origin, half: 1 << (level - 1), level, inside: values.map(super::isosurface::inside), values };
+    let lattice = Lattice { origin, half: 1 << (level - 1), level, inside: values.map(super::samples::inside), values };
     if lattice.simple(samples, deviation.over(lo, hi) * PLANES_WITHIN) {
         Decided::Leaf(corners_of(&values))
     } else {
