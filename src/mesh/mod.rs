@@ -13,6 +13,7 @@ mod detail;
 pub mod deviation;
 pub mod dual;
 mod iso_job;
+mod lattice;
 pub(crate) use iso_job::approx;
 pub mod isosurface;
 pub mod lower;
