@@ -1,8 +1,8 @@
 //! Draws the meshing-by-error chart (issue 62): triangles and time against the
-//! deviation a mesh was measured at, log–log, one curve per mesher and shape. Reads
-//! `SERIES DEVIATION TRIANGLES SECONDS` lines on standard input (the series a word:
-//! `scnc-gyroid`, `fidget-gyroid`, `manifold-gyroid`, `scnc-molecule`, …) and writes the
-//! PNG named by its one argument: the triangles above, the time below.
+//! deviation a mesh was measured at, log–log, one curve per mesher. Reads
+//! `SERIES DEVIATION TRIANGLES SECONDS` lines on standard input (the series a word, as
+//! `scripts/mesh-error-table.sh` writes them: `scnc`, `fidget`, `Manifold`) and writes
+//! the PNG named by its one argument: the triangles above, the time below.
 
 use std::io::{Read, Write};
 use std::process::ExitCode;

@@ -44,8 +44,6 @@ pub struct Contoured {
     pub mass: Vec<DVec3>,
     /// The leaf each vertex was made in.
     pub leaf_of: Vec<u32>,
-    /// Faces two sheets crossed twice, given a vertex per segment.
-    pub doubled: usize,
 }
 
 /// One leaf's crossings on its border, by the neighbour whose face they lie on: what
@@ -199,7 +197,7 @@ pub fn contour(tree: &Tree, samples: &Samples, edges: &[MinEdge]) -> Contoured {
             mesh.triangles.push([centre, corners[k], corners[(k + 1) % corners.len()]]);
         }
     }
-    Contoured { mesh, mass, leaf_of, doubled: doubled_faces.len() }
+    Contoured { mesh, mass, leaf_of }
 }
 
 /// Every leaf's incidences, grouped by a counting sort on the leaf (numbers are dense).

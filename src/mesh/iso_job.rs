@@ -221,7 +221,6 @@ pub(super) fn isosurface_object(
             coarsest: surface.cells.1,
             farthest,
             deviation: surface.deviation,
-            doubled: surface.doubled,
         }),
     })
 }

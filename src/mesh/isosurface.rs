@@ -66,19 +66,12 @@ pub enum IsoError {
 pub struct Surface {
     /// The triangles, closed, manifold and wound outward.
     pub mesh: TriMesh,
-    /// Faces crossed twice by two sheets (a part thinner than its cell), given a vertex
-    /// per segment so that the mesh stays manifold there.
-    pub doubled: usize,
-    /// Pairs of triangles that still cross each other after [`super::unfold`].
-    pub crossing_pairs: usize,
     /// The leaves the mesh was made on.
     pub leaves: usize,
     /// The smallest and largest leaf that holds a vertex.
     pub cells: (f64, f64),
     /// The deviation from the surface, measured on every triangle (under a tolerance).
     pub deviation: Option<MeasuredDeviation>,
-    /// Rounds of splitting the measurement asked for.
-    pub rounds: usize,
 }
 
 /// The gradient of a distance bound by central differences on a tetrahedron, for a
@@ -140,19 +133,16 @@ pub fn extract_within(field: IsoField, grid: &Grid, plan: &Plan, max_cells: usiz
         let mut mesh = contoured.mesh;
         let sizes: Vec<f64> =
             contoured.leaf_of.iter().map(|&l| grid.cell * f64::from(1u32 << tree.leaf(l).1)).collect();
-        let crossing_pairs = super::unfold::unfold(&mut mesh, &contoured.mass, &sizes);
+        super::unfold::unfold(&mut mesh, &contoured.mass, &sizes);
         let cells = sizes.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &s| (lo.min(s), hi.max(s)));
-        let done = |mesh: TriMesh, deviation: Option<MeasuredDeviation>, rounds: usize| Surface {
+        let done = |mesh: TriMesh, deviation: Option<MeasuredDeviation>| Surface {
             mesh,
-            doubled: contoured.doubled,
-            crossing_pairs,
             leaves: tree.leaf_count(),
             cells,
             deviation,
-            rounds,
         };
         let Plan::Within { deviation: bound, .. } = plan else {
-            return Ok(done(mesh, None, rounds));
+            return Ok(done(mesh, None));
         };
         let found = deviation::measure(&mesh, field, &|p| SAMPLED_SHARE * bound.at(p));
         // The leaves of every vertex of a triangle found too far, and of every vertex
@@ -167,7 +157,7 @@ pub fn extract_within(field: IsoField, grid: &Grid, plan: &Plan, max_cells: usiz
         split.par_sort_unstable();
         split.dedup();
         if split.is_empty() || rounds == ROUNDS {
-            return Ok(done(mesh, Some(found.measured), rounds));
+            return Ok(done(mesh, Some(found.measured)));
         }
         tree.split(&split, &samples, plan, max_cells).map_err(|TooMany::Cells(c)| too_many(c))?;
         rounds += 1;

@@ -90,8 +90,6 @@ pub struct IsoAccuracy {
     pub farthest: f64,
     /// Its deviation from the surface measured on every triangle (under a tolerance).
     pub deviation: Option<deviation::MeasuredDeviation>,
-    /// Faces two sheets crossed twice, kept manifold with a vertex per segment.
-    pub doubled: usize,
 }
 
 impl MeshJob {
