@@ -50,6 +50,45 @@ impl Lattice {
         self.point_inside(e.start) != self.point_inside(end)
     }
 
+    /// Whether a sheet may pass between the lattice's points though none of them sees it
+    /// (a field's plate or shell thinner than half the cell, which no CSG part names).
+    /// Along a fine edge, the field falls from both ends towards a minimum between them
+    /// where a sheet lies; the tangent lines at the two ends meet at about that minimum's
+    /// value, and below zero they say the edge crosses a sheet twice. Scale-free, so a
+    /// field whose bound is loose reads the same; a surface beside the cell, or on its
+    /// lattice (a box's face on a grid plane), slopes one way along every edge.
+    fn may_hide_a_sheet(&self, samples: &Samples) -> bool {
+        let step = samples.cell() * f64::from(self.half);
+        // Every point is on one side (the caller found no crossing): measured from it.
+        let side = if self.inside[0] { -1.0 } else { 1.0 };
+        let point = |n: usize| {
+            let (i, j, k) = (n % 3, n / 3 % 3, n / 9);
+            samples.point([
+                self.origin[0] + self.half * i as u32,
+                self.origin[1] + self.half * j as u32,
+                self.origin[2] + self.half * k as u32,
+            ])
+        };
+        let gradients: [DVec3; 27] =
+            std::array::from_fn(|n| (samples.field().surf)(point(n).as_vec3a()).g.as_dvec3() * side);
+        (0..27).any(|n| {
+            let start = [n % 3, n / 3 % 3, n / 9];
+            (0..3).filter(|&axis| start[axis] < 2).any(|axis| {
+                let mut end = start;
+                end[axis] += 1;
+                let m = at(end[0], end[1], end[2]);
+                let (f0, f1) = (f64::from(self.values[n]) * side, f64::from(self.values[m]) * side);
+                let (a, b) = (gradients[n][axis], gradients[m][axis]);
+                if !(a < 0.0 && b > 0.0) {
+                    return false;
+                }
+                // f0 + a·t = f1 + b·(t − step)
+                let t = (f0 - f1 + b * step) / (b - a);
+                t > 0.0 && t < step && f0 + a * t < 0.0
+            })
+        })
+    }
+
     /// Whether the cell may be a leaf: its surface one disk its corners show, its tangent
     /// planes within `planes` of its vertex. Long because it is the one sequence of
     /// checks over the lattice's arrays, kept on the stack.
@@ -87,9 +126,9 @@ impl Lattice {
             }
         }
         if edges.is_empty() {
-            // No sign change on the lattice: nothing to contour here (the cell was not
-            // ruled out, but what its grid points see is empty).
-            return true;
+            // No sign change on the lattice: nothing to contour here, unless a sheet
+            // thinner than the lattice's step passes between its points.
+            return !self.may_hide_a_sheet(samples);
         }
         let edge_of = |start: [usize; 3], axis: usize| index[axis][at(start[0], start[1], start[2])];
         let mut parent: Vec<usize> = (0..edges.len()).collect();

@@ -340,6 +340,28 @@ fn thin_parts_stay_manifold_at_every_tolerance() {
     }
 }
 
+/// A field's plate far thinner than the coarse cells a tolerance starts from (no CSG
+/// part names it, and no lattice point of those cells lies inside it) is still found,
+/// closed, with its volume: the slab |y| < h cut by the unit ball, π(2h − 2h³/3).
+#[test]
+fn thin_field_plates_are_found_under_a_tolerance() {
+    for h in [0.02, 0.005] {
+        let exact = std::f64::consts::PI * (2.0 * h - 2.0 * h * h * h / 3.0);
+        let plate =
+            format!("field(p => max(abs(p.y) - {h}, length(p) - 1), bounds = [[-1.1, -1.1, -1.1], [1.1, 1.1, 1.1]])");
+        for t in [0.01, 0.003] {
+            let m = exported_within(&plate, t);
+            assert_closed_manifold_outward(&plate, &m);
+            let v = m.signed_volume();
+            assert!(
+                (v - exact).abs() < 0.02 * exact,
+                "a plate {} thick at --tolerance {t}: volume {v}, exact {exact}",
+                2.0 * h
+            );
+        }
+    }
+}
+
 /// Under a tolerance every small part is seen: a lattice of 125 spheres 0.05 across,
 /// far smaller than the cells their smooth surroundings allow, each its own closed piece.
 #[test]
