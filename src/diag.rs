@@ -408,6 +408,8 @@ pub mod codes {
     pub const SKIPPED_EMPTY: &str = "W0805";
     /// An isosurface whose volume is far from the volume its shape's samples measure.
     pub const LOST_VOLUME: &str = "W0804";
+    /// An isosurface left farther than its tolerance from its shape in places.
+    pub const TOLERANCE_UNMET: &str = "W0806";
 }
 
 /// Edit distance for "did you mean" suggestions.

@@ -206,6 +206,7 @@ pub(super) fn isosurface_object(
     let warnings = lost_parts(&lost, solid.len(), span, finest, across, from)
         .into_iter()
         .chain(if lost.is_empty() { lost_volume(&mesh, &*dist, &bounds, span, finest, across, from) } else { None })
+        .chain(surface.unmet.map(|u| unmet_tolerance(u, span, surface.cells.0)))
         .collect();
     let farthest = mesh.positions.par_iter().map(|p| f64::from(dist(p.as_vec3a()).abs())).reduce(|| 0.0, f64::max);
     Ok(MeshJob {
@@ -427,6 +428,23 @@ fn lost_volume(
         )),
         CellFrom::Tolerance => d.with_hint(format!("try a `--tolerance` below {}", approx(cell))),
     })
+}
+
+/// The warning for a mesh left farther than its tolerance in places when the rounds of
+/// refinement ended (`isosurface::ROUNDS`) or the leaves there were the finest.
+fn unmet_tolerance(u: isosurface::Unmet, span: Span, cell: f64) -> Diagnostic {
+    let places = if u.places == 1 { "one place".to_string() } else { format!("{} places", u.places) };
+    Diagnostic::warning(
+        codes::TOLERANCE_UNMET,
+        span,
+        format!("the mesh lies up to {:.2}× the tolerance from the shape in {places}", u.worst),
+        format!("meshed down to cell {}", approx(cell)),
+    )
+    .with_note(format!(
+        "the leaves there were split for {} rounds or are the finest (half the tolerance): the surface bends or creases faster than they follow",
+        isosurface::ROUNDS
+    ))
+    .with_hint("`--stats` gives the measured deviation; a smaller `--tolerance` meets this one there")
 }
 
 /// A ratio as a percentage people read: whole percents, or one decimal below 10 %.

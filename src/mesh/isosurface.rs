@@ -72,6 +72,18 @@ pub struct Surface {
     pub cells: (f64, f64),
     /// The deviation from the surface, measured on every triangle (under a tolerance).
     pub deviation: Option<MeasuredDeviation>,
+    /// Where the rounds ended with samples farther than the whole tolerance.
+    pub unmet: Option<Unmet>,
+}
+
+/// Triangles and vertices left with a sample farther than the whole tolerance (not only
+/// its sampled share) when the rounds ended or the leaves under them could not be split.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Unmet {
+    /// How many triangles and vertices.
+    pub places: usize,
+    /// The farthest sample's distance in tolerances (above 1).
+    pub worst: f64,
 }
 
 /// The gradient of a distance bound by central differences on a tetrahedron, for a
@@ -135,14 +147,15 @@ pub fn extract_within(field: IsoField, grid: &Grid, plan: &Plan, max_cells: usiz
             contoured.leaf_of.iter().map(|&l| grid.cell * f64::from(1u32 << tree.leaf(l).1)).collect();
         super::unfold::unfold(&mut mesh, &contoured.mass, &sizes);
         let cells = sizes.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &s| (lo.min(s), hi.max(s)));
-        let done = |mesh: TriMesh, deviation: Option<MeasuredDeviation>| Surface {
+        let done = |mesh: TriMesh, deviation: Option<MeasuredDeviation>, unmet: Option<Unmet>| Surface {
             mesh,
             leaves: tree.leaf_count(),
             cells,
             deviation,
+            unmet,
         };
         let Plan::Within { deviation: bound, .. } = plan else {
-            return Ok(done(mesh, None));
+            return Ok(done(mesh, None, None));
         };
         let found = deviation::measure(&mesh, field, &|p| SAMPLED_SHARE * bound.at(p));
         // The leaves of every vertex of a triangle found too far, and of every vertex
@@ -157,11 +170,19 @@ pub fn extract_within(field: IsoField, grid: &Grid, plan: &Plan, max_cells: usiz
         split.par_sort_unstable();
         split.dedup();
         if split.is_empty() || rounds == ROUNDS {
-            return Ok(done(mesh, Some(found.measured)));
+            return Ok(done(mesh, Some(found.measured), unmet(&found)));
         }
         tree.split(&split, &samples, plan, max_cells).map_err(|TooMany::Cells(c)| too_many(c))?;
         rounds += 1;
     }
+}
+
+/// The triangles and vertices `found` over the sampled share of the tolerance that lie
+/// farther than the whole tolerance, if any do.
+fn unmet(found: &deviation::Found) -> Option<Unmet> {
+    let whole: Vec<f64> =
+        found.triangles.iter().chain(&found.vertices).map(|&(_, r)| r * SAMPLED_SHARE).filter(|&r| r > 1.0).collect();
+    (!whole.is_empty()).then(|| Unmet { places: whole.len(), worst: whole.iter().copied().fold(1.0, f64::max) })
 }
 
 /// The memory a mesh of `leaves` leaves takes while it is made, by [`CELL_BYTES`]; the
@@ -267,6 +288,21 @@ mod tests {
         assert!(matches!(extract(&f, &grid(1.0, 2e-4)), Err(IsoError::TooManyCells { .. })));
         let thin = |p: Vec3A| p.length() - 1e-4;
         assert_eq!(extract(&thin, &grid(1.0, 0.3)).err(), Some(IsoError::NoSurface));
+    }
+
+    /// Only what lies beyond the whole tolerance, not its sampled share, is unmet: a
+    /// triangle at 1.1 shares is within it, one at 1.3 and a vertex at 1.5 are not.
+    #[test]
+    fn unmet_counts_what_passes_the_whole_tolerance() {
+        let found = |triangles: Vec<(u32, f64)>, vertices: Vec<(u32, f64)>| deviation::Found {
+            measured: MeasuredDeviation::default(),
+            triangles,
+            vertices,
+        };
+        let u = unmet(&found(vec![(0, 1.1), (1, 1.3)], vec![(2, 1.5)])).expect("unmet");
+        assert_eq!(u.places, 2);
+        assert!((u.worst - 1.5 * SAMPLED_SHARE).abs() < 1e-12, "{u:?}");
+        assert_eq!(unmet(&found(vec![(0, 1.1)], vec![(1, 1.2)])), None);
     }
 
     /// Under a tolerance a sphere is meshed with cells far coarser than the finest, and
