@@ -1,19 +1,28 @@
 #!/usr/bin/env bash
-# Meshing by error (issue 62): the gyroid sheet of benches/scenes/gyroid-sheet.scn meshed
-# by `scnc export --tolerance`, by fidget's dual contouring (benches/fidget-mesh, its VM
-# evaluator: faster than its JIT here) and by Manifold's level set (benches/manifold.py,
-# with `pip install manifold3d`), each file then measured against the same field by
+# Meshing by error (issue 62), each mesh file measured against its scene's field by
 # examples/deviation (15 points a triangle). Wall time and peak resident memory are of
 # the whole process (`/usr/bin/time`), one run each: compare within one run of this
 # script. A tool that is missing is skipped.
-# Usage: scripts/mesh-error-table.sh [PLOT_ROWS_FILE]
+# - `gyroid`: the sheet of benches/scenes/gyroid-sheet.scn meshed by `scnc export
+#   --tolerance`, by fidget's dual contouring (benches/fidget-mesh, its VM evaluator:
+#   faster than its JIT here) and by Manifold's level set (benches/manifold.py, with
+#   `pip install manifold3d`).
+# - `chain`: the 1,000-sphere molecule of benches/scenes/chain-1000.scn meshed by
+#   `scnc export --tolerance` and by the uniform cells of `--detail` (the mesher the
+#   error-driven one replaced: every cell near the surface the same size).
+# Usage: scripts/mesh-error-table.sh [gyroid|chain] [PLOT_ROWS_FILE]
 # prints a Markdown table; PLOT_ROWS_FILE gets `SERIES DEVIATION TRIANGLES SECONDS` lines
 # for `cargo run --release --example mesh_plot -- chart.png < PLOT_ROWS_FILE`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-rows=${1:-/dev/null}
+which=${1:-gyroid}
+rows=${2:-/dev/null}
+case $which in
+  gyroid) scene=benches/scenes/gyroid-sheet.scn ;;
+  chain) scene=benches/scenes/chain-1000.scn ;;
+  *) echo "usage: $0 [gyroid|chain] [PLOT_ROWS_FILE]" >&2; exit 2 ;;
+esac
 : > "$rows"
-scene=benches/scenes/gyroid-sheet.scn
 cargo build --release --quiet --bin scnc --example deviation
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
@@ -38,6 +47,21 @@ row() {
 
 echo "| mesher | setting | triangles | wall s | peak MB | max deviation | 99.9 % | open or non-manifold edges |"
 echo "|---|---|---|---|---|---|---|---|"
+if [ "$which" = chain ]; then
+  # The chain stands on a plane, which no mesh file holds.
+  for t in 0.02 0.01 0.005 0.002 0.001; do
+    read -r wall mb < <(timed target/release/scnc export "$scene" -o "$out/s.stl" --skip-unbounded --tolerance "$t")
+    read -r tris bad max p999 < <(measured "$out/s.stl")
+    row scnc "--tolerance $t" "$wall" "$mb" "$tris" "$bad" "$max" "$p999"
+  done
+  for d in 46 80 114 160; do
+    read -r wall mb < <(timed target/release/scnc export "$scene" -o "$out/s.stl" --skip-unbounded --detail "$d")
+    read -r tris bad max p999 < <(measured "$out/s.stl")
+    row uniform "--detail $d" "$wall" "$mb" "$tris" "$bad" "$max" "$p999"
+  done
+  exit 0
+fi
+
 for t in 0.01 0.005 0.003 0.002 0.001; do
   read -r wall mb < <(timed target/release/scnc export "$scene" -o "$out/s.stl" --tolerance "$t")
   read -r tris bad max p999 < <(measured "$out/s.stl")
