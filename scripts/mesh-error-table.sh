@@ -52,12 +52,12 @@ if [ "$which" = chain ]; then
   for t in 0.02 0.01 0.005 0.002 0.001; do
     read -r wall mb < <(timed target/release/scnc export "$scene" -o "$out/s.stl" --skip-unbounded --tolerance "$t")
     read -r tris bad max p999 < <(measured "$out/s.stl")
-    row scnc "--tolerance $t" "$wall" "$mb" "$tris" "$bad" "$max" "$p999"
+    row scnc-by-error "--tolerance $t" "$wall" "$mb" "$tris" "$bad" "$max" "$p999"
   done
   for d in 46 80 114 160; do
     read -r wall mb < <(timed target/release/scnc export "$scene" -o "$out/s.stl" --skip-unbounded --detail "$d")
     read -r tris bad max p999 < <(measured "$out/s.stl")
-    row uniform "--detail $d" "$wall" "$mb" "$tris" "$bad" "$max" "$p999"
+    row uniform-cells "--detail $d" "$wall" "$mb" "$tris" "$bad" "$max" "$p999"
   done
   exit 0
 fi
