@@ -39,9 +39,9 @@ pub const MAX_CELLS: usize = 4_000_000;
 /// bulge a little farther where the surface bends or creases. On the gyroid sheet of
 /// `benches/scenes/gyroid-sheet.scn` at tolerance 0.01, measured at 15 points a
 /// triangle (`cargo run --release --example deviation`), a whole share let points reach
-/// 1.29 of the tolerance and 0.8 keeps them at 0.88; 0.75 left the farthest point at
-/// 0.002 where it was (1.02 of it, an upper bound: its triangle's samples were within),
-/// for 5 % more triangles (`scripts/mesh-error-table.sh` has the ladder).
+/// 1.29 of the tolerance and 0.8 kept them at 0.88 (on `e8ac92c`); 0.75 left the
+/// farthest point at 0.002 where it was, for 5 % more triangles. The ladder on today's
+/// mesher is `scripts/mesh-error-table.sh`'s, in docs/performance.md.
 pub const SAMPLED_SHARE: f64 = 0.8;
 
 /// Rounds of measuring and splitting under a tolerance.
