@@ -84,6 +84,9 @@ pub struct Transport {
     pub balls: Vec<Ball>,
     /// How many of `balls` are spheres of light.
     pub lamps: usize,
+    /// Whether any object glows (bounded or not): only then can a light ray's first
+    /// surface send light back.
+    pub glowing: bool,
     /// Every source, in the order a uniform pick indexes.
     pub sources: Vec<Source>,
     /// The thin lens's radius (0: a pinhole).
@@ -118,6 +121,7 @@ impl Transport {
             rects: Vec::new(),
             balls: Vec::new(),
             lamps: 0,
+            glowing: !effects.glowing.is_empty(),
             sources: Vec::new(),
             lens_radius: (scene.camera.aperture * 0.5) as f32,
             focus: scene.camera.focus_distance.unwrap_or_else(|| (scene.camera.look_at - origin).length()) as f32,

@@ -230,7 +230,17 @@ enum Event {
 /// light transport draws itself, whichever is nearer.
 fn first_event(g: &dyn Geometry, t: &Transport, ray: &Ray, c: &mut Counters) -> Event {
     let hit = g.intersect(ray, c);
-    let mut nearest = hit.map_or(ray.t_max, |h| h.t);
+    match (nearest_lamp(t, ray, hit.map_or(ray.t_max, |h| h.t)), hit) {
+        (Some((radiance, d)), _) => Event::Lamp(radiance, d),
+        (None, Some(h)) => Event::Surface(h),
+        (None, None) => Event::Escape,
+    }
+}
+
+/// The nearest rectangle or sphere of light along `ray` before `limit`: the radiance it
+/// sends back along the ray (0 from behind), and its distance.
+fn nearest_lamp(t: &Transport, ray: &Ray, limit: f32) -> Option<(f32, f32)> {
+    let mut nearest = limit;
     let mut lamp = None;
     for r in &t.rects {
         if let Some(d) = lights::rect_hit(r, ray.origin, ray.dir) {
@@ -248,10 +258,45 @@ fn first_event(g: &dyn Geometry, t: &Transport, ray: &Ray, c: &mut Counters) -> 
             }
         }
     }
-    match (lamp, hit) {
-        (Some(radiance), _) => Event::Lamp(radiance, nearest),
-        (None, Some(h)) => Event::Surface(h),
-        (None, None) => Event::Escape,
+    lamp.map(|radiance| (radiance, nearest))
+}
+
+/// The radiance a light ray brings back: what it meets first, emitting or not. When
+/// nothing glows and the ray was aimed at a lamp, only that lamp (or a nearer one) can
+/// send light along it, so an any-hit shadow query up to the lamp stands in for the
+/// closest hit and its shading (the same light, for less work on every back-end).
+fn light_along(
+    g: &dyn Geometry,
+    frame: &Frame,
+    t: &Transport,
+    ray: &Ray,
+    aimed_at_lamp: bool,
+    c: &mut Counters,
+) -> Vec3A {
+    if aimed_at_lamp && !t.glowing {
+        return match nearest_lamp(t, ray, ray.t_max) {
+            Some((radiance, d)) if radiance > 0.0 => {
+                let mut shadow = *ray;
+                shadow.t_max = d;
+                if g.occluded(&shadow, c) {
+                    Vec3A::ZERO
+                } else {
+                    Vec3A::splat(radiance)
+                }
+            }
+            _ => Vec3A::ZERO,
+        };
+    }
+    match first_event(g, t, ray, c) {
+        Event::Escape => Vec3A::splat(t.environment),
+        Event::Lamp(radiance, _) => Vec3A::splat(radiance),
+        Event::Surface(h) => {
+            if h.from_inside {
+                Vec3A::ZERO
+            } else {
+                frame.materials.materials[h.material as usize].emission * (1.0 / 255.0)
+            }
+        }
     }
 }
 
@@ -436,18 +481,12 @@ fn sample_light(
         return Vec3A::ZERO;
     }
     c.light_rays += 1;
-    let le = match first_event(g, t, &light_ray(dir, frame.max_distance), c) {
-        Event::Escape => Vec3A::splat(t.environment),
-        Event::Lamp(radiance, _) => Vec3A::splat(radiance),
-        Event::Surface(h) => {
-            let m = &frame.materials.materials[h.material as usize];
-            if h.from_inside {
-                Vec3A::ZERO
-            } else {
-                m.emission * (1.0 / 255.0)
-            }
-        }
+    let aimed_at_lamp = match source {
+        Source::Rect(_) => true,
+        Source::Ball(i) => i < t.lamps,
+        Source::Delta(_) | Source::Environment => false,
     };
+    let le = light_along(g, frame, t, &light_ray(dir, frame.max_distance), aimed_at_lamp, c);
     if le == Vec3A::ZERO {
         return Vec3A::ZERO;
     }
