@@ -180,9 +180,14 @@ pub fn extract_within(field: IsoField, grid: &Grid, plan: &Plan, max_cells: usiz
 /// The triangles and vertices `found` over the sampled share of the tolerance that lie
 /// farther than the whole tolerance, if any do.
 fn unmet(found: &deviation::Found) -> Option<Unmet> {
-    let whole: Vec<f64> =
-        found.triangles.iter().chain(&found.vertices).map(|&(_, r)| r * SAMPLED_SHARE).filter(|&r| r > 1.0).collect();
-    (!whole.is_empty()).then(|| Unmet { places: whole.len(), worst: whole.iter().copied().fold(1.0, f64::max) })
+    let (places, worst) = found
+        .triangles
+        .iter()
+        .chain(&found.vertices)
+        .map(|&(_, r)| r * SAMPLED_SHARE)
+        .filter(|&r| r > 1.0)
+        .fold((0, 1.0f64), |(n, worst), r| (n + 1, worst.max(r)));
+    (places > 0).then_some(Unmet { places, worst })
 }
 
 /// The memory a mesh of `leaves` leaves takes while it is made, by [`CELL_BYTES`]; the

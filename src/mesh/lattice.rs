@@ -26,6 +26,17 @@ pub(super) const fn at(i: usize, j: usize, k: usize) -> usize {
     i + 3 * j + 9 * k
 }
 
+/// The finest-grid coordinates of lattice point `p` (offsets in half-cells) of the cell
+/// at `origin` whose half-cell is `half` finest cells.
+pub(super) fn lattice_point(origin: [u32; 3], half: u32, p: [usize; 3]) -> [u32; 3] {
+    std::array::from_fn(|a| origin[a] + half * p[a] as u32)
+}
+
+/// The offsets `(i, j, k)` of lattice index `n` ([`at`]'s inverse).
+pub(super) const fn offsets(n: usize) -> [usize; 3] {
+    [n % 3, n / 3 % 3, n / 9]
+}
+
 /// A fine edge of the lattice: along `axis`, from lattice point `start`.
 #[derive(Clone, Copy)]
 struct FineEdge {
@@ -61,18 +72,12 @@ impl Lattice {
         let step = samples.cell() * f64::from(self.half);
         // Every point is on one side (the caller found no crossing): measured from it.
         let side = if self.inside[0] { -1.0 } else { 1.0 };
-        let point = |n: usize| {
-            let (i, j, k) = (n % 3, n / 3 % 3, n / 9);
-            samples.point([
-                self.origin[0] + self.half * i as u32,
-                self.origin[1] + self.half * j as u32,
-                self.origin[2] + self.half * k as u32,
-            ])
-        };
-        let gradients: [DVec3; 27] =
-            std::array::from_fn(|n| (samples.field().surf)(point(n).as_vec3a()).g.as_dvec3() * side);
+        let gradients: [DVec3; 27] = std::array::from_fn(|n| {
+            let p = samples.point(lattice_point(self.origin, self.half, offsets(n)));
+            (samples.field().surf)(p.as_vec3a()).g.as_dvec3() * side
+        });
         (0..27).any(|n| {
-            let start = [n % 3, n / 3 % 3, n / 9];
+            let start = offsets(n);
             (0..3).filter(|&axis| start[axis] < 2).any(|axis| {
                 let mut end = start;
                 end[axis] += 1;
@@ -114,7 +119,7 @@ impl Lattice {
         let mut index = [[usize::MAX; 27]; 3];
         for (axis, of_axis) in index.iter_mut().enumerate() {
             for (n, slot) in of_axis.iter_mut().enumerate() {
-                let start = [n % 3, n / 3 % 3, n / 9];
+                let start = offsets(n);
                 if start[axis] == 2 {
                     continue;
                 }
@@ -219,11 +224,7 @@ impl Lattice {
         let crossings: Vec<_> = edges
             .iter()
             .map(|e| {
-                let start = [
-                    self.origin[0] + self.half * e.start[0] as u32,
-                    self.origin[1] + self.half * e.start[1] as u32,
-                    self.origin[2] + self.half * e.start[2] as u32,
-                ];
+                let start = lattice_point(self.origin, self.half, e.start);
                 let mut end = e.start;
                 end[e.axis] += 1;
                 let ends =

@@ -27,7 +27,7 @@ use std::sync::Arc;
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::lattice::{at, Lattice};
+use super::lattice::{at, lattice_point, offsets, Lattice};
 use super::octree::{key, unkey, Grid};
 use super::samples::Samples;
 
@@ -518,10 +518,7 @@ fn known_lattice(samples: &Samples, todo: &Todo, origin: [u32; 3], level: u32) -
 /// The 3×3×3 lattice of the node at `origin`, `level` ≥ 1, looked up.
 fn lattice_values(samples: &Samples, origin: [u32; 3], level: u32) -> [f32; 27] {
     let half = 1u32 << (level - 1);
-    std::array::from_fn(|n| {
-        let (i, j, k) = (n % 3, n / 3 % 3, n / 9);
-        samples.value([origin[0] + half * i as u32, origin[1] + half * j as u32, origin[2] + half * k as u32])
-    })
+    std::array::from_fn(|n| samples.value(lattice_point(origin, half, offsets(n))))
 }
 
 /// Each child of the node at `origin`, `level` (≥ 1): empty, or what it knows from its
@@ -557,7 +554,7 @@ fn children_known(samples: &Samples, origin: [u32; 3], level: u32, lattice: &[f3
     std::array::from_fn(|k| {
         let c = super::cube::corner_offset(k).map(|x| 2 * x as usize);
         let child: [f32; 27] = std::array::from_fn(|n| {
-            let (i, j, l) = (n % 3, n / 3 % 3, n / 9);
+            let [i, j, l] = offsets(n);
             fine[(c[0] + i) + 5 * (c[1] + j) + 25 * (c[2] + l)]
         });
         let o = child_origin(origin, 2 * quarter, k);
