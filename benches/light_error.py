@@ -1,0 +1,209 @@
+"""Issue 60's time to equal error: the Cornell box (examples/light/cornell.scn, the same
+scene as examples/mitsuba/cornell.xml and examples/cycles/cornell.py) rendered by scnc,
+Mitsuba 3 and Blender Cycles at a ladder of samples, each image's RMSE against the truth
+estimated, and the time each renderer needs to reach a target RMSE.
+
+    python3 benches/light_error.py [--res 512] [--ladder 16,64,256,1024] [--cycles-ladder 16,64,256] \
+        [--ref-spp 4096] [--sampler multijitter] [--target 0.02] [--rows rows.txt] [--skip cycles]
+
+How the error is estimated (all radiance, linear, every pixel and channel):
+- The reference is Mitsuba at `--ref-spp` samples; its own noise is known from Mitsuba's
+  pairs below (variance × N is constant for an unbiased renderer), and is subtracted from
+  every MSE measured against it: MSE(truth) = MSE(reference) − σ²_M / ref_spp.
+- Mitsuba and Cycles render every rung twice with different seeds: two independent
+  images differ by twice one's variance, so MSE(truth) = MSE(pair) / 2, needing no
+  reference (Cycles' scene differs in small ways, mesh spheres and its filter, so it is
+  held only to its own truth). scnc has no seed (its sampler is deterministic), so it is
+  held to the reference.
+- Each renderer's RMSE is extrapolated as c/√N from its top rung (the slope over the
+  ladder is printed), its time fitted as a + b·N (start-up, scene loading, JIT and BVH in a); the time to `--target` is
+  a + b·(c / target)².
+Wall time of the whole command for scnc, of load + render for Mitsuba, of the render call
+for Cycles (each renderer's start-up cost counted once in a), 2 threads each.
+`--rows` writes `RENDERER SAMPLES RMSE SECONDS` lines for `cargo run --release --example
+light_plot -- out.png < rows.txt`.
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+SCENES = {
+    "cornell": (os.path.join(ROOT, "examples", "light", "cornell.scn"),
+                os.path.join(ROOT, "examples", "mitsuba", "cornell.xml")),
+    "gyroid-room": (os.path.join(ROOT, "benches", "scenes", "gyroid-room.scn"),
+                    os.path.join(ROOT, "examples", "mitsuba", "gyroid-room.xml")),
+}
+SHEET = os.path.join(ROOT, "benches", "scenes", "gyroid-sheet.scn")
+SCENE, XML = SCENES["cornell"]
+# Extra `name=value` pairs for Mitsuba's scene file (the gyroid room's mesh).
+XML_ARGS = {}
+CYCLES = os.path.join(ROOT, "examples", "cycles", "cornell.py")
+SCNC = os.path.join(ROOT, "target", "release", "scnc")
+
+
+def read_exr(path):
+    import mitsuba as mi
+    return np.array(mi.Bitmap(path), dtype=np.float64)[:, :, :3]
+
+
+def scnc(res, spp, tmp):
+    out = os.path.join(tmp, f"scnc-{spp}.exr")
+    start = time.time()
+    subprocess.run([SCNC, "render", SCENE, "-o", out, "--width", str(res), "--height", str(res),
+                    "--samples", str(spp), "--threads", "2"], check=True, stderr=subprocess.DEVNULL)
+    return read_exr(out), time.time() - start
+
+
+MITSUBA_CHILD = r"""
+import json, sys, time
+import numpy as np
+import mitsuba as mi
+xml, variant, sampler, res, spp, seed, out, extra = sys.argv[1:9]
+mi.set_variant(variant)
+mi.set_log_level(mi.LogLevel.Warn)
+start = time.time()
+scene = mi.load_file(xml, spp=int(spp), res=int(res), sampler=sampler, **json.loads(extra))
+# The LLVM variant renders lazily: the image is computed when it is read, so the clock
+# stops after writing it.
+mi.Bitmap(mi.render(scene, seed=int(seed))).write(out)
+print(json.dumps({"seconds": time.time() - start}))
+"""
+
+
+def mitsuba(variant, sampler, res, spp, seed, tmp):
+    """One Mitsuba render in its own process, so that every rung pays the same start-up."""
+    out = os.path.join(tmp, f"mitsuba-{spp}-{seed}.exr")
+    r = subprocess.run([sys.executable, "-c", MITSUBA_CHILD, XML, variant, sampler, str(res), str(spp), str(seed),
+                        out, json.dumps(XML_ARGS)],
+                       check=True, capture_output=True, text=True, env={**os.environ, "DRJIT_NUM_THREADS": "2"})
+    # Mitsuba's own log lines (coloured) share standard output: the figure is the last
+    # JSON object in it.
+    return read_exr(out), json.loads(r.stdout[r.stdout.rindex('{"seconds"'):].splitlines()[0])["seconds"]
+
+
+def cycles(res, spp, seed, tmp):
+    out = os.path.join(tmp, f"cycles-{spp}-{seed}.exr")
+    r = subprocess.run([sys.executable, CYCLES, "--res", str(res), "--spp", str(spp), "--seed", str(seed),
+                        "--out", out], check=True, capture_output=True, text=True)
+    seconds = float([l for l in r.stderr.splitlines() if l.startswith("cycles:")][-1].split()[1])
+    return read_exr(out), seconds
+
+
+def mse(a, b):
+    return float(np.mean((a - b) ** 2))
+
+
+def fit(ladder, rmse, seconds):
+    """c and the slope of RMSE against N on log–log, and a, b of time = a + b·N. c is
+    RMSE·√N at the top rung: a sampler that converges faster than 1/√N at the low rungs
+    (stratified and quasi-random ones do) is not credited with keeping that up."""
+    n = np.array(ladder, dtype=np.float64)
+    slope, _ = np.polyfit(np.log(n), np.log(rmse), 1)
+    c = float(rmse[-1] * np.sqrt(n[-1]))
+    b, a = np.polyfit(n, np.array(seconds), 1)
+    return c, float(slope), float(max(a, 0.0)), float(b)
+
+
+def main():
+    p = argparse.ArgumentParser()
+    p.add_argument("--res", type=int, default=512)
+    p.add_argument("--ladder", default="16,64,256,1024")
+    p.add_argument("--cycles-ladder", default="16,64,256")
+    p.add_argument("--sampler", default="multijitter", help="Mitsuba's sampler (its best at equal samples here)")
+    p.add_argument("--ref-spp", type=int, default=4096)
+    p.add_argument("--target", type=float, default=0.02)
+    p.add_argument("--variant", default="llvm_ad_rgb")
+    p.add_argument("--rows")
+    p.add_argument("--skip", default="")
+    p.add_argument("--scene", default="cornell", choices=sorted(SCENES))
+    a = p.parse_args()
+    global SCENE, XML
+    SCENE, XML = SCENES[a.scene]
+    ladder = [int(x) for x in a.ladder.split(",")]
+    skip = set(a.skip.split(",")) - {""}
+    results = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        log = lambda *m: print(*m, file=sys.stderr, flush=True)
+        meshing = 0.0
+        if a.scene == "gyroid-room":
+            # The other renderers get scnc's own mesh of the field; making it is part of
+            # their time (Cycles is left out here: it is slower than Mitsuba on the box).
+            skip.add("cycles")
+            mesh = os.path.join(tmp, "gyroid.ply")
+            start = time.time()
+            subprocess.run([SCNC, "export", SHEET, "-o", mesh, "--tolerance", "0.001", "--threads", "2"], check=True,
+                           stderr=subprocess.DEVNULL)
+            meshing = time.time() - start
+            XML_ARGS["mesh"] = mesh
+            log(f"meshing the gyroid sheet at --tolerance 0.001: {meshing:.1f} s")
+        log(f"reference: Mitsuba {a.res}² × {a.ref_spp}")
+        ref, t_ref = mitsuba(a.variant, a.sampler, a.res, a.ref_spp, 1000, tmp)
+        log(f"  {t_ref:.1f} s, mean {ref.mean(axis=(0, 1))}")
+        # Mitsuba's pairs give its variance, and so the reference's own noise.
+        m_rows, var_m = [], []
+        for n in ladder:
+            x, t1 = mitsuba(a.variant, a.sampler, a.res, n, 1, tmp)
+            y, t2 = mitsuba(a.variant, a.sampler, a.res, n, 2, tmp)
+            e2 = mse(x, y) / 2
+            var_m.append(e2 * n)
+            m_rows.append((n, e2, (t1 + t2) / 2 + meshing))
+            log(f"  mitsuba {n}: {t1:.1f} / {t2:.1f} s, rmse {e2 ** 0.5:.4f}, against ref "
+                f"{mse(x, ref) ** 0.5:.4f}")
+        ref_noise = float(np.mean(var_m)) / a.ref_spp
+        results["Mitsuba 3"] = m_rows
+        if "scnc" not in skip:
+            rows = []
+            for n in ladder:
+                x, t = scnc(a.res, n, tmp)
+                e2 = max(mse(x, ref) - ref_noise, 1e-12)
+                rows.append((n, e2, t))
+                log(f"  scnc {n}: {t:.1f} s, rmse {e2 ** 0.5:.4f} (against ref {mse(x, ref) ** 0.5:.4f}), "
+                    f"mean {x.mean(axis=(0, 1))}")
+            results["scnc"] = rows
+        if "cycles" not in skip:
+            rows = []
+            for n in [int(x) for x in a.cycles_ladder.split(",")]:
+                x, t1 = cycles(a.res, n, 1, tmp)
+                y, t2 = cycles(a.res, n, 2, tmp)
+                e2 = mse(x, y) / 2
+                rows.append((n, e2, (t1 + t2) / 2))
+                log(f"  cycles {n}: {t1:.1f} / {t2:.1f} s, rmse {e2 ** 0.5:.4f}, mean {x.mean(axis=(0, 1))}")
+            results["Cycles"] = rows
+    if meshing:
+        print(f"Mitsuba's times include meshing the field at --tolerance 0.001: {meshing:.1f} s\n")
+    print(f"{a.scene} {a.res}², reference Mitsuba ({a.sampler}) × {a.ref_spp} (its noise, RMSE "
+          f"{ref_noise ** 0.5:.4f}, subtracted), target RMSE {a.target}, 2 threads each\n")
+    print("| renderer | samples | seconds | RMSE |")
+    print("|---|---|---|---|")
+    summary = {}
+    for name, rows in results.items():
+        for n, e2, t in rows:
+            print(f"| {name} | {n} | {t:.2f} | {e2 ** 0.5:.4f} |")
+        c, slope, a0, b = fit([r[0] for r in rows], [r[1] ** 0.5 for r in rows], [r[2] for r in rows])
+        need = (c / a.target) ** 2
+        summary[name] = (slope, a0, b, need, a0 + b * need)
+    print("\n| renderer | RMSE slope | start-up s | s per sample | samples to target | seconds to target |")
+    print("|---|---|---|---|---|---|")
+    for name, (slope, a0, b, need, t) in summary.items():
+        print(f"| {name} | {slope:.3f} | {a0:.2f} | {b:.4f} | {need:.0f} | {t:.1f} |")
+    if "scnc" in summary:
+        for name in ("Mitsuba 3", "Cycles"):
+            if name in summary:
+                print(f"\nscnc's time to target against {name}'s: {summary['scnc'][4] / summary[name][4]:.2f}×")
+    if a.rows:
+        with open(a.rows, "w") as f:
+            for name, rows in results.items():
+                for n, e2, t in rows:
+                    f.write(f"{name.split()[0]} {n} {e2 ** 0.5:.6g} {t:.4g}\n")
+
+
+if __name__ == "__main__":
+    main()
