@@ -42,9 +42,6 @@ SCENES = {
                     os.path.join(ROOT, "examples", "mitsuba", "gyroid-room.xml")),
 }
 SHEET = os.path.join(ROOT, "benches", "scenes", "gyroid-sheet.scn")
-SCENE, XML = SCENES["cornell"]
-# Extra `name=value` pairs for Mitsuba's scene file (the gyroid room's mesh).
-XML_ARGS = {}
 CYCLES = os.path.join(ROOT, "examples", "cycles", "cornell.py")
 SCNC = os.path.join(ROOT, "target", "release", "scnc")
 
@@ -54,10 +51,10 @@ def read_exr(path):
     return np.array(mi.Bitmap(path), dtype=np.float64)[:, :, :3]
 
 
-def scnc(res, spp, tmp):
+def scnc(scene, res, spp, tmp):
     out = os.path.join(tmp, f"scnc-{spp}.exr")
     start = time.time()
-    subprocess.run([SCNC, "render", SCENE, "-o", out, "--width", str(res), "--height", str(res),
+    subprocess.run([SCNC, "render", scene, "-o", out, "--width", str(res), "--height", str(res),
                     "--samples", str(spp), "--threads", "2"], check=True, stderr=subprocess.DEVNULL)
     return read_exr(out), time.time() - start
 
@@ -78,11 +75,12 @@ print(json.dumps({"seconds": time.time() - start}))
 """
 
 
-def mitsuba(variant, sampler, res, spp, seed, tmp):
-    """One Mitsuba render in its own process, so that every rung pays the same start-up."""
+def mitsuba(xml, extra, variant, sampler, res, spp, seed, tmp):
+    """One Mitsuba render of `xml` (`extra`: more of its parameters, the gyroid room's
+    mesh) in its own process, so that every rung pays the same start-up."""
     out = os.path.join(tmp, f"mitsuba-{spp}-{seed}.exr")
-    r = subprocess.run([sys.executable, "-c", MITSUBA_CHILD, XML, variant, sampler, str(res), str(spp), str(seed),
-                        out, json.dumps(XML_ARGS)],
+    r = subprocess.run([sys.executable, "-c", MITSUBA_CHILD, xml, variant, sampler, str(res), str(spp), str(seed),
+                        out, json.dumps(extra)],
                        check=True, capture_output=True, text=True, env={**os.environ, "DRJIT_NUM_THREADS": "2"})
     # Mitsuba's own log lines (coloured) share standard output: the figure is the last
     # JSON object in it.
@@ -99,6 +97,14 @@ def cycles(res, spp, seed, tmp):
 
 def mse(a, b):
     return float(np.mean((a - b) ** 2))
+
+
+def pair(render, n):
+    """Two renders of `n` samples with seeds 1 and 2: the MSE of one against the truth
+    (two independent images differ by twice one's variance), their mean time, the first."""
+    x, t1 = render(n, 1)
+    y, t2 = render(n, 2)
+    return mse(x, y) / 2, (t1 + t2) / 2, x, (t1, t2)
 
 
 def fit(ladder, rmse, seconds):
@@ -125,8 +131,8 @@ def main():
     p.add_argument("--skip", default="")
     p.add_argument("--scene", default="cornell", choices=sorted(SCENES))
     a = p.parse_args()
-    global SCENE, XML
-    SCENE, XML = SCENES[a.scene]
+    scene, xml = SCENES[a.scene]
+    extra = {}
     ladder = [int(x) for x in a.ladder.split(",")]
     skip = set(a.skip.split(",")) - {""}
     results = {}
@@ -142,19 +148,18 @@ def main():
             subprocess.run([SCNC, "export", SHEET, "-o", mesh, "--tolerance", "0.001", "--threads", "2"], check=True,
                            stderr=subprocess.DEVNULL)
             meshing = time.time() - start
-            XML_ARGS["mesh"] = mesh
+            extra["mesh"] = mesh
             log(f"meshing the gyroid sheet at --tolerance 0.001: {meshing:.1f} s")
+        render_m = lambda spp, seed: mitsuba(xml, extra, a.variant, a.sampler, a.res, spp, seed, tmp)
         log(f"reference: Mitsuba {a.res}² × {a.ref_spp}")
-        ref, t_ref = mitsuba(a.variant, a.sampler, a.res, a.ref_spp, 1000, tmp)
+        ref, t_ref = render_m(a.ref_spp, 1000)
         log(f"  {t_ref:.1f} s, mean {ref.mean(axis=(0, 1))}")
         # Mitsuba's pairs give its variance, and so the reference's own noise.
         m_rows, var_m = [], []
         for n in ladder:
-            x, t1 = mitsuba(a.variant, a.sampler, a.res, n, 1, tmp)
-            y, t2 = mitsuba(a.variant, a.sampler, a.res, n, 2, tmp)
-            e2 = mse(x, y) / 2
+            e2, t, x, (t1, t2) = pair(render_m, n)
             var_m.append(e2 * n)
-            m_rows.append((n, e2, (t1 + t2) / 2 + meshing))
+            m_rows.append((n, e2, t + meshing))
             log(f"  mitsuba {n}: {t1:.1f} / {t2:.1f} s, rmse {e2 ** 0.5:.4f}, against ref "
                 f"{mse(x, ref) ** 0.5:.4f}")
         ref_noise = float(np.mean(var_m)) / a.ref_spp
@@ -162,7 +167,7 @@ def main():
         if "scnc" not in skip:
             rows = []
             for n in ladder:
-                x, t = scnc(a.res, n, tmp)
+                x, t = scnc(scene, a.res, n, tmp)
                 e2 = max(mse(x, ref) - ref_noise, 1e-12)
                 rows.append((n, e2, t))
                 log(f"  scnc {n}: {t:.1f} s, rmse {e2 ** 0.5:.4f} (against ref {mse(x, ref) ** 0.5:.4f}), "
@@ -171,10 +176,8 @@ def main():
         if "cycles" not in skip:
             rows = []
             for n in [int(x) for x in a.cycles_ladder.split(",")]:
-                x, t1 = cycles(a.res, n, 1, tmp)
-                y, t2 = cycles(a.res, n, 2, tmp)
-                e2 = mse(x, y) / 2
-                rows.append((n, e2, (t1 + t2) / 2))
+                e2, t, x, (t1, t2) = pair(lambda spp, seed: cycles(a.res, spp, seed, tmp), n)
+                rows.append((n, e2, t))
                 log(f"  cycles {n}: {t1:.1f} / {t2:.1f} s, rmse {e2 ** 0.5:.4f}, mean {x.mean(axis=(0, 1))}")
             results["Cycles"] = rows
     if meshing:

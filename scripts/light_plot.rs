@@ -7,8 +7,7 @@ use std::io::{Read, Write};
 use std::process::ExitCode;
 
 use plotters::chart::SeriesLabelPosition;
-use plotters::style::{RGBColor, BLACK, BLUE, GREEN, MAGENTA, RED};
-use scnc::study::chart::{loglog, Point, Series};
+use scnc::study::chart::{loglog, named_rows, series_by_name, Point};
 
 fn main() -> ExitCode {
     let Some(out) = std::env::args().nth(1) else {
@@ -20,26 +19,15 @@ fn main() -> ExitCode {
         let _ = writeln!(std::io::stderr(), "error: cannot read the rows: {e}");
         return ExitCode::from(1);
     }
-    let colours = [BLUE, RED, GREEN, MAGENTA, BLACK, RGBColor(200, 120, 0)];
-    let mut series: Vec<Series> = Vec::new();
-    for (line_no, line) in text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty() && !l.starts_with('#')) {
-        let words: Vec<&str> = line.split_whitespace().collect();
-        let numbers: Result<Vec<f64>, _> = words.iter().skip(1).map(|w| w.parse::<f64>()).collect();
-        let (name, [samples, rmse, seconds]) = match (words.first(), numbers.as_deref()) {
-            (Some(n), Ok([s, r, t])) => (*n, [*s, *r, *t]),
-            _ => {
-                let _ =
-                    writeln!(std::io::stderr(), "error: line {}: expected `SERIES SAMPLES RMSE SECONDS`", line_no + 1);
-                return ExitCode::from(1);
-            }
-        };
-        let k = series.iter().position(|s| s.name == name).unwrap_or_else(|| {
-            let colour = colours[series.len() % colours.len()];
-            series.push(Series { name: name.into(), colour, points: Vec::new() });
-            series.len() - 1
-        });
-        series[k].points.push(Point { x: rmse, y: seconds, label: Some(format!("{samples}")), ..Point::default() });
-    }
+    let rows = match named_rows(&text, 3) {
+        Ok(rows) => rows,
+        Err(line) => {
+            let _ = writeln!(std::io::stderr(), "error: line {line}: expected `SERIES SAMPLES RMSE SECONDS`");
+            return ExitCode::from(1);
+        }
+    };
+    let series =
+        series_by_name(&rows, |n| Point { x: n[1], y: n[2], label: Some(format!("{}", n[0])), ..Point::default() });
     let chart = loglog(
         "time against error: the Cornell box (labels: samples per pixel)",
         ("RMSE against the converged image (radiance)", "wall seconds, 2 threads"),

@@ -8,8 +8,7 @@ use std::io::{Read, Write};
 use std::process::ExitCode;
 
 use plotters::chart::SeriesLabelPosition;
-use plotters::style::{RGBColor, BLACK, BLUE, GREEN, MAGENTA, RED};
-use scnc::study::chart::{loglog, Point, Series};
+use scnc::study::chart::{loglog, named_rows, series_by_name, Point};
 
 fn main() -> ExitCode {
     let Some(out) = std::env::args().nth(1) else {
@@ -21,34 +20,15 @@ fn main() -> ExitCode {
         let _ = writeln!(std::io::stderr(), "error: cannot read the table: {e}");
         return ExitCode::from(1);
     }
-    let colours = [BLUE, RED, GREEN, MAGENTA, BLACK, RGBColor(200, 120, 0)];
-    let (mut triangles, mut seconds): (Vec<Series>, Vec<Series>) = (Vec::new(), Vec::new());
-    for (line_no, line) in text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty() && !l.starts_with('#')) {
-        let words: Vec<&str> = line.split_whitespace().collect();
-        let numbers: Result<Vec<f64>, _> = words.iter().skip(1).map(|w| w.parse::<f64>()).collect();
-        let (name, [deviation, tris, secs]) = match (words.first(), numbers.as_deref()) {
-            (Some(n), Ok([d, t, s])) => (*n, [*d, *t, *s]),
-            _ => {
-                let _ = writeln!(
-                    std::io::stderr(),
-                    "error: line {}: expected `SERIES DEVIATION TRIANGLES SECONDS`",
-                    line_no + 1
-                );
-                return ExitCode::from(1);
-            }
-        };
-        let k = match triangles.iter().position(|s| s.name == name) {
-            Some(k) => k,
-            None => {
-                let colour = colours[triangles.len() % colours.len()];
-                triangles.push(Series { name: name.into(), colour, points: Vec::new() });
-                seconds.push(Series { name: name.into(), colour, points: Vec::new() });
-                triangles.len() - 1
-            }
-        };
-        triangles[k].points.push(Point { x: deviation, y: tris, ..Point::default() });
-        seconds[k].points.push(Point { x: deviation, y: secs, ..Point::default() });
-    }
+    let rows = match named_rows(&text, 3) {
+        Ok(rows) => rows,
+        Err(line) => {
+            let _ = writeln!(std::io::stderr(), "error: line {line}: expected `SERIES DEVIATION TRIANGLES SECONDS`");
+            return ExitCode::from(1);
+        }
+    };
+    let triangles = series_by_name(&rows, |n| Point { x: n[0], y: n[1], ..Point::default() });
+    let seconds = series_by_name(&rows, |n| Point { x: n[0], y: n[2], ..Point::default() });
     let upper = loglog(
         "triangles against the measured maximum deviation",
         ("maximum deviation from the surface (scene units)", "triangles"),

@@ -54,11 +54,7 @@ fn run() -> Result<(), String> {
     let start = Instant::now();
     let object = scnc::mesh::MeshObject::new(&mesh, DAffine3::IDENTITY, 0, None, scnc::mesh::Normals::Flat);
     let build = start.elapsed().as_secs_f64();
-    let (lo, hi) = mesh
-        .positions
-        .iter()
-        .fold((glam::DVec3::INFINITY, glam::DVec3::NEG_INFINITY), |(a, b), p| (a.min(*p), b.max(*p)));
-    let (lo, hi) = (lo.as_vec3a(), hi.as_vec3a());
+    let scnc::accel::Aabb { min: lo, max: hi } = object.bounds();
     let mut rng = Pcg(seed.wrapping_mul(0x9e3779b97f4a7c15) | 1);
     let rays: Vec<Ray> = (0..count)
         .map(|_| {

@@ -84,6 +84,44 @@ pub struct Series {
     pub points: Vec<Point>,
 }
 
+/// The colours measurement charts give their series, in order of first appearance.
+pub const PALETTE: [RGBColor; 6] = [BLUE, RED, GREEN, MAGENTA, BLACK, RGBColor(200, 120, 0)];
+
+/// The rows of a measurement table, `NAME x₁ … xₙ` with `columns` numbers each (blank
+/// lines and `#` comments skipped), or the number (from 1) of the first line that is not
+/// one: what `scripts/mesh-error-table.sh` and `benches/light_error.py` write for their
+/// charts.
+pub fn named_rows(text: &str, columns: usize) -> Result<Vec<(&str, Vec<f64>)>, usize> {
+    text.lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty() && !l.starts_with('#'))
+        .map(|(n, line)| {
+            let mut words = line.split_whitespace();
+            let name = words.next().ok_or(n + 1)?;
+            let numbers: Vec<f64> = words.map(str::parse).collect::<Result<_, _>>().map_err(|_| n + 1)?;
+            (numbers.len() == columns).then_some((name, numbers)).ok_or(n + 1)
+        })
+        .collect()
+}
+
+/// One series per name of `rows`, in order of first appearance and coloured from
+/// [`PALETTE`], each row a point made by `point` from its numbers.
+pub fn series_by_name(rows: &[(&str, Vec<f64>)], point: impl Fn(&[f64]) -> Point) -> Vec<Series> {
+    let mut series: Vec<Series> = Vec::new();
+    for (name, numbers) in rows {
+        let k = series.iter().position(|s| s.name == *name).unwrap_or_else(|| {
+            series.push(Series {
+                name: (*name).into(),
+                colour: PALETTE[series.len() % PALETTE.len()],
+                points: Vec::new(),
+            });
+            series.len() - 1
+        });
+        series[k].points.push(point(numbers));
+    }
+    series
+}
+
 /// Plots `axis` against mean geometric error for every row, one curve per back-end; the
 /// settings no other beats in both cost and error (the Pareto front) are ringed.
 pub fn error_chart(rows: &[Row], axis: Axis, title: &str) -> Result<Image, String> {
@@ -246,5 +284,26 @@ fn tick(v: f64) -> String {
     } else {
         let s = format!("{v:.3}");
         s.trim_end_matches('0').trim_end_matches('.').to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Rows are read by name with their numbers, comments and blank lines skipped; a line
+    /// with a word for a number or the wrong count is named by its number.
+    #[test]
+    fn named_rows_read_and_name_bad_lines() {
+        let rows = named_rows("# head\nscnc 1 2\n\nfidget 3 4\nscnc 5 6\n", 2).expect("rows");
+        assert_eq!(rows, vec![("scnc", vec![1.0, 2.0]), ("fidget", vec![3.0, 4.0]), ("scnc", vec![5.0, 6.0])]);
+        assert_eq!(named_rows("a 1 2\nb 1 x\n", 2), Err(2));
+        assert_eq!(named_rows("a 1 2 3\n", 2), Err(1));
+        let series = series_by_name(&rows, |n| Point { x: n[0], y: n[1], ..Point::default() });
+        assert_eq!(
+            series.iter().map(|s| (s.name.as_str(), s.points.len())).collect::<Vec<_>>(),
+            [("scnc", 2), ("fidget", 1)]
+        );
+        assert_eq!((series[0].colour, series[1].colour), (PALETTE[0], PALETTE[1]));
     }
 }
