@@ -120,14 +120,15 @@ pub enum Refined {
 /// surface): there `f < threshold` holds in a shell up to `L` thresholds thick, and
 /// taking it for the surface draws the shape bigger the larger `L` is stated.
 ///
-/// The first-order distance `f / |∇f|`, from the object's surface closure `surf` (the
-/// value and analytic gradient its hits are shaded with, scaled as `f` is), does not
-/// depend on `L`: where it is below the threshold the hit stands;
-/// where not, the ray steps by it (no surface nearer under the field's linear model,
-/// and a step that still lands inside is bisected back to the crossing) until it is,
-/// or until the bound rises past the threshold again, as beside a silhouette, where the
-/// march resumes. A shape's silhouette is then where its field's zero set is, whatever
-/// `L` says; `L` only sets how many steps the march takes getting there.
+/// The hit stands where Newton's steps from it, with the object's surface closure
+/// `surf` (the value and analytic gradient its hits are shaded with, scaled as `f` is),
+/// reach the surface within the threshold ([`on_surface`]): that does not depend on
+/// `L`. Where they do not, the ray steps by the first-order distance `f / |∇f|`, at
+/// least the threshold (no surface nearer under the field's linear model, and a step
+/// that still lands inside is bisected back to the crossing) until they do, or until
+/// the bound rises past the threshold again, as beside a silhouette, where the march
+/// resumes. A shape's silhouette is then where its field's zero set is, whatever `L`
+/// says; `L` only sets how many steps the march takes getting there.
 #[inline(never)]
 pub fn refine(
     f: &dyn Fn(Vec3A) -> f32,
@@ -153,30 +154,34 @@ pub fn refine(
         if d <= 0.0 || d.is_nan() {
             return Refined::Hit(t, threshold);
         }
-        let slope = g.length();
-        // A bound within a few times the field's slope here draws the surface within a
-        // few thresholds, as every bound does; below that the confirmation is worth its
-        // risk (a step past a part thinner than the threshold that the bound alone
-        // would have taken for a hit).
         // (A NaN slope fails the range test too.)
-        if !(f32::MIN_POSITIVE..=TRUSTED_SLOPE).contains(&slope) {
+        let slope = g.length();
+        if !(f32::MIN_POSITIVE..).contains(&slope) {
             return Refined::Hit(t, threshold);
         }
-        let estimate = d / slope;
-        if estimate < threshold {
+        if on_surface(surf, origin + dir * t, (d, g), threshold, evals) {
             return Refined::Hit(t, threshold);
         }
-        let next = (t + estimate.max(d)).min(t1);
-        let super::Surf { d: dn, g: gn, .. } = surf(origin + dir * next);
-        *evals += 1;
-        // The step trusts the field's linear model: where the field is not linear at
-        // the step's scale (features the size of the threshold, a gradient the
-        // differences cannot resolve), the model does not predict the value at its end,
-        // and the hit the bound gave stands, as without the confirmation.
-        let predicted = d + g.dot(dir) * (next - t);
-        if (dn - predicted).abs() > 0.5 * d {
-            return Refined::Hit(t, threshold);
-        }
+        // The step trusts the field's linear model where the model predicts the value at
+        // its end. Where it does not (the field is not linear at the step's scale: a
+        // crease where a `max` switches branches, features the size of the threshold),
+        // a shorter step is tried, down to the bound's own step `d`, which no surface
+        // can be nearer than whatever the model says. Taking the bound's hit there, as
+        // this did before, drew surfaces that are not there: beside the crease of
+        // `max(sheet, ball)` the ball's branch reads its distance over the whole field's
+        // slope bound, a shell that many thresholds thick around a sphere the solid only
+        // touches at its rim (the gyroid room's bright rim, docs/light.md).
+        let mut reach = (d / slope).max(threshold);
+        let (next, dn, gn) = loop {
+            let next = (t + reach).min(t1);
+            let super::Surf { d: dn, g: gn, .. } = surf(origin + dir * next);
+            *evals += 1;
+            let predicted = d + g.dot(dir) * (next - t);
+            if reach <= d || (dn - predicted).abs() <= 0.5 * d {
+                break (next, dn, gn);
+            }
+            reach = (reach * SHORTER).max(d);
+        };
         if dn < 0.0 {
             // Crossed: bisect to the threshold, keeping the outside end.
             let (mut a, mut b) = (t, next);
@@ -203,9 +208,48 @@ pub fn refine(
     Refined::Miss
 }
 
-/// The slope of the bound (its gradient's length) above which a hit is taken as the
-/// bound gives it: a bound that understates the distance by less than 4×.
-const TRUSTED_SLOPE: f32 = 0.25;
+/// Whether the solid's surface is within `reach` of `p`, where the bound is `d` and its
+/// gradient `g`: Newton's steps onto the zero set, each along the gradient of the branch
+/// that holds the value where it stands, so that beside a crease of `max(a, b)` they
+/// alternate between the two faces and end on the edge where they meet. The first-order
+/// distance of the branch in hand alone cannot see that: beside a gyroid sheet cut by a
+/// ball, just outside the ball, the sheet's branch may read a distance under the
+/// threshold where the solid is many thresholds away. Steps that do not converge (a flat
+/// gradient, a field not smooth at this scale) cannot tell, and the point counts as on
+/// the surface, as the bound alone would have it.
+fn on_surface(
+    surf: &dyn Fn(Vec3A) -> super::Surf,
+    p: Vec3A,
+    (mut d, mut g): (f32, Vec3A),
+    reach: f32,
+    evals: &mut u64,
+) -> bool {
+    let mut q = p;
+    for _ in 0..NEWTON_STEPS {
+        let gg = g.length_squared();
+        if gg.is_nan() || gg <= 0.0 || d * d <= gg * (reach * CONVERGED).powi(2) {
+            return true;
+        }
+        q -= g * (d / gg);
+        if (q - p).length() > reach {
+            return false;
+        }
+        let next = surf(q);
+        *evals += 1;
+        (d, g) = (next.d, next.g);
+    }
+    true
+}
+
+/// Newton's steps [`on_surface`] takes: a crease between two faces converges in a few.
+const NEWTON_STEPS: u32 = 6;
+
+/// The first-order distance, in parts of the reach, below which [`on_surface`] has
+/// arrived.
+const CONVERGED: f32 = 0.05;
+
+/// What a step the linear model did not predict is cut to before it is tried again.
+const SHORTER: f32 = 0.25;
 
 /// Halvings of a crossed step: enough to bring any f32 span below a threshold of a
 /// millionth of it, and an end where the threshold is zero (at the camera).

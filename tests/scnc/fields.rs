@@ -272,6 +272,34 @@ fn field_hits_lie_on_the_surface() {
     assert_eq!(hits, 200, "every ray at the twisted box's axis hits it");
 }
 
+/// A field's crease is drawn where its solid is, not where one of its branches is: a
+/// slab as steep as the stated bound, cut by a ball that the bound makes 20 times too
+/// shallow, covers what the same intersection built from shapes covers. Just outside the
+/// ball along the slab's face, the slab's branch reads a distance under the threshold
+/// while the solid is many thresholds away; the march took that for a hit and drew a
+/// phantom rim (as at the gyroid sheet's rim beside a light, docs/light.md).
+#[test]
+fn a_crease_is_drawn_where_the_solid_is() {
+    const N: u32 = 128;
+    const B: &str = "bounds = [[-1.2, -1.2, -1.2], [1.2, 1.2, 1.2]]";
+    let mask = |object: &str| {
+        let text = format!(
+            "camera(position = [0, 1.2, -4], look_at = [0, 0, 0], fov = 40)\n\
+             light ambient(1)\nobject {object}\n"
+        );
+        coverage(&scene(&text), Mode::Sdf, N)
+    };
+    let truth = mask("intersect(sphere(1), box(2, 0.3, 2))");
+    assert!(truth.iter().filter(|&&c| c).count() > 2000, "the cut ball covers too little to compare");
+    for object in [
+        format!("field(p => max(20 * (abs(p.y) - 0.3), length(p) - 1), {B}, lipschitz = 20)"),
+        format!("field(p => max(20 * (abs(p.y) - 0.3), length(p) - 1), {B})"),
+    ] {
+        let differ = truth.iter().zip(&mask(&object)).filter(|(a, b)| a != b).count();
+        assert!(differ * 1000 <= (N * N) as usize, "{object} differs from its shape on {differ} of {} pixels", N * N);
+    }
+}
+
 /// The domain operations cover what the shapes they describe cover, in every mode: an
 /// elongated sphere is a capsule, a sphere mirrored across x is the pair, six copies by
 /// `polar` are the six spheres turned by hand (one copy crossing its sector, measured
