@@ -88,8 +88,10 @@ fn studio_streams_what_scnc_render_makes() {
     assert_eq!(status, 200);
     let msgs = messages(&body);
     let kinds: String = msgs.iter().map(|(k, _)| *k as char).collect();
-    assert!(kinds.starts_with("LMBM") && kinds.ends_with('S'), "{kinds}");
-    let full: Vec<u8> = msgs.iter().skip(4).filter(|(k, _)| *k == b'B').flat_map(|(_, p)| p[12..].to_vec()).collect();
+    assert!(kinds.starts_with("CLMBM") && kinds.ends_with('S'), "{kinds}");
+    let compiled: serde_json::Value = serde_json::from_slice(&msgs[0].1).unwrap();
+    assert_eq!(compiled, serde_json::json!({ "diagnostics": [], "params": [] }));
+    let full: Vec<u8> = msgs.iter().skip(5).filter(|(k, _)| *k == b'B').flat_map(|(_, p)| p[12..].to_vec()).collect();
     let full = image::RgbImage::from_raw(160, 120, full).expect("a full 160×120 frame");
     if let Some(d) = image_difference("streamed", &full, &rendered(&scene)) {
         panic!("the streamed frame differs from `scnc render`'s: {d}");
@@ -99,6 +101,23 @@ fn studio_streams_what_scnc_render_makes() {
     let msgs = messages(&body);
     assert_eq!(msgs.len(), 1);
     assert!(msgs[0].0 == b'E' && String::from_utf8_lossy(&msgs[0].1).contains("E0201"));
+    // An edit is compiled once, for its image: the stream brings the editor its
+    // warnings and the controls the parameters, with the page's values.
+    let (_, body) = s.post(
+        "/api/render?coarse=1&set=%7B%22r%22%3A%221.5%22%7D",
+        "param r = 1 in 0.5 .. 2\nobject field(p => 20 * (length(p) - r), bounds = [[-2, -2, -2], [2, 2, 2]])\n",
+    );
+    let msgs = messages(&body);
+    assert_eq!(msgs[0].0, b'C');
+    let compiled: serde_json::Value = serde_json::from_slice(&msgs[0].1).unwrap();
+    let warnings = compiled["diagnostics"].as_array().unwrap();
+    assert!(warnings.iter().any(|d| d["severity"] == "warning"), "{compiled}");
+    let params = compiled["params"].as_array().unwrap();
+    assert_eq!(
+        (params.len(), params[0]["name"].as_str(), params[0]["value"].as_f64()),
+        (1, Some("r"), Some(1.5)),
+        "{compiled}"
+    );
     // The camera line, through the formatter, and still a scene.
     let (_, body) = s.post("/api/camera?yaw=30&pitch=10&zoom=1.5", &text);
     let v: serde_json::Value = serde_json::from_slice(&body).unwrap();

@@ -51,20 +51,25 @@ pub(crate) fn params(studio: &Studio, text: String, set: &Overrides) -> Reply {
             "diagnostics": diagnostics_json(&compiled.map, &compiled.diagnostics),
         }));
     };
-    let root = compiled.map.file(FileId(0)).text.as_str();
-    let list: Vec<serde_json::Value> = scene
+    Reply::json(&serde_json::json!({ "params": param_list(&compiled.map, scene) }))
+}
+
+/// `scene`'s parameters as the page's controls take them: each as `scnc params` prints
+/// it, with the UTF-16 range of its default in the root file of `map`.
+pub(crate) fn param_list(map: &SourceMap, scene: &scnc::ir::Scene) -> Vec<serde_json::Value> {
+    let root = map.file(FileId(0)).text.as_str();
+    scene
         .params
         .iter()
         .map(|p| {
             let mut j = crate::cli::param_json(p);
-            let (_, range) = compiled.map.local_range(p.default_span);
+            let (_, range) = map.local_range(p.default_span);
             j["from"] = to_utf16(root, range.start).into();
             j["to"] = to_utf16(root, range.end).into();
             j["source"] = p.value.source().into();
             j
         })
-        .collect();
-    Reply::json(&serde_json::json!({ "params": list }))
+        .collect()
 }
 
 /// The hover text at UTF-16 position `pos`.

@@ -7,8 +7,10 @@
 //! The stream is a sequence of messages (see [`super::http::Stream::message`]):
 //! `M` the image about to come (JSON), `B` a band of it (`y0`, `rows`, `width` as u32
 //! and RGB bytes), `S` the render's statistics, `A` the accuracy against the finest rung,
-//! `N` a note, `E` diagnostics that stopped it, `X` overtaken by a newer request, and
-//! `L` lowering begun (`objects`: how many), sent after the scene compiled.
+//! `N` a note, `E` diagnostics that stopped it, `X` overtaken by a newer request,
+//! `C` the compiled scene's diagnostics (warnings) and parameters, for the editor and the
+//! controls, and `L` lowering begun (`objects`: how many), sent after the scene compiled.
+//! An edit asks for nothing else: the text is compiled once, for its image.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
@@ -221,9 +223,19 @@ fn json_message(out: &mut Stream, kind: u8, value: serde_json::Value) -> std::io
 fn run(studio: &Studio, text: &str, ask: &Ask, out: &mut Stream, current: &Wanted) -> std::io::Result<()> {
     let loader = studio.files.loader();
     let mut compiled = studio.files.compile(text.to_string(), &ask.set);
+    studio.files.watch(compiled.map.files().map(|(_, f)| f.path.clone()).collect());
     let Some(first) = compiled.scene.take() else {
         return json_message(out, b'E', diagnostics_json(&compiled.map, &compiled.diagnostics));
     };
+    // What the editor shows of this text comes with its image, from this one compile.
+    json_message(
+        out,
+        b'C',
+        serde_json::json!({
+            "diagnostics": diagnostics_json(&compiled.map, &compiled.diagnostics),
+            "params": super::edit::param_list(&compiled.map, &first),
+        }),
+    )?;
     let declared = first.settings.clone();
     let mut scene = if ask.frame > 0 && ask.frame < declared.frames {
         let (scene, diagnostics) = scnc::with_big_stack(|| compiled.frame(ask.frame, &declared, &loader))

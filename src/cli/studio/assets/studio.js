@@ -20,10 +20,9 @@ const state = {
   fps: 24,
   playing: false,
   render: null, // the AbortController of the render in flight
-  checkSeq: 0,
   lastText: "",
   params: {}, // the parameter controls' values (name → text); the file keeps its own
-  paramList: [], // the scene's params, as /api/params last listed them
+  paramList: [], // the scene's params, as the last compile listed them
   paramsFor: null, // the text that list is of
   paramShape: "", // what the controls were built from
   paramSeq: 0,
@@ -69,14 +68,6 @@ function showDiagnostics(list) {
     li.onclick = () => select(d.from, d.to);
     return li;
   }));
-}
-
-async function check(text) {
-  const seq = ++state.checkSeq;
-  try {
-    const r = await (await post("/api/check", text)).json();
-    if (seq === state.checkSeq) showDiagnostics(r.diagnostics);
-  } catch (e) { /* the server is gone: the status line says so on the next render */ }
 }
 
 // --- rendering -----------------------------------------------------------------------
@@ -203,6 +194,13 @@ async function render(sourceText, opts = {}) {
             `${a.threshold}/255 and RMSE ${a.rmse.toFixed(4)} against the finest rung (${a.reference_ms.toFixed(0)} ms)`;
           break;
         }
+        case "C": {
+          const c = json(payload);
+          showDiagnostics(c.diagnostics);
+          state.paramsFor = sourceText;
+          showParams(c.params);
+          break;
+        }
         case "N": $("note").textContent = json(payload).note; break;
         case "E":
           showDiagnostics(json(payload));
@@ -245,8 +243,8 @@ async function render(sourceText, opts = {}) {
 
 function edited(newText) {
   state.lastText = newText;
-  check(newText);
-  loadParams(newText);
+  // One request: the render's stream brings the diagnostics and the parameters of the
+  // one compile it makes (`C`), or the errors that stop it (`E`).
   render(newText);
 }
 
