@@ -1,12 +1,13 @@
 //! Incoherent-ray throughput of the mesh back-end's BVH, for issue 60's comparison with
 //! Embree (`benches/embree.py` casts the same rays):
-//! `cargo run --release --example rays -- MESH.stl [--rays N] [--seed S] [--write RAYS.bin]`.
+//! `cargo run --release --example rays -- MESH.stl [--rays N] [--seed S] [--write RAYS.bin] [--binary]`.
 //! Origins are uniform in the mesh's box, directions uniform on the sphere — every ray
 //! starts somewhere else and points anywhere, as a path's bounces do. Each ray is one
 //! closest hit with its surface (`MeshObject::intersect`, what the tracer asks of a mesh) on one thread (rays per second per core),
 //! best of three passes over the same rays; `--write` saves them as little-endian f32
 //! `ox oy oz dx dy dz` for the other tool, and the hit count and mean distance are
-//! printed so the two can be checked against each other.
+//! printed so the two can be checked against each other. The BVH is the four-wide one
+//! light transport gives meshes (`MeshObject::widen`); `--binary` walks the binary one.
 
 use std::io::Write;
 use std::process::ExitCode;
@@ -42,7 +43,7 @@ impl Pcg {
 
 fn run() -> Result<(), String> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let usage = "usage: rays MESH.stl [--rays N] [--seed S] [--write RAYS.bin]";
+    let usage = "usage: rays MESH.stl [--rays N] [--seed S] [--write RAYS.bin] [--binary]";
     let path = args.first().ok_or(usage)?;
     let option = |name: &str| args.iter().position(|a| a == name).and_then(|i| args.get(i + 1)).cloned();
     let count: usize = option("--rays").map_or(Ok(1_000_000), |s| s.parse()).map_err(|e| format!("--rays: {e}"))?;
@@ -52,7 +53,11 @@ fn run() -> Result<(), String> {
     // written back in the file's frame for the other tool, which reads the file raw.
     let mesh = Format::Stl.read(&bytes).map_err(|e| format!("{path}: {e}"))?;
     let start = Instant::now();
-    let object = scnc::mesh::MeshObject::new(&mesh, DAffine3::IDENTITY, 0, None, scnc::mesh::Normals::Flat);
+    let mut object = scnc::mesh::MeshObject::new(&mesh, DAffine3::IDENTITY, 0, None, scnc::mesh::Normals::Flat);
+    let binary = args.iter().any(|a| a == "--binary");
+    if !binary {
+        object.widen();
+    }
     let build = start.elapsed().as_secs_f64();
     let scnc::accel::Aabb { min: lo, max: hi } = object.bounds();
     let mut rng = Pcg(seed.wrapping_mul(0x9e3779b97f4a7c15) | 1);
@@ -95,9 +100,10 @@ fn run() -> Result<(), String> {
     }
     let _ = writeln!(
         std::io::stdout(),
-        "scnc: {} triangles, BVH built in {build:.2} s (all threads); {count} rays, {hits} hits, mean t {:.6} (file units); \
+        "scnc: {} triangles, {} BVH built in {build:.2} s (all threads); {count} rays, {hits} hits, mean t {:.6} (file units); \
          best of 3 on one thread: {best:.3} s = {:.2} M rays/s; per ray {:.1} nodes, {:.1} triangle tests",
         mesh.triangles.len(),
+        if binary { "binary" } else { "four-wide" },
         sum / hits.max(1) as f64 * STL_PER_UNIT,
         count as f64 / best / 1e6,
         counters.node_visits as f64 / (3 * count) as f64,

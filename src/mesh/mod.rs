@@ -401,6 +401,14 @@ impl MeshObject {
         Hit { t: hit.t, point, normal, material, error, object, behind, from_inside }
     }
 
+    /// Gives the BVH its four-wide copy, which single rays then walk ([`Bvh::widen`]):
+    /// worth its memory (about as much again as the binary nodes) where most rays are
+    /// incoherent, as under light transport; camera rays go in packets over the binary
+    /// nodes either way.
+    pub fn widen(&mut self) {
+        self.bvh.widen();
+    }
+
     /// The closest hit within `(ray.t_min, t_max)`, with its surface.
     pub fn intersect(&self, ray: &Ray, shear: &triangle::Shear, t_max: f32, c: &mut Counters) -> Option<Hit> {
         self.closest(ray, shear, t_max, c).map(|(i, hit)| self.surface(i, hit, NO_OBJECT, ray.dir))

@@ -397,6 +397,9 @@ fn lower_reusing(
     let warnings: Vec<Diagnostic> = lowered.iter().flat_map(|(_, w, _)| w.iter().cloned()).collect();
     // Building the meshes (vertices to render space, BVHs) is most of the lowering time
     // of a scene of many meshes; they are independent, so they are built in parallel.
+    // Under light transport nearly every ray is a lone, incoherent one: meshes get the
+    // four-wide BVH those walk faster (`docs/light.md`, against Embree).
+    let incoherent = frame.transport.is_some();
     let objects: Vec<Object> = lowered
         .into_par_iter()
         .map(|(part, _, span)| {
@@ -405,7 +408,10 @@ fn lower_reusing(
                     Object { kind: ObjectKind::Sdf(s), bounds, sphere, half_space, hull, span }
                 }
                 Lowered::Mesh(job) => {
-                    let m = job.build_until(&|| budget.abandoned());
+                    let mut m = job.build_until(&|| budget.abandoned());
+                    if incoherent {
+                        m.widen();
+                    }
                     let (bounds, sphere) = (Some(m.bounds()), m.sphere());
                     Object { bounds, sphere, half_space: None, hull: None, kind: ObjectKind::Mesh(Arc::new(m)), span }
                 }

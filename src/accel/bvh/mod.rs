@@ -16,6 +16,7 @@ mod build;
 mod packet;
 mod point;
 mod walk;
+mod wide;
 
 use glam::{Vec3A, Vec4};
 
@@ -69,21 +70,21 @@ impl Node {
 
 /// The children a walk deferred, last in first out: a fixed array covers every tree but
 /// degenerate ones, which spill to the heap (an empty `Vec` does not allocate).
-struct Deferred<T> {
-    fixed: [T; STACK],
+struct Deferred<T, const N: usize = STACK> {
+    fixed: [T; N],
     len: usize,
     spill: Vec<T>,
 }
 
-impl<T: Copy> Deferred<T> {
+impl<T: Copy, const N: usize> Deferred<T, N> {
     #[inline(always)]
-    fn new(fill: T) -> Deferred<T> {
-        Deferred { fixed: [fill; STACK], len: 0, spill: Vec::new() }
+    fn new(fill: T) -> Deferred<T, N> {
+        Deferred { fixed: [fill; N], len: 0, spill: Vec::new() }
     }
 
     #[inline(always)]
     fn push(&mut self, item: T) {
-        if self.len < STACK {
+        if self.len < N {
             self.fixed[self.len] = item;
             self.len += 1;
         } else {
@@ -118,6 +119,9 @@ pub struct Bvh {
     /// Primitive indices of the leaves; empty when the caller ordered its primitives
     /// by the leaves ([`Bvh::build_ordered`]).
     prims: Vec<u32>,
+    /// The same tree with four children a node, root first, which the single-ray walks
+    /// take when it is there ([`Bvh::widen`]); empty otherwise.
+    wide: Vec<wide::Wide>,
 }
 
 /// Deepest tree the builder makes.
@@ -127,7 +131,13 @@ const STACK: usize = 16;
 
 impl Default for Bvh {
     fn default() -> Bvh {
-        Bvh { nodes: Vec::new(), root_box: Aabb::EMPTY, root: Child { index: 0, count: 0 }, prims: Vec::new() }
+        Bvh {
+            nodes: Vec::new(),
+            root_box: Aabb::EMPTY,
+            root: Child { index: 0, count: 0 },
+            prims: Vec::new(),
+            wide: Vec::new(),
+        }
     }
 }
 
@@ -144,7 +154,10 @@ impl Bvh {
 
     /// Bytes of the nodes, the root and the index array.
     pub fn bytes(&self) -> usize {
-        self.nodes.len() * std::mem::size_of::<Node>() + std::mem::size_of::<(Aabb, Child)>() + self.prims.len() * 4
+        self.nodes.len() * std::mem::size_of::<Node>()
+            + std::mem::size_of::<(Aabb, Child)>()
+            + self.prims.len() * 4
+            + self.wide_bytes()
     }
 
     /// Number of nodes in the tree, leaves included.
@@ -274,6 +287,46 @@ mod tests {
             let (a, b) = (visited(&indexed, origin, dir, None), visited(&ordered, origin, dir, Some(&order)));
             assert_eq!(a, b, "the ordered tree visits what the indexed one does");
             assert!(expected.iter().all(|p| a.contains(p)), "ray {i} missed a box: {expected:?} ⊄ {a:?}");
+        }
+    }
+
+    /// The four-wide copy visits every box a ray meets, and its closest hit is the
+    /// binary walk's, on trees large and deep (the peeled chain of the stack test
+    /// below) and on a lone leaf.
+    #[test]
+    fn wide_walks_find_what_binary_walks_find() {
+        let chain: Vec<Aabb> = (0..35)
+            .map(|i| {
+                let x = 12.5f32.powi(i);
+                Aabb { min: Vec3A::new(x, -1.0, -1.0), max: Vec3A::new(x * 1.01, 1.0, 1.0) }
+            })
+            .collect();
+        for (boxes, leaf) in [(scattered(3000), 4), (scattered(3), 4), (chain, 1)] {
+            let binary = Bvh::build(&boxes, leaf);
+            let mut wide = binary.clone();
+            wide.widen();
+            wide.validate(&boxes).expect("widening keeps the binary tree");
+            assert!(wide.bytes() >= binary.bytes());
+            let mut next = xorshift(0x51_7cc1_b727_220a);
+            for i in 0..400 {
+                let origin = Vec3A::new(next(), next(), next()) * 14.0 - 2.0;
+                let mut dir = Vec3A::new(next(), next(), next()) * 2.0 - 1.0;
+                if i % 10 == 0 {
+                    dir.x = 0.0; // axis-parallel rays: an infinite reciprocal
+                }
+                let dir = if i % 50 == 1 { Vec3A::X } else { dir.normalize() };
+                let inv = dir.recip();
+                let expected = brute(&boxes, origin, dir);
+                let seen = visited(&wide, origin, dir, None);
+                assert!(expected.iter().all(|p| seen.contains(p)), "ray {i} missed a box: {expected:?} ⊄ {seen:?}");
+                let hit = |bvh: &Bvh| {
+                    let mut visits = 0;
+                    bvh.closest(origin, inv, 0.0, f32::MAX, &mut visits, |p, t_max| {
+                        boxes[p as usize].slab(origin, inv, 0.0, t_max).map(|(near, _)| near)
+                    })
+                };
+                assert_eq!(hit(&wide).map(|h| h.1), hit(&binary).map(|h| h.1), "ray {i}");
+            }
         }
     }
 

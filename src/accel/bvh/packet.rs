@@ -216,7 +216,7 @@ impl Bvh {
         }
         // Deferred children: the child, its first active ray and that ray's entry distance,
         // and where its box is (parent node, child slot) should that ray be done with it.
-        let mut deferred_children = Deferred::new((Child { index: 0, count: 0 }, 0usize, 0f32, 0u32, 0usize));
+        let mut deferred_children = Deferred::<_>::new((Child { index: 0, count: 0 }, 0usize, 0f32, 0u32, 0usize));
         let mut ray = lane_splat(rays, first);
         // For one group of four, testing the group itself costs what the frustum would.
         let frustum = if N > 1 { Frustum::new(rays, t_max) } else { None };

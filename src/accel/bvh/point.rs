@@ -37,7 +37,7 @@ impl Bvh {
             return;
         }
         let ps = splat3(p);
-        let mut deferred = Deferred::new((Child { index: 0, count: 0 }, 0f32));
+        let mut deferred = Deferred::<_>::new((Child { index: 0, count: 0 }, 0f32));
         let mut cur = root;
         loop {
             if cur.count > 0 {

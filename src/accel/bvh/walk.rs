@@ -131,10 +131,13 @@ impl Bvh {
             leaf(root.index, root.count, t_max);
             return;
         }
+        if !self.wide.is_empty() {
+            return self.wide_leaves(origin, inv_dir, t_min, t_max, visits, leaf);
+        }
         let ray = RaySplat::new(origin, inv_dir, t_min);
         // Deferred children with their entry distances: a popped child is skipped when it
         // starts beyond the closest hit found since, without testing its box again.
-        let mut deferred_children = Deferred::new((Child { index: 0, count: 0 }, 0f32));
+        let mut deferred_children = Deferred::<_>::new((Child { index: 0, count: 0 }, 0f32));
         let mut cur = root;
         loop {
             if cur.count > 0 {
