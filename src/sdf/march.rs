@@ -122,7 +122,7 @@ pub enum Refined {
 ///
 /// The hit stands where Newton's steps from it, with the object's surface closure
 /// `surf` (the value and analytic gradient its hits are shaded with, scaled as `f` is),
-/// reach the surface within the threshold ([`on_surface`]): that does not depend on
+/// reach the surface within the threshold (`on_surface`): that does not depend on
 /// `L`. Where they do not, the ray steps by the first-order distance `f / |∇f|`, at
 /// least the threshold (no surface nearer under the field's linear model, and a step
 /// that still lands inside is bisected back to the crossing) until they do, or until

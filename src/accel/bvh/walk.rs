@@ -3,7 +3,7 @@
 
 use glam::{Vec3A, Vec4, Vec4Swizzles};
 
-use super::{Bvh, Child, Deferred, Node};
+use super::{Bvh, Child, Deferred, Node, STACK};
 use crate::accel::aabb::enters4;
 
 /// Per-ray constants of the two-box slab test, splat across lanes.
@@ -135,42 +135,60 @@ impl Bvh {
             return self.wide_leaves(origin, inv_dir, t_min, t_max, visits, leaf);
         }
         let ray = RaySplat::new(origin, inv_dir, t_min);
-        // Deferred children with their entry distances: a popped child is skipped when it
-        // starts beyond the closest hit found since, without testing its box again.
-        let mut deferred_children = Deferred::<_>::new((Child { index: 0, count: 0 }, 0f32));
-        let mut cur = root;
-        loop {
-            if cur.count > 0 {
-                if leaf(cur.index, cur.count, t_max) {
-                    return;
-                }
-            } else {
-                *visits += 1;
-                let node = &self.nodes[cur.index as usize];
-                let (enters, near) = ray.enters(node, *t_max);
-                if enters != 0 {
-                    // Branching on the order, and storing only a real deferral, measured
-                    // faster than a branchless select that always writes the stack (bench
-                    // `primary rays/intersect mesh-high/06-many-spheres`).
-                    let (next, deferred) = match enters {
-                        0b01 => (node.children[0], None),
-                        0b10 => (node.children[1], None),
-                        _ if near.x <= near.y => (node.children[0], Some((node.children[1], near.y))),
-                        _ => (node.children[1], Some((node.children[0], near.x))),
-                    };
-                    cur = next;
-                    if let Some(deferred) = deferred {
-                        deferred_children.push(deferred);
-                    }
-                    continue;
-                }
+        descend::<STACK>(root, t_max, visits, leaf, |index, t_max, deferred| {
+            let node = &self.nodes[index as usize];
+            let (enters, near) = ray.enters(node, t_max);
+            // Branching on the order, and storing only a real deferral, measured faster
+            // than a branchless select that always writes the stack (bench `primary
+            // rays/intersect mesh-high/06-many-spheres`).
+            let (next, later) = match enters {
+                0 => return None,
+                0b01 => (node.children[0], None),
+                0b10 => (node.children[1], None),
+                _ if near.x <= near.y => (node.children[0], Some((node.children[1], near.y))),
+                _ => (node.children[1], Some((node.children[0], near.x))),
+            };
+            if let Some(later) = later {
+                deferred.push(later);
             }
-            loop {
-                let Some((next, t_near)) = deferred_children.pop() else { return };
-                if t_near <= *t_max {
-                    cur = next;
-                    break;
-                }
+            Some(next)
+        });
+    }
+}
+
+/// The loop both single-ray walks share, from `root` (an interior node): a leaf goes to
+/// `leaf` (true stops the walk), an interior node to `open(index, t_max, deferred)`,
+/// which defers the children to come back to, with their entry distances, and returns
+/// the one to go down now (`None`: the ray enters none). Deferred children are popped
+/// last in first out, and one that starts beyond the closest hit found since is skipped
+/// without testing its box again.
+#[inline(always)]
+pub(super) fn descend<const N: usize>(
+    root: Child,
+    t_max: &mut f32,
+    visits: &mut u64,
+    mut leaf: impl FnMut(u32, u32, &mut f32) -> bool,
+    mut open: impl FnMut(u32, f32, &mut Deferred<(Child, f32), N>) -> Option<Child>,
+) {
+    let mut deferred = Deferred::<(Child, f32), N>::new((Child { index: 0, count: 0 }, 0f32));
+    let mut cur = root;
+    loop {
+        if cur.count > 0 {
+            if leaf(cur.index, cur.count, t_max) {
+                return;
+            }
+        } else {
+            *visits += 1;
+            if let Some(next) = open(cur.index, *t_max, &mut deferred) {
+                cur = next;
+                continue;
+            }
+        }
+        loop {
+            let Some((next, t_near)) = deferred.pop() else { return };
+            if t_near <= *t_max {
+                cur = next;
+                break;
             }
         }
     }

@@ -66,7 +66,7 @@ impl Bvh {
         t_min: f32,
         t_max: &mut f32,
         visits: &mut u64,
-        mut leaf: impl FnMut(u32, u32, &mut f32) -> bool,
+        leaf: impl FnMut(u32, u32, &mut f32) -> bool,
     ) {
         // Each axis's near plane is the minimum where the ray goes up it: lanes [0, 3)
         // or [3, 6) of the planes, picked once per ray.
@@ -76,51 +76,36 @@ impl Bvh {
         let o = [Vec4::splat(origin.x), Vec4::splat(origin.y), Vec4::splat(origin.z)];
         let inv = [Vec4::splat(inv_dir.x), Vec4::splat(inv_dir.y), Vec4::splat(inv_dir.z)];
         let t_low = Vec4::splat(t_min);
-        let mut deferred = super::Deferred::<(Child, f32), WIDE_STACK>::new((NONE, 0.0));
-        let mut cur = Child { index: 0, count: 0 };
-        loop {
-            if cur.count > 0 {
-                if leaf(cur.index, cur.count, t_max) {
-                    return;
-                }
-            } else {
-                *visits += 1;
-                let node = &self.wide[cur.index as usize];
-                let axis = |k: usize| ((node.planes[near[k]] - o[k]) * inv[k], (node.planes[far[k]] - o[k]) * inv[k]);
-                let (mut enters, entry) = enters4([axis(0), axis(1), axis(2)], t_low, Vec4::splat(*t_max));
-                enters &= 0b1111;
-                if enters != 0 {
-                    // The lanes entered, nearest first: the nearest is walked now, the
-                    // others deferred farthest first so the next nearest pops first.
-                    let entry = entry.to_array();
-                    let mut order = [0usize; 4];
-                    let mut n = 0;
-                    while enters != 0 {
-                        let k = enters.trailing_zeros() as usize;
-                        enters &= enters - 1;
-                        let mut at = n;
-                        while at > 0 && entry[order[at - 1]] > entry[k] {
-                            order[at] = order[at - 1];
-                            at -= 1;
-                        }
-                        order[at] = k;
-                        n += 1;
-                    }
-                    for &k in order[1..n].iter().rev() {
-                        deferred.push((node.children[k], entry[k]));
-                    }
-                    cur = node.children[order[0]];
-                    continue;
-                }
+        let root = Child { index: 0, count: 0 };
+        super::walk::descend::<WIDE_STACK>(root, t_max, visits, leaf, |index, t_max, deferred| {
+            let node = &self.wide[index as usize];
+            let axis = |k: usize| ((node.planes[near[k]] - o[k]) * inv[k], (node.planes[far[k]] - o[k]) * inv[k]);
+            let (mut enters, entry) = enters4([axis(0), axis(1), axis(2)], t_low, Vec4::splat(t_max));
+            enters &= 0b1111;
+            if enters == 0 {
+                return None;
             }
-            loop {
-                let Some((next, t_near)) = deferred.pop() else { return };
-                if t_near <= *t_max {
-                    cur = next;
-                    break;
+            // The lanes entered, nearest first: the nearest is walked now, the others
+            // deferred farthest first so the next nearest pops first.
+            let entry = entry.to_array();
+            let mut order = [0usize; 4];
+            let mut n = 0;
+            while enters != 0 {
+                let k = enters.trailing_zeros() as usize;
+                enters &= enters - 1;
+                let mut at = n;
+                while at > 0 && entry[order[at - 1]] > entry[k] {
+                    order[at] = order[at - 1];
+                    at -= 1;
                 }
+                order[at] = k;
+                n += 1;
             }
-        }
+            for &k in order[1..n].iter().rev() {
+                deferred.push((node.children[k], entry[k]));
+            }
+            Some(node.children[order[0]])
+        });
     }
 }
 
