@@ -43,19 +43,50 @@ fn unit(x: u32) -> f32 {
     ((x >> 8) as f32) * (1.0 / (1u32 << 24) as f32)
 }
 
-/// The Sobol sequence's second dimension (generator polynomial `x + 1`): its direction
-/// numbers are `v_k = v_{k−1} ^ (v_{k−1} >> 1)` from `v_0 = 2^31`.
-fn sobol_second(mut index: u32) -> u32 {
-    let mut v = 1u32 << 31;
-    let mut out = 0;
-    while index != 0 {
-        if index & 1 != 0 {
-            out ^= v;
-        }
-        index >>= 1;
-        v ^= v >> 1;
+/// The Sobol sequence's second dimension (generator polynomial `x + 1`): the XOR of the
+/// direction numbers of `index`'s set bits, a byte at a time from [`SOBOL_SECOND`]. The
+/// shuffled index is a full 32-bit number, and a loop over its bits (the definition,
+/// kept in the tests) was a fifth of the path loop's samples in `perf record` of the
+/// Cornell box at 128² × 64 on one thread.
+fn sobol_second(index: u32) -> u32 {
+    let t = &SOBOL_SECOND;
+    t[0][(index & 0xff) as usize]
+        ^ t[1][((index >> 8) & 0xff) as usize]
+        ^ t[2][((index >> 16) & 0xff) as usize]
+        ^ t[3][(index >> 24) as usize]
+}
+
+/// [`sobol_second`] of every byte in each of an index's four bytes: entry `[k][b]` is the
+/// XOR of the direction numbers `v_{8k + j}` for the bits `j` set in `b`, where
+/// `v_j = v_{j−1} ^ (v_{j−1} >> 1)` from `v_0 = 2^31`.
+static SOBOL_SECOND: [[u32; 256]; 4] = sobol_second_bytes();
+
+const fn sobol_second_bytes() -> [[u32; 256]; 4] {
+    let mut v = [0u32; 32];
+    v[0] = 1 << 31;
+    let mut j = 1;
+    while j < 32 {
+        v[j] = v[j - 1] ^ (v[j - 1] >> 1);
+        j += 1;
     }
-    out
+    let mut table = [[0u32; 256]; 4];
+    let mut k = 0;
+    while k < 4 {
+        let mut b = 0;
+        while b < 256 {
+            let (mut out, mut bit) = (0u32, 0);
+            while bit < 8 {
+                if b & (1 << bit) != 0 {
+                    out ^= v[8 * k + bit];
+                }
+                bit += 1;
+            }
+            table[k][b] = out;
+            b += 1;
+        }
+        k += 1;
+    }
+    table
 }
 
 /// Laine and Karras's hash-based Owen scramble of a bit-reversed value (Burley's
@@ -119,6 +150,29 @@ mod tests {
                     }
                 }
             }
+        }
+    }
+
+    /// The table gives the second dimension as its definition does: the XOR of the
+    /// direction numbers of the index's set bits.
+    #[test]
+    fn the_second_dimension_by_bytes_is_the_definition() {
+        let by_bits = |mut index: u32| {
+            let (mut v, mut out) = (1u32 << 31, 0);
+            while index != 0 {
+                if index & 1 != 0 {
+                    out ^= v;
+                }
+                index >>= 1;
+                v ^= v >> 1;
+            }
+            out
+        };
+        let mut x = 1u32;
+        for i in (0..4096).chain([u32::MAX, 1 << 31, 0x8000_0001]) {
+            x = hash(x ^ i);
+            assert_eq!(sobol_second(i), by_bits(i), "index {i}");
+            assert_eq!(sobol_second(x), by_bits(x), "index {x}");
         }
     }
 
