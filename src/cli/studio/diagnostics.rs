@@ -1,4 +1,5 @@
-//! What the page is told about the text: diagnostics as it shows them, and positions,
+//! What the page is told about the text: diagnostics as it shows them, the parameters
+//! its controls take, and positions,
 //! which the page counts in UTF-16 code units (JavaScript strings) and the compiler in
 //! bytes. Every position crosses [`to_byte`] or [`to_utf16`].
 
@@ -63,6 +64,24 @@ pub(crate) fn diagnostics_json(map: &SourceMap, diagnostics: &[Diagnostic]) -> s
         })
         .collect();
     serde_json::Value::Array(list)
+}
+
+/// `scene`'s parameters as the page's controls take them: each as `scnc params` prints
+/// it, with the UTF-16 range of its default in the root file of `map`.
+pub(crate) fn param_list(map: &SourceMap, scene: &scnc::ir::Scene) -> Vec<serde_json::Value> {
+    let root = map.file(FileId(0)).text.as_str();
+    scene
+        .params
+        .iter()
+        .map(|p| {
+            let mut j = crate::cli::param_json(p);
+            let (_, range) = map.local_range(p.default_span);
+            j["from"] = to_utf16(root, range.start).into();
+            j["to"] = to_utf16(root, range.end).into();
+            j["source"] = p.value.source().into();
+            j
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -10,7 +10,7 @@ use scnc::lsp::analysis::{Analysis, CandidateKind};
 use scnc::meshfile::{Format, WriteOptions};
 use scnc::source::{FileId, SourceMap};
 
-use super::diagnostics::{diagnostics_json, to_byte, to_utf16};
+use super::diagnostics::{diagnostics_json, param_list, to_byte, to_utf16};
 use super::http::Reply;
 use super::preview::View;
 use super::Studio;
@@ -52,24 +52,6 @@ pub(crate) fn params(studio: &Studio, text: String, set: &Overrides) -> Reply {
         }));
     };
     Reply::json(&serde_json::json!({ "params": param_list(&compiled.map, scene) }))
-}
-
-/// `scene`'s parameters as the page's controls take them: each as `scnc params` prints
-/// it, with the UTF-16 range of its default in the root file of `map`.
-pub(crate) fn param_list(map: &SourceMap, scene: &scnc::ir::Scene) -> Vec<serde_json::Value> {
-    let root = map.file(FileId(0)).text.as_str();
-    scene
-        .params
-        .iter()
-        .map(|p| {
-            let mut j = crate::cli::param_json(p);
-            let (_, range) = map.local_range(p.default_span);
-            j["from"] = to_utf16(root, range.start).into();
-            j["to"] = to_utf16(root, range.end).into();
-            j["source"] = p.value.source().into();
-            j
-        })
-        .collect()
 }
 
 /// The hover text at UTF-16 position `pos`.

@@ -233,7 +233,7 @@ fn run(studio: &Studio, text: &str, ask: &Ask, out: &mut Stream, current: &Wante
         b'C',
         serde_json::json!({
             "diagnostics": diagnostics_json(&compiled.map, &compiled.diagnostics),
-            "params": super::edit::param_list(&compiled.map, &first),
+            "params": super::diagnostics::param_list(&compiled.map, &first),
         }),
     )?;
     let declared = first.settings.clone();
