@@ -47,17 +47,19 @@ fn unit(x: u32) -> f32 {
     ((x >> 8) as f32) * (1.0 / (1u32 << 24) as f32)
 }
 
-/// The Sobol sequence's second dimension (generator polynomial `x + 1`): the XOR of the
-/// direction numbers of `index`'s set bits, a byte at a time from [`SOBOL_SECOND`]. The
-/// shuffled index is a full 32-bit number, and a loop over its bits (the definition,
-/// kept in the tests) was a fifth of the path loop's samples in `perf record` of the
-/// Cornell box at 128² × 64 on one thread.
+/// The Sobol sequence's second dimension, for the tests: [`sobol_second_reversed`]
+/// reversed back.
 #[cfg(test)]
 fn sobol_second(index: u32) -> u32 {
     sobol_second_reversed(index).reverse_bits()
 }
 
-/// [`sobol_second`] bit-reversed, which is what its scramble takes.
+/// The Sobol sequence's second dimension (generator polynomial `x + 1`) bit-reversed,
+/// which is what its scramble takes: the XOR of the direction numbers of `index`'s set
+/// bits, a byte at a time from [`SOBOL_SECOND_REVERSED`]. The shuffled index is a full
+/// 32-bit number, and a loop over its bits (the definition, kept in the tests) was a
+/// fifth of the path loop's samples in `perf record` of the Cornell box at 128² × 64 on
+/// one thread.
 fn sobol_second_reversed(index: u32) -> u32 {
     let t = &SOBOL_SECOND_REVERSED;
     t[0][(index & 0xff) as usize]
