@@ -37,7 +37,7 @@ fn analyse(studio: &Studio, text: String) -> Analysis {
 /// `scnc check` of the editor's text; the files it read are watched from now on.
 pub(crate) fn check(studio: &Studio, text: String) -> Reply {
     let a = analyse(studio, text);
-    studio.files.watch(a.map.files().map(|(_, f)| f.path.clone()).collect());
+    studio.files.watch_read(&a.map);
     Reply::json(&serde_json::json!({ "diagnostics": diagnostics_json(&a.map, &a.diagnostics) }))
 }
 

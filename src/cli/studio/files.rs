@@ -102,6 +102,11 @@ impl Files {
         self.watch(vec![self.root.clone()]);
     }
 
+    /// Watches the files a compile read (those of its `map`) from now on.
+    pub(crate) fn watch_read(&self, map: &scnc::source::SourceMap) {
+        self.watch(map.files().map(|(_, f)| f.path.clone()).collect());
+    }
+
     /// Watches `files` (the last compile's) from now on.
     pub(crate) fn watch(&self, files: Vec<PathBuf>) {
         use notify::Watcher as _;

@@ -223,7 +223,7 @@ fn json_message(out: &mut Stream, kind: u8, value: serde_json::Value) -> std::io
 fn run(studio: &Studio, text: &str, ask: &Ask, out: &mut Stream, current: &Wanted) -> std::io::Result<()> {
     let loader = studio.files.loader();
     let mut compiled = studio.files.compile(text.to_string(), &ask.set);
-    studio.files.watch(compiled.map.files().map(|(_, f)| f.path.clone()).collect());
+    studio.files.watch_read(&compiled.map);
     let Some(first) = compiled.scene.take() else {
         return json_message(out, b'E', diagnostics_json(&compiled.map, &compiled.diagnostics));
     };
