@@ -3,10 +3,12 @@
 //! `scnc merge` adds passes into the image one render of all `n` samples makes, bit for
 //! bit (integer sums do not depend on how they are grouped).
 //!
-//! A pass file (`.scnpass`) is the line `SCNPASS1`, one line of JSON (the image's size,
+//! A pass file (`.scnpass`) is the line `SCNPASS2`, one line of JSON (the image's size,
 //! the samples in all and in this pass, exposure, colour mode), then per pixel, rows top
-//! to bottom, three little-endian 128-bit sums (`render::path::SUM_SCALE` per unit of
-//! radiance).
+//! to bottom, the film's sums (`render::path::PathPixel`): three little-endian 128-bit
+//! sums of radiance × weight and the 64-bit sum of the weights (`WEIGHT_ONE` a
+//! sample). `SCNPASS1` passes, from before the film splatted its samples, held no
+//! weights and are refused.
 
 use std::io::{BufRead, Read};
 use std::path::Path;
@@ -15,7 +17,10 @@ use scnc::ir::ColorSpace;
 use scnc::render::path::PathPixel;
 use scnc::render::{encode_as, BitDepth, Image};
 
-const MAGIC: &str = "SCNPASS1";
+const MAGIC: &str = "SCNPASS2";
+
+/// The first line of a pass from before the film splatted its samples.
+const OLD_MAGIC: &str = "SCNPASS1";
 
 /// What a pass says of itself.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -63,13 +68,19 @@ pub(crate) fn write_pass(path: &Path, info: &PassInfo, image: &Image) -> std::io
 const MAX_HEADER: u64 = 4096;
 
 /// Reads a pass: its header and sums.
-fn read_pass(path: &Path) -> Result<(PassInfo, Vec<[i128; 3]>), String> {
+fn read_pass(path: &Path) -> Result<(PassInfo, Vec<PathPixel>), String> {
     let cannot = |e: &dyn std::fmt::Display| format!("cannot read `{}`: {e}", path.display());
     let not_a_pass = || format!("`{}` is not a pass (as `scnc render --pass I/N -o x.scnpass` writes)", path.display());
     let file = std::fs::File::open(path).map_err(|e| cannot(&e))?;
     let mut r = std::io::BufReader::new(file);
     let mut line = String::new();
     (&mut r).take(MAX_HEADER).read_line(&mut line).map_err(|e| cannot(&e))?;
+    if line.trim_end() == OLD_MAGIC {
+        return Err(format!(
+            "`{}` is a pass of an older scnc, whose film kept no weights: render it again",
+            path.display()
+        ));
+    }
     if line.trim_end() != MAGIC {
         return Err(not_a_pass());
     }
@@ -85,14 +96,15 @@ fn read_pass(path: &Path) -> Result<(PassInfo, Vec<[i128; 3]>), String> {
             info.height
         ));
     }
+    let size = PathPixel::BYTES as u64;
     let mut bytes = Vec::new();
-    r.take(pixels * 48 + 1).read_to_end(&mut bytes).map_err(|e| cannot(&e))?;
-    if bytes.len() as u64 != pixels * 48 {
+    r.take(pixels * size + 1).read_to_end(&mut bytes).map_err(|e| cannot(&e))?;
+    if bytes.len() as u64 != pixels * size {
         return Err(format!("`{}` is cut short or too long for a {}×{} pass", path.display(), info.width, info.height));
     }
     let sums = bytes
-        .chunks_exact(48)
-        .map(|p| std::array::from_fn(|k| i128::from_le_bytes(p[16 * k..16 * k + 16].try_into().unwrap_or([0; 16]))))
+        .chunks_exact(PathPixel::BYTES)
+        .map(|p| p.try_into().map_or_else(|_| PathPixel::default(), PathPixel::read_sums))
         .collect();
     Ok((info, sums))
 }
@@ -142,8 +154,8 @@ pub(crate) fn merge_passes(paths: &[std::path::PathBuf], depth: BitDepth) -> Res
     let mut pixels = Vec::with_capacity(count * depth.pixel_bytes());
     for k in 0..count {
         let mut px = PathPixel::default();
-        for (_, (i, sums)) in &passes {
-            px.merge(&PathPixel { sum: sums[k], count: i.count });
+        for (_, (_, sums)) in &passes {
+            px.merge(&sums[k]);
         }
         encode_as(px.colour(info.exposure), color, depth, &mut pixels);
     }

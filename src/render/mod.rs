@@ -49,9 +49,9 @@ pub enum BitDepth {
     /// 32-bit float, linear and unclamped: radiance (1 = a white surface at full light,
     /// 255 in an 8-bit image) for OpenEXR output and measurements.
     Float,
-    /// A light-transport pass's exact sums: per channel a 128-bit fixed-point integer
-    /// (`path::SUM_SCALE` per unit of radiance, little-endian), which passes of any split
-    /// add to the same bits.
+    /// A light-transport pass's exact sums ([`path::PathPixel`]): per channel a 128-bit
+    /// fixed-point sum of radiance × weight, and the 64-bit sum of the weights
+    /// (little-endian), which passes of any split add to the same bits.
     Sums,
 }
 
@@ -71,9 +71,12 @@ impl BitDepth {
         self.bits() as usize / 8
     }
 
-    /// Bytes of one pixel (three channels).
+    /// Bytes of one pixel: three channels (and a sums pixel's weight).
     pub fn pixel_bytes(self) -> usize {
-        3 * self.sample_bytes()
+        match self {
+            BitDepth::Sums => path::PathPixel::BYTES,
+            _ => 3 * self.sample_bytes(),
+        }
     }
 }
 
@@ -109,18 +112,35 @@ pub fn encode_as(colour: Vec3A, color: ColorSpace, depth: BitDepth, out: &mut Ve
 }
 
 impl Image {
-    /// A float image (linear radiance) as the frame's pixels show it: scaled to 0–255,
-    /// clamped and encoded as its colour mode says, 8 bits a channel. Any other image
-    /// is returned as it is.
+    /// A float image (linear radiance) or light transport's sums as the frame's pixels
+    /// show them: scaled to 0–255 (sums by the frame's exposure), clamped and encoded as
+    /// its colour mode says, 8 bits a channel. Any other image is returned as it is.
     pub fn tone_mapped(&self, frame: &Frame) -> Image {
-        if self.depth != BitDepth::Float {
-            return self.clone();
-        }
         let mut pixels = Vec::with_capacity(self.width as usize * self.height as usize * 3);
-        for c in self.floats().chunks_exact(3) {
-            encode_as(Vec3A::new(c[0], c[1], c[2]) * 255.0, frame.color, BitDepth::Eight, &mut pixels);
+        match self.depth {
+            BitDepth::Float => {
+                for c in self.floats().chunks_exact(3) {
+                    encode_as(Vec3A::new(c[0], c[1], c[2]) * 255.0, frame.color, BitDepth::Eight, &mut pixels);
+                }
+            }
+            BitDepth::Sums => {
+                let exposure = frame.transport.as_ref().map_or(1.0, |t| t.exposure);
+                for p in self.sums() {
+                    encode_as(p.colour(exposure), frame.color, BitDepth::Eight, &mut pixels);
+                }
+            }
+            BitDepth::Eight | BitDepth::Sixteen => return self.clone(),
         }
         Image { width: self.width, height: self.height, depth: BitDepth::Eight, pixels }
+    }
+
+    /// A sums image's pixels (empty for any other depth).
+    pub fn sums(&self) -> Vec<path::PathPixel> {
+        if self.depth != BitDepth::Sums {
+            return Vec::new();
+        }
+        let bytes = self.pixels.chunks_exact(path::PathPixel::BYTES);
+        bytes.map(|b| b.try_into().map_or_else(|_| path::PathPixel::default(), path::PathPixel::read_sums)).collect()
     }
 
     /// A float image's values, three a pixel (empty for any other depth).
@@ -178,7 +198,8 @@ pub fn render(geometry: &dyn Geometry, frame: &Frame, progress: &(dyn Fn() + Syn
 /// Renders the pixels of `region` (inside the frame, not empty) into an image of the
 /// region's size, each pixel exactly as [`render`] gives it: camera rays are cast in
 /// 4×4 blocks aligned to the whole image, so the blocks the region touches are traced
-/// whole and cropped.
+/// whole and cropped; light transport's samples reach a pixel from its neighbours, so
+/// its region is traced with a border of one pixel.
 pub fn render_region(
     geometry: &dyn Geometry,
     frame: &Frame,
@@ -199,15 +220,7 @@ pub fn render_region_until(
     stop: &(dyn Fn() -> bool + Sync),
 ) -> Option<(Image, Counters)> {
     if let Some(t) = &frame.transport {
-        let block = |xy, wh, c: &mut Counters| path::block(geometry, frame, t, xy, wh, c);
-        let write = |p: &path::PathPixel, out: &mut Vec<u8>| {
-            if frame.bit_depth == BitDepth::Sums {
-                p.write_sums(out);
-            } else {
-                encode(p.colour(t.exposure), frame, out);
-            }
-        };
-        return rows(frame, region, progress, stop, block, write);
+        return path::rows(geometry, frame, t, region, progress, stop);
     }
     effects::specialise(&frame.effects, Rows { geometry, frame, region, progress, stop })
 }

@@ -419,6 +419,15 @@ fn light_transport_converges_while_idle_and_an_edit_restarts_it() {
     // the noise falls as the root of their ratio, 32 times.
     assert!(passes[0]["noise_percent"].is_null());
     assert!(noise(11) < noise(1) / 8.0, "the noise falls: {} then {}", noise(1), noise(11));
+    // The film's sums are added exactly: the last image is `scnc render`'s of as many
+    // samples, pixel for pixel.
+    let last = messages(&body).into_iter().rev().find(|(k, _)| *k == b'B').expect("an image").1;
+    let shown = image::RgbImage::from_raw(8, 8, last[12..].to_vec()).expect("an 8×8 image");
+    let file = scene.with_file_name("glow.scn");
+    std::fs::write(&file, glow.replace("height = 8)", "height = 8, samples = 4096)")).unwrap();
+    if let Some(d) = image_difference("converged", &shown, &rendered(&file)) {
+        panic!("4,096 samples in the studio differ from `scnc render --samples 4096`: {d}");
+    }
 
     // A larger image converges for long; a light render sent meanwhile comes back at
     // once, and the accumulation is told it was overtaken.

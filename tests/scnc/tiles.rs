@@ -35,6 +35,44 @@ fn merged_tiles_are_the_whole_render_byte_for_byte() {
     }
 }
 
+/// Light transport splats a sample into its neighbours' pixels too, so a part is traced
+/// with a border: tiles across the film's strips of rows (of 16), merged, and a region
+/// are still the whole render's pixels byte for byte.
+#[test]
+fn light_transport_parts_are_the_whole_render() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let scene = "examples/light/cornell.scn";
+    let size = ["--width", "23", "--height", "37", "--samples", "4"];
+    let full = dir.path().join("full.png");
+    ok(&scnc(&[&["render", scene, "-o", path(&full)][..], &size].concat()));
+    for n in [2u32, 5] {
+        let parts: Vec<String> = (0..n)
+            .map(|i| {
+                let part = dir.path().join(format!("part-{i}.png"));
+                let tile = format!("{i}/{n}");
+                ok(&scnc(&[&["render", scene, "-o", path(&part), "--tile", &tile][..], &size].concat()));
+                path(&part).to_string()
+            })
+            .collect();
+        let merged = dir.path().join("merged.png");
+        let mut args = vec!["merge"];
+        args.extend(parts.iter().map(String::as_str));
+        args.extend(["-o", path(&merged)]);
+        ok(&scnc(&args));
+        let same = std::fs::read(&full).expect("full") == std::fs::read(&merged).expect("merged");
+        assert!(same, "{n} tiles of light transport merged differ from the whole render");
+    }
+    let part = dir.path().join("part.png");
+    ok(&scnc(&[&["render", scene, "-o", path(&part), "--region", "1,15,22,18"][..], &size].concat()));
+    let full = image::open(&full).expect("full").to_rgb8();
+    let part = image::open(&part).expect("part").to_rgba8();
+    for (x, y, p) in part.enumerate_pixels() {
+        if (1..22).contains(&x) && (15..18).contains(&y) {
+            assert_eq!(p.0[..3], full.get_pixel(x, y).0, "({x}, {y})");
+        }
+    }
+}
+
 /// A region cut across the 4×4 blocks has exactly the whole render's pixels there and
 /// is transparent elsewhere.
 #[test]

@@ -270,12 +270,13 @@ fn run(studio: &Studio, text: &str, ask: &Ask, out: &mut Stream, current: &Wante
         Err(d) => return json_message(out, b'E', diagnostics_json(&compiled.map, &[d])),
     };
     let lower_s = started.elapsed().as_secs_f64();
-    // Light transport converges in front of the user: one sample a pixel first, in float
-    // so later passes can be added to it, then ever more while nothing newer is asked.
+    // Light transport converges in front of the user: one sample a pixel first, as the
+    // film's exact sums so later passes add to it, then ever more while nothing newer
+    // is asked.
     let converging = frame.transport.is_some();
     if converging {
         frame.samples = 1;
-        frame.bit_depth = scnc::render::BitDepth::Float;
+        frame.bit_depth = scnc::render::BitDepth::Sums;
     }
     let meta = |level: &str, width: u32, height: u32| {
         serde_json::json!({
@@ -362,10 +363,11 @@ fn run(studio: &Studio, text: &str, ask: &Ask, out: &mut Stream, current: &Wante
 const MOST_STUDIO_SAMPLES: u32 = 4096;
 
 /// Light transport's preview converging: passes of as many new samples as the image
-/// has (so each halves the noise's variance), each added to the float sums and the
+/// has (so each halves the noise's variance), each added to the film's sums and the
 /// whole image sent, with a `P` message of the samples a pixel has and the noise
-/// estimate, until [`MOST_STUDIO_SAMPLES`] or a newer request. `first` is the float
-/// image of the first sample.
+/// estimate, until [`MOST_STUDIO_SAMPLES`] or a newer request. `first` is the sums
+/// image of the first sample; after each pass the image is the very one `scnc render
+/// --samples` makes of as many.
 fn converge(
     studio: &Studio,
     world: &scnc::world::World,
@@ -374,7 +376,7 @@ fn converge(
     out: &mut Stream,
     current: &Wanted,
 ) -> std::io::Result<()> {
-    let mut sums = first.floats();
+    let mut sums = first.sums();
     let mut total = 1u32;
     let full = PixelRect::full(frame.width, frame.height);
     let started = Instant::now();
@@ -388,8 +390,8 @@ fn converge(
         let rendered =
             studio.preview.pool.install(|| scnc::render::render_region_until(world, &pass, full, &|| {}, &stop));
         let Some((image, c)) = rendered else { return out.message(b'X', b"{}") };
-        for (s, v) in sums.iter_mut().zip(image.floats()) {
-            *s += v * total as f32;
+        for (s, p) in sums.iter_mut().zip(image.sums()) {
+            s.merge(&p);
         }
         let done = total * 2;
         // The pass's estimate for its own samples, scaled to all of them (the error of a
@@ -399,8 +401,11 @@ fn converge(
             let pass_noise = c.noise_ppm as f64 / c.noise_pixels as f64 / 1e6;
             100.0 * pass_noise * (f64::from(total) / f64::from(done)).sqrt()
         });
-        let mean: Vec<u8> = sums.iter().flat_map(|s| (s / done as f32).to_ne_bytes()).collect();
-        let shown = Image { width: frame.width, height: frame.height, depth: frame.bit_depth, pixels: mean };
+        let mut pixels = Vec::with_capacity(sums.len() * scnc::render::path::PathPixel::BYTES);
+        for s in &sums {
+            s.write_sums(&mut pixels);
+        }
+        let shown = Image { width: frame.width, height: frame.height, depth: frame.bit_depth, pixels };
         send_band(out, 0, &shown.tone_mapped(frame))?;
         total = done;
         json_message(

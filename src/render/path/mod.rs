@@ -3,9 +3,10 @@
 //! environment light, `render(bounces = …)`). Every other scene never reaches this
 //! module and renders as the Whitted tracer always did.
 //!
-//! A path starts at the camera (a thin lens when `aperture > 0`, its pixel position
-//! drawn from a tent filter one pixel wide each side) and meets at most `bounces`
-//! surfaces that scatter it. At each it adds light sampled towards one source of the
+//! A path starts at the camera (a thin lens when `aperture > 0`) through a point drawn
+//! uniformly in its pixel, and its radiance is splatted into the pixels whose tent
+//! filter reaches that point ([`film`]). It meets at most `bounces` surfaces that
+//! scatter it. At each it adds light sampled towards one source of the
 //! light mixture ([`lights`]) and continues in a direction its BSDF ([`bsdf`]) chooses;
 //! emission found either way is weighted by the power heuristic, so every emitter is
 //! sampled both ways and neither technique's weakness shows. Delta lobes (mirror,
@@ -24,12 +25,15 @@
 //! map, which scales by `2^exposure` and clamps to the image's range.
 
 pub mod bsdf;
+mod film;
 pub mod lights;
 pub mod sampler;
 
 use glam::Vec3A;
 
 use self::bsdf::{Bsdf, Lobe};
+pub(super) use self::film::rows;
+pub use self::film::{PathPixel, MOST_SAMPLE_RADIANCE, WEIGHT_ONE};
 use self::lights::Source;
 pub use self::lights::Transport;
 use self::sampler::Sampler;
@@ -40,115 +44,58 @@ use crate::trace::{spawn_offset, Counters, Geometry, Hit, Ray, PATH_BINS};
 /// Surfaces a path meets before Russian roulette may end it.
 const ROULETTE_AFTER: u32 = 3;
 
-/// Units of a [`PathPixel`]'s sums per unit of radiance: 2³², far below an f32's
-/// resolution of any visible value.
-pub const SUM_SCALE: f64 = 4_294_967_296.0;
-
-/// The most radiance one sample adds to a sum, 2⁷⁴ (about 1.9·10²²): a million
-/// samples of it still fit 128 bits. Only a sample beyond it (an emission strength of
-/// 10³⁰ seen directly) is held to it, and its pixel is white in any image.
-pub const MOST_SAMPLE_RADIANCE: f64 = 18_889_465_931_478_580_854_784.0;
-
-/// A pixel of light transport: the exact sum of its samples' radiance per channel, in
-/// fixed point so that sums of the same samples split any way between passes are the
-/// same bits (`render --pass`, `scnc merge`), and how many samples it has.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct PathPixel {
-    /// Radiance × [`SUM_SCALE`], summed.
-    pub sum: [i128; 3],
-    /// Samples summed.
-    pub count: u32,
-}
-
-impl PathPixel {
-    /// Adds one sample's radiance (finite, not negative).
-    pub fn add(&mut self, l: Vec3A) {
-        for (s, v) in self.sum.iter_mut().zip(l.to_array()) {
-            *s += (f64::from(v).min(MOST_SAMPLE_RADIANCE) * SUM_SCALE) as i128;
-        }
-        self.count += 1;
-    }
-
-    /// Adds another pixel's samples (another pass of the same pixel).
-    pub fn merge(&mut self, o: &PathPixel) {
-        for (s, v) in self.sum.iter_mut().zip(o.sum) {
-            *s = s.saturating_add(v);
-        }
-        self.count += o.count;
-    }
-
-    /// The mean radiance × `exposure`, in the tracer's 0–255 units (255 = radiance 1).
-    pub fn colour(&self, exposure: f32) -> Vec3A {
-        let k = 255.0 * f64::from(exposure) / (SUM_SCALE * f64::from(self.count.max(1)));
-        Vec3A::from_array(self.sum.map(|s| (s as f64 * k) as f32))
-    }
-
-    /// The sums as 48 little-endian bytes.
-    pub fn write_sums(&self, out: &mut Vec<u8>) {
-        for s in self.sum {
-            out.extend(s.to_le_bytes());
-        }
-    }
-}
-
-/// The pixels (each a [`PathPixel`]) of a block of up to 4×4 pixels from `(x, y)`, `w`
-/// wide and `h` high; pixel `(dx, dy)` is entry `4·dy + dx`. Each has `frame.samples`
-/// paths, or with adaptive sampling as many as its noise needs.
-pub(super) fn block(
+/// A pixel's samples, each splatted where it lands by `splat(position in the pixel,
+/// radiance)`: `frame.samples` of them, or with adaptive sampling as many as the
+/// pixel's noise needs.
+pub(super) fn pixel(
     g: &dyn Geometry,
     frame: &Frame,
     t: &Transport,
-    (x, y): (u32, u32),
-    (w, h): (u32, u32),
+    (px, py): (u32, u32),
     c: &mut Counters,
-) -> [PathPixel; 16] {
+    splat: &mut dyn FnMut((f32, f32), Vec3A),
+) {
     let most = frame.samples.max(1);
-    let mut out = [PathPixel::default(); 16];
-    for dy in 0..h {
-        for dx in 0..w {
-            let (px, py) = (x + dx, y + dy);
-            let pixel = py.wrapping_mul(frame.width).wrapping_add(px);
-            let mut p = Noise::default();
-            let mut sums = PathPixel::default();
-            // Adaptive sampling doubles the samples until the error estimate is small
-            // enough: powers of two keep every pair of the sampler stratified.
-            let mut target = if t.noise.is_some() { ADAPTIVE_FIRST.min(most) } else { most };
-            loop {
-                while sums.count < target {
-                    let mut sampler = Sampler::new(pixel, t.first_sample.wrapping_add(sums.count));
-                    let ray = camera_ray(frame, t, (px, py), &mut sampler);
-                    c.primary_rays += 1;
-                    let mut l = radiance(g, frame, t, ray, &mut sampler, c);
-                    if !l.is_finite() {
-                        c.nonfinite_samples += 1;
-                        l = Vec3A::ZERO;
-                    }
-                    if let Some(most) = t.clamp {
-                        let top = l.max_element();
-                        if top > most {
-                            l *= most / top;
-                            c.clamped_samples += 1;
-                        }
-                    }
-                    p.add(l);
-                    sums.add(l);
-                }
-                match t.noise {
-                    Some(eps) if sums.count < most && p.relative_error(sums.count, t.exposure) > eps => {
-                        target = target.saturating_mul(2).min(most);
-                    }
-                    _ => break,
+    let pixel = py.wrapping_mul(frame.width).wrapping_add(px);
+    let mut p = Noise::default();
+    let mut count = 0u32;
+    // Adaptive sampling doubles the samples until the error estimate is small enough:
+    // powers of two keep every pair of the sampler stratified.
+    let mut target = if t.noise.is_some() { ADAPTIVE_FIRST.min(most) } else { most };
+    loop {
+        while count < target {
+            let mut sampler = Sampler::new(pixel, t.first_sample.wrapping_add(count));
+            let at = sampler.next2();
+            let ray = camera_ray(frame, t, (px as f32 + at.0, py as f32 + at.1), &mut sampler);
+            c.primary_rays += 1;
+            let mut l = radiance(g, frame, t, ray, &mut sampler, c);
+            if !l.is_finite() {
+                c.nonfinite_samples += 1;
+                l = Vec3A::ZERO;
+            }
+            if let Some(most) = t.clamp {
+                let top = l.max_element();
+                if top > most {
+                    l *= most / top;
+                    c.clamped_samples += 1;
                 }
             }
-            c.path_pixels += 1;
-            if sums.count >= 2 {
-                c.noise_pixels += 1;
-                c.noise_ppm += (f64::from(p.relative_error(sums.count, t.exposure)) * 1e6).min(1e12) as u64;
+            p.add(l);
+            splat(at, l);
+            count += 1;
+        }
+        match t.noise {
+            Some(eps) if count < most && p.relative_error(count, t.exposure) > eps => {
+                target = target.saturating_mul(2).min(most);
             }
-            out[(4 * dy + dx) as usize] = sums;
+            _ => break,
         }
     }
-    out
+    c.path_pixels += 1;
+    if count >= 2 {
+        c.noise_pixels += 1;
+        c.noise_ppm += (f64::from(p.relative_error(count, t.exposure)) * 1e6).min(1e12) as u64;
+    }
 }
 
 /// Samples adaptive sampling takes before it first estimates a pixel's error.
@@ -185,22 +132,10 @@ impl Noise {
     }
 }
 
-/// A tent-distributed offset in (−1, 1) from a number in [0, 1): the pixel filter,
-/// importance-sampled so every sample weighs the same.
-fn tent(u: f32) -> f32 {
-    let u = 2.0 * u;
-    if u < 1.0 {
-        u.sqrt() - 1.0
-    } else {
-        1.0 - (2.0 - u).max(0.0).sqrt()
-    }
-}
-
-/// The camera ray of one sample: through the pixel at a tent-filtered offset, from a
-/// point of the lens when it has an aperture.
-fn camera_ray(frame: &Frame, t: &Transport, (px, py): (u32, u32), s: &mut Sampler) -> Ray {
-    let (u1, u2) = s.next2();
-    let dir = frame.direction(px as f32 + 0.5 + tent(u1), py as f32 + 0.5 + tent(u2));
+/// The camera ray of one sample: through the point `(x, y)` of the image plane (in
+/// pixels), from a point of the lens when it has an aperture.
+fn camera_ray(frame: &Frame, t: &Transport, (x, y): (f32, f32), s: &mut Sampler) -> Ray {
+    let dir = frame.direction(x, y);
     // Drawn whether or not there is a lens, so the later pairs are the same either way.
     let (l1, l2) = s.next2();
     if t.lens_radius <= 0.0 {
