@@ -5,7 +5,7 @@
 //!
 //! A path starts at the camera (a thin lens when `aperture > 0`) through a point drawn
 //! uniformly in its pixel, and its radiance is splatted into the pixels whose tent
-//! filter reaches that point ([`film`]). It meets at most `bounces` surfaces that
+//! filter reaches that point (`film.rs`). It meets at most `bounces` surfaces that
 //! scatter it. At each it adds light sampled towards one source of the
 //! light mixture ([`lights`]) and continues in a direction its BSDF ([`bsdf`]) chooses;
 //! emission found either way is weighted by the power heuristic, so every emitter is
