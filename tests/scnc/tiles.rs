@@ -7,6 +7,25 @@ use crate::support::{ok, path, refused, scnc};
 /// A size whose rows and columns are not multiples of the 4×4 blocks rays go in.
 const SIZE: [&str; 4] = ["--width", "97", "--height", "61"];
 
+/// The bytes of `scene` rendered with `args` as `n` tiles (`--tile I/N`) in `dir` and
+/// merged by `scnc merge`.
+fn tiles_merged(dir: &std::path::Path, scene: &str, args: &[&str], n: u32) -> Vec<u8> {
+    let parts: Vec<String> = (0..n)
+        .map(|i| {
+            let part = dir.join(format!("part-{i}.png"));
+            let tile = format!("{i}/{n}");
+            ok(&scnc(&[&["render", scene, "-o", path(&part), "--tile", &tile][..], args].concat()));
+            path(&part).to_string()
+        })
+        .collect();
+    let merged = dir.join("merged.png");
+    let mut merge = vec!["merge"];
+    merge.extend(parts.iter().map(String::as_str));
+    merge.extend(["-o", path(&merged)]);
+    ok(&scnc(&merge));
+    std::fs::read(&merged).expect("merged")
+}
+
 #[test]
 fn merged_tiles_are_the_whole_render_byte_for_byte() {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -15,28 +34,16 @@ fn merged_tiles_are_the_whole_render_byte_for_byte() {
     {
         let full = dir.path().join("full.png");
         ok(&scnc(&[&["render", scene, "-o", path(&full)][..], &SIZE, extra].concat()));
+        let args = [&SIZE[..], extra].concat();
         for n in [1u32, 3, 7] {
-            let parts: Vec<String> = (0..n)
-                .map(|i| {
-                    let part = dir.path().join(format!("part-{i}.png"));
-                    let tile = format!("{i}/{n}");
-                    ok(&scnc(&[&["render", scene, "-o", path(&part), "--tile", &tile][..], &SIZE, extra].concat()));
-                    path(&part).to_string()
-                })
-                .collect();
-            let merged = dir.path().join("merged.png");
-            let mut args = vec!["merge"];
-            args.extend(parts.iter().map(String::as_str));
-            args.extend(["-o", path(&merged)]);
-            ok(&scnc(&args));
-            let same = std::fs::read(&full).expect("full") == std::fs::read(&merged).expect("merged");
+            let same = tiles_merged(dir.path(), scene, &args, n) == std::fs::read(&full).expect("full");
             assert!(same, "{scene}: {n} tiles merged differ from the whole render");
         }
     }
 }
 
 /// Light transport splats a sample into its neighbours' pixels too, so a part is traced
-/// with a border: tiles across the film's strips of rows (of 16), merged, and a region
+/// with a border: tiles across the film's strips of rows (of 8), merged, and a region
 /// are still the whole render's pixels byte for byte.
 #[test]
 fn light_transport_parts_are_the_whole_render() {
@@ -46,20 +53,7 @@ fn light_transport_parts_are_the_whole_render() {
     let full = dir.path().join("full.png");
     ok(&scnc(&[&["render", scene, "-o", path(&full)][..], &size].concat()));
     for n in [2u32, 5] {
-        let parts: Vec<String> = (0..n)
-            .map(|i| {
-                let part = dir.path().join(format!("part-{i}.png"));
-                let tile = format!("{i}/{n}");
-                ok(&scnc(&[&["render", scene, "-o", path(&part), "--tile", &tile][..], &size].concat()));
-                path(&part).to_string()
-            })
-            .collect();
-        let merged = dir.path().join("merged.png");
-        let mut args = vec!["merge"];
-        args.extend(parts.iter().map(String::as_str));
-        args.extend(["-o", path(&merged)]);
-        ok(&scnc(&args));
-        let same = std::fs::read(&full).expect("full") == std::fs::read(&merged).expect("merged");
+        let same = tiles_merged(dir.path(), scene, &size, n) == std::fs::read(&full).expect("full");
         assert!(same, "{n} tiles of light transport merged differ from the whole render");
     }
     let part = dir.path().join("part.png");
