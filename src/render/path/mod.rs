@@ -36,7 +36,7 @@ pub(super) use self::film::rows;
 pub use self::film::{PathPixel, MOST_SAMPLE_RADIANCE, WEIGHT_ONE};
 use self::lights::Source;
 pub use self::lights::Transport;
-use self::sampler::Sampler;
+use self::sampler::{PixelSeeds, Sampler};
 use super::transmit::{self, Media};
 use super::{Frame, ShadeLight};
 use crate::trace::{spawn_offset, Counters, Geometry, Hit, Ray, PATH_BINS};
@@ -58,13 +58,14 @@ pub(super) fn pixel(
     let most = frame.samples.max(1);
     let pixel = py.wrapping_mul(frame.width).wrapping_add(px);
     let mut p = Noise::default();
+    let mut seeds = PixelSeeds::new(pixel);
     let mut count = 0u32;
     // Adaptive sampling doubles the samples until the error estimate is small enough:
     // powers of two keep every pair of the sampler stratified.
     let mut target = if t.noise.is_some() { ADAPTIVE_FIRST.min(most) } else { most };
     loop {
         while count < target {
-            let mut sampler = Sampler::new(pixel, t.first_sample.wrapping_add(count));
+            let mut sampler = Sampler::new(&mut seeds, t.first_sample.wrapping_add(count));
             let at = sampler.next2();
             let ray = camera_ray(frame, t, (px as f32 + at.0, py as f32 + at.1), &mut sampler);
             c.primary_rays += 1;

@@ -9,36 +9,72 @@
 //! pure function of (pixel, sample index, dimension): the image is the same on any
 //! thread count, and any subset of the samples can be rendered anywhere.
 
-/// The numbers of one sample of one pixel, drawn in pairs.
-pub struct Sampler {
+/// Pairs whose seeds a pixel keeps: the pixel position, the lens and four a surface for
+/// eight bounces fit.
+const KEPT_PAIRS: usize = 48;
+
+/// The scrambling seeds of one pixel's pairs of dimensions. They depend on the pixel
+/// and the pair, not the sample, so every sample of the pixel shares them: kept as far
+/// as its paths have reached, three of a pair's five hashes are paid once a pixel
+/// instead of once a number.
+pub struct PixelSeeds {
     pixel: u32,
-    index: u32,
+    kept: usize,
+    seeds: [[u32; 3]; KEPT_PAIRS],
+}
+
+impl PixelSeeds {
+    /// The seeds of the pixel numbered `pixel`, none computed yet.
+    pub fn new(pixel: u32) -> PixelSeeds {
+        PixelSeeds { pixel, kept: 0, seeds: [[0; 3]; KEPT_PAIRS] }
+    }
+
+    /// Pair `pair`'s seeds: the shuffle's, and the two dimensions' scrambles'.
+    #[inline]
+    fn get(&mut self, pair: u32) -> [u32; 3] {
+        let k = pair as usize;
+        if k < self.kept {
+            return self.seeds[k];
+        }
+        let seed = hash(self.pixel ^ hash(pair.wrapping_add(0x9e37_79b9)));
+        let seeds = [seed, hash(seed ^ 0x5bd1_e995), hash(seed ^ 0x27d4_eb2f)];
+        // Pairs are drawn in order, so the one after the last kept is the next to keep.
+        if k == self.kept && k < KEPT_PAIRS {
+            self.seeds[k] = seeds;
+            self.kept += 1;
+        }
+        seeds
+    }
+}
+
+/// The numbers of one sample of one pixel, drawn in pairs.
+pub struct Sampler<'s> {
+    seeds: &'s mut PixelSeeds,
+    /// The sample's index bit-reversed, which the shuffle of every pair takes.
+    reversed: u32,
     pair: u32,
 }
 
-impl Sampler {
-    /// Sample `index` of the pixel numbered `pixel`.
-    pub fn new(pixel: u32, index: u32) -> Sampler {
-        Sampler { pixel, index, pair: 0 }
+impl<'s> Sampler<'s> {
+    /// Sample `index` of the pixel whose seeds are `seeds`.
+    pub fn new(seeds: &'s mut PixelSeeds, index: u32) -> Sampler<'s> {
+        Sampler { seeds, reversed: index.reverse_bits(), pair: 0 }
     }
 
     /// The next pair of numbers in `[0, 1)`.
+    #[inline]
     pub fn next2(&mut self) -> (f32, f32) {
-        let seed = hash(self.pixel ^ hash(self.pair.wrapping_add(0x9e37_79b9)));
+        let [shuffle, first, second] = self.seeds.get(self.pair);
         self.pair += 1;
-        let i = nested_uniform_scramble(self.index, seed);
+        // The index shuffled: `nested_uniform_scramble(index, shuffle)`.
+        let i = laine_karras(self.reversed, shuffle).reverse_bits();
         // The first dimension is `i` bit-reversed, so its scramble (which reverses its
         // input) takes `i` itself; the second's table holds its numbers reversed. The same
         // numbers as `nested_uniform_scramble` of each, with two bit reversals fewer (x86
         // has no instruction for one).
-        let x = laine_karras(i, hash(seed ^ 0x5bd1_e995)).reverse_bits();
-        let y = laine_karras(sobol_second_reversed(i), hash(seed ^ 0x27d4_eb2f)).reverse_bits();
+        let x = laine_karras(i, first).reverse_bits();
+        let y = laine_karras(sobol_second_reversed(i), second).reverse_bits();
         (unit(x), unit(y))
-    }
-
-    /// The next number in `[0, 1)` (half a pair: one-dimensional needs are few).
-    pub fn next1(&mut self) -> f32 {
-        self.next2().0
     }
 }
 
@@ -113,7 +149,9 @@ fn laine_karras(mut x: u32, seed: u32) -> u32 {
     x
 }
 
-/// An Owen scramble of `x`'s bits, most significant first.
+/// An Owen scramble of `x`'s bits, most significant first: the definition the sampler's
+/// shortcuts are tested against.
+#[cfg(test)]
 fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
     laine_karras(x.reverse_bits(), seed).reverse_bits()
 }
@@ -142,7 +180,8 @@ mod tests {
                 let n = 1u32 << k;
                 let points: Vec<Vec<(f32, f32)>> = (0..n)
                     .map(|i| {
-                        let mut s = Sampler::new(pixel, i);
+                        let mut seeds = PixelSeeds::new(pixel);
+                        let mut s = Sampler::new(&mut seeds, i);
                         (0..4).map(|_| s.next2()).collect()
                     })
                     .collect();
@@ -189,12 +228,38 @@ mod tests {
         }
     }
 
+    /// The sampler's numbers are the definition's — a fresh scramble of the index, then
+    /// of each dimension, with seeds hashed from pixel and pair — for every sample of a
+    /// pixel sharing its kept seeds, and past the pairs it keeps.
+    #[test]
+    fn kept_seeds_give_the_definitions_numbers() {
+        let definition = |pixel: u32, index: u32, pair: u32| {
+            let seed = hash(pixel ^ hash(pair.wrapping_add(0x9e37_79b9)));
+            let i = nested_uniform_scramble(index, seed);
+            let x = nested_uniform_scramble(i.reverse_bits(), hash(seed ^ 0x5bd1_e995));
+            let y = nested_uniform_scramble(sobol_second(i), hash(seed ^ 0x27d4_eb2f));
+            (unit(x), unit(y))
+        };
+        for pixel in [0u32, 99, 65_535] {
+            let mut seeds = PixelSeeds::new(pixel);
+            // Samples reaching different depths, so some find their seeds kept and some
+            // keep them.
+            for (index, pairs) in [(0u32, 3u32), (1, 10), (5, 2), (u32::MAX, KEPT_PAIRS as u32 + 7), (77, 60)] {
+                let mut s = Sampler::new(&mut seeds, index);
+                for pair in 0..pairs {
+                    assert_eq!(s.next2(), definition(pixel, index, pair), "pixel {pixel}, sample {index}, pair {pair}");
+                }
+            }
+        }
+    }
+
     /// Different pixels and different pairs get different points: the scrambles are
     /// independent, not one pattern repeated.
     #[test]
     fn pixels_and_pairs_are_scrambled_apart() {
         let first = |pixel, pair| {
-            let mut s = Sampler::new(pixel, 0);
+            let mut seeds = PixelSeeds::new(pixel);
+            let mut s = Sampler::new(&mut seeds, 0);
             (0..pair).for_each(|_| {
                 s.next2();
             });
