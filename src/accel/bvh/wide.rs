@@ -2,7 +2,9 @@
 //! collapsed so that a visit tests four boxes at once and the chain of dependent node
 //! loads from the root to a leaf is about half as long. A walk over a large mesh waits
 //! on memory, one node per level (`perf annotate` put 48 % of its samples on the first
-//! use of each node's boxes, `docs/light.md`); halving the levels halves those waits.
+//! use of each node's boxes, `docs/light.md`); halving the levels halves those waits,
+//! and quantising the boxes to bytes (as Embree's and Ylitie et al.'s compressed wide
+//! BVHs do) makes a node one cache line instead of two.
 //!
 //! The binary nodes stay: the packet walks, the resumable ray walk and the point walks
 //! use them, and the builder makes them first.
@@ -12,35 +14,94 @@ use glam::{Vec3A, Vec4};
 use super::{Bvh, Child, Node};
 use crate::accel::aabb::enters4;
 
-/// Four children's boxes across lanes: `planes[axis]` their minima and `planes[3 + axis]`
-/// their maxima. An unused lane holds an empty box (minima +∞, maxima −∞), which no ray
-/// enters because the walk takes each axis's near plane by the ray's direction.
+/// Four children's boxes, quantised against the node's own box: one cache line a node,
+/// half the unquantised layout's two, so twice as much of a large mesh's tree stays in
+/// cache (the walk waits on its nodes' first loads). Each plane is a byte `q` standing
+/// for [`decode`]`(origin, exponent, q)`, rounded outwards when the node is made and
+/// checked there in the walk's own arithmetic, so a quantised box always holds its
+/// child's box: a ray enters every box it entered before, and a few more.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(64))]
 pub(super) struct Wide {
-    planes: [Vec4; 6],
-    children: [Child; 4],
+    /// The node's box minimum, which every lane's planes are measured from.
+    origin: [f32; 3],
+    /// Per axis, the quantum's power of two.
+    exponent: [i8; 3],
+    /// The lanes in use, a bit each: an unused lane is never entered.
+    used: u8,
+    /// Leaf children's primitive counts; 0 for an interior child.
+    counts: [u8; 4],
+    /// Each lane's planes in quanta: `q[axis]` the minima, `q[3 + axis]` the maxima.
+    q: [[u8; 4]; 6],
+    /// Each lane's child: a leaf's first slot, or an interior node's place in `wide`.
+    index: [u32; 4],
 }
 
-/// An unused lane's child (never entered: its box is empty).
-const NONE: Child = Child { index: 0, count: 0 };
+/// A node with no lane in use, filled lane by lane.
+const EMPTY: Wide = Wide { origin: [0.0; 3], exponent: [0; 3], used: 0, counts: [0; 4], q: [[0; 4]; 6], index: [0; 4] };
 
-/// A node with every lane unused, filled lane by lane.
-const EMPTY: Wide = Wide {
-    planes: [
-        Vec4::INFINITY,
-        Vec4::INFINITY,
-        Vec4::INFINITY,
-        Vec4::NEG_INFINITY,
-        Vec4::NEG_INFINITY,
-        Vec4::NEG_INFINITY,
-    ],
-    children: [NONE; 4],
-};
+/// The plane a quantised coordinate stands for: `origin + q·2^exponent` in f32, a
+/// multiply and an add, exactly as the walk computes it lane by lane.
+#[inline(always)]
+fn decode(origin: f32, exponent: i8, q: u8) -> f32 {
+    origin + f32::from(q) * quantum(exponent)
+}
+
+/// `2^exponent` (`exponent` within f32's normal range, which [`quantise`] keeps).
+#[inline(always)]
+fn quantum(exponent: i8) -> f32 {
+    f32::from_bits(((i32::from(exponent) + 127) as u32) << 23)
+}
+
+/// One axis of a node: the exponent and each lane's `(q_min, q_max)` for children
+/// spanning `[lo[k], hi[k]]` inside the node's `[origin, top]`, each plane rounded
+/// outwards as [`decode`] computes it; `None` if the node's extent is not finite.
+fn quantise(origin: f32, top: f32, lanes: &[(f32, f32)]) -> Option<(i8, Vec<(u8, u8)>)> {
+    if !(origin.is_finite() && top.is_finite() && origin <= top) {
+        return None;
+    }
+    // The smallest quantum whose 255 steps reach the top (past the origin), counted in
+    // the rounded arithmetic: near a large origin a step may round away.
+    let wanted = ((top - origin) / 255.0).log2().ceil();
+    let mut e = if wanted.is_finite() { (wanted as i32).clamp(-126, 127) } else { -126 };
+    while !(decode(origin, e as i8, 255) >= top && decode(origin, e as i8, 255) > origin) {
+        if e >= 127 {
+            return None;
+        }
+        e += 1;
+    }
+    let e = e as i8;
+    let planes = lanes
+        .iter()
+        .map(|&(lo, hi)| {
+            // The largest q not above the minimum (q = 0 is the origin, never above it)
+            // and the smallest not below the maximum (255 is at least the top).
+            let step = quantum(e);
+            let mut q_lo = (((lo - origin) / step).floor().clamp(0.0, 255.0)) as u8;
+            while q_lo > 0 && decode(origin, e, q_lo) > lo {
+                q_lo -= 1;
+            }
+            while q_lo < 255 && decode(origin, e, q_lo + 1) <= lo {
+                q_lo += 1;
+            }
+            let mut q_hi = (((hi - origin) / step).ceil().clamp(0.0, 255.0)) as u8;
+            while q_hi < 255 && decode(origin, e, q_hi) < hi {
+                q_hi += 1;
+            }
+            while q_hi > 0 && decode(origin, e, q_hi - 1) >= hi {
+                q_hi -= 1;
+            }
+            (q_lo, q_hi)
+        })
+        .collect();
+    Some((e, planes))
+}
 
 impl Bvh {
     /// Adds the four-wide copy of the tree that [`closest`](Bvh::closest) and
-    /// [`any`](Bvh::any) then walk (`nodes` stay for the other walks).
+    /// [`any`](Bvh::any) then walk (`nodes` stay for the other walks). A tree a
+    /// quantised node cannot hold (a leaf of more than 255 primitives, a box that is not
+    /// finite) stays binary: the walks are the same either way, only slower.
     pub fn widen(&mut self) {
         self.wide.clear();
         let Some((_, root)) = self.root() else { return };
@@ -48,8 +109,9 @@ impl Bvh {
             return;
         }
         let mut wide = Vec::with_capacity(self.nodes.len() / 2 + 1);
-        collapse(&self.nodes, root.index, &mut wide);
-        self.wide = wide;
+        if collapse(&self.nodes, root.index, &mut wide).is_some() {
+            self.wide = wide;
+        }
     }
 
     /// Bytes of the four-wide copy.
@@ -79,9 +141,14 @@ impl Bvh {
         let root = Child { index: 0, count: 0 };
         super::walk::descend::<WIDE_STACK>(root, t_max, visits, leaf, |index, t_max, deferred| {
             let node = &self.wide[index as usize];
-            let axis = |k: usize| ((node.planes[near[k]] - o[k]) * inv[k], (node.planes[far[k]] - o[k]) * inv[k]);
+            let axis = |k: usize| {
+                let (base, step) = (Vec4::splat(node.origin[k]), Vec4::splat(quantum(node.exponent[k])));
+                // `decode`, lane by lane.
+                let plane = |q: [u8; 4]| base + Vec4::from_array(q.map(f32::from)) * step;
+                ((plane(node.q[near[k]]) - o[k]) * inv[k], (plane(node.q[far[k]]) - o[k]) * inv[k])
+            };
             let (mut enters, entry) = enters4([axis(0), axis(1), axis(2)], t_low, Vec4::splat(t_max));
-            enters &= 0b1111;
+            enters &= u32::from(node.used);
             if enters == 0 {
                 return None;
             }
@@ -101,10 +168,11 @@ impl Bvh {
                 order[at] = k;
                 n += 1;
             }
+            let child = |k: usize| Child { index: node.index[k], count: u32::from(node.counts[k]) };
             for &k in order[1..n].iter().rev() {
-                deferred.push((node.children[k], entry[k]));
+                deferred.push((child(k), entry[k]));
             }
-            Some(node.children[order[0]])
+            Some(child(order[0]))
         });
     }
 }
@@ -113,12 +181,12 @@ impl Bvh {
 const WIDE_STACK: usize = 48;
 
 /// Appends the four-wide node made from binary node `index` and, after it, those of its
-/// descendants; returns its place in `wide`.
+/// descendants; returns its place in `wide`, or `None` if some node cannot be quantised.
 ///
 /// Each node takes the binary node's two children and opens the largest interior one
 /// among them (by surface area) until it holds four or only leaves: the children a ray
 /// is likeliest to enter are the ones worth testing together.
-fn collapse(nodes: &[Node], index: u32, wide: &mut Vec<Wide>) -> u32 {
+fn collapse(nodes: &[Node], index: u32, wide: &mut Vec<Wide>) -> Option<u32> {
     let at = wide.len();
     wide.push(EMPTY);
     let node = &nodes[index as usize];
@@ -135,14 +203,66 @@ fn collapse(nodes: &[Node], index: u32, wide: &mut Vec<Wide>) -> u32 {
         let n = &nodes[c.index as usize];
         kids.extend((0..2).map(|j| (n.child_box(j), n.children[j])));
     }
+    let whole = kids.iter().fold(crate::accel::Aabb::EMPTY, |b, (k, _)| b.union(*k));
     let mut made = EMPTY;
-    for (lane, (b, c)) in kids.into_iter().enumerate() {
-        for axis in 0..3 {
-            made.planes[axis][lane] = b.min[axis];
-            made.planes[3 + axis][lane] = b.max[axis];
+    for axis in 0..3 {
+        let lanes: Vec<(f32, f32)> = kids.iter().map(|(b, _)| (b.min[axis], b.max[axis])).collect();
+        let (e, planes) = quantise(whole.min[axis], whole.max[axis], &lanes)?;
+        made.origin[axis] = whole.min[axis];
+        made.exponent[axis] = e;
+        for (lane, (lo, hi)) in planes.into_iter().enumerate() {
+            made.q[axis][lane] = lo;
+            made.q[3 + axis][lane] = hi;
         }
-        made.children[lane] = if c.count > 0 { c } else { Child { index: collapse(nodes, c.index, wide), count: 0 } };
+    }
+    for (lane, (_, c)) in kids.into_iter().enumerate() {
+        made.used |= 1 << lane;
+        if c.count > 0 {
+            made.counts[lane] = u8::try_from(c.count).ok()?;
+            made.index[lane] = c.index;
+        } else {
+            made.index[lane] = collapse(nodes, c.index, wide)?;
+        }
     }
     wide[at] = made;
-    at as u32
+    Some(at as u32)
+}
+
+/// A quantised node is one cache line.
+const _: () = assert!(std::mem::size_of::<Wide>() == 64);
+
+#[cfg(test)]
+impl Bvh {
+    /// Whether every quantised lane's box holds the exact union of the primitive boxes
+    /// below it, with the quantised boxes' summed half-area over the exact ones' (how
+    /// much looser quantising made the tree).
+    pub(super) fn wide_holds(&self, boxes: &[crate::accel::Aabb]) -> (bool, f64) {
+        use crate::accel::Aabb;
+        fn below(bvh: &Bvh, boxes: &[Aabb], index: u32, ok: &mut bool, area: &mut (f64, f64)) -> Aabb {
+            let node = &bvh.wide[index as usize];
+            let mut whole = Aabb::EMPTY;
+            for lane in (0..4).filter(|&l| node.used & (1 << l) != 0) {
+                let exact = if node.counts[lane] > 0 {
+                    let first = node.index[lane];
+                    (first..first + u32::from(node.counts[lane]))
+                        .fold(Aabb::EMPTY, |b, k| b.union(boxes[bvh.prim(k) as usize]))
+                } else {
+                    below(bvh, boxes, node.index[lane], ok, area)
+                };
+                let plane = |axis: usize, q: u8| decode(node.origin[axis], node.exponent[axis], q);
+                let min = Vec3A::from_array([0, 1, 2].map(|a| plane(a, node.q[a][lane])));
+                let max = Vec3A::from_array([0, 1, 2].map(|a| plane(a, node.q[3 + a][lane])));
+                *ok &= min.cmple(exact.min).all() && max.cmpge(exact.max).all();
+                area.0 += f64::from(Aabb { min, max }.half_area());
+                area.1 += f64::from(exact.half_area());
+                whole = whole.union(exact);
+            }
+            whole
+        }
+        let (mut ok, mut area) = (true, (0.0, 0.0));
+        if !self.wide.is_empty() {
+            below(self, boxes, 0, &mut ok, &mut area);
+        }
+        (ok, area.0 / area.1.max(f64::MIN_POSITIVE))
+    }
 }
