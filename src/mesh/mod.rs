@@ -27,7 +27,7 @@ pub mod triangle;
 pub mod twist;
 pub mod unfold;
 
-use glam::{DAffine3, DVec3, Vec3A, Vec4};
+use glam::{DAffine3, DVec3, Vec3, Vec3A, Vec4};
 use rayon::prelude::*;
 
 pub use detail::Detail;
@@ -144,6 +144,9 @@ pub struct MeshObject {
     /// Per-triangle material ids, or one for the whole mesh.
     materials: Materials,
     bvh: Bvh,
+    /// Each triangle's corners in place, in the BVH's leaf order, when the BVH is widened
+    /// for incoherent rays ([`MeshObject::widen`]); empty otherwise.
+    corners: Vec<[Vec3; 3]>,
     bounds: Aabb,
     /// Whether the triangles bound a convex polytope (or lie in one plane).
     convex: bool,
@@ -260,7 +263,17 @@ impl MeshObject {
             Some(_) => Materials::One(mats.first().copied().unwrap_or(material)),
             None => Materials::One(material),
         };
-        MeshObject { positions, triangles, shading, materials, bvh, bounds, convex: false, isosurface: None }
+        MeshObject {
+            positions,
+            triangles,
+            shading,
+            materials,
+            bvh,
+            corners: Vec::new(),
+            bounds,
+            convex: false,
+            isosurface: None,
+        }
     }
 
     /// Whether the triangles bound a convex polytope (or lie in one plane): then every
@@ -294,14 +307,18 @@ impl MeshObject {
             triangles: self.triangles.len(),
             vertex_bytes,
             index_bytes,
-            bvh_bytes: self.bvh.bytes(),
+            bvh_bytes: self.bvh.bytes() + self.corners.len() * std::mem::size_of::<[Vec3; 3]>(),
             bvh_nodes: self.bvh.node_count(),
             bvh_depth: self.bvh.depth(),
             isosurface: self.isosurface,
         }
     }
 
+    #[inline]
     fn tri(&self, i: u32) -> (Vec3A, Vec3A, Vec3A) {
+        if let Some([a, b, c]) = self.corners.get(i as usize) {
+            return (Vec3A::from(*a), Vec3A::from(*b), Vec3A::from(*c));
+        }
         let t = self.triangles[i as usize];
         (self.positions[t[0] as usize], self.positions[t[1] as usize], self.positions[t[2] as usize])
     }
@@ -407,6 +424,12 @@ impl MeshObject {
     /// nodes either way.
     pub fn widen(&mut self) {
         self.bvh.widen();
+        self.corners = (0..self.triangles.len() as u32)
+            .map(|i| {
+                let (a, b, c) = self.tri(i);
+                [a, b, c].map(Vec3::from)
+            })
+            .collect();
     }
 
     /// The closest hit within `(ray.t_min, t_max)`, with its surface.
