@@ -398,7 +398,8 @@ fn lower_reusing(
     // Building the meshes (vertices to render space, BVHs) is most of the lowering time
     // of a scene of many meshes; they are independent, so they are built in parallel.
     // Under light transport nearly every ray is a lone, incoherent one: meshes get the
-    // four-wide BVH those walk faster (`docs/light.md`, against Embree).
+    // four-wide BVH and the corners in place those walk faster (`MeshObject::widen`,
+    // `docs/light.md` against Embree).
     let incoherent = frame.transport.is_some();
     let objects: Vec<Object> = lowered
         .into_par_iter()

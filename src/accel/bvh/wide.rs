@@ -17,7 +17,7 @@ use crate::accel::aabb::enters4;
 /// Four children's boxes, quantised against the node's own box: one cache line a node,
 /// half the unquantised layout's two, so twice as much of a large mesh's tree stays in
 /// cache (the walk waits on its nodes' first loads). Each plane is a byte `q` standing
-/// for [`decode`]`(origin, exponent, q)`, rounded outwards when the node is made and
+/// for [`decode`]`(origin, exponent, q)`, rounded outwards ([`quantise`]) when the node is made and
 /// checked there in the walk's own arithmetic, so a quantised box always holds its
 /// child's box: a ray enters every box it entered before, and a few more.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -53,48 +53,48 @@ fn quantum(exponent: i8) -> f32 {
     f32::from_bits(((i32::from(exponent) + 127) as u32) << 23)
 }
 
-/// One axis of a node: the exponent and each lane's `(q_min, q_max)` for children
-/// spanning `[lo[k], hi[k]]` inside the node's `[origin, top]`, each plane rounded
-/// outwards as [`decode`] computes it; `None` if the node's extent is not finite.
-fn quantise(origin: f32, top: f32, lanes: &[(f32, f32)]) -> Option<(i8, Vec<(u8, u8)>)> {
+/// The exponent of one axis of a node spanning `[origin, top]`: the smallest quantum
+/// whose 255 steps reach the top (and pass the origin), counted in [`decode`]'s rounded
+/// arithmetic, since near a large origin a step may round away; `None` if the extent is
+/// not finite.
+fn exponent(origin: f32, top: f32) -> Option<i8> {
     if !(origin.is_finite() && top.is_finite() && origin <= top) {
         return None;
     }
-    // The smallest quantum whose 255 steps reach the top (past the origin), counted in
-    // the rounded arithmetic: near a large origin a step may round away.
     let wanted = ((top - origin) / 255.0).log2().ceil();
     let mut e = if wanted.is_finite() { (wanted as i32).clamp(-126, 127) } else { -126 };
-    while !(decode(origin, e as i8, 255) >= top && decode(origin, e as i8, 255) > origin) {
+    loop {
+        let end = decode(origin, e as i8, 255);
+        if end >= top && end > origin {
+            return Some(e as i8);
+        }
         if e >= 127 {
             return None;
         }
         e += 1;
     }
-    let e = e as i8;
-    let planes = lanes
-        .iter()
-        .map(|&(lo, hi)| {
-            // The largest q not above the minimum (q = 0 is the origin, never above it)
-            // and the smallest not below the maximum (255 is at least the top).
-            let step = quantum(e);
-            let mut q_lo = (((lo - origin) / step).floor().clamp(0.0, 255.0)) as u8;
-            while q_lo > 0 && decode(origin, e, q_lo) > lo {
-                q_lo -= 1;
-            }
-            while q_lo < 255 && decode(origin, e, q_lo + 1) <= lo {
-                q_lo += 1;
-            }
-            let mut q_hi = (((hi - origin) / step).ceil().clamp(0.0, 255.0)) as u8;
-            while q_hi < 255 && decode(origin, e, q_hi) < hi {
-                q_hi += 1;
-            }
-            while q_hi > 0 && decode(origin, e, q_hi - 1) >= hi {
-                q_hi -= 1;
-            }
-            (q_lo, q_hi)
-        })
-        .collect();
-    Some((e, planes))
+}
+
+/// One lane's planes on an axis of [`exponent`] `e` from `origin`, rounded outwards as
+/// [`decode`] computes them: the largest `q` not above `lo` (0, the origin, never is)
+/// and the smallest not below `hi` (255 is at least the node's top).
+fn quantise(origin: f32, e: i8, (lo, hi): (f32, f32)) -> (u8, u8) {
+    let step = quantum(e);
+    let mut q_lo = ((lo - origin) / step).floor().clamp(0.0, 255.0) as u8;
+    while q_lo > 0 && decode(origin, e, q_lo) > lo {
+        q_lo -= 1;
+    }
+    while q_lo < 255 && decode(origin, e, q_lo + 1) <= lo {
+        q_lo += 1;
+    }
+    let mut q_hi = ((hi - origin) / step).ceil().clamp(0.0, 255.0) as u8;
+    while q_hi < 255 && decode(origin, e, q_hi) < hi {
+        q_hi += 1;
+    }
+    while q_hi > 0 && decode(origin, e, q_hi - 1) >= hi {
+        q_hi -= 1;
+    }
+    (q_lo, q_hi)
 }
 
 impl Bvh {
@@ -206,13 +206,11 @@ fn collapse(nodes: &[Node], index: u32, wide: &mut Vec<Wide>) -> Option<u32> {
     let whole = kids.iter().fold(crate::accel::Aabb::EMPTY, |b, (k, _)| b.union(*k));
     let mut made = EMPTY;
     for axis in 0..3 {
-        let lanes: Vec<(f32, f32)> = kids.iter().map(|(b, _)| (b.min[axis], b.max[axis])).collect();
-        let (e, planes) = quantise(whole.min[axis], whole.max[axis], &lanes)?;
-        made.origin[axis] = whole.min[axis];
+        let (origin, e) = (whole.min[axis], exponent(whole.min[axis], whole.max[axis])?);
+        made.origin[axis] = origin;
         made.exponent[axis] = e;
-        for (lane, (lo, hi)) in planes.into_iter().enumerate() {
-            made.q[axis][lane] = lo;
-            made.q[3 + axis][lane] = hi;
+        for (lane, (b, _)) in kids.iter().enumerate() {
+            (made.q[axis][lane], made.q[3 + axis][lane]) = quantise(origin, e, (b.min[axis], b.max[axis]));
         }
     }
     for (lane, (_, c)) in kids.into_iter().enumerate() {
