@@ -59,6 +59,7 @@ fn run() -> Result<(), String> {
         object.widen();
     }
     let build = start.elapsed().as_secs_f64();
+    let memory = object.memory();
     let scnc::accel::Aabb { min: lo, max: hi } = object.bounds();
     let mut rng = Pcg(seed.wrapping_mul(0x9e3779b97f4a7c15) | 1);
     let rays: Vec<Ray> = (0..count)
@@ -100,10 +101,11 @@ fn run() -> Result<(), String> {
     }
     let _ = writeln!(
         std::io::stdout(),
-        "scnc: {} triangles, {} BVH built in {build:.2} s (all threads); {count} rays, {hits} hits, mean t {:.6} (file units); \
+        "scnc: {} triangles, {} BVH built in {build:.2} s (all threads), {:.1} MB with its vertices and indices; {count} rays, {hits} hits, mean t {:.6} (file units); \
          best of 3 on one thread: {best:.3} s = {:.2} M rays/s; per ray {:.1} nodes, {:.1} triangle tests",
         mesh.triangles.len(),
         if binary { "binary" } else { "four-wide" },
+        (memory.bvh_bytes + memory.vertex_bytes + memory.index_bytes) as f64 / 1e6,
         sum / hits.max(1) as f64 * STL_PER_UNIT,
         count as f64 / best / 1e6,
         counters.node_visits as f64 / (3 * count) as f64,

@@ -27,7 +27,7 @@ pub mod triangle;
 pub mod twist;
 pub mod unfold;
 
-use glam::{DAffine3, DVec3, Vec3, Vec3A, Vec4};
+use glam::{DAffine3, DVec3, Vec3A, Vec4};
 use rayon::prelude::*;
 
 pub use detail::Detail;
@@ -144,9 +144,10 @@ pub struct MeshObject {
     /// Per-triangle material ids, or one for the whole mesh.
     materials: Materials,
     bvh: Bvh,
-    /// Each triangle's corners in place, in the BVH's leaf order, when the BVH is widened
-    /// for incoherent rays ([`MeshObject::widen`]); empty otherwise.
-    corners: Vec<[Vec3; 3]>,
+    /// The triangles' corners in place, four across lanes, one entry per block of the
+    /// BVH's leaves ([`Bvh::blocks`]), when the BVH is widened for incoherent rays
+    /// ([`MeshObject::widen`]); empty otherwise.
+    blocks: Vec<triangle::Block>,
     bounds: Aabb,
     /// Whether the triangles bound a convex polytope (or lie in one plane).
     convex: bool,
@@ -269,7 +270,7 @@ impl MeshObject {
             shading,
             materials,
             bvh,
-            corners: Vec::new(),
+            blocks: Vec::new(),
             bounds,
             convex: false,
             isosurface: None,
@@ -307,7 +308,7 @@ impl MeshObject {
             triangles: self.triangles.len(),
             vertex_bytes,
             index_bytes,
-            bvh_bytes: self.bvh.bytes() + self.corners.len() * std::mem::size_of::<[Vec3; 3]>(),
+            bvh_bytes: self.bvh.bytes() + self.blocks.len() * std::mem::size_of::<triangle::Block>(),
             bvh_nodes: self.bvh.node_count(),
             bvh_depth: self.bvh.depth(),
             isosurface: self.isosurface,
@@ -316,9 +317,6 @@ impl MeshObject {
 
     #[inline]
     fn tri(&self, i: u32) -> (Vec3A, Vec3A, Vec3A) {
-        if let Some([a, b, c]) = self.corners.get(i as usize) {
-            return (Vec3A::from(*a), Vec3A::from(*b), Vec3A::from(*c));
-        }
         let t = self.triangles[i as usize];
         (self.positions[t[0] as usize], self.positions[t[1] as usize], self.positions[t[2] as usize])
     }
@@ -331,18 +329,58 @@ impl MeshObject {
         shear: &triangle::Shear,
         t_max: f32,
         c: &mut Counters,
-    ) -> Option<(u32, triangle::TriHit)> {
+    ) -> Option<(TriRef, triangle::TriHit)> {
+        if !self.blocks.is_empty() {
+            return self.closest_in_blocks(ray, shear, t_max, c);
+        }
         let mut best = None;
         let mut tests = 0u64;
         self.bvh.closest(ray.origin, ray.inv_dir, ray.t_min, t_max, &mut c.node_visits, |i, t_max| {
             tests += 1;
             let (a, b, cc) = self.tri(i);
             let hit = triangle::intersect(ray.origin, shear, a, b, cc, ray.t_min, t_max)?;
-            best = Some((i, hit));
+            best = Some((TriRef::plain(i), hit));
             Some(hit.t)
         });
         c.triangle_tests += tests;
         best
+    }
+
+    /// [`closest`](Self::closest) over the widened BVH, a block of four triangles a test:
+    /// the same hit, since a block's test is four single tests in slot order.
+    fn closest_in_blocks(
+        &self,
+        ray: &Ray,
+        shear: &triangle::Shear,
+        mut t_max: f32,
+        c: &mut Counters,
+    ) -> Option<(TriRef, triangle::TriHit)> {
+        let mut best = None;
+        let mut tests = 0u64;
+        self.bvh.block_leaves(
+            ray.origin,
+            ray.inv_dir,
+            ray.t_min,
+            &mut t_max,
+            &mut c.node_visits,
+            |blocks, n, t_max| {
+                tests += u64::from(n);
+                for b in blocks {
+                    if let Some((lane, hit)) =
+                        shear.intersect_block(ray.origin, &self.blocks[b as usize], ray.t_min, *t_max)
+                    {
+                        *t_max = hit.t;
+                        best = Some((b, lane, hit));
+                    }
+                }
+                false
+            },
+        );
+        c.triangle_tests += tests;
+        // The build ordered the triangles by their slots (`Bvh::build_ordered`).
+        best.map(|(b, lane, hit)| {
+            (TriRef { id: self.bvh.blocks()[b as usize].first + lane as u32, block: b * 4 + lane as u32 }, hit)
+        })
     }
 
     /// [`closest`](Self::closest) for the rays of a packet in `lanes` (groups of four,
@@ -357,7 +395,7 @@ impl MeshObject {
         lanes: u32,
         t_max: &mut [Vec4; N],
         c: &mut Counters,
-        mut hit: impl FnMut(usize, usize, u32, triangle::TriHit),
+        mut hit: impl FnMut(usize, usize, TriRef, triangle::TriHit),
     ) {
         let mut tests = 0u64;
         self.bvh.each_packet(rays, lanes, t_max, &mut c.node_visits, |i, lanes, t_max| {
@@ -377,7 +415,7 @@ impl MeshObject {
                 // bench `primary rays/blocks mesh-high/full-frame-sphere 1000`).
                 for l in (0..4).filter(|l| found.mask & (1 << l) != 0) {
                     t_max[g][l] = found.t[l];
-                    hit(g, l, i, found.lane(l));
+                    hit(g, l, TriRef::plain(i), found.lane(l));
                 }
             }
         });
@@ -387,8 +425,14 @@ impl MeshObject {
     /// The surface at a hit found by [`closest`](Self::closest): point, normal (interpolated
     /// when smooth, else the face's), material and error, numbered `object`. Done once per
     /// ray, for the winner.
-    pub fn surface(&self, i: u32, hit: triangle::TriHit, object: u32, dir: Vec3A) -> Hit {
-        let (a, b, cc) = self.tri(i);
+    pub fn surface(&self, tri: TriRef, hit: triangle::TriHit, object: u32, dir: Vec3A) -> Hit {
+        let i = tri.id;
+        // A block's corners are where the test just read them; the index array and the
+        // positions would be two more waits on memory.
+        let (a, b, cc) = match self.blocks.get((tri.block / 4) as usize) {
+            Some(block) => block.corners((tri.block % 4) as usize).into(),
+            None => self.tri(i),
+        };
         let geometric = (b - a).cross(cc - a);
         let point = a * hit.bary[0] + b * hit.bary[1] + cc * hit.bary[2];
         let [u, v, w] = hit.bary;
@@ -425,12 +469,16 @@ impl MeshObject {
     /// nodes either way.
     pub fn widen(&mut self) {
         self.bvh.widen();
-        self.corners = (0..self.triangles.len() as u32)
-            .map(|i| {
-                let (a, b, c) = self.tri(i);
-                [a, b, c].map(Vec3::from)
-            })
-            .collect();
+        let blocks = self.bvh.blocks().iter().map(|b| {
+            let corners: Vec<[Vec3A; 3]> = (b.first..b.first + b.count)
+                .map(|i| {
+                    let (a, b, c) = self.tri(i);
+                    [a, b, c]
+                })
+                .collect();
+            triangle::Block::new(&corners)
+        });
+        self.blocks = blocks.collect();
     }
 
     /// The closest hit within `(ray.t_min, t_max)`, with its surface.
@@ -439,8 +487,27 @@ impl MeshObject {
     }
 
     /// Whether any triangle lies along the ray within `(ray.t_min, t_max)`.
-    pub fn occluded(&self, ray: &Ray, shear: &triangle::Shear, t_max: f32, c: &mut Counters) -> bool {
+    pub fn occluded(&self, ray: &Ray, shear: &triangle::Shear, mut t_max: f32, c: &mut Counters) -> bool {
         let mut tests = 0u64;
+        if !self.blocks.is_empty() {
+            let mut hit = false;
+            self.bvh.block_leaves(
+                ray.origin,
+                ray.inv_dir,
+                ray.t_min,
+                &mut t_max,
+                &mut c.node_visits,
+                |blocks, n, t_max| {
+                    tests += u64::from(n);
+                    hit = blocks.into_iter().any(|b| {
+                        shear.intersect_block(ray.origin, &self.blocks[b as usize], ray.t_min, *t_max).is_some()
+                    });
+                    hit
+                },
+            );
+            c.triangle_tests += tests;
+            return hit;
+        }
         let hit = self.bvh.any(ray.origin, ray.inv_dir, ray.t_min, t_max, &mut c.node_visits, |i, t_max| {
             tests += 1;
             let (a, b, cc) = self.tri(i);
@@ -448,6 +515,23 @@ impl MeshObject {
         });
         c.triangle_tests += tests;
         hit
+    }
+}
+
+/// A triangle a ray hit: its number and, when the test read it from a block of
+/// [`MeshObject::widen`], the block and lane (`4·block + lane`) holding its corners.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TriRef {
+    /// The triangle's number.
+    pub id: u32,
+    /// `4·block + lane`, or `u32::MAX` when not found in a block.
+    block: u32,
+}
+
+impl TriRef {
+    /// Triangle `id`, found outside the blocks.
+    fn plain(id: u32) -> TriRef {
+        TriRef { id, block: u32::MAX }
     }
 }
 

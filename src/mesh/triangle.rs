@@ -17,6 +17,10 @@ use glam::{Mat3A, Vec3A, Vec4};
 #[derive(Clone, Copy, Debug)]
 pub struct Shear {
     m: Mat3A,
+    /// The axes `kx`, `ky`, `kz` and the factors `sx`, `sy`, `sz` the rows are made of,
+    /// for [`Shear::intersect_block`]'s lane-wise form.
+    k: [usize; 3],
+    s: [f32; 3],
 }
 
 /// The shear's axes for a direction: `kz` the dominant axis, `kx` and `ky` the other
@@ -53,7 +57,88 @@ impl Shear {
         cols[kx] = Vec3A::X;
         cols[ky] = Vec3A::Y;
         cols[kz] = Vec3A::new(-sx, -sy, sz);
-        Shear { m: Mat3A::from_cols(cols[0], cols[1], cols[2]) }
+        Shear { m: Mat3A::from_cols(cols[0], cols[1], cols[2]), k: [kx, ky, kz], s: [sx, sy, sz] }
+    }
+
+    /// [`intersect`] for the four triangles of `block` at once: the closest hit within
+    /// `(t_min, t_max)` and its lane, the lowest lane on a tie, as four single tests in
+    /// lane order would find it. Lane by lane the arithmetic is the single test's (its
+    /// matrix rows add `0·p` terms, which can only change the sign of a zero), so the
+    /// same hits, distances and weights, and shared edges stay watertight.
+    #[inline(always)]
+    pub fn intersect_block(&self, origin: Vec3A, block: &Block, t_min: f32, t_max: f32) -> Option<(usize, TriHit)> {
+        let [kx, ky, kz] = self.k;
+        let o = origin.to_array();
+        let [sx, sy, sz] = self.s.map(Vec4::splat);
+        let shear = |v: &[Vec4; 3]| {
+            let axis = |k: usize| v[k] - Vec4::splat(o[k]);
+            let (dx, dy, dz) = (axis(kx), axis(ky), axis(kz));
+            [dx - sx * dz, dy - sy * dz, sz * dz]
+        };
+        let [[ax, ay, az], [bx, by, bz], [cx, cy, cz]] = [shear(&block.0[0]), shear(&block.0[1]), shear(&block.0[2])];
+        let [mut u, mut v, mut w] = edge_functions((ax, ay), (bx, by), (cx, cy));
+        let zero = (u.cmpeq(Vec4::ZERO) | v.cmpeq(Vec4::ZERO) | w.cmpeq(Vec4::ZERO)).bitmask();
+        let inside = if zero == 0 {
+            // No edge function is zero, so a lane is inside exactly when the three share
+            // their sign bit (NaN lanes, the padding among them, fail `det` below).
+            let (su, sv, sw) = (u.is_negative_bitmask(), v.is_negative_bitmask(), w.is_negative_bitmask());
+            !((su ^ sv) | (su ^ sw)) & 0b1111
+        } else {
+            for l in crate::trace::lanes(zero) {
+                [u[l], v[l], w[l]] = edge_functions_f64((ax[l], ay[l]), (bx[l], by[l]), (cx[l], cy[l]));
+            }
+            let neg = u.cmplt(Vec4::ZERO) | v.cmplt(Vec4::ZERO) | w.cmplt(Vec4::ZERO);
+            let pos = u.cmpgt(Vec4::ZERO) | v.cmpgt(Vec4::ZERO) | w.cmpgt(Vec4::ZERO);
+            !(neg & pos).bitmask() & 0b1111
+        };
+        if inside == 0 {
+            return None;
+        }
+        let det = u + v + w;
+        let t_scaled = u * az + v * bz + w * cz;
+        let inv = Vec4::ONE / det;
+        let t = t_scaled * inv;
+        let ok = det.cmpne(Vec4::ZERO)
+            & det.abs().cmplt(Vec4::INFINITY)
+            & t.cmpgt(Vec4::splat(t_min))
+            & t.cmplt(Vec4::splat(t_max));
+        let mut mask = ok.bitmask() & inside;
+        let mut best: Option<usize> = None;
+        while mask != 0 {
+            let l = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            if best.is_none_or(|b| t[l] < t[b]) {
+                best = Some(l);
+            }
+        }
+        best.map(|l| (l, TriHit { t: t[l], bary: [u[l] * inv[l], v[l] * inv[l], w[l] * inv[l]] }))
+    }
+}
+
+/// Four triangles' corners across lanes, `0[corner][axis]`, for
+/// [`Shear::intersect_block`]: one test of a BVH leaf's block. A block of fewer than
+/// four fills its other lanes with NaN, which never hit.
+#[derive(Clone, Copy, Debug)]
+pub struct Block([[Vec4; 3]; 3]);
+
+impl Block {
+    /// The block of `triangles` (at most four), their corners in order.
+    pub fn new(triangles: &[[Vec3A; 3]]) -> Block {
+        debug_assert!(triangles.len() <= 4);
+        let mut lanes = [[[f32::NAN; 4]; 3]; 3];
+        for (l, corners) in triangles.iter().enumerate() {
+            for (c, p) in corners.iter().enumerate() {
+                for axis in 0..3 {
+                    lanes[c][axis][l] = p[axis];
+                }
+            }
+        }
+        Block(lanes.map(|c| c.map(Vec4::from_array)))
+    }
+
+    /// Lane `l`'s corners.
+    pub fn corners(&self, l: usize) -> [Vec3A; 3] {
+        self.0.map(|c| Vec3A::new(c[0][l], c[1][l], c[2][l]))
     }
 }
 
@@ -312,5 +397,46 @@ mod tests {
             }
         }
         assert!(checked[0] > 100 && checked[1] > 100, "hits and misses both tested: {checked:?}");
+    }
+    /// A block's test finds what single tests of its triangles in lane order find: the
+    /// same closest hit, distance and weights, the lowest lane on a tie, none in the
+    /// padding lanes, for rays through shared edges too.
+    #[test]
+    fn a_block_is_its_triangles_tested_in_order() {
+        let (a, b) = (Vec3A::new(-1.0, -1.0, 3.0), Vec3A::new(1.0, 1.0, 3.0));
+        let (c, d) = (Vec3A::new(1.0, -1.0, 3.0), Vec3A::new(-1.0, 1.0, 3.0));
+        // Two halves of a quad, the quad again behind it (a tie with lane 0 at equal t is
+        // impossible there, so its lane 3 copy of lane 0 makes one), and blocks of two
+        // and one whose other lanes are padding.
+        let far = Vec3A::new(0.0, 0.0, 1.5);
+        let full = [[a, c, b], [a, b, d], [a + far, c + far, b + far], [a, c, b]];
+        let origins = [Vec3A::new(0.3, -0.7, -2.0), Vec3A::new(-4.0, 2.0, 9.0), Vec3A::new(1e3, 1e3, -1e3)];
+        let mut seen = [0usize; 3];
+        for blocks in [&full[..], &full[..2], &full[1..2]] {
+            let block = Block::new(blocks);
+            for (l, tri) in blocks.iter().enumerate() {
+                assert_eq!(block.corners(l), *tri);
+            }
+            for origin in origins {
+                for i in 0..300 {
+                    let s = i as f32 / 300.0;
+                    for target in [a + (b - a) * s, Vec3A::new(2.4 * s - 1.2, 0.7 - 1.3 * s, 3.0)] {
+                        let shear = Shear::new((target - origin).normalize());
+                        let mut single = None;
+                        let mut t_max = f32::MAX;
+                        for (l, [v0, v1, v2]) in blocks.iter().enumerate() {
+                            if let Some(hit) = intersect(origin, &shear, *v0, *v1, *v2, 0.0, t_max) {
+                                t_max = hit.t;
+                                single = Some((l, hit));
+                            }
+                        }
+                        let found = shear.intersect_block(origin, &block, 0.0, f32::MAX);
+                        assert_eq!(found, single, "{} triangles, origin {origin}, target {target}", blocks.len());
+                        seen[found.map_or(0, |(l, _)| l.min(1) + 1)] += 1;
+                    }
+                }
+            }
+        }
+        assert!(seen.iter().all(|&n| n > 50), "misses, lane 0 and later lanes all tested: {seen:?}");
     }
 }

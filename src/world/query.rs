@@ -143,7 +143,7 @@ pub(super) enum Found<'w> {
     /// out of the object (it started inside).
     Sdf { object: u32, sdf: &'w SdfObject, t: f32, error: f32, leaving: bool },
     /// A triangle hit.
-    Mesh { object: u32, mesh: &'w MeshObject, tri: u32, hit: mesh::triangle::TriHit },
+    Mesh { object: u32, mesh: &'w MeshObject, tri: mesh::TriRef, hit: mesh::triangle::TriHit },
 }
 
 impl Found<'_> {

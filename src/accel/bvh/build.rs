@@ -238,7 +238,7 @@ impl Bvh {
         drop(refs);
         let mut nodes = Vec::with_capacity(root.len());
         let root = lay_out(root, &mut nodes);
-        Bvh { nodes, root_box: span.bounds, root, prims, wide: Vec::new() }
+        Bvh { nodes, root_box: span.bounds, root, prims, wide: Vec::new(), blocks: Vec::new() }
     }
 
     /// Builds like [`build_until`](Self::build_until) and returns the leaves' primitive order: the

@@ -122,6 +122,19 @@ pub struct Bvh {
     /// The same tree with four children a node, root first, which the single-ray walks
     /// take when it is there ([`Bvh::widen`]); empty otherwise.
     wide: Vec<wide::Wide>,
+    /// The four-wide tree's leaves as blocks of at most four consecutive slots, in the
+    /// order its leaves name them ([`Bvh::blocks`]); empty when there is no wide tree.
+    blocks: Vec<LeafBlock>,
+}
+
+/// Up to four consecutive leaf slots of the four-wide tree, which a caller may test
+/// together (a mesh tests a block's triangles in one four-lane test).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LeafBlock {
+    /// The block's first slot.
+    pub first: u32,
+    /// Its slots, 1 to 4.
+    pub count: u32,
 }
 
 /// Deepest tree the builder makes.
@@ -137,6 +150,7 @@ impl Default for Bvh {
             root: Child { index: 0, count: 0 },
             prims: Vec::new(),
             wide: Vec::new(),
+            blocks: Vec::new(),
         }
     }
 }

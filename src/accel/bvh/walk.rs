@@ -132,7 +132,9 @@ impl Bvh {
             return;
         }
         if !self.wide.is_empty() {
-            return self.wide_leaves(origin, inv_dir, t_min, t_max, visits, leaf);
+            return self.wide_leaves(origin, inv_dir, t_min, t_max, visits, |block, count, t_max| {
+                leaf(self.blocks[block as usize].first, count, t_max)
+            });
         }
         let ray = RaySplat::new(origin, inv_dir, t_min);
         descend::<STACK>(root, t_max, visits, leaf, |index, t_max, deferred| {

@@ -11,7 +11,7 @@
 
 use glam::{Vec3A, Vec4};
 
-use super::{Bvh, Child, Node};
+use super::{Bvh, Child, LeafBlock, Node};
 use crate::accel::aabb::enters4;
 
 /// Four children's boxes, quantised against the node's own box: one cache line a node,
@@ -33,7 +33,8 @@ pub(super) struct Wide {
     counts: [u8; 4],
     /// Each lane's planes in quanta: `q[axis]` the minima, `q[3 + axis]` the maxima.
     q: [[u8; 4]; 6],
-    /// Each lane's child: a leaf's first slot, or an interior node's place in `wide`.
+    /// Each lane's child: a leaf's first block in `blocks`, or an interior node's place
+    /// in `wide`.
     index: [u32; 4],
 }
 
@@ -104,22 +105,56 @@ impl Bvh {
     /// finite) stays binary: the walks are the same either way, only slower.
     pub fn widen(&mut self) {
         self.wide.clear();
+        self.blocks.clear();
         let Some((_, root)) = self.root() else { return };
         if root.count > 0 {
             return;
         }
-        let mut wide = Vec::with_capacity(self.nodes.len() / 2 + 1);
-        if collapse(&self.nodes, root.index, &mut wide).is_some() {
-            self.wide = wide;
+        let mut made = (Vec::with_capacity(self.nodes.len() / 2 + 1), Vec::with_capacity(self.nodes.len() / 2 + 1));
+        if collapse(&self.nodes, root.index, &mut made).is_some() {
+            (self.wide, self.blocks) = made;
         }
+    }
+
+    /// The four-wide tree's leaves in blocks of up to four slots, numbered as
+    /// [`block_leaves`](Bvh::block_leaves) hands them out; empty unless the tree was
+    /// [widened](Bvh::widen).
+    pub fn blocks(&self) -> &[LeafBlock] {
+        &self.blocks
     }
 
     /// Bytes of the four-wide copy.
     pub(super) fn wide_bytes(&self) -> usize {
-        self.wide.len() * std::mem::size_of::<Wide>()
+        self.wide.len() * std::mem::size_of::<Wide>() + self.blocks.len() * std::mem::size_of::<LeafBlock>()
     }
 
-    /// [`leaves`](Bvh::leaves) over the four-wide nodes, whose root is `wide[0]`.
+    /// Visits the four-wide tree's leaves front to back along the ray, a leaf as its
+    /// blocks: `leaf(blocks, slots, t_max)` gets the leaf's range of [`blocks`](Bvh::blocks)
+    /// and its number of slots,
+    /// may lower `t_max` to the closest hit so far, and returns true to stop the walk.
+    /// Only for a widened tree (`blocks` not empty); the root box is tested here.
+    #[inline]
+    pub fn block_leaves(
+        &self,
+        origin: Vec3A,
+        inv_dir: Vec3A,
+        t_min: f32,
+        t_max: &mut f32,
+        visits: &mut u64,
+        mut leaf: impl FnMut(std::ops::Range<u32>, u32, &mut f32) -> bool,
+    ) {
+        debug_assert!(!self.wide.is_empty());
+        *visits += 1;
+        if self.root_box.slab(origin, inv_dir, t_min, *t_max).is_none() {
+            return;
+        }
+        self.wide_leaves(origin, inv_dir, t_min, t_max, visits, |first, count, t_max| {
+            leaf(first..first + count.div_ceil(4), count, t_max)
+        });
+    }
+
+    /// [`leaves`](Bvh::leaves) over the four-wide nodes, whose root is `wide[0]`, except
+    /// that a leaf is named by its first block, not its first slot.
     #[inline]
     pub(super) fn wide_leaves(
         &self,
@@ -152,9 +187,9 @@ impl Bvh {
             if enters == 0 {
                 return None;
             }
+            let entry = entry.to_array();
             // The lanes entered, nearest first: the nearest is walked now, the others
             // deferred farthest first so the next nearest pops first.
-            let entry = entry.to_array();
             let mut order = [0usize; 4];
             let mut n = 0;
             while enters != 0 {
@@ -181,14 +216,15 @@ impl Bvh {
 const WIDE_STACK: usize = 48;
 
 /// Appends the four-wide node made from binary node `index` and, after it, those of its
-/// descendants; returns its place in `wide`, or `None` if some node cannot be quantised.
+/// descendants, and their leaves' blocks, in the order the nodes name them; returns its
+/// place in `wide`, or `None` if some node cannot be quantised.
 ///
 /// Each node takes the binary node's two children and opens the largest interior one
 /// among them (by surface area) until it holds four or only leaves: the children a ray
 /// is likeliest to enter are the ones worth testing together.
-fn collapse(nodes: &[Node], index: u32, wide: &mut Vec<Wide>) -> Option<u32> {
-    let at = wide.len();
-    wide.push(EMPTY);
+fn collapse(nodes: &[Node], index: u32, made_so_far: &mut (Vec<Wide>, Vec<LeafBlock>)) -> Option<u32> {
+    let at = made_so_far.0.len();
+    made_so_far.0.push(EMPTY);
     let node = &nodes[index as usize];
     let mut kids: Vec<(crate::accel::Aabb, Child)> = (0..2).map(|k| (node.child_box(k), node.children[k])).collect();
     while kids.len() < 4 {
@@ -217,12 +253,15 @@ fn collapse(nodes: &[Node], index: u32, wide: &mut Vec<Wide>) -> Option<u32> {
         made.used |= 1 << lane;
         if c.count > 0 {
             made.counts[lane] = u8::try_from(c.count).ok()?;
-            made.index[lane] = c.index;
+            let blocks = &mut made_so_far.1;
+            made.index[lane] = blocks.len() as u32;
+            blocks
+                .extend((0..c.count).step_by(4).map(|k| LeafBlock { first: c.index + k, count: (c.count - k).min(4) }));
         } else {
-            made.index[lane] = collapse(nodes, c.index, wide)?;
+            made.index[lane] = collapse(nodes, c.index, made_so_far)?;
         }
     }
-    wide[at] = made;
+    made_so_far.0[at] = made;
     Some(at as u32)
 }
 
@@ -241,7 +280,7 @@ impl Bvh {
             let mut whole = Aabb::EMPTY;
             for lane in (0..4).filter(|&l| node.used & (1 << l) != 0) {
                 let exact = if node.counts[lane] > 0 {
-                    let first = node.index[lane];
+                    let first = bvh.blocks[node.index[lane] as usize].first;
                     (first..first + u32::from(node.counts[lane]))
                         .fold(Aabb::EMPTY, |b, k| b.union(boxes[bvh.prim(k) as usize]))
                 } else {
