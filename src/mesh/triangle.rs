@@ -75,43 +75,19 @@ impl Shear {
             let (dx, dy, dz) = (axis(kx), axis(ky), axis(kz));
             [dx - sx * dz, dy - sy * dz, sz * dz]
         };
-        let [[ax, ay, az], [bx, by, bz], [cx, cy, cz]] = [shear(&block.0[0]), shear(&block.0[1]), shear(&block.0[2])];
-        let [mut u, mut v, mut w] = edge_functions((ax, ay), (bx, by), (cx, cy));
-        let zero = (u.cmpeq(Vec4::ZERO) | v.cmpeq(Vec4::ZERO) | w.cmpeq(Vec4::ZERO)).bitmask();
-        let inside = if zero == 0 {
-            // No edge function is zero, so a lane is inside exactly when the three share
-            // their sign bit (NaN lanes, the padding among them, fail `det` below).
-            let (su, sv, sw) = (u.is_negative_bitmask(), v.is_negative_bitmask(), w.is_negative_bitmask());
-            !((su ^ sv) | (su ^ sw)) & 0b1111
-        } else {
-            for l in crate::trace::lanes(zero) {
-                [u[l], v[l], w[l]] = edge_functions_f64((ax[l], ay[l]), (bx[l], by[l]), (cx[l], cy[l]));
-            }
-            let neg = u.cmplt(Vec4::ZERO) | v.cmplt(Vec4::ZERO) | w.cmplt(Vec4::ZERO);
-            let pos = u.cmpgt(Vec4::ZERO) | v.cmpgt(Vec4::ZERO) | w.cmpgt(Vec4::ZERO);
-            !(neg & pos).bitmask() & 0b1111
-        };
-        if inside == 0 {
-            return None;
-        }
-        let det = u + v + w;
-        let t_scaled = u * az + v * bz + w * cz;
-        let inv = Vec4::ONE / det;
-        let t = t_scaled * inv;
-        let ok = det.cmpne(Vec4::ZERO)
-            & det.abs().cmplt(Vec4::INFINITY)
-            & t.cmpgt(Vec4::splat(t_min))
-            & t.cmplt(Vec4::splat(t_max));
-        let mut mask = ok.bitmask() & inside;
-        let mut best: Option<usize> = None;
+        let corners = [shear(&block.0[0]), shear(&block.0[1]), shear(&block.0[2])];
+        let hits = lanes_hit(corners, Vec4::splat(t_min), Vec4::splat(t_max), 0b1111)?;
+        let (mut mask, t) = (hits.mask, hits.t);
+        let mut best = mask.trailing_zeros() as usize;
+        mask &= mask - 1;
         while mask != 0 {
             let l = mask.trailing_zeros() as usize;
             mask &= mask - 1;
-            if best.is_none_or(|b| t[l] < t[b]) {
-                best = Some(l);
+            if t[l] < t[best] {
+                best = l;
             }
         }
-        best.map(|l| (l, TriHit { t: t[l], bary: [u[l] * inv[l], v[l] * inv[l], w[l] * inv[l]] }))
+        Some((best, TriHit { t: t[best], bary: hits.bary.map(|b| b[best]) }))
     }
 }
 
@@ -232,35 +208,48 @@ impl<const N: usize> PacketShear<N> {
     pub fn intersect4(&self, g: usize, tri: &PacketTriangle, t_min: Vec4, t_max: Vec4, lanes: u32) -> Option<TriHit4> {
         let s = &self.s[g];
         let shear = |[dx, dy, dz]: [Vec4; 3]| [dx - s[0] * dz, dy - s[1] * dz, s[2] * dz];
-        let [[ax, ay, az], [bx, by, bz], [cx, cy, cz]] = tri.0.map(shear);
-        let [mut u, mut v, mut w] = edge_functions((ax, ay), (bx, by), (cx, cy));
-        let zero = (u.cmpeq(Vec4::ZERO) | v.cmpeq(Vec4::ZERO) | w.cmpeq(Vec4::ZERO)).bitmask() & lanes;
-        let inside = if zero == 0 {
-            // No edge function is zero, so a lane is inside exactly when the three share
-            // their sign bit (NaN lanes may pass; their `det` fails below).
-            let (su, sv, sw) = (u.is_negative_bitmask(), v.is_negative_bitmask(), w.is_negative_bitmask());
-            !((su ^ sv) | (su ^ sw)) & lanes
-        } else {
-            // Rare: the ray passes through an edge or vertex's projection.
-            for l in crate::trace::lanes(zero) {
-                [u[l], v[l], w[l]] = edge_functions_f64((ax[l], ay[l]), (bx[l], by[l]), (cx[l], cy[l]));
-            }
-            let neg = u.cmplt(Vec4::ZERO) | v.cmplt(Vec4::ZERO) | w.cmplt(Vec4::ZERO);
-            let pos = u.cmpgt(Vec4::ZERO) | v.cmpgt(Vec4::ZERO) | w.cmpgt(Vec4::ZERO);
-            !(neg & pos).bitmask() & lanes
-        };
-        if inside == 0 {
-            return None;
-        }
-        let det = u + v + w;
-        let t_scaled = u * az + v * bz + w * cz;
-        let inv = Vec4::ONE / det;
-        let t = t_scaled * inv;
-        // `det` finite and non-zero, `t` inside the open interval; NaN lanes compare false.
-        let ok = det.cmpne(Vec4::ZERO) & det.abs().cmplt(Vec4::INFINITY) & t.cmpgt(t_min) & t.cmplt(t_max);
-        let mask = ok.bitmask() & inside;
-        (mask != 0).then_some(TriHit4 { mask, t, bary: [u * inv, v * inv, w * inv] })
+        lanes_hit(tri.0.map(shear), t_min, t_max, lanes)
     }
+}
+
+/// The watertight test's second half for four lanes of sheared corners `a b c` (each
+/// `[x, y, z]` across lanes): the lanes in `lanes` whose triangle the ray (the +z axis
+/// after the shear) crosses within `(t_min, t_max)`, with their distances and weights.
+/// Lane by lane the single test's arithmetic, so the same hits.
+#[inline(always)]
+fn lanes_hit(
+    [[ax, ay, az], [bx, by, bz], [cx, cy, cz]]: [[Vec4; 3]; 3],
+    t_min: Vec4,
+    t_max: Vec4,
+    lanes: u32,
+) -> Option<TriHit4> {
+    let [mut u, mut v, mut w] = edge_functions((ax, ay), (bx, by), (cx, cy));
+    let zero = (u.cmpeq(Vec4::ZERO) | v.cmpeq(Vec4::ZERO) | w.cmpeq(Vec4::ZERO)).bitmask() & lanes;
+    let inside = if zero == 0 {
+        // No edge function is zero, so a lane is inside exactly when the three share
+        // their sign bit (NaN lanes may pass; their `det` fails below).
+        let (su, sv, sw) = (u.is_negative_bitmask(), v.is_negative_bitmask(), w.is_negative_bitmask());
+        !((su ^ sv) | (su ^ sw)) & lanes
+    } else {
+        // Rare: the ray passes through an edge or vertex's projection.
+        for l in crate::trace::lanes(zero) {
+            [u[l], v[l], w[l]] = edge_functions_f64((ax[l], ay[l]), (bx[l], by[l]), (cx[l], cy[l]));
+        }
+        let neg = u.cmplt(Vec4::ZERO) | v.cmplt(Vec4::ZERO) | w.cmplt(Vec4::ZERO);
+        let pos = u.cmpgt(Vec4::ZERO) | v.cmpgt(Vec4::ZERO) | w.cmpgt(Vec4::ZERO);
+        !(neg & pos).bitmask() & lanes
+    };
+    if inside == 0 {
+        return None;
+    }
+    let det = u + v + w;
+    let t_scaled = u * az + v * bz + w * cz;
+    let inv = Vec4::ONE / det;
+    let t = t_scaled * inv;
+    // `det` finite and non-zero, `t` inside the open interval; NaN lanes compare false.
+    let ok = det.cmpne(Vec4::ZERO) & det.abs().cmplt(Vec4::INFINITY) & t.cmpgt(t_min) & t.cmplt(t_max);
+    let mask = ok.bitmask() & inside;
+    (mask != 0).then_some(TriHit4 { mask, t, bary: [u * inv, v * inv, w * inv] })
 }
 
 /// Hits of four rays on one triangle: the lanes that hit, their distances and barycentric weights.
