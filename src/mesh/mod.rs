@@ -346,6 +346,19 @@ impl MeshObject {
         best
     }
 
+    /// Walks the widened BVH's leaves front to back along the ray, handing `block(b,
+    /// t_max)` each of a leaf's blocks in turn until it returns true, which stops the
+    /// walk; counts a leaf's triangles as tested.
+    #[inline]
+    fn each_block(&self, ray: &Ray, t_max: &mut f32, c: &mut Counters, mut block: impl FnMut(u32, &mut f32) -> bool) {
+        let mut tests = 0u64;
+        self.bvh.block_leaves(ray.origin, ray.inv_dir, ray.t_min, t_max, &mut c.node_visits, |blocks, n, t_max| {
+            tests += u64::from(n);
+            blocks.into_iter().any(|b| block(b, t_max))
+        });
+        c.triangle_tests += tests;
+    }
+
     /// [`closest`](Self::closest) over the widened BVH, a block of four triangles a test:
     /// the same hit, since a block's test is four single tests in slot order.
     fn closest_in_blocks(
@@ -356,27 +369,13 @@ impl MeshObject {
         c: &mut Counters,
     ) -> Option<(TriRef, triangle::TriHit)> {
         let mut best = None;
-        let mut tests = 0u64;
-        self.bvh.block_leaves(
-            ray.origin,
-            ray.inv_dir,
-            ray.t_min,
-            &mut t_max,
-            &mut c.node_visits,
-            |blocks, n, t_max| {
-                tests += u64::from(n);
-                for b in blocks {
-                    if let Some((lane, hit)) =
-                        shear.intersect_block(ray.origin, &self.blocks[b as usize], ray.t_min, *t_max)
-                    {
-                        *t_max = hit.t;
-                        best = Some((b, lane, hit));
-                    }
-                }
-                false
-            },
-        );
-        c.triangle_tests += tests;
+        self.each_block(ray, &mut t_max, c, |b, t_max| {
+            if let Some((lane, hit)) = shear.intersect_block(ray.origin, &self.blocks[b as usize], ray.t_min, *t_max) {
+                *t_max = hit.t;
+                best = Some((b, lane, hit));
+            }
+            false
+        });
         // The build ordered the triangles by their slots (`Bvh::build_ordered`).
         best.map(|(b, lane, hit)| {
             (TriRef { id: self.bvh.blocks()[b as usize].first + lane as u32, block: b * 4 + lane as u32 }, hit)
@@ -470,13 +469,10 @@ impl MeshObject {
     pub fn widen(&mut self) {
         self.bvh.widen();
         let blocks = self.bvh.blocks().iter().map(|b| {
-            let corners: Vec<[Vec3A; 3]> = (b.first..b.first + b.count)
-                .map(|i| {
-                    let (a, b, c) = self.tri(i);
-                    [a, b, c]
-                })
-                .collect();
-            triangle::Block::new(&corners)
+            triangle::Block::new((b.first..b.first + b.count).map(|i| {
+                let (a, b, c) = self.tri(i);
+                [a, b, c]
+            }))
         });
         self.blocks = blocks.collect();
     }
@@ -488,26 +484,15 @@ impl MeshObject {
 
     /// Whether any triangle lies along the ray within `(ray.t_min, t_max)`.
     pub fn occluded(&self, ray: &Ray, shear: &triangle::Shear, mut t_max: f32, c: &mut Counters) -> bool {
-        let mut tests = 0u64;
         if !self.blocks.is_empty() {
             let mut hit = false;
-            self.bvh.block_leaves(
-                ray.origin,
-                ray.inv_dir,
-                ray.t_min,
-                &mut t_max,
-                &mut c.node_visits,
-                |blocks, n, t_max| {
-                    tests += u64::from(n);
-                    hit = blocks.into_iter().any(|b| {
-                        shear.intersect_block(ray.origin, &self.blocks[b as usize], ray.t_min, *t_max).is_some()
-                    });
-                    hit
-                },
-            );
-            c.triangle_tests += tests;
+            self.each_block(ray, &mut t_max, c, |b, t_max| {
+                hit = shear.intersect_block(ray.origin, &self.blocks[b as usize], ray.t_min, *t_max).is_some();
+                hit
+            });
             return hit;
         }
+        let mut tests = 0u64;
         let hit = self.bvh.any(ray.origin, ray.inv_dir, ray.t_min, t_max, &mut c.node_visits, |i, t_max| {
             tests += 1;
             let (a, b, cc) = self.tri(i);

@@ -99,10 +99,10 @@ pub struct Block([[Vec4; 3]; 3]);
 
 impl Block {
     /// The block of `triangles` (at most four), their corners in order.
-    pub fn new(triangles: &[[Vec3A; 3]]) -> Block {
-        debug_assert!(triangles.len() <= 4);
+    pub fn new(triangles: impl IntoIterator<Item = [Vec3A; 3]>) -> Block {
         let mut lanes = [[[f32::NAN; 4]; 3]; 3];
-        for (l, corners) in triangles.iter().enumerate() {
+        for (l, corners) in triangles.into_iter().enumerate() {
+            assert!(l < 4, "a block holds at most four triangles");
             for (c, p) in corners.iter().enumerate() {
                 for axis in 0..3 {
                     lanes[c][axis][l] = p[axis];
@@ -402,7 +402,7 @@ mod tests {
         let origins = [Vec3A::new(0.3, -0.7, -2.0), Vec3A::new(-4.0, 2.0, 9.0), Vec3A::new(1e3, 1e3, -1e3)];
         let mut seen = [0usize; 3];
         for blocks in [&full[..], &full[..2], &full[1..2]] {
-            let block = Block::new(blocks);
+            let block = Block::new(blocks.iter().copied());
             for (l, tri) in blocks.iter().enumerate() {
                 assert_eq!(block.corners(l), *tri);
             }

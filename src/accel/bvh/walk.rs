@@ -118,6 +118,11 @@ impl Bvh {
         visits: &mut u64,
         mut leaf: impl FnMut(u32, u32, &mut f32) -> bool,
     ) {
+        if !self.wide.is_empty() {
+            return self.block_leaves(origin, inv_dir, t_min, t_max, visits, |blocks, count, t_max| {
+                leaf(self.blocks[blocks.start as usize].first, count, t_max)
+            });
+        }
         let Some((root_box, root)) = self.root() else { return };
         *visits += 1;
         if root_box.slab(origin, inv_dir, t_min, *t_max).is_none() {
@@ -130,11 +135,6 @@ impl Bvh {
         if root.count > 0 {
             leaf(root.index, root.count, t_max);
             return;
-        }
-        if !self.wide.is_empty() {
-            return self.wide_leaves(origin, inv_dir, t_min, t_max, visits, |block, count, t_max| {
-                leaf(self.blocks[block as usize].first, count, t_max)
-            });
         }
         let ray = RaySplat::new(origin, inv_dir, t_min);
         descend::<STACK>(root, t_max, visits, leaf, |index, t_max, deferred| {

@@ -130,9 +130,9 @@ impl Bvh {
 
     /// Visits the four-wide tree's leaves front to back along the ray, a leaf as its
     /// blocks: `leaf(blocks, slots, t_max)` gets the leaf's range of [`blocks`](Bvh::blocks)
-    /// and its number of slots,
-    /// may lower `t_max` to the closest hit so far, and returns true to stop the walk.
-    /// Only for a widened tree (`blocks` not empty); the root box is tested here.
+    /// and its number of slots, may lower `t_max` to the closest hit so far, and returns
+    /// true to stop the walk. Only for a widened tree (`blocks` not empty); the root box
+    /// is tested here. The slot-naming walks take it on a widened tree.
     #[inline]
     pub fn block_leaves(
         &self,
@@ -148,23 +148,6 @@ impl Bvh {
         if self.root_box.slab(origin, inv_dir, t_min, *t_max).is_none() {
             return;
         }
-        self.wide_leaves(origin, inv_dir, t_min, t_max, visits, |first, count, t_max| {
-            leaf(first..first + count.div_ceil(4), count, t_max)
-        });
-    }
-
-    /// [`leaves`](Bvh::leaves) over the four-wide nodes, whose root is `wide[0]`, except
-    /// that a leaf is named by its first block, not its first slot.
-    #[inline]
-    pub(super) fn wide_leaves(
-        &self,
-        origin: Vec3A,
-        inv_dir: Vec3A,
-        t_min: f32,
-        t_max: &mut f32,
-        visits: &mut u64,
-        leaf: impl FnMut(u32, u32, &mut f32) -> bool,
-    ) {
         // Each axis's near plane is the minimum where the ray goes up it: lanes [0, 3)
         // or [3, 6) of the planes, picked once per ray.
         let up = [inv_dir.x >= 0.0, inv_dir.y >= 0.0, inv_dir.z >= 0.0];
@@ -174,6 +157,7 @@ impl Bvh {
         let inv = [Vec4::splat(inv_dir.x), Vec4::splat(inv_dir.y), Vec4::splat(inv_dir.z)];
         let t_low = Vec4::splat(t_min);
         let root = Child { index: 0, count: 0 };
+        let leaf = |first: u32, count: u32, t_max: &mut f32| leaf(first..first + count.div_ceil(4), count, t_max);
         super::walk::descend::<WIDE_STACK>(root, t_max, visits, leaf, |index, t_max, deferred| {
             let node = &self.wide[index as usize];
             let axis = |k: usize| {
@@ -187,9 +171,9 @@ impl Bvh {
             if enters == 0 {
                 return None;
             }
-            let entry = entry.to_array();
             // The lanes entered, nearest first: the nearest is walked now, the others
             // deferred farthest first so the next nearest pops first.
+            let entry = entry.to_array();
             let mut order = [0usize; 4];
             let mut n = 0;
             while enters != 0 {
