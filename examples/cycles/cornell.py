@@ -19,6 +19,7 @@ import sys
 import time
 
 import bpy
+import mathutils
 
 
 def material(name, colour=None, glass=False, emission=None):
@@ -55,7 +56,8 @@ def scnc_at(x, y, z):
     return (x, z, y)
 
 
-def build(res, spp, seed):
+def setup(res, spp, seed):
+    """A new Cycles scene: the renderer's settings, the image and a black world."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     scene.render.engine = "CYCLES"
@@ -91,7 +93,26 @@ def build(res, spp, seed):
     world.use_nodes = True
     world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
     scene.world = world
+    return scene
 
+
+def camera(scene, at, look_at, fov):
+    """A camera at scnc's `at` looking at `look_at`, `fov` degrees vertically."""
+    cam = bpy.data.cameras.new("camera")
+    cam.sensor_fit = "VERTICAL"
+    cam.angle = math.radians(fov)
+    cam_obj = bpy.data.objects.new("camera", cam)
+    scene.collection.objects.link(cam_obj)
+    cam_obj.location = scnc_at(*at)
+    # Blender's camera looks down its -z with +y up: turned so that -z points at the
+    # target and +y is up (Blender's +z, scnc's +y).
+    direction = mathutils.Vector(scnc_at(*look_at)) - mathutils.Vector(scnc_at(*at))
+    cam_obj.rotation_euler = direction.to_track_quat("-Z", "Y").to_euler()
+    scene.camera = cam_obj
+
+
+def build(res, spp, seed):
+    scene = setup(res, spp, seed)
     white = material("white", (186, 186, 186))
     red = material("red", (160, 16, 16))
     green = material("green", (36, 140, 36))
@@ -121,20 +142,12 @@ def build(res, spp, seed):
     o.scale = (0.5, 0.4, 1)
     place(o, lamp)
 
-    cam = bpy.data.cameras.new("camera")
-    cam.sensor_fit = "VERTICAL"
-    cam.angle = math.radians(40)
-    cam_obj = bpy.data.objects.new("camera", cam)
-    scene.collection.objects.link(cam_obj)
-    cam_obj.location = scnc_at(0, 1, -3.4)
-    # Blender's camera looks down its -z with +y up; turned 90° about x it looks along
-    # +y (scnc's +z) with +z (scnc's +y) up.
-    cam_obj.rotation_euler = (math.pi / 2, 0, 0)
-    scene.camera = cam_obj
+    camera(scene, (0, 1, -3.4), (0, 1, 0), 40)
     return scene
 
 
-def main():
+def main(build=build):
+    """Renders the scene `build` makes, as the command line asks."""
     p = argparse.ArgumentParser()
     p.add_argument("--res", type=int, default=128)
     p.add_argument("--spp", type=int, default=64)
