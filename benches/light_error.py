@@ -16,8 +16,8 @@ How the error is estimated (all radiance, linear, every pixel and channel):
 - Mitsuba and Cycles render every rung twice with different seeds: two independent
   images differ by twice one's variance, so MSE(truth) = MSE(pair) / 2, needing no
   reference (Cycles' scene differs in small ways, mesh spheres and its filter, so it is
-  held only to its own truth; its RMSE against the reference is logged beside it). scnc has no seed (its sampler is deterministic), so it is
-  held to the reference.
+  held only to its own truth; its RMSE against the reference is logged beside it). scnc
+  has no seed (its sampler is deterministic), so it is held to the reference.
 - Each renderer's RMSE is extrapolated as c/√N from its top rung (the slope over the
   ladder is printed), its time fitted as a + b·N (start-up, scene loading, JIT and BVH in a); the time to `--target` is
   a + b·(c / target)².
@@ -181,8 +181,8 @@ def main():
             results["scnc"] = rows
         if "cycles" not in skip:
             rows = []
+            render_c = lambda spp, seed: cycles(cycles_script, cycles_extra, a.res, spp, seed, tmp)
             for n in [int(x) for x in a.cycles_ladder.split(",")]:
-                render_c = lambda spp, seed: cycles(cycles_script, cycles_extra, a.res, spp, seed, tmp)
                 e2, t, x, (t1, t2) = pair(render_c, n)
                 rows.append((n, e2, t + meshing))
                 # Against Mitsuba's reference as well: what its own noise does not explain
