@@ -6,6 +6,10 @@
 //! traces (the tent's squared weights integrate to 4/9 in two dimensions), which is
 //! what the tent's importance-sampled offsets of one sample to one pixel gave away.
 //!
+//! Adaptive sampling: a pixel that stopped early is scaled to the weight of one that
+//! took every sample ([`Patch::scale`]), so the splat still averages its neighbours as
+//! a uniform density of samples would.
+//!
 //! Exactness: a sample's weights are fixed-point numbers that sum to [`WEIGHT_ONE`]
 //! exactly, and every sum is an integer, so the pixels of any split of the samples
 //! (`render --pass`, `scnc merge`), of any region (`--tile`, `--region`, the studio's
@@ -115,6 +119,48 @@ fn axis(u: f32) -> (i64, u32) {
     (if d < 0.0 { -1 } else { 1 }, neighbour.min(AXIS_ONE))
 }
 
+/// One pixel's samples splatted: the sums of the pixel (the centre) and of the eight
+/// around it that its samples reach.
+#[derive(Default)]
+pub(super) struct Patch {
+    cells: [[PathPixel; 3]; 3],
+}
+
+impl Patch {
+    /// Splats a sample of radiance `l` at `(u1, u2)` in the pixel.
+    pub(super) fn splat(&mut self, (u1, u2): (f32, f32), l: Vec3A) {
+        let l = l.to_array().map(|v| f64::from(v).min(MOST_SAMPLE_RADIANCE));
+        let ((sx, nx), (sy, ny)) = (axis(u1), axis(u2));
+        for (dy, wy) in [(0, AXIS_ONE - ny), (sy, ny)] {
+            for (dx, wx) in [(0, AXIS_ONE - nx), (sx, nx)] {
+                let w = u64::from(wx) * u64::from(wy);
+                if w > 0 {
+                    self.cells[(dy + 1) as usize][(dx + 1) as usize].splat(l, w);
+                }
+            }
+        }
+    }
+
+    /// Scales the patch from `count` samples to the weight of `most`: with adaptive
+    /// sampling, a pixel that stopped early must weigh in its neighbours as much as one
+    /// that took every sample, or a neighbour's splatted pixel is a mean weighted by
+    /// where the noise was (a light's edge pixels took the dark wall's radiance beside
+    /// them: `adaptive_sampling_leaves_the_image_unbiased`). The scale is exact
+    /// integer arithmetic up to the rounding of one division, and none at all when
+    /// `count == most` (a fixed number of samples).
+    pub(super) fn scale(&mut self, count: u32, most: u32) {
+        if count == most || count == 0 {
+            return;
+        }
+        let (n, m) = (i128::from(count), i128::from(most));
+        let scaled = |x: i128| (x / n).saturating_mul(m).saturating_add((x % n) * m / n);
+        for p in self.cells.iter_mut().flatten() {
+            p.sum = p.sum.map(scaled);
+            p.weight = u64::try_from(scaled(i128::from(p.weight))).unwrap_or(u64::MAX);
+        }
+    }
+}
+
 /// A strip's sums: the pixels of rows `y0 .. y0 + rows` and columns `x0 .. x0 + width`
 /// (the traced pixels and a border of one around them, possibly outside the image).
 struct Sums {
@@ -129,17 +175,14 @@ impl Sums {
         Sums { x0, y0, width, cells: vec![PathPixel::default(); width * rows] }
     }
 
-    /// Splats a sample of pixel `(px, py)` at `(u1, u2)` in it.
-    fn splat(&mut self, (px, py): (u32, u32), (u1, u2): (f32, f32), l: Vec3A) {
-        let l = l.to_array().map(|v| f64::from(v).min(MOST_SAMPLE_RADIANCE));
-        let ((sx, nx), (sy, ny)) = (axis(u1), axis(u2));
-        for (dy, wy) in [(0, AXIS_ONE - ny), (sy, ny)] {
-            for (dx, wx) in [(0, AXIS_ONE - nx), (sx, nx)] {
-                let w = u64::from(wx) * u64::from(wy);
-                if w > 0 {
-                    let (cx, cy) = (i64::from(px) + dx - self.x0, i64::from(py) + dy - self.y0);
-                    self.cells[cy as usize * self.width + cx as usize].splat(l, w);
-                }
+    /// Adds pixel `(px, py)`'s samples, held in `patch`.
+    fn add(&mut self, (px, py): (u32, u32), patch: &Patch) {
+        for (dy, row) in patch.cells.iter().enumerate() {
+            let cy = i64::from(py) + dy as i64 - 1 - self.y0;
+            let start = cy as usize * self.width;
+            let cx = (i64::from(px) - 1 - self.x0) as usize;
+            for (cell, p) in self.cells[start + cx..start + cx + 3].iter_mut().zip(row) {
+                cell.merge(p);
             }
         }
     }
@@ -212,7 +255,9 @@ pub(crate) fn rows(
                     }
                     for py in by..(by + 4).min(y1) {
                         for px in bx..(bx + 4).min(traced.x1) {
-                            super::pixel(g, frame, t, (px, py), &mut c, &mut |u, l| sums.splat((px, py), u, l));
+                            let mut patch = Patch::default();
+                            super::pixel(g, frame, t, (px, py), &mut c, &mut patch);
+                            sums.add((px, py), &patch);
                         }
                     }
                 }
@@ -282,11 +327,11 @@ mod tests {
             let (side, n) = axis(u);
             assert!(n <= AXIS_ONE / 2);
             assert_eq!(side, if u < 0.5 { -1 } else { 1 });
-            let mut sums = Sums::new(-1, -1, 3, 3);
-            sums.splat((0, 0), (u, 1.0 - u), Vec3A::ONE);
-            let total: u64 = sums.cells.iter().map(|p| p.weight).sum();
+            let mut patch = Patch::default();
+            patch.splat((u, 1.0 - u), Vec3A::ONE);
+            let total: u64 = patch.cells.iter().flatten().map(|p| p.weight).sum();
             assert_eq!(total, WEIGHT_ONE, "u = {u}");
-            assert!(sums.cells.iter().all(|p| p.sum[0] as u64 == p.weight));
+            assert!(patch.cells.iter().flatten().all(|p| p.sum[0] as u64 == p.weight));
         }
     }
 

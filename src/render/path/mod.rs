@@ -33,6 +33,7 @@ use glam::Vec3A;
 
 use self::bsdf::{Bsdf, Lobe};
 pub(super) use self::film::rows;
+use self::film::Patch;
 pub use self::film::{PathPixel, MOST_SAMPLE_RADIANCE, WEIGHT_ONE};
 use self::lights::Source;
 pub use self::lights::Transport;
@@ -44,16 +45,16 @@ use crate::trace::{spawn_offset, Counters, Geometry, Hit, Ray, PATH_BINS};
 /// Surfaces a path meets before Russian roulette may end it.
 const ROULETTE_AFTER: u32 = 3;
 
-/// A pixel's samples, each splatted where it lands by `splat(position in the pixel,
-/// radiance)`: `frame.samples` of them, or with adaptive sampling as many as the
-/// pixel's noise needs.
+/// A pixel's samples, each splatted into `patch` where it lands: `frame.samples` of
+/// them, or with adaptive sampling as many as the pixel's noise needs, weighed as
+/// `frame.samples` ([`Patch::scale`]).
 pub(super) fn pixel(
     g: &dyn Geometry,
     frame: &Frame,
     t: &Transport,
     (px, py): (u32, u32),
     c: &mut Counters,
-    splat: &mut dyn FnMut((f32, f32), Vec3A),
+    patch: &mut Patch,
 ) {
     let most = frame.samples.max(1);
     let pixel = py.wrapping_mul(frame.width).wrapping_add(px);
@@ -82,7 +83,7 @@ pub(super) fn pixel(
                 }
             }
             p.add(l);
-            splat(at, l);
+            patch.splat(at, l);
             count += 1;
         }
         match t.noise {
@@ -92,6 +93,7 @@ pub(super) fn pixel(
             _ => break,
         }
     }
+    patch.scale(count, most);
     c.path_pixels += 1;
     if count >= 2 {
         c.noise_pixels += 1;
