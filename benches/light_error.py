@@ -7,6 +7,7 @@ estimated, and the time each renderer needs to reach a target RMSE.
 
     python3 benches/light_error.py [--scene cornell] [--res 512] [--ladder 16,64,256,1024] \
         [--cycles-ladder 16,64,256] [--ref-spp 4096] [--sampler multijitter] [--target 0.02] \
+        [--noise-ladder 0.1,0.05,0.03] [--noise-cap 4096] [--cycles-noise-ladder 0.02,0.01] \
         [--rows rows.txt] [--skip cycles]
 
 How the error is estimated (all radiance, linear, every pixel and channel):
@@ -23,6 +24,10 @@ How the error is estimated (all radiance, linear, every pixel and channel):
   a + b·(c / target)².
 Wall time of the whole command for scnc, of load + render for Mitsuba, of the render call
 for Cycles (each renderer's start-up cost counted once in a), 2 threads each.
+scnc also renders with adaptive sampling (`--noise ε --samples cap`, one rung an ε of
+`--noise-ladder`), held to the reference as its fixed rungs are; its time to the target
+is interpolated between rungs on log RMSE against log time. `--cycles-noise-ladder` does
+the same for Cycles' adaptive sampling (`adaptive_threshold`), held to itself by pairs.
 `--rows` writes `RENDERER SAMPLES RMSE SECONDS` lines for `cargo run --release --example
 light_plot -- out.png < rows.txt`.
 """
@@ -55,12 +60,19 @@ def read_exr(path):
     return np.array(mi.Bitmap(path), dtype=np.float64)[:, :, :3]
 
 
-def scnc(scene, res, spp, tmp):
-    out = os.path.join(tmp, f"scnc-{spp}.exr")
+def scnc(scene, res, spp, tmp, noise=None):
+    """One scnc render: `spp` samples a pixel, or with `noise` adaptive sampling up to
+    `spp`; the image, the wall time and the mean samples a pixel (from `--stats`)."""
+    out = os.path.join(tmp, f"scnc-{spp}-{noise}.exr")
+    more = ["--noise", str(noise)] if noise else []
     start = time.time()
-    subprocess.run([SCNC, "render", scene, "-o", out, "--width", str(res), "--height", str(res),
-                    "--samples", str(spp), "--threads", "2"], check=True, stderr=subprocess.DEVNULL)
-    return read_exr(out), time.time() - start
+    r = subprocess.run([SCNC, "render", scene, "-o", out, "--width", str(res), "--height", str(res),
+                        "--samples", str(spp), "--threads", "2", "--stats", *more],
+                       check=True, capture_output=True, text=True)
+    seconds = time.time() - start
+    line = [l for l in r.stderr.splitlines() if "samples per pixel" in l][0]
+    taken = float(line.split("(")[1].split()[0])
+    return read_exr(out), seconds, taken
 
 
 MITSUBA_CHILD = r"""
@@ -124,6 +136,18 @@ def fit(ladder, rmse, seconds):
     return c, float(slope), float(max(a, 0.0)), float(b)
 
 
+def time_to(rungs, target):
+    """The time to RMSE `target` of adaptive rungs `(threshold, samples, MSE, seconds)`:
+    interpolated on log RMSE against log time between the rungs that bracket it, or
+    extrapolated from the two nearest."""
+    pts = sorted((np.log(t), 0.5 * np.log(e2)) for _, _, e2, t in rungs)
+    goal = np.log(target)
+    k = next((i for i in range(len(pts) - 1) if pts[i + 1][1] <= goal <= pts[i][1]),
+             0 if goal > pts[0][1] else len(pts) - 2)
+    (t0, e0), (t1, e1) = pts[k], pts[k + 1]
+    return float(np.exp(t0 + (goal - e0) * (t1 - t0) / (e1 - e0)))
+
+
 def main():
     p = argparse.ArgumentParser()
     p.add_argument("--res", type=int, default=512)
@@ -136,12 +160,15 @@ def main():
     p.add_argument("--rows")
     p.add_argument("--skip", default="")
     p.add_argument("--scene", default="cornell", choices=sorted(SCENES))
+    p.add_argument("--noise-ladder", default="0.1,0.05,0.03", help="scnc --noise rungs (empty: none)")
+    p.add_argument("--noise-cap", type=int, default=4096, help="the most samples with adaptive sampling")
+    p.add_argument("--cycles-noise-ladder", default="", help="Cycles adaptive thresholds (empty: none)")
     a = p.parse_args()
     scene, xml, cycles_script = SCENES[a.scene]
     extra, cycles_extra = {}, []
     ladder = [int(x) for x in a.ladder.split(",")]
     skip = set(a.skip.split(",")) - {""}
-    results = {}
+    results, adaptive, cycles_adaptive = {}, [], []
     with tempfile.TemporaryDirectory() as tmp:
         log = lambda *m: print(*m, file=sys.stderr, flush=True)
         meshing = 0.0
@@ -173,12 +200,21 @@ def main():
         if "scnc" not in skip:
             rows = []
             for n in ladder:
-                x, t = scnc(scene, a.res, n, tmp)
+                x, t, _ = scnc(scene, a.res, n, tmp)
                 e2 = max(mse(x, ref) - ref_noise, 1e-12)
                 rows.append((n, e2, t))
                 log(f"  scnc {n}: {t:.1f} s, rmse {e2 ** 0.5:.4f} (against ref {mse(x, ref) ** 0.5:.4f}), "
                     f"mean {x.mean(axis=(0, 1))}")
             results["scnc"] = rows
+            # Adaptive sampling: each rung an ε, its samples wherever the noise is. Its
+            # time to the target is interpolated on log RMSE against log time between the
+            # rungs around it (or extrapolated from the two nearest).
+            for eps in [float(x) for x in a.noise_ladder.split(",") if x]:
+                x, t, taken = scnc(scene, a.res, a.noise_cap, tmp, eps)
+                e2 = max(mse(x, ref) - ref_noise, 1e-12)
+                adaptive.append((eps, taken, e2, t))
+                log(f"  scnc --noise {eps}: {t:.1f} s, {taken:.1f} samples a pixel, rmse {e2 ** 0.5:.4f}, "
+                    f"mean {x.mean(axis=(0, 1))}")
         if "cycles" not in skip:
             rows = []
             render_c = lambda spp, seed: cycles(cycles_script, cycles_extra, a.res, spp, seed, tmp)
@@ -190,6 +226,13 @@ def main():
                 log(f"  cycles {n}: {t1:.1f} / {t2:.1f} s, rmse {e2 ** 0.5:.4f}, against ref "
                     f"{mse(x, ref) ** 0.5:.4f}, mean {x.mean(axis=(0, 1))}")
             results["Cycles"] = rows
+            # Cycles' own adaptive sampling, as scnc's: pairs of seeds at each threshold.
+            for th in [float(x) for x in a.cycles_noise_ladder.split(",") if x]:
+                more = [*cycles_extra, "--adaptive-threshold", str(th)]
+                render_a = lambda spp, seed: cycles(cycles_script, more, a.res, spp, seed, tmp)
+                e2, t, x, (t1, t2) = pair(render_a, a.noise_cap)
+                cycles_adaptive.append((th, float("nan"), e2, t + meshing))
+                log(f"  cycles --adaptive-threshold {th}: {t1:.1f} / {t2:.1f} s, rmse {e2 ** 0.5:.4f}")
     if meshing:
         print(f"Mitsuba's and Cycles' times include meshing the field at --tolerance 0.001: {meshing:.1f} s\n")
     print(f"{a.scene} {a.res}², reference Mitsuba ({a.sampler}) × {a.ref_spp} (its noise, RMSE "
@@ -211,11 +254,26 @@ def main():
         for name in ("Mitsuba 3", "Cycles"):
             if name in summary:
                 print(f"\nscnc's time to target against {name}'s: {summary['scnc'][4] / summary[name][4]:.2f}×")
+    for name, rungs in (("scnc --noise", adaptive), ("Cycles adaptive", cycles_adaptive)):
+        if len(rungs) < 2:
+            continue
+        print(f"\n| {name} (most samples {a.noise_cap}) | threshold | samples a pixel | seconds | RMSE |")
+        print("|---|---|---|---|---|")
+        for eps, taken, e2, t in rungs:
+            shown = "—" if np.isnan(taken) else f"{taken:.1f}"
+            print(f"| | {eps} | {shown} | {t:.2f} | {e2 ** 0.5:.4f} |")
+        t_goal = time_to(rungs, a.target)
+        print(f"\n{name}: {t_goal:.1f} s to RMSE {a.target}")
+        for other in ("Mitsuba 3", "Cycles"):
+            if other in summary:
+                print(f"{name}'s time to target against {other}'s fixed samples: {t_goal / summary[other][4]:.2f}×")
     if a.rows:
         with open(a.rows, "w") as f:
             for name, rows in results.items():
                 for n, e2, t in rows:
                     f.write(f"{name.split()[0]} {n} {e2 ** 0.5:.6g} {t:.4g}\n")
+            for _, taken, e2, t in adaptive:
+                f.write(f"scnc-noise {taken:.0f} {e2 ** 0.5:.6g} {t:.4g}\n")
 
 
 if __name__ == "__main__":

@@ -10,7 +10,7 @@ mirrored. Colours are scnc's divided by 255 (its linear colour mode). The area l
 an emissive rectangle of strength 40 (Cycles' emission strength is radiance), sampled by
 Cycles' light tree with MIS as scnc and Mitsuba sample theirs. Spheres are smooth UV
 spheres of 256 × 128 faces (Cycles has no analytic sphere). Unbiased settings: no light
-clamp, no glossy filter, no adaptive sampling, no denoising; 8 bounces of every kind
+clamp, no glossy filter, no adaptive sampling (unless `--adaptive-threshold`), no denoising; 8 bounces of every kind
 (scnc's default `bounces`), two threads.
 """
 import argparse
@@ -153,8 +153,13 @@ def main(build=build):
     p.add_argument("--spp", type=int, default=64)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", required=True)
+    p.add_argument("--adaptive-threshold", type=float, default=0.0,
+                   help="Cycles' adaptive sampling to this noise threshold, --spp the most (0: off)")
     a = p.parse_args()
     scene = build(a.res, a.spp, a.seed)
+    if a.adaptive_threshold > 0:
+        scene.cycles.use_adaptive_sampling = True
+        scene.cycles.adaptive_threshold = a.adaptive_threshold
     scene.render.filepath = a.out
     start = time.time()
     bpy.ops.render.render(write_still=True)
