@@ -48,14 +48,7 @@ const ROULETTE_AFTER: u32 = 3;
 /// A pixel's samples, each splatted into `patch` where it lands: `frame.samples` of
 /// them, or with adaptive sampling as many as the pixel's noise needs, weighed as
 /// `frame.samples` ([`Patch::scale`]).
-pub(super) fn pixel(
-    g: &dyn Geometry,
-    frame: &Frame,
-    t: &Transport,
-    (px, py): (u32, u32),
-    c: &mut Counters,
-    patch: &mut Patch,
-) {
+fn pixel(g: &dyn Geometry, frame: &Frame, t: &Transport, (px, py): (u32, u32), c: &mut Counters, patch: &mut Patch) {
     let most = frame.samples.max(1);
     let pixel = py.wrapping_mul(frame.width).wrapping_add(px);
     let mut p = Noise::default();
