@@ -10,8 +10,8 @@ mirrored. Colours are scnc's divided by 255 (its linear colour mode). The area l
 an emissive rectangle of strength 40 (Cycles' emission strength is radiance), sampled by
 Cycles' light tree with MIS as scnc and Mitsuba sample theirs. Spheres are smooth UV
 spheres of 256 × 128 faces (Cycles has no analytic sphere). Unbiased settings: no light
-clamp, no glossy filter, no adaptive sampling (unless `--adaptive-threshold`), no denoising; 8 bounces of every kind
-(scnc's default `bounces`), two threads.
+clamp, no glossy filter, no adaptive sampling (unless `--adaptive-threshold`), no
+denoising; 8 bounces of every kind (scnc's default `bounces`), two threads.
 """
 import argparse
 import math

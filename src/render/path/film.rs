@@ -177,11 +177,10 @@ impl Sums {
 
     /// Adds pixel `(px, py)`'s samples, held in `patch`.
     fn add(&mut self, (px, py): (u32, u32), patch: &Patch) {
+        let cx = (i64::from(px) - 1 - self.x0) as usize;
         for (dy, row) in patch.cells.iter().enumerate() {
-            let cy = i64::from(py) + dy as i64 - 1 - self.y0;
-            let start = cy as usize * self.width;
-            let cx = (i64::from(px) - 1 - self.x0) as usize;
-            for (cell, p) in self.cells[start + cx..start + cx + 3].iter_mut().zip(row) {
+            let start = (i64::from(py) + dy as i64 - 1 - self.y0) as usize * self.width + cx;
+            for (cell, p) in self.cells[start..start + 3].iter_mut().zip(row) {
                 cell.merge(p);
             }
         }
